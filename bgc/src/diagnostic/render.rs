@@ -1,0 +1,138 @@
+//! Rendering diagnostics: rustc-like text and JSON.
+
+use super::{Diagnostic, Severity};
+use crate::span::SourceMap;
+use codespan_reporting::diagnostic as cs;
+use codespan_reporting::files::SimpleFiles;
+use codespan_reporting::term;
+use serde::Serialize;
+
+/// Renders diagnostics as text like rustc's: `error[BG0201]: ...` then `--> FILE:LINE:COL` and the source excerpt.
+/// `color` adds ANSI colours (for terminals).
+pub fn to_text(sources: &SourceMap, diags: &[Diagnostic], color: bool) -> String {
+    let mut files = SimpleFiles::new();
+    for (_, f) in sources.files() {
+        files.add(f.name.clone(), f.text.clone());
+    }
+    let config = term::Config::default();
+    let mut out = String::new();
+    for d in diags {
+        let cs_diag = to_codespan(d);
+        let mut buf: Vec<u8> = Vec::new();
+        let ok = if color {
+            let mut w = term::termcolor::Ansi::new(&mut buf);
+            term::emit_to_write_style(&mut w, &config, &files, &cs_diag).is_ok()
+        } else {
+            let mut w = term::termcolor::NoColor::new(&mut buf);
+            term::emit_to_write_style(&mut w, &config, &files, &cs_diag).is_ok()
+        };
+        if ok {
+            out.push_str(&String::from_utf8_lossy(&buf));
+        } else {
+            // A label out of range of its file: fall back to the message alone rather than losing it.
+            out.push_str(&format!(
+                "{}[{}]: {}\n",
+                severity_word(d.severity),
+                d.code.0,
+                d.message
+            ));
+        }
+    }
+    out
+}
+
+fn severity_word(s: Severity) -> &'static str {
+    match s {
+        Severity::Error => "error",
+        Severity::Warning => "warning",
+        Severity::Note => "note",
+    }
+}
+
+fn to_codespan(d: &Diagnostic) -> cs::Diagnostic<usize> {
+    let severity = match d.severity {
+        Severity::Error => cs::Severity::Error,
+        Severity::Warning => cs::Severity::Warning,
+        Severity::Note => cs::Severity::Note,
+    };
+    let labels = d
+        .labels
+        .iter()
+        .map(|l| {
+            let style = if l.primary {
+                cs::LabelStyle::Primary
+            } else {
+                cs::LabelStyle::Secondary
+            };
+            cs::Label::new(style, l.span.file.0 as usize, l.span.range()).with_message(&l.message)
+        })
+        .collect();
+    let mut notes = d.notes.clone();
+    if let Some(h) = &d.help {
+        notes.push(format!("help: {h}"));
+    }
+    cs::Diagnostic::new(severity)
+        .with_code(d.code.0)
+        .with_message(&d.message)
+        .with_labels(labels)
+        .with_notes(notes)
+}
+
+#[derive(Serialize)]
+struct JsonLabel<'a> {
+    file: &'a str,
+    line: usize,
+    column: usize,
+    end_line: usize,
+    end_column: usize,
+    start: u32,
+    end: u32,
+    message: &'a str,
+    primary: bool,
+}
+
+#[derive(Serialize)]
+struct JsonDiagnostic<'a> {
+    code: &'a str,
+    severity: Severity,
+    message: &'a str,
+    labels: Vec<JsonLabel<'a>>,
+    notes: &'a [String],
+    help: Option<&'a str>,
+}
+
+/// Diagnostics as a JSON array, with line and column (1-based) for every label.
+pub fn to_json_value(sources: &SourceMap, diags: &[Diagnostic]) -> serde_json::Value {
+    let items: Vec<JsonDiagnostic> = diags
+        .iter()
+        .map(|d| JsonDiagnostic {
+            code: d.code.0,
+            severity: d.severity,
+            message: &d.message,
+            labels: d
+                .labels
+                .iter()
+                .map(|l| {
+                    let file = sources.get(l.span.file);
+                    let (line, column) = file.map_or((0, 0), |f| f.line_col(l.span.start as usize));
+                    let (end_line, end_column) =
+                        file.map_or((0, 0), |f| f.line_col(l.span.end as usize));
+                    JsonLabel {
+                        file: file.map_or("", |f| f.name.as_str()),
+                        line,
+                        column,
+                        end_line,
+                        end_column,
+                        start: l.span.start,
+                        end: l.span.end,
+                        message: &l.message,
+                        primary: l.primary,
+                    }
+                })
+                .collect(),
+            notes: &d.notes,
+            help: d.help.as_deref(),
+        })
+        .collect();
+    serde_json::to_value(items).unwrap_or(serde_json::Value::Null)
+}

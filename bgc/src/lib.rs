@@ -1,0 +1,12 @@
+//! bgc: a bond-graph modelling language and compiler.
+//!
+//! The pipeline is a sequence of stages with plain data between them (see docs/ARCHITECTURE.md):
+//! [`syntax`] parses text into an AST, [`lower`] resolves names, components, domains and units into the bond-graph
+//! IR of [`ir`], and later stages analyse causality and derive equations. No stage prints or touches files; the CLI
+//! (`src/main.rs`) and the build-script API do.
+
+pub mod diagnostic;
+pub mod ir;
+pub mod span;
+pub mod syntax;
+pub mod units;

@@ -14,5 +14,6 @@ pub mod design;
 pub mod estimation;
 pub mod linalg;
 pub mod model;
+pub mod noise;
 pub mod sim;
 pub mod statespace;

@@ -21,6 +21,12 @@
 //! themselves inserted) and refined by Brent's method on `ln |L|` and on `arg(−L)`; the distance to −1 is
 //! refined by golden-section search. A static crossing at `ω = 0` is included when `L(0)` is finite and
 //! negative, as python-control does.
+//!
+//! The back-support exoskeleton paper (Shojaei Barjuei et al. 2020, Sec. 5.2) reads a delay margin of 0.007 s
+//! as "a minimum sampling frequency of 143 Hz", i.e. `1 / DM`. That is the bound for a controller whose
+//! output is one whole sample late; a zero-order hold alone delays by `T/2` on average, which would allow
+//! `T < 2 DM`. Either reading can be applied to [`StabilityMargins::delay_margin`]; this module reports
+//! the delay itself.
 
 use super::error::AnalysisError;
 use super::freqresp::{C64, check_siso, dc_gain, siso_response, transfer_at};
@@ -151,43 +157,6 @@ pub fn stability_margins(loop_tf: &StateSpace) -> Result<StabilityMargins, Analy
         all_gain_margins: phase_crossings,
         all_phase_margins: gain_crossings,
     })
-}
-
-/// The closed-loop bandwidth: the first frequency (rad/s) at which `|G|` falls `drop_db` below its DC value
-/// (`drop_db = -3.0` for the usual −3 dB bandwidth), or `None` if it never does on the search grid.
-///
-/// This is python-control's `bandwidth(sys, dbdrop)`; the back-support exoskeleton paper uses the same
-/// definition ("the first frequency in which the gain descends to below −3 dB of its DC value").
-pub fn bandwidth(sys: &StateSpace, drop_db: f64) -> Result<Option<f64>, AnalysisError> {
-    check_siso(sys, "bandwidth")?;
-    if !(drop_db.is_finite() && drop_db < 0.0) {
-        return Err(AnalysisError::BadParameter {
-            name: "drop_db",
-            value: drop_db,
-            reason: "the drop must be a finite negative number of dB",
-        });
-    }
-    let g0 = dc_gain(sys)?[(0, 0)].abs();
-    if g0 == 0.0 {
-        return Err(AnalysisError::ZeroDcGain);
-    }
-    let level = |w: f64| -> Result<f64, AnalysisError> {
-        Ok(20.0 * (siso_response(sys, w)?.norm() / g0).log10() - drop_db)
-    };
-    let grid = search_grid(sys)?;
-    let (mut w_prev, mut f_prev) = (0.0, -drop_db);
-    for &w in &grid {
-        let f = match level(w) {
-            Ok(f) => f,
-            Err(AnalysisError::PoleOnContour { .. }) => continue,
-            Err(e) => return Err(e),
-        };
-        if f < 0.0 {
-            return brent_root(level, w_prev, w, f_prev, f).map(Some);
-        }
-        (w_prev, f_prev) = (w, f);
-    }
-    Ok(None)
 }
 
 /// The loop response at `w`, or `None` on a pole of the loop (such points break brackets).

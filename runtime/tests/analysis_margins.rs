@@ -167,3 +167,19 @@ fn margins_need_a_siso_loop() {
         })
     ));
 }
+
+#[test]
+fn static_crossing_at_zero_frequency_and_lead_loop() {
+    // control.stability_margins(control.tf([-0.5], [1, 1])) -> (2.0, inf, inf, 0.0, nan, nan)
+    let m = stability_margins(&tf(&[-0.5], &[1.0, 1.0])).unwrap();
+    assert_eq!(m.gain_margin, 2.0);
+    assert_eq!(m.phase_crossover, Some(0.0));
+    assert_eq!(m.phase_margin, f64::INFINITY);
+    assert_eq!(m.delay_margin, f64::INFINITY);
+    // control.stability_margins(control.tf([3, 0.5], [1, 2, 1]))
+    // -> (inf, 128.07461366165205, inf, nan, 2.6251028535207204, nan)
+    let m = stability_margins(&tf(&[3.0, 0.5], &[1.0, 2.0, 1.0])).unwrap();
+    assert_eq!(m.gain_margin, f64::INFINITY);
+    assert!(rel(m.phase_margin, 128.07461366165205) < 1e-6, "{m:?}");
+    assert!(rel(m.gain_crossover.unwrap(), 2.6251028535207204) < 1e-6);
+}

@@ -14,7 +14,9 @@
 //!   `DM = PM_rad / ω_gc` with `PM` taken in `[0°, 360°)` (a negative phase margin already means an unstable
 //!   loop; the delay then needed to go round once more is reported, as MATLAB's `allmargin` does). For a
 //!   discrete loop the delay margin is given in seconds, not samples.
-//! - stability margin: the smallest distance `min |1 + L(jω)|` from the Nyquist curve to −1.
+//! - stability margin: the smallest distance `min |1 + L(jω)|` from the Nyquist curve to −1 over the grid
+//!   (python-control's polynomial method looks only for stationary points and reports infinity when it finds
+//!   none, e.g. for a monotone `|1 + L|`; here the minimum is always reported).
 //!
 //! The crossings are found on a dense logarithmic grid (200 points per decade, spanning three decades beyond
 //! the slowest and fastest poles, widened until the loop gain is small at the top, with the pole frequencies

@@ -103,6 +103,11 @@ where
     Mdl: ContinuousModel<NX, NU, NY>,
     U: Fn(f64) -> SVector<f64, NU>,
 {
+    if NX == 0 {
+        // Nothing to integrate: a model without states only maps inputs to outputs.
+        out.extend(seg.output_times.iter().map(|_| *seg.x0));
+        return Ok(*seg.x0);
+    }
     // The first non-finite derivative seen by the solver, reported if the solver then fails.
     let bad_derivative: Cell<Option<(f64, usize)>> = Cell::new(None);
     let rhs = |x: &[f64], _p: &[f64], t: f64, dx: &mut [f64]| {

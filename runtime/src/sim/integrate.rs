@@ -1,0 +1,235 @@
+//! One integration segment of a [`ContinuousModel`] on diffsol.
+//!
+//! The segment solves `ẋ = f(t, x, u(t)) + w` from `(t0, x0)` to `t_end` with the chosen method, reporting the
+//! state at requested times inside the segment by the solver's own dense output (Hermite/Nordsieck
+//! interpolation of the accepted steps, of the method's order). The Jacobian handed to the implicit methods
+//! is the model's `jac_x`. A fresh solver is started for each segment, so an input that jumps at the segment
+//! boundary (a zero-order hold) never enters an implicit method's step history.
+
+use std::cell::Cell;
+
+use diffsol::error::DiffsolError;
+use diffsol::{
+    NalgebraLU, NalgebraMat, NalgebraVec, OdeBuilder, OdeEquations, OdeSolverMethod,
+    OdeSolverStopReason,
+};
+use nalgebra::{SMatrix, SVector};
+
+use super::error::SimError;
+use crate::model::ContinuousModel;
+
+type M = NalgebraMat<f64>;
+type Ls = NalgebraLU<f64>;
+
+/// The integration method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Method {
+    /// Variable-order variable-step BDF (orders 1–5): for stiff models. The default.
+    #[default]
+    Bdf,
+    /// Singly diagonally implicit Runge–Kutta ESDIRK3(4): stiff, one-step (cheap restarts).
+    Esdirk34,
+    /// TR-BDF2 (an ESDIRK of order 2): stiff, robust, low order.
+    TrBdf2,
+    /// Tsitouras 5(4) explicit Runge–Kutta: for non-stiff models.
+    Tsit45,
+}
+
+/// Solver settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SolverOptions {
+    pub method: Method,
+    /// Relative tolerance of the local error test.
+    pub rtol: f64,
+    /// Absolute tolerance of the local error test (all states).
+    pub atol: f64,
+    /// Upper bound on internal steps within one segment (one sample interval or one open-loop run).
+    pub max_steps: usize,
+}
+
+impl Default for SolverOptions {
+    fn default() -> Self {
+        SolverOptions {
+            method: Method::Bdf,
+            rtol: 1e-8,
+            atol: 1e-10,
+            max_steps: 1_000_000,
+        }
+    }
+}
+
+impl SolverOptions {
+    pub(crate) fn check(&self) -> Result<(), SimError> {
+        for (name, value) in [("rtol", self.rtol), ("atol", self.atol)] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(SimError::BadSetting {
+                    name,
+                    value,
+                    reason: "tolerances must be finite and positive",
+                });
+            }
+        }
+        if self.max_steps == 0 {
+            return Err(SimError::BadSetting {
+                name: "max_steps",
+                value: 0.0,
+                reason: "at least one step must be allowed",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A segment to integrate.
+pub(crate) struct Segment<'a, const NX: usize> {
+    pub t0: f64,
+    pub t_end: f64,
+    pub x0: &'a SVector<f64, NX>,
+    /// Added to the model's derivative over the whole segment (a held process disturbance).
+    pub disturbance: &'a SVector<f64, NX>,
+    /// Times in `(t0, t_end]`, increasing, at which the state is wanted.
+    pub output_times: &'a [f64],
+}
+
+/// Integrates one segment; returns the state at `t_end` and pushes the states at `output_times` to `out`.
+pub(crate) fn integrate_segment<Mdl, U, const NX: usize, const NU: usize, const NY: usize>(
+    model: &Mdl,
+    input: U,
+    seg: &Segment<'_, NX>,
+    opts: &SolverOptions,
+    out: &mut Vec<SVector<f64, NX>>,
+) -> Result<SVector<f64, NX>, SimError>
+where
+    Mdl: ContinuousModel<NX, NU, NY>,
+    U: Fn(f64) -> SVector<f64, NU>,
+{
+    if NX == 0 {
+        // Nothing to integrate: a model without states only maps inputs to outputs.
+        out.extend(seg.output_times.iter().map(|_| *seg.x0));
+        return Ok(*seg.x0);
+    }
+    // The first non-finite derivative seen by the solver, reported if the solver then fails.
+    let bad_derivative: Cell<Option<(f64, usize)>> = Cell::new(None);
+    let rhs = |x: &[f64], _p: &[f64], t: f64, dx: &mut [f64]| {
+        let xs = SVector::<f64, NX>::from_column_slice(x);
+        let mut d = SVector::<f64, NX>::zeros();
+        model.rhs(t, &xs, &input(t), &mut d);
+        d += seg.disturbance;
+        if bad_derivative.get().is_none()
+            && let Some(i) = d.iter().position(|v| !v.is_finite())
+        {
+            bad_derivative.set(Some((t, i)));
+        }
+        dx.copy_from_slice(d.as_slice());
+    };
+    let jac = |x: &[f64], _p: &[f64], t: f64, v: &[f64], jv: &mut [f64]| {
+        let xs = SVector::<f64, NX>::from_column_slice(x);
+        let mut j = SMatrix::<f64, NX, NX>::zeros();
+        model.jac_x(t, &xs, &input(t), &mut j);
+        let prod = j * SVector::<f64, NX>::from_column_slice(v);
+        jv.copy_from_slice(prod.as_slice());
+    };
+    let x0 = *seg.x0;
+    let init = move |_p: &[f64], _t: f64, y: &mut [f64]| y.copy_from_slice(x0.as_slice());
+    let problem = OdeBuilder::<M>::new()
+        .t0(seg.t0)
+        .rtol(opts.rtol)
+        .atol([opts.atol])
+        .rhs_implicit(rhs, jac)
+        .init(init, NX)
+        .build()
+        .map_err(|e| solver_error(seg.t0, e))?;
+    let failure = |time: f64, e: DiffsolError| failure_cause(&bad_derivative, time, e);
+    match opts.method {
+        Method::Bdf => {
+            let solver = problem.bdf::<Ls>().map_err(|e| failure(seg.t0, e))?;
+            drive(solver, seg, opts, out, &bad_derivative)
+        }
+        Method::Esdirk34 => {
+            let solver = problem.esdirk34::<Ls>().map_err(|e| failure(seg.t0, e))?;
+            drive(solver, seg, opts, out, &bad_derivative)
+        }
+        Method::TrBdf2 => {
+            let solver = problem.tr_bdf2::<Ls>().map_err(|e| failure(seg.t0, e))?;
+            drive(solver, seg, opts, out, &bad_derivative)
+        }
+        Method::Tsit45 => {
+            let solver = problem.tsit45().map_err(|e| failure(seg.t0, e))?;
+            drive(solver, seg, opts, out, &bad_derivative)
+        }
+    }
+}
+
+fn drive<'a, Eqn, S, const NX: usize>(
+    mut solver: S,
+    seg: &Segment<'_, NX>,
+    opts: &SolverOptions,
+    out: &mut Vec<SVector<f64, NX>>,
+    bad_derivative: &Cell<Option<(f64, usize)>>,
+) -> Result<SVector<f64, NX>, SimError>
+where
+    Eqn: OdeEquations<T = f64, V = NalgebraVec<f64>> + 'a,
+    S: OdeSolverMethod<'a, Eqn>,
+{
+    let failure = |time: f64, e: DiffsolError| failure_cause(bad_derivative, time, e);
+    solver
+        .set_stop_time(seg.t_end)
+        .map_err(|e| failure(seg.t0, e))?;
+    let mut next_output = 0;
+    for _ in 0..opts.max_steps {
+        let reason = solver.step().map_err(|e| failure(solver.state().t, e))?;
+        let t_now = solver.state().t;
+        let y = to_svector::<NX>(solver.state().y);
+        if let Some(index) = y.iter().position(|v| !v.is_finite()) {
+            // Prefer the cause (the first non-finite derivative) over the symptom when it is known.
+            return Err(match bad_derivative.get() {
+                Some((time, index)) => SimError::NonFiniteDerivative { time, index },
+                None => SimError::NonFiniteState { time: t_now, index },
+            });
+        }
+        let reached = matches!(reason, OdeSolverStopReason::TstopReached);
+        while let Some(&t) = seg.output_times.get(next_output) {
+            if reached && t >= seg.t_end {
+                out.push(y);
+            } else if t <= t_now {
+                let v = solver.interpolate(t).map_err(|e| failure(t, e))?;
+                out.push(to_svector::<NX>(&v));
+            } else {
+                break;
+            }
+            next_output += 1;
+        }
+        if reached {
+            return Ok(y);
+        }
+    }
+    Err(SimError::TooManySteps {
+        from: seg.t0,
+        to: seg.t_end,
+        time: solver.state().t,
+        max_steps: opts.max_steps,
+    })
+}
+
+fn to_svector<const NX: usize>(v: &NalgebraVec<f64>) -> SVector<f64, NX> {
+    SVector::<f64, NX>::from_fn(|i, _| v[i])
+}
+
+/// A solver error, attributed to the model when it had returned a non-finite derivative.
+fn failure_cause(
+    bad_derivative: &Cell<Option<(f64, usize)>>,
+    time: f64,
+    e: DiffsolError,
+) -> SimError {
+    match bad_derivative.get() {
+        Some((time, index)) => SimError::NonFiniteDerivative { time, index },
+        None => solver_error(time, e),
+    }
+}
+
+fn solver_error(time: f64, e: DiffsolError) -> SimError {
+    SimError::Solver {
+        time,
+        message: e.to_string(),
+    }
+}

@@ -81,7 +81,9 @@ pub struct KalmanFilter<const NX: usize, const NU: usize, const NY: usize> {
 }
 
 impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY> {
-    /// A time-varying filter. `q` must be symmetric positive semi-definite, `r` and `p0` positive definite.
+    /// A time-varying filter. `q` and `r` must be symmetric positive semi-definite (a noise-free sensor is
+    /// allowed; an innovation covariance that ends up singular is then reported by `update`), `p0` positive
+    /// definite.
     pub fn new(
         model: LinearDiscreteModel<NX, NU, NY>,
         q: SMatrix<f64, NX, NX>,
@@ -91,7 +93,7 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
     ) -> Result<Self, EstimationError> {
         model.validate()?;
         check_positive_semidefinite("Q", &q)?;
-        check_positive_definite("R", &r)?;
+        check_positive_semidefinite("R", &r)?;
         check_finite("x0", &x0)?;
         check_positive_definite("P0", &p0)?;
         Ok(KalmanFilter {

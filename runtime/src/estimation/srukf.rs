@@ -61,7 +61,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         p0: SMatrix<f64, NX, NX>,
     ) -> Result<Self, EstimationError> {
         check_positive_semidefinite("Q", &q)?;
-        check_positive_definite("R", &r)?;
+        check_positive_semidefinite("R", &r)?;
         check_finite("x0", &x0)?;
         check_positive_definite("P0", &p0)?;
         let not_pd = |name| EstimationError::NotPositiveDefinite {
@@ -73,7 +73,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
             x: x0,
             s: cholesky_lower(&p0).ok_or(not_pd("P0"))?,
             sqrt_q: cholesky_psd(&q).ok_or(not_pd("Q"))?,
-            sqrt_r: cholesky_lower(&r).ok_or(not_pd("R"))?,
+            sqrt_r: cholesky_psd(&r).ok_or(not_pd("R"))?,
             x_mean: weighted_mean::<NX, NS>,
             x_residual: subtract::<NX>,
             y_mean: weighted_mean::<NY, NS>,

@@ -60,7 +60,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
     UnscentedKalmanFilter<NX, NU, NY, NS>
 {
     /// A UKF with sigma points `points`, process noise `q` (positive semi-definite), measurement noise `r`
-    /// (positive definite) and initial estimate `(x0, p0)` (`p0` positive definite).
+    /// (positive semi-definite; a singular innovation covariance is reported by `update`) and initial estimate `(x0, p0)` (`p0` positive definite).
     pub fn new(
         points: SigmaPoints<NX, NS>,
         q: SMatrix<f64, NX, NX>,
@@ -69,7 +69,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         p0: SMatrix<f64, NX, NX>,
     ) -> Result<Self, EstimationError> {
         check_positive_semidefinite("Q", &q)?;
-        check_positive_definite("R", &r)?;
+        check_positive_semidefinite("R", &r)?;
         check_finite("x0", &x0)?;
         check_positive_definite("P0", &p0)?;
         Ok(UnscentedKalmanFilter {
@@ -121,7 +121,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         r: SMatrix<f64, NY, NY>,
     ) -> Result<(), EstimationError> {
         check_positive_semidefinite("Q", &q)?;
-        check_positive_definite("R", &r)?;
+        check_positive_semidefinite("R", &r)?;
         self.q = q;
         self.r = r;
         Ok(())

@@ -1,6 +1,9 @@
 //! Filters that must agree: the UKF, augmented UKF and KF on linear models; the square-root UKF and the UKF;
 //! the augmented UKF against a direct numpy transcription of Wan and van der Merwe's Algorithm 3.1.
 
+// Reference values are pasted as numpy printed them (17 significant digits).
+#![allow(clippy::excessive_precision)]
+
 use bgc_runtime::estimation::srukf::SquareRootUkf;
 use bgc_runtime::estimation::ukf_augmented::AugmentedUkf;
 use bgc_runtime::estimation::{

@@ -1,5 +1,8 @@
 //! Estimators against filterpy and scipy.
 
+// Reference values are pasted as numpy printed them (17 significant digits).
+#![allow(clippy::excessive_precision)]
+
 use bgc_runtime::estimation::kalman::steady_state_gain;
 use bgc_runtime::estimation::{
     KalmanFilter, LinearDiscreteModel, SigmaPoints, UnscentedKalmanFilter, UpdateOutcome,

@@ -11,10 +11,23 @@
 //!
 //! 1. parameter time update: `ŵ⁻ = ŵ`, `P_w⁻ = P_w / λ_RLS`;
 //! 2. state time update with the model at `ŵ⁻`: `x⁻ = UT[f(·, u, ŵ⁻)]`;
-//! 3. parameter measurement update: sigma points `Wᵢ` of `(ŵ⁻, P_w⁻)`; each predicts the measurement by
+//! 3. state measurement update with `h(·, u, ŵ⁻)`, giving the innovation covariance `S`;
+//! 4. parameter measurement update: sigma points `Wᵢ` of `(ŵ⁻, P_w⁻)`; each predicts the measurement by
 //!    running the model from the previous state estimate, `dᵢ = h(f(x̂, u, Wᵢ), u, Wᵢ)` (Eq. 24 with
-//!    `Y(x, w) = h(f(x, u, w), u, w)`); then `K_w = P_wd S_d⁻¹`, `ŵ = ŵ⁻ + K_w (y − d̂)`, with `S_d` including `R`;
-//! 4. state measurement update with `h(·, u, ŵ⁻)`.
+//!    `Y(x, w) = h(f(x, u, w), u, w)`); then `S_d = Σ W⁽ᶜ⁾ (dᵢ − d̂)(dᵢ − d̂)ᵀ + P_e`, `K_w = P_wd S_d⁻¹`,
+//!    `ŵ = ŵ⁻ + K_w (y − d̂)`.
+//!
+//! The paper leaves the covariance `P_e` of the observation error `e` of Eqs. 24 and 26 open. By default we
+//! take `P_e = S` ([`ParameterObservationNoise::StateInnovation`]): the parameter observation starts from an
+//! uncertain state estimate, and that uncertainty (`C P⁻ Cᵀ` in the linear case) belongs to `e` as much as the
+//! sensor noise `R` does. With `P_e = R` alone ([`ParameterObservationNoise::MeasurementNoise`]) the parameter
+//! filter reads state-estimation errors as parameter errors, which makes it fragile when the state is poorly
+//! known.
+//!
+//! The parameters must act on the one-step prediction of `y`. With position measurements of an explicit-Euler
+//! second-order model they do not (the position after one step does not depend on the force law), and no
+//! dual filter of this form can learn them; a semi-implicit discretisation, a velocity or force measurement,
+//! or the paper's torque observation (Eq. 25) makes them observable.
 //!
 //! Both filters see the same measurement. The paper's own observation for the parameters is a joint torque
 //! (Eqs. 24–25); a model that measures such a quantity includes it in `y` and `h`.
@@ -227,6 +240,19 @@ pub struct DualUkf<
     param_policy: FaultPolicy,
     param_innovation: SVector<f64, NY>,
     param_measurement_mean: MeanFn<NY, NSP>,
+    param_noise: ParameterObservationNoise,
+}
+
+/// The covariance `P_e` of the parameter filter's observation error `e` (Eqs. 24, 26).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParameterObservationNoise {
+    /// `P_e = S`, the state filter's innovation covariance `Cov(y − ŷ⁻)` at this step: the error of the
+    /// parameter observation includes the uncertainty of the state estimate it starts from, not only the
+    /// sensor noise. Without it the parameter filter takes state errors for parameter errors and can diverge
+    /// when the parameters act weakly on `y`. The default.
+    StateInnovation,
+    /// `P_e = R`, the sensor noise alone (the textbook dual UKF; only safe when the state is known well).
+    MeasurementNoise,
 }
 
 impl<
@@ -265,6 +291,7 @@ impl<
             param_policy: FaultPolicy::default(),
             param_innovation: SVector::zeros(),
             param_measurement_mean: weighted_mean::<NY, NSP>,
+            param_noise: ParameterObservationNoise::StateInnovation,
         })
     }
 
@@ -272,6 +299,12 @@ impl<
     /// measurements; the residual is the state filter's measurement residual).
     pub fn with_parameter_measurement_mean(mut self, mean: MeanFn<NY, NSP>) -> Self {
         self.param_measurement_mean = mean;
+        self
+    }
+
+    /// Chooses the observation-error covariance of the parameter filter.
+    pub fn with_parameter_observation_noise(mut self, noise: ParameterObservationNoise) -> Self {
+        self.param_noise = noise;
         self
     }
 
@@ -346,6 +379,9 @@ impl<
             });
         }
 
+        // State filter measurement update with the prior parameters (those the prediction used).
+        let state = st.update(y, u, |x, u| model.observe(x, u, &w_prior))?;
+
         // Parameter filter: Eq. 27 time update, then the measurement update through the model.
         let mut w = w_prior;
         let mut pw = self.pw / self.forgetting;
@@ -372,14 +408,14 @@ impl<
             self.param_measurement_mean,
             y_residual,
         );
-        sd += st.measurement_noise();
+        sd += match self.param_noise {
+            ParameterObservationNoise::MeasurementNoise => *st.measurement_noise(),
+            ParameterObservationNoise::StateInnovation => *st.innovation_covariance(),
+        };
         let pwd = cross_covariance(&wpts, &w, &ds, &d_hat, wc, subtract::<NP>, y_residual);
         let e = y_residual(y, &d_hat);
         let (parameters, _) =
             kalman_correct(&mut w, &mut pw, &e, &sd, &pwd, &self.param_policy, FILTER)?;
-
-        // State filter measurement update with the prior parameters (those the prediction used).
-        let state = st.update(y, u, |x, u| model.observe(x, u, &w_prior))?;
 
         model.commit(&w)?;
         self.state = st;

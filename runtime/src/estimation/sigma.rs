@@ -12,7 +12,19 @@
 //! Wan and van der Merwe (2000), the paper's reference [51], with `1/(2(L+λ))`.
 //!
 //! Because stable Rust cannot write `2N + 1` as a const generic, the number of points is a second parameter
-//! `NS`; [`SigmaPoints::new`] refuses any `NS ≠ 2N + 1` at compile time.
+//! `NS`; [`SigmaPoints::new`] refuses any `NS ≠ 2N + 1` at compile time:
+//!
+//! ```compile_fail
+//! // 3 states need 7 sigma points, not 6: this does not build.
+//! let _ = bgc_runtime::estimation::SigmaPoints::<3, 6>::new(1.0, 2.0, 0.0);
+//! ```
+//!
+//! ```
+//! let points = bgc_runtime::estimation::SigmaPoints::<3, 7>::new(1.0, 2.0, 0.0).unwrap();
+//! // α = 1, κ = 0: λ = 0, so W₀⁽ᵐ⁾ = 0 and the other six weights are 1/6.
+//! assert_eq!(points.mean_weights()[0], 0.0);
+//! assert!((points.mean_weights().sum() - 1.0).abs() < 1e-15);
+//! ```
 
 use super::dense::cholesky_lower;
 use super::fault::EstimationError;

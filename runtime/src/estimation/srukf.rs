@@ -28,6 +28,7 @@ use super::fault::{
 use super::sigma::{
     MeanFn, ResidualFn, SigmaPoints, cross_covariance, first_bad_column, subtract, weighted_mean,
 };
+use crate::model::DiscreteModel;
 use nalgebra::{SMatrix, SVector};
 
 const FILTER: &str = "square-root UKF";
@@ -229,6 +230,33 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         self.x = x;
         self.s = s;
         Ok(UpdateOutcome::Accepted { nis, repair })
+    }
+
+    /// [`Self::predict`] with a [`DiscreteModel`]'s `step` as the process function.
+    pub fn predict_model<M: DiscreteModel<NX, NU, NY>>(
+        &mut self,
+        model: &M,
+        u: &SVector<f64, NU>,
+    ) -> Result<Option<CovarianceRepair>, EstimationError> {
+        self.predict(u, |x, u| {
+            let mut next = SVector::zeros();
+            model.step(x, u, &mut next);
+            next
+        })
+    }
+
+    /// [`Self::update`] with a [`DiscreteModel`]'s `outputs` as the measurement function.
+    pub fn update_model<M: DiscreteModel<NX, NU, NY>>(
+        &mut self,
+        model: &M,
+        y: &SVector<f64, NY>,
+        u: &SVector<f64, NU>,
+    ) -> Result<UpdateOutcome, EstimationError> {
+        self.update(y, u, |x, u| {
+            let mut out = SVector::zeros();
+            model.outputs(x, u, &mut out);
+            out
+        })
     }
 
     /// The lower factor of `Σ W⁽ᶜ⁾ rᵢ rᵢᵀ + noise noiseᵀ` for residuals `rᵢ = residual(pointsᵢ, mean)`.

@@ -60,7 +60,8 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
     UnscentedKalmanFilter<NX, NU, NY, NS>
 {
     /// A UKF with sigma points `points`, process noise `q` (positive semi-definite), measurement noise `r`
-    /// (positive semi-definite; a singular innovation covariance is reported by `update`) and initial estimate `(x0, p0)` (`p0` positive definite).
+    /// (positive semi-definite; a singular innovation covariance is reported by `update`) and initial
+    /// estimate `(x0, p0)` (`p0` positive definite).
     pub fn new(
         points: SigmaPoints<NX, NS>,
         q: SMatrix<f64, NX, NX>,

@@ -114,7 +114,9 @@ fn filter_steps_do_not_allocate() {
             health
                 .record_innovation(kf.innovation(), kf.innovation_covariance())
                 .unwrap();
-            health.record_state_error(&SVector::<f64, 7>::zeros(), kf.covariance());
+            health
+                .record_state_error(&SVector::<f64, 7>::zeros(), kf.covariance())
+                .unwrap();
         }
         std::hint::black_box(health.report());
     });

@@ -64,6 +64,12 @@ pub enum EstimationError {
         "Riccati iteration did not converge in {iterations} iterations (last relative change {change:e})"
     )]
     NotConverged { iterations: usize, change: f64 },
+    /// A matrix that must be invertible is numerically singular.
+    #[error("matrix {name} is singular")]
+    SingularMatrix { name: &'static str },
+    /// A value given to a statistic is NaN or infinite.
+    #[error("{what} has a non-finite entry")]
+    NonFiniteValue { what: &'static str },
     /// No sensor of a fusion gave a finite value.
     #[error("none of the {sensors} sensors gave a finite value")]
     NoFiniteMeasurement { sensors: usize },

@@ -83,10 +83,7 @@ impl<const NX: usize, const NY: usize, const NL: usize> FilterHealth<NX, NY, NL>
         s: &SMatrix<f64, NY, NY>,
     ) -> Result<(), EstimationError> {
         if e.iter().any(|v| !v.is_finite()) {
-            return Err(EstimationError::NonFiniteModelOutput {
-                function: "innovation given to the health monitor",
-                sigma_point: 0,
-            });
+            return Err(EstimationError::NonFiniteValue { what: "innovation" });
         }
         let singular = EstimationError::SingularInnovation {
             filter: "health monitor",
@@ -114,8 +111,17 @@ impl<const NX: usize, const NY: usize, const NL: usize> FilterHealth<NX, NY, NL>
         Ok(())
     }
 
-    /// Records a state error `x_true − x̂` with the filter's covariance `p`.
-    pub fn record_state_error(&mut self, err: &SVector<f64, NX>, p: &SMatrix<f64, NX, NX>) {
+    /// Records a state error `x_true − x̂` with the filter's covariance `p`; non-finite values are refused.
+    pub fn record_state_error(
+        &mut self,
+        err: &SVector<f64, NX>,
+        p: &SMatrix<f64, NX, NX>,
+    ) -> Result<(), EstimationError> {
+        if err.iter().chain(p.iter()).any(|v| !v.is_finite()) {
+            return Err(EstimationError::NonFiniteValue {
+                what: "state error or covariance",
+            });
+        }
         self.sum_err += err;
         for i in 0..NX {
             if err[i].abs() > p[(i, i)].max(0.0).sqrt() {
@@ -123,6 +129,7 @@ impl<const NX: usize, const NY: usize, const NL: usize> FilterHealth<NX, NY, NL>
             }
         }
         self.n_states += 1;
+        Ok(())
     }
 
     /// The number of innovations recorded.
@@ -245,10 +252,18 @@ mod tests {
     fn state_error_statistics_and_refusals() {
         let mut h = FilterHealth::<2, 1, 2>::new();
         let p = Matrix2::new(1.0, 0.0, 0.0, 0.25);
-        h.record_state_error(&Vector2::new(0.5, 0.6), &p); // second outside 0.5
-        h.record_state_error(&Vector2::new(-1.5, 0.1), &p); // first outside 1
-        h.record_state_error(&Vector2::new(0.1, -0.1), &p);
-        h.record_state_error(&Vector2::new(0.3, 0.2), &p);
+        for e in [
+            Vector2::new(0.5, 0.6),  // second outside 0.5
+            Vector2::new(-1.5, 0.1), // first outside 1
+            Vector2::new(0.1, -0.1),
+            Vector2::new(0.3, 0.2),
+        ] {
+            h.record_state_error(&e, &p).unwrap();
+        }
+        assert!(
+            h.record_state_error(&Vector2::new(f64::NAN, 0.0), &p)
+                .is_err()
+        );
         assert!((h.state_error_mean() - Vector2::new(-0.15, 0.2)).norm() < 1e-15);
         assert_eq!(h.fraction_outside_one_sigma(), Vector2::new(0.25, 0.25));
         assert!(

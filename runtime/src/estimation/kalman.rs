@@ -252,11 +252,7 @@ pub fn filter_gain_from_predictor<const NX: usize, const NY: usize>(
 ) -> Result<SMatrix<f64, NX, NY>, EstimationError> {
     check_finite("A", a)?;
     check_finite("L", l)?;
-    super::dense::solve_general(a, l).ok_or(EstimationError::InvalidSetting {
-        name: "cond(A)",
-        value: f64::INFINITY,
-        reason: "A must be invertible to turn a predictor gain into a filter gain",
-    })
+    super::dense::solve_general(a, l).ok_or(EstimationError::SingularMatrix { name: "A" })
 }
 
 /// The optimal steady-state gains and covariances of a linear filter.

@@ -64,6 +64,18 @@ pub enum EstimationError {
         "Riccati iteration did not converge in {iterations} iterations (last relative change {change:e})"
     )]
     NotConverged { iterations: usize, change: f64 },
+    /// A dynamically sized matrix does not have the filter's fixed size.
+    #[error("matrix {name} is {rows}x{cols}, expected {expected_rows}x{expected_cols}")]
+    Shape {
+        name: &'static str,
+        rows: usize,
+        cols: usize,
+        expected_rows: usize,
+        expected_cols: usize,
+    },
+    /// A model given to a discrete filter is continuous-time.
+    #[error("the model is continuous-time; a discrete filter needs a sampled model")]
+    NotDiscrete,
     /// A matrix that must be invertible is numerically singular.
     #[error("matrix {name} is singular")]
     SingularMatrix { name: &'static str },

@@ -33,7 +33,8 @@ use super::fault::{
     CovarianceRepair, EstimationError, FaultPolicy, UpdateOutcome, check_finite,
     check_positive_definite, check_positive_semidefinite, repair_covariance,
 };
-use nalgebra::{SMatrix, SVector};
+use crate::statespace::StateSpace;
+use nalgebra::{DMatrix, SMatrix, SVector};
 
 const FILTER: &str = "Kalman filter";
 
@@ -47,6 +48,21 @@ pub struct LinearDiscreteModel<const NX: usize, const NU: usize, const NY: usize
 }
 
 impl<const NX: usize, const NU: usize, const NY: usize> LinearDiscreteModel<NX, NU, NY> {
+    /// The fixed-size model of a discrete-time [`StateSpace`] (sizes and sample time checked).
+    pub fn from_state_space(ss: &StateSpace) -> Result<Self, EstimationError> {
+        if ss.dt.is_none() {
+            return Err(EstimationError::NotDiscrete);
+        }
+        let m = LinearDiscreteModel {
+            a: fixed_from_dynamic("A", &ss.a)?,
+            b: fixed_from_dynamic("B", &ss.b)?,
+            c: fixed_from_dynamic("C", &ss.c)?,
+            d: fixed_from_dynamic("D", &ss.d)?,
+        };
+        m.validate()?;
+        Ok(m)
+    }
+
     /// Checks that every matrix is finite.
     pub fn validate(&self) -> Result<(), EstimationError> {
         check_finite("A", &self.a)?;
@@ -237,6 +253,24 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
     }
 }
 
+/// Copies a dynamically sized matrix (e.g. a gain from [`crate::design`]) into a fixed-size one, checking
+/// its shape.
+pub fn fixed_from_dynamic<const R: usize, const C: usize>(
+    name: &'static str,
+    m: &DMatrix<f64>,
+) -> Result<SMatrix<f64, R, C>, EstimationError> {
+    if m.nrows() != R || m.ncols() != C {
+        return Err(EstimationError::Shape {
+            name,
+            rows: m.nrows(),
+            cols: m.ncols(),
+            expected_rows: R,
+            expected_cols: C,
+        });
+    }
+    Ok(SMatrix::from_fn(|i, j| m[(i, j)]))
+}
+
 /// The predictor gain `L = A K` from the innovation gain `K`.
 pub fn predictor_gain<const NX: usize, const NY: usize>(
     a: &SMatrix<f64, NX, NX>,
@@ -340,4 +374,51 @@ pub fn steady_state_gain<const NX: usize, const NY: usize>(
         iterations: max_iterations,
         change,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::dmatrix;
+
+    #[test]
+    fn model_from_state_space_checks_shape_and_sampling() {
+        let ss = StateSpace::new_discrete(
+            dmatrix![1.0, 0.1; 0.0, 1.0],
+            dmatrix![0.0; 0.1],
+            dmatrix![1.0, 0.0],
+            dmatrix![0.0],
+            0.1,
+        )
+        .unwrap();
+        let m = LinearDiscreteModel::<2, 1, 1>::from_state_space(&ss).unwrap();
+        assert_eq!(m.a[(0, 1)], 0.1);
+        assert_eq!(m.b[(1, 0)], 0.1);
+        assert!(matches!(
+            LinearDiscreteModel::<3, 1, 1>::from_state_space(&ss),
+            Err(EstimationError::Shape {
+                name: "A",
+                rows: 2,
+                expected_rows: 3,
+                ..
+            })
+        ));
+        let mut cont = ss.clone();
+        cont.dt = None;
+        assert_eq!(
+            LinearDiscreteModel::<2, 1, 1>::from_state_space(&cont),
+            Err(EstimationError::NotDiscrete)
+        );
+    }
+
+    /// `A` singular: a predictor gain cannot be turned back into a filter gain.
+    #[test]
+    fn filter_gain_from_predictor_needs_invertible_a() {
+        let a = SMatrix::<f64, 2, 2>::new(1.0, 2.0, 2.0, 4.0);
+        let l = SMatrix::<f64, 2, 1>::new(0.1, 0.2);
+        assert_eq!(
+            filter_gain_from_predictor(&a, &l),
+            Err(EstimationError::SingularMatrix { name: "A" })
+        );
+    }
 }

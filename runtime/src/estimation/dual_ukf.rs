@@ -1,0 +1,494 @@
+//! The dual UKF: a state UKF and a parameter UKF run side by side (paper 000, Eqs. 6–27; Wan and van der
+//! Merwe 2000, Sec. 4).
+//!
+//! The parameters `w` follow the random walk of Eq. 23, `w[k+1] = w[k] + r[k]`, with the process-noise
+//! covariance of Eq. 27, `P_r = (λ_RLS⁻¹ − 1) P_w`. The parameter time update is therefore
+//! `P_w⁻ = P_w + P_r = P_w / λ_RLS`: recursive least squares with exponential forgetting, weighting past data by
+//! `λ_RLS^age`. (Eq. 27 calls `P_r` the "innovation covariance"; it is the covariance of the parameter process
+//! noise `r` of Eq. 23, which is how it is used here.)
+//!
+//! One step at time `k` with input `u` and measurement `y`, from the posteriors `(x̂, P)` and `(ŵ, P_w)`:
+//!
+//! 1. parameter time update: `ŵ⁻ = ŵ`, `P_w⁻ = P_w / λ_RLS`;
+//! 2. state time update with the model at `ŵ⁻`: `x⁻ = UT[f(·, u, ŵ⁻)]`;
+//! 3. state measurement update with `h(·, u, ŵ⁻)`, giving the innovation covariance `S`;
+//! 4. parameter measurement update: sigma points `Wᵢ` of `(ŵ⁻, P_w⁻)`; each predicts the measurement by
+//!    running the model from the previous state estimate, `dᵢ = h(f(x̂, u, Wᵢ), u, Wᵢ)` (Eq. 24 with
+//!    `Y(x, w) = h(f(x, u, w), u, w)`); then `S_d = Σ W⁽ᶜ⁾ (dᵢ − d̂)(dᵢ − d̂)ᵀ + P_e`, `K_w = P_wd S_d⁻¹`,
+//!    `ŵ = ŵ⁻ + K_w (y − d̂)`.
+//!
+//! The paper leaves the covariance `P_e` of the observation error `e` of Eqs. 24 and 26 open. By default we
+//! take `P_e = S` ([`ParameterObservationNoise::StateInnovation`]): the parameter observation starts from an
+//! uncertain state estimate, and that uncertainty (`C P⁻ Cᵀ` in the linear case) belongs to `e` as much as the
+//! sensor noise `R` does. With `P_e = R` alone ([`ParameterObservationNoise::MeasurementNoise`]) the parameter
+//! filter reads state-estimation errors as parameter errors, which makes it fragile when the state is poorly
+//! known.
+//!
+//! The parameters must act on the one-step prediction of `y`. With position measurements of an explicit-Euler
+//! second-order model they do not (the position after one step does not depend on the force law), and no
+//! dual filter of this form can learn them; a semi-implicit discretisation, a velocity or force measurement,
+//! or the paper's torque observation (Eq. 25) makes them observable.
+//!
+//! Both filters see the same measurement. The paper's own observation for the parameters is a joint torque
+//! (Eqs. 24–25); a model that measures such a quantity includes it in `y` and `h`.
+//!
+//! A non-finite measurement is rejected by both filters; the state is then the prediction and the parameters
+//! are left as they were (no forgetting without data). Each filter gates its own NIS. A step that returns an
+//! error changes nothing, also on a [`Parametric`] model (whose parameters are set to `ŵ` only when the step
+//! succeeds).
+
+use super::dense::first_non_finite;
+use super::fault::{
+    CovarianceRepair, EstimationError, FaultPolicy, RejectReason, UpdateOutcome, check_finite,
+    check_positive_definite, repair_covariance,
+};
+use super::sigma::{
+    MeanFn, SigmaPoints, cross_covariance, first_bad_column, subtract, unscented_transform,
+    weighted_mean,
+};
+use super::ukf::{UnscentedKalmanFilter, kalman_correct};
+use crate::model::{DiscreteModel, ParamError, Parametric};
+use nalgebra::{SMatrix, SVector};
+
+const FILTER: &str = "dual UKF parameter filter";
+
+/// The model a dual UKF runs: `x[k+1] = f(x, u, w)` and `y = h(x, u, w)`.
+pub trait DualModel<const NX: usize, const NU: usize, const NY: usize, const NP: usize> {
+    /// `f(x, u, w)`.
+    fn propagate(
+        &mut self,
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, NU>,
+        w: &SVector<f64, NP>,
+    ) -> SVector<f64, NX>;
+    /// `h(x, u, w)`.
+    fn observe(
+        &mut self,
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, NU>,
+        w: &SVector<f64, NP>,
+    ) -> SVector<f64, NY>;
+    /// Called with the new parameter estimate before a successful step is committed; an error aborts the step.
+    fn commit(&mut self, _w: &SVector<f64, NP>) -> Result<(), EstimationError> {
+        Ok(())
+    }
+    /// An error the model met while evaluating (e.g. a refused parameter), reported in place of the
+    /// non-finite output it caused.
+    fn take_error(&mut self) -> Option<EstimationError> {
+        None
+    }
+}
+
+/// A [`DualModel`] from two closures `f(x, u, w)` and `h(x, u, w)`.
+pub struct DualFns<F, H> {
+    pub f: F,
+    pub h: H,
+}
+
+impl<const NX: usize, const NU: usize, const NY: usize, const NP: usize, F, H>
+    DualModel<NX, NU, NY, NP> for DualFns<F, H>
+where
+    F: FnMut(&SVector<f64, NX>, &SVector<f64, NU>, &SVector<f64, NP>) -> SVector<f64, NX>,
+    H: FnMut(&SVector<f64, NX>, &SVector<f64, NU>, &SVector<f64, NP>) -> SVector<f64, NY>,
+{
+    fn propagate(
+        &mut self,
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, NU>,
+        w: &SVector<f64, NP>,
+    ) -> SVector<f64, NX> {
+        (self.f)(x, u, w)
+    }
+
+    fn observe(
+        &mut self,
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, NU>,
+        w: &SVector<f64, NP>,
+    ) -> SVector<f64, NY> {
+        (self.h)(x, u, w)
+    }
+}
+
+/// A [`DualModel`] over a [`DiscreteModel`] + [`Parametric`] model whose parameters `indices[j]` are
+/// estimated as `w[j]`. A refused parameter value makes the step fail with
+/// [`EstimationError::ParamRefused`].
+pub struct ParametricDualModel<'a, M, const NP: usize> {
+    model: &'a mut M,
+    indices: [usize; NP],
+    refused: Option<ParamError>,
+}
+
+impl<'a, M: Parametric, const NP: usize> ParametricDualModel<'a, M, NP> {
+    /// Wraps `model`; `indices` are the model's parameter indices in the order of `w`.
+    pub fn new(model: &'a mut M, indices: [usize; NP]) -> Self {
+        ParametricDualModel {
+            model,
+            indices,
+            refused: None,
+        }
+    }
+
+    /// The model's current values of the estimated parameters (a starting guess for the filter).
+    pub fn current(&self) -> Result<SVector<f64, NP>, EstimationError> {
+        let mut w = SVector::<f64, NP>::zeros();
+        for (j, &index) in self.indices.iter().enumerate() {
+            w[j] = self
+                .model
+                .param(index)
+                .ok_or(ParamError::NoSuchParam { index })?;
+        }
+        Ok(w)
+    }
+
+    fn set(&mut self, w: &SVector<f64, NP>) -> bool {
+        for (j, &index) in self.indices.iter().enumerate() {
+            if let Err(e) = self.model.set_param(index, w[j]) {
+                self.refused.get_or_insert(e);
+                return false;
+            }
+        }
+        true
+    }
+}
+
+impl<M, const NX: usize, const NU: usize, const NY: usize, const NP: usize>
+    DualModel<NX, NU, NY, NP> for ParametricDualModel<'_, M, NP>
+where
+    M: DiscreteModel<NX, NU, NY> + Parametric,
+{
+    fn propagate(
+        &mut self,
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, NU>,
+        w: &SVector<f64, NP>,
+    ) -> SVector<f64, NX> {
+        if !self.set(w) {
+            return SVector::repeat(f64::NAN);
+        }
+        let mut next = SVector::zeros();
+        self.model.step(x, u, &mut next);
+        next
+    }
+
+    fn observe(
+        &mut self,
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, NU>,
+        w: &SVector<f64, NP>,
+    ) -> SVector<f64, NY> {
+        if !self.set(w) {
+            return SVector::repeat(f64::NAN);
+        }
+        let mut y = SVector::zeros();
+        self.model.outputs(x, u, &mut y);
+        y
+    }
+
+    fn commit(&mut self, w: &SVector<f64, NP>) -> Result<(), EstimationError> {
+        if self.set(w) {
+            Ok(())
+        } else {
+            Err(self.take_error_inner())
+        }
+    }
+
+    fn take_error(&mut self) -> Option<EstimationError> {
+        self.refused.take().map(EstimationError::ParamRefused)
+    }
+}
+
+impl<M, const NP: usize> ParametricDualModel<'_, M, NP> {
+    fn take_error_inner(&mut self) -> EstimationError {
+        match self.refused.take() {
+            Some(e) => EstimationError::ParamRefused(e),
+            None => EstimationError::InvalidSetting {
+                name: "parameter",
+                value: f64::NAN,
+                reason: "the model refused the parameter estimate",
+            },
+        }
+    }
+}
+
+/// What a dual UKF step did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DualOutcome {
+    /// A repair of the predicted state covariance.
+    pub state_prediction_repair: Option<CovarianceRepair>,
+    /// The state filter's measurement update.
+    pub state: UpdateOutcome,
+    /// The parameter filter's measurement update.
+    pub parameters: UpdateOutcome,
+}
+
+/// A dual UKF over `NX` states and `NP` parameters (`NSX = 2 NX + 1`, `NSP = 2 NP + 1` sigma points).
+#[derive(Clone, Debug)]
+pub struct DualUkf<
+    const NX: usize,
+    const NU: usize,
+    const NY: usize,
+    const NP: usize,
+    const NSX: usize,
+    const NSP: usize,
+> {
+    state: UnscentedKalmanFilter<NX, NU, NY, NSX>,
+    param_points: SigmaPoints<NP, NSP>,
+    w: SVector<f64, NP>,
+    pw: SMatrix<f64, NP, NP>,
+    forgetting: f64,
+    param_policy: FaultPolicy,
+    param_innovation: SVector<f64, NY>,
+    param_measurement_mean: MeanFn<NY, NSP>,
+    param_noise: ParameterObservationNoise,
+}
+
+/// The covariance `P_e` of the parameter filter's observation error `e` (Eqs. 24, 26).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParameterObservationNoise {
+    /// `P_e = S`, the state filter's innovation covariance `Cov(y − ŷ⁻)` at this step: the error of the
+    /// parameter observation includes the uncertainty of the state estimate it starts from, not only the
+    /// sensor noise. Without it the parameter filter takes state errors for parameter errors and can diverge
+    /// when the parameters act weakly on `y`. The default.
+    StateInnovation,
+    /// `P_e = R`, the sensor noise alone (the textbook dual UKF; only safe when the state is known well).
+    MeasurementNoise,
+}
+
+impl<
+    const NX: usize,
+    const NU: usize,
+    const NY: usize,
+    const NP: usize,
+    const NSX: usize,
+    const NSP: usize,
+> DualUkf<NX, NU, NY, NP, NSX, NSP>
+{
+    /// A dual UKF from a configured state UKF, parameter sigma points, the initial parameter estimate
+    /// `(w0, pw0)` and the forgetting factor `λ_RLS ∈ (0, 1]` (1: no forgetting).
+    pub fn new(
+        state: UnscentedKalmanFilter<NX, NU, NY, NSX>,
+        param_points: SigmaPoints<NP, NSP>,
+        w0: SVector<f64, NP>,
+        pw0: SMatrix<f64, NP, NP>,
+        forgetting: f64,
+    ) -> Result<Self, EstimationError> {
+        check_finite("w0", &w0)?;
+        check_positive_definite("Pw0", &pw0)?;
+        if !(forgetting > 0.0 && forgetting <= 1.0) {
+            return Err(EstimationError::InvalidSetting {
+                name: "lambda_RLS",
+                value: forgetting,
+                reason: "the forgetting factor must lie in (0, 1]",
+            });
+        }
+        Ok(DualUkf {
+            state,
+            param_points,
+            w: w0,
+            pw: pw0,
+            forgetting,
+            param_policy: FaultPolicy::default(),
+            param_innovation: SVector::zeros(),
+            param_measurement_mean: weighted_mean::<NY, NSP>,
+            param_noise: ParameterObservationNoise::StateInnovation,
+        })
+    }
+
+    /// Replaces the mean of the measurement predictions of the parameter sigma points (needed with angle
+    /// measurements; the residual is the state filter's measurement residual).
+    pub fn with_parameter_measurement_mean(mut self, mean: MeanFn<NY, NSP>) -> Self {
+        self.param_measurement_mean = mean;
+        self
+    }
+
+    /// Chooses the observation-error covariance of the parameter filter.
+    pub fn with_parameter_observation_noise(mut self, noise: ParameterObservationNoise) -> Self {
+        self.param_noise = noise;
+        self
+    }
+
+    /// Sets the fault policy of the parameter filter (the state filter keeps its own).
+    pub fn set_parameter_fault_policy(
+        &mut self,
+        policy: FaultPolicy,
+    ) -> Result<(), EstimationError> {
+        policy.validate()?;
+        self.param_policy = policy;
+        Ok(())
+    }
+
+    /// The state filter, e.g. to change its fault policy.
+    pub fn state_filter_mut(&mut self) -> &mut UnscentedKalmanFilter<NX, NU, NY, NSX> {
+        &mut self.state
+    }
+
+    /// One predict–update step of both filters.
+    pub fn step<M: DualModel<NX, NU, NY, NP>>(
+        &mut self,
+        model: &mut M,
+        u: &SVector<f64, NU>,
+        y: &SVector<f64, NY>,
+    ) -> Result<DualOutcome, EstimationError> {
+        let result = self.step_inner(model, u, y);
+        match (result, model.take_error()) {
+            (_, Some(e)) => Err(e),
+            (r, None) => r,
+        }
+    }
+
+    /// [`Self::step`] with closures `f(x, u, w)` and `h(x, u, w)`.
+    pub fn step_with<F, H>(
+        &mut self,
+        u: &SVector<f64, NU>,
+        y: &SVector<f64, NY>,
+        f: F,
+        h: H,
+    ) -> Result<DualOutcome, EstimationError>
+    where
+        F: FnMut(&SVector<f64, NX>, &SVector<f64, NU>, &SVector<f64, NP>) -> SVector<f64, NX>,
+        H: FnMut(&SVector<f64, NX>, &SVector<f64, NU>, &SVector<f64, NP>) -> SVector<f64, NY>,
+    {
+        self.step(&mut DualFns { f, h }, u, y)
+    }
+
+    fn step_inner<M: DualModel<NX, NU, NY, NP>>(
+        &mut self,
+        model: &mut M,
+        u: &SVector<f64, NU>,
+        y: &SVector<f64, NY>,
+    ) -> Result<DualOutcome, EstimationError> {
+        if let Some(index) = first_non_finite(u) {
+            return Err(EstimationError::NonFiniteInput { index });
+        }
+        let mut st = self.state.clone();
+        let x_prev = *st.state();
+        let w_prior = self.w;
+        let state_prediction_repair = st.predict(u, |x, u| model.propagate(x, u, &w_prior))?;
+
+        if let Some(index) = first_non_finite(y) {
+            let rejected = UpdateOutcome::Rejected {
+                reason: RejectReason::NonFiniteMeasurement { index },
+            };
+            model.commit(&self.w)?;
+            self.state = st;
+            return Ok(DualOutcome {
+                state_prediction_repair,
+                state: rejected,
+                parameters: rejected,
+            });
+        }
+
+        // State filter measurement update with the prior parameters (those the prediction used).
+        let state = st.update(y, u, |x, u| model.observe(x, u, &w_prior))?;
+
+        // Parameter filter: Eq. 27 time update, then the measurement update through the model.
+        let mut w = w_prior;
+        let mut pw = self.pw / self.forgetting;
+        repair_covariance(&mut pw, self.param_policy.eigen_floor, FILTER)?;
+        let wpts = self.param_points.generate(&w, &pw)?;
+        let mut ds = SMatrix::<f64, NY, NSP>::zeros();
+        for i in 0..NSP {
+            let wi: SVector<f64, NP> = wpts.column(i).into_owned();
+            let xi = model.propagate(&x_prev, u, &wi);
+            ds.set_column(i, &model.observe(&xi, u, &wi));
+        }
+        if let Some(sigma_point) = first_bad_column(&ds) {
+            return Err(EstimationError::NonFiniteModelOutput {
+                function: "model at a parameter sigma point",
+                sigma_point,
+            });
+        }
+        let y_residual = st.measurement_residual();
+        let wc = self.param_points.covariance_weights();
+        let (d_hat, mut sd) = unscented_transform(
+            &ds,
+            self.param_points.mean_weights(),
+            wc,
+            self.param_measurement_mean,
+            y_residual,
+        );
+        sd += match self.param_noise {
+            ParameterObservationNoise::MeasurementNoise => *st.measurement_noise(),
+            ParameterObservationNoise::StateInnovation => *st.innovation_covariance(),
+        };
+        let pwd = cross_covariance(&wpts, &w, &ds, &d_hat, wc, subtract::<NP>, y_residual);
+        let e = y_residual(y, &d_hat);
+        let (parameters, _) =
+            kalman_correct(&mut w, &mut pw, &e, &sd, &pwd, &self.param_policy, FILTER)?;
+
+        model.commit(&w)?;
+        self.state = st;
+        self.w = w;
+        self.pw = pw;
+        self.param_innovation = e;
+        Ok(DualOutcome {
+            state_prediction_repair,
+            state,
+            parameters,
+        })
+    }
+
+    /// [`Self::step`] on a [`DiscreteModel`] + [`Parametric`] model, estimating its parameters `indices`
+    /// (in the order of `w`). On success the model holds the new parameter estimate.
+    pub fn step_parametric<M>(
+        &mut self,
+        model: &mut M,
+        indices: [usize; NP],
+        u: &SVector<f64, NU>,
+        y: &SVector<f64, NY>,
+    ) -> Result<DualOutcome, EstimationError>
+    where
+        M: DiscreteModel<NX, NU, NY> + Parametric,
+    {
+        let before = self.w;
+        let mut adapter = ParametricDualModel::new(model, indices);
+        let result = self.step(&mut adapter, u, y);
+        if result.is_err() {
+            // Leave the model at the estimate the filter still holds; a refusal here cannot happen because
+            // that estimate was accepted before.
+            let _ = adapter.set(&before);
+        }
+        result
+    }
+
+    /// The state estimate.
+    pub fn state(&self) -> &SVector<f64, NX> {
+        self.state.state()
+    }
+
+    /// The state error covariance.
+    pub fn state_covariance(&self) -> &SMatrix<f64, NX, NX> {
+        self.state.covariance()
+    }
+
+    /// The parameter estimate.
+    pub fn parameters(&self) -> &SVector<f64, NP> {
+        &self.w
+    }
+
+    /// The parameter error covariance.
+    pub fn parameter_covariance(&self) -> &SMatrix<f64, NP, NP> {
+        &self.pw
+    }
+
+    /// The forgetting factor `λ_RLS`.
+    pub fn forgetting_factor(&self) -> f64 {
+        self.forgetting
+    }
+
+    /// The state filter's innovation of the last finite measurement.
+    pub fn innovation(&self) -> &SVector<f64, NY> {
+        self.state.innovation()
+    }
+
+    /// The state filter's innovation covariance.
+    pub fn innovation_covariance(&self) -> &SMatrix<f64, NY, NY> {
+        self.state.innovation_covariance()
+    }
+
+    /// The parameter filter's innovation of the last accepted step.
+    pub fn parameter_innovation(&self) -> &SVector<f64, NY> {
+        &self.param_innovation
+    }
+}

@@ -1,0 +1,424 @@
+//! The discrete-time linear Kalman filter on fixed sizes.
+//!
+//! Model: `x[k+1] = A x[k] + B u[k] + w[k]`, `y[k] = C x[k] + D u[k] + v[k]`, `w ~ N(0, Q)`, `v ~ N(0, R)`.
+//!
+//! Time update (predict): `x⁻ = A x + B u`, `P⁻ = A P Aᵀ + Q`.
+//! Measurement update with the innovation `e = y − C x⁻ − D u`, `S = C P⁻ Cᵀ + R`:
+//! `x = x⁻ + K e` and the Joseph form `P = (I − K C) P⁻ (I − K C)ᵀ + K R Kᵀ`, which stays symmetric positive
+//! semi-definite under rounding and is the correct covariance for *any* gain `K`, not only the optimal one.
+//!
+//! # Filter gain and predictor gain
+//!
+//! The gain `K` used here is the **innovation (filter) gain** `K = P⁻ Cᵀ S⁻¹`: it corrects the *current*
+//! prediction, `x̂[k|k] = x̂[k|k−1] + K e[k]` (MATLAB's `dlqe` `M`, filterpy's `K`). The **predictor gain**
+//! `L = A K` appears when the update and the next prediction are merged into the one-step predictor
+//! `x̂[k+1|k] = A x̂[k|k−1] + B u[k] + L (y[k] − C x̂[k|k−1] − D u[k])` (the form of a discrete observer and of
+//! a DARE solution `L = A P Cᵀ (C P Cᵀ + R)⁻¹`). [`predictor_gain`] and [`filter_gain_from_predictor`] convert
+//! between them; the latter needs `A` invertible.
+//!
+//! # Steady state
+//!
+//! [`KalmanFilter::with_fixed_gain`] takes a filter gain from outside (for instance from a DARE solver) and
+//! skips the gain computation. The covariance is still propagated with the Joseph form, so that it is the true
+//! error covariance of the fixed-gain filter and the NIS gate and health statistics stay meaningful; with the
+//! optimal gain it converges to the steady-state covariance. [`steady_state_gain`] computes the optimal
+//! steady-state gain by iterating the Riccati recursion to convergence (a fallback when no DARE solver is at
+//! hand) and checks the DARE residual of the result.
+//!
+//! Faults follow [`super::fault`]: non-finite or gated measurements are rejected, a singular `S` is an error,
+//! the covariance is symmetrised after every step and repaired if it loses definiteness.
+
+use super::dense::{cholesky_lower, cholesky_solve, first_non_finite, symmetrise};
+use super::fault::{
+    CovarianceRepair, EstimationError, FaultPolicy, UpdateOutcome, check_finite,
+    check_positive_definite, check_positive_semidefinite, repair_covariance,
+};
+use crate::statespace::StateSpace;
+use nalgebra::{DMatrix, SMatrix, SVector};
+
+const FILTER: &str = "Kalman filter";
+
+/// A discrete linear model `x[k+1] = A x + B u`, `y = C x + D u` with fixed sizes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinearDiscreteModel<const NX: usize, const NU: usize, const NY: usize> {
+    pub a: SMatrix<f64, NX, NX>,
+    pub b: SMatrix<f64, NX, NU>,
+    pub c: SMatrix<f64, NY, NX>,
+    pub d: SMatrix<f64, NY, NU>,
+}
+
+impl<const NX: usize, const NU: usize, const NY: usize> LinearDiscreteModel<NX, NU, NY> {
+    /// The fixed-size model of a discrete-time [`StateSpace`] (sizes and sample time checked).
+    pub fn from_state_space(ss: &StateSpace) -> Result<Self, EstimationError> {
+        if ss.dt.is_none() {
+            return Err(EstimationError::NotDiscrete);
+        }
+        let m = LinearDiscreteModel {
+            a: fixed_from_dynamic("A", &ss.a)?,
+            b: fixed_from_dynamic("B", &ss.b)?,
+            c: fixed_from_dynamic("C", &ss.c)?,
+            d: fixed_from_dynamic("D", &ss.d)?,
+        };
+        m.validate()?;
+        Ok(m)
+    }
+
+    /// Checks that every matrix is finite.
+    pub fn validate(&self) -> Result<(), EstimationError> {
+        check_finite("A", &self.a)?;
+        check_finite("B", &self.b)?;
+        check_finite("C", &self.c)?;
+        check_finite("D", &self.d)
+    }
+}
+
+/// How the gain is obtained.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GainMode<const NX: usize, const NY: usize> {
+    /// `K = P⁻ Cᵀ S⁻¹` at every update.
+    TimeVarying,
+    /// A fixed innovation (filter) gain, e.g. the steady-state gain.
+    Fixed(SMatrix<f64, NX, NY>),
+}
+
+/// A discrete Kalman filter with `NX` states, `NU` inputs and `NY` measurements.
+#[derive(Clone, Debug)]
+pub struct KalmanFilter<const NX: usize, const NU: usize, const NY: usize> {
+    model: LinearDiscreteModel<NX, NU, NY>,
+    q: SMatrix<f64, NX, NX>,
+    r: SMatrix<f64, NY, NY>,
+    x: SVector<f64, NX>,
+    p: SMatrix<f64, NX, NX>,
+    gain_mode: GainMode<NX, NY>,
+    gain: SMatrix<f64, NX, NY>,
+    innovation: SVector<f64, NY>,
+    innovation_cov: SMatrix<f64, NY, NY>,
+    policy: FaultPolicy,
+}
+
+impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY> {
+    /// A time-varying filter. `q` and `r` must be symmetric positive semi-definite (a noise-free sensor is
+    /// allowed; an innovation covariance that ends up singular is then reported by `update`), `p0` positive
+    /// definite.
+    pub fn new(
+        model: LinearDiscreteModel<NX, NU, NY>,
+        q: SMatrix<f64, NX, NX>,
+        r: SMatrix<f64, NY, NY>,
+        x0: SVector<f64, NX>,
+        p0: SMatrix<f64, NX, NX>,
+    ) -> Result<Self, EstimationError> {
+        model.validate()?;
+        check_positive_semidefinite("Q", &q)?;
+        check_positive_semidefinite("R", &r)?;
+        check_finite("x0", &x0)?;
+        check_positive_definite("P0", &p0)?;
+        Ok(KalmanFilter {
+            model,
+            q,
+            r,
+            x: x0,
+            p: p0,
+            gain_mode: GainMode::TimeVarying,
+            gain: SMatrix::zeros(),
+            innovation: SVector::zeros(),
+            innovation_cov: r,
+            policy: FaultPolicy::default(),
+        })
+    }
+
+    /// A steady-state filter with the fixed innovation gain `k` (see the module docs for predictor gains).
+    pub fn with_fixed_gain(
+        model: LinearDiscreteModel<NX, NU, NY>,
+        q: SMatrix<f64, NX, NX>,
+        r: SMatrix<f64, NY, NY>,
+        k: SMatrix<f64, NX, NY>,
+        x0: SVector<f64, NX>,
+        p0: SMatrix<f64, NX, NX>,
+    ) -> Result<Self, EstimationError> {
+        check_finite("K", &k)?;
+        let mut f = Self::new(model, q, r, x0, p0)?;
+        f.gain_mode = GainMode::Fixed(k);
+        f.gain = k;
+        Ok(f)
+    }
+
+    /// Replaces the fault policy (NIS gate, eigenvalue floor).
+    pub fn set_fault_policy(&mut self, policy: FaultPolicy) -> Result<(), EstimationError> {
+        policy.validate()?;
+        self.policy = policy;
+        Ok(())
+    }
+
+    /// Re-initialises the estimate.
+    pub fn set_state(
+        &mut self,
+        x: SVector<f64, NX>,
+        p: SMatrix<f64, NX, NX>,
+    ) -> Result<(), EstimationError> {
+        check_finite("x", &x)?;
+        check_positive_definite("P", &p)?;
+        self.x = x;
+        self.p = p;
+        Ok(())
+    }
+
+    /// The time update `x⁻ = A x + B u`, `P⁻ = A P Aᵀ + Q`. A non-finite `u` is an error and changes nothing.
+    pub fn predict(
+        &mut self,
+        u: &SVector<f64, NU>,
+    ) -> Result<Option<CovarianceRepair>, EstimationError> {
+        if let Some(index) = first_non_finite(u) {
+            return Err(EstimationError::NonFiniteInput { index });
+        }
+        let m = &self.model;
+        let x = m.a * self.x + m.b * u;
+        let mut p = m.a * self.p * m.a.transpose() + self.q;
+        let repair = repair_covariance(&mut p, self.policy.eigen_floor, FILTER)?;
+        self.x = x;
+        self.p = p;
+        Ok(repair)
+    }
+
+    /// The measurement update with measurement `y` taken while input `u` was applied (for the `D u` term).
+    pub fn update(
+        &mut self,
+        y: &SVector<f64, NY>,
+        u: &SVector<f64, NU>,
+    ) -> Result<UpdateOutcome, EstimationError> {
+        if let Some(index) = first_non_finite(y) {
+            return Ok(UpdateOutcome::Rejected {
+                reason: super::fault::RejectReason::NonFiniteMeasurement { index },
+            });
+        }
+        if let Some(index) = first_non_finite(u) {
+            return Err(EstimationError::NonFiniteInput { index });
+        }
+        let m = &self.model;
+        let e = y - m.c * self.x - m.d * u;
+        let mut s = m.c * self.p * m.c.transpose() + self.r;
+        symmetrise(&mut s);
+        let singular = EstimationError::SingularInnovation { filter: FILTER };
+        let ls = cholesky_lower(&s).ok_or(singular.clone())?;
+        let nis = e.dot(&cholesky_solve(&ls, &e).ok_or(singular.clone())?);
+        self.innovation = e;
+        self.innovation_cov = s;
+        if let Some(reason) = self.policy.gate(nis) {
+            return Ok(UpdateOutcome::Rejected { reason });
+        }
+        let k = match self.gain_mode {
+            GainMode::Fixed(k) => k,
+            // K = P Cᵀ S⁻¹, i.e. Kᵀ = S⁻¹ C P (P and S symmetric).
+            GainMode::TimeVarying => cholesky_solve(&ls, &(m.c * self.p))
+                .ok_or(singular)?
+                .transpose(),
+        };
+        let i_kc = SMatrix::<f64, NX, NX>::identity() - k * m.c;
+        let x = self.x + k * e;
+        let mut p = i_kc * self.p * i_kc.transpose() + k * self.r * k.transpose();
+        let repair = repair_covariance(&mut p, self.policy.eigen_floor, FILTER)?;
+        self.x = x;
+        self.p = p;
+        self.gain = k;
+        Ok(UpdateOutcome::Accepted { nis, repair })
+    }
+
+    /// The state estimate.
+    pub fn state(&self) -> &SVector<f64, NX> {
+        &self.x
+    }
+
+    /// The error covariance of the estimate.
+    pub fn covariance(&self) -> &SMatrix<f64, NX, NX> {
+        &self.p
+    }
+
+    /// The innovation gain used by the last accepted update (the fixed gain in steady-state mode).
+    pub fn gain(&self) -> &SMatrix<f64, NX, NY> {
+        &self.gain
+    }
+
+    /// The innovation `e = y − C x⁻ − D u` of the last finite measurement (also when it was gated out).
+    pub fn innovation(&self) -> &SVector<f64, NY> {
+        &self.innovation
+    }
+
+    /// The innovation covariance `S` of the last finite measurement.
+    pub fn innovation_covariance(&self) -> &SMatrix<f64, NY, NY> {
+        &self.innovation_cov
+    }
+
+    /// The model the filter runs.
+    pub fn model(&self) -> &LinearDiscreteModel<NX, NU, NY> {
+        &self.model
+    }
+}
+
+/// Copies a dynamically sized matrix (e.g. a gain from [`crate::design`]) into a fixed-size one, checking
+/// its shape.
+pub fn fixed_from_dynamic<const R: usize, const C: usize>(
+    name: &'static str,
+    m: &DMatrix<f64>,
+) -> Result<SMatrix<f64, R, C>, EstimationError> {
+    if m.nrows() != R || m.ncols() != C {
+        return Err(EstimationError::Shape {
+            name,
+            rows: m.nrows(),
+            cols: m.ncols(),
+            expected_rows: R,
+            expected_cols: C,
+        });
+    }
+    Ok(SMatrix::from_fn(|i, j| m[(i, j)]))
+}
+
+/// The predictor gain `L = A K` from the innovation gain `K`.
+pub fn predictor_gain<const NX: usize, const NY: usize>(
+    a: &SMatrix<f64, NX, NX>,
+    k: &SMatrix<f64, NX, NY>,
+) -> SMatrix<f64, NX, NY> {
+    a * k
+}
+
+/// The innovation gain `K = A⁻¹ L` from a predictor gain `L`; an error when `A` is singular.
+pub fn filter_gain_from_predictor<const NX: usize, const NY: usize>(
+    a: &SMatrix<f64, NX, NX>,
+    l: &SMatrix<f64, NX, NY>,
+) -> Result<SMatrix<f64, NX, NY>, EstimationError> {
+    check_finite("A", a)?;
+    check_finite("L", l)?;
+    super::dense::solve_general(a, l).ok_or(EstimationError::SingularMatrix { name: "A" })
+}
+
+/// The optimal steady-state gains and covariances of a linear filter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SteadyStateGain<const NX: usize, const NY: usize> {
+    /// Innovation (filter) gain `K = P Cᵀ (C P Cᵀ + R)⁻¹`.
+    pub filter_gain: SMatrix<f64, NX, NY>,
+    /// Predictor gain `L = A K`.
+    pub predictor_gain: SMatrix<f64, NX, NY>,
+    /// The a-priori covariance `P`, the stabilising solution of the DARE
+    /// `P = A P Aᵀ − A P Cᵀ (C P Cᵀ + R)⁻¹ C P Aᵀ + Q`.
+    pub predicted_covariance: SMatrix<f64, NX, NX>,
+    /// The a-posteriori covariance `(I − K C) P`.
+    pub filtered_covariance: SMatrix<f64, NX, NX>,
+    /// Iterations used.
+    pub iterations: usize,
+}
+
+/// Iterates the Riccati recursion `P ← A (P − P Cᵀ S⁻¹ C P) Aᵀ + Q` from `P = Q + I` until the relative change
+/// is below `tol`, then checks the DARE residual. Converges when `(A, C)` is detectable and `(A, Q^½)`
+/// stabilisable; otherwise [`EstimationError::NotConverged`].
+pub fn steady_state_gain<const NX: usize, const NY: usize>(
+    a: &SMatrix<f64, NX, NX>,
+    c: &SMatrix<f64, NY, NX>,
+    q: &SMatrix<f64, NX, NX>,
+    r: &SMatrix<f64, NY, NY>,
+    tol: f64,
+    max_iterations: usize,
+) -> Result<SteadyStateGain<NX, NY>, EstimationError> {
+    check_finite("A", a)?;
+    check_finite("C", c)?;
+    check_positive_semidefinite("Q", q)?;
+    check_positive_definite("R", r)?;
+    if !(tol > 0.0 && tol.is_finite()) {
+        return Err(EstimationError::InvalidSetting {
+            name: "tol",
+            value: tol,
+            reason: "the tolerance must be positive and finite",
+        });
+    }
+    let singular = EstimationError::SingularInnovation {
+        filter: "Riccati iteration",
+    };
+    let filtered = |p: &SMatrix<f64, NX, NX>| -> Result<_, EstimationError> {
+        let mut s = c * p * c.transpose() + r;
+        symmetrise(&mut s);
+        let ls = cholesky_lower(&s).ok_or(singular.clone())?;
+        let k = cholesky_solve(&ls, &(c * p))
+            .ok_or(singular.clone())?
+            .transpose();
+        let mut pf = p - k * c * p;
+        symmetrise(&mut pf);
+        Ok((k, pf))
+    };
+    let mut p = q + SMatrix::<f64, NX, NX>::identity();
+    let mut change = f64::INFINITY;
+    for it in 1..=max_iterations {
+        let (_, pf) = filtered(&p)?;
+        let mut next = a * pf * a.transpose() + q;
+        symmetrise(&mut next);
+        if !super::dense::all_finite(&next) {
+            break;
+        }
+        change = (next - p).norm() / next.norm().max(f64::MIN_POSITIVE);
+        p = next;
+        if change < tol {
+            let (k, pf) = filtered(&p)?;
+            let residual = (a * pf * a.transpose() + q - p).norm() / p.norm().max(1.0);
+            if residual > 1e3 * tol.max(f64::EPSILON) {
+                return Err(EstimationError::NotConverged {
+                    iterations: it,
+                    change: residual,
+                });
+            }
+            return Ok(SteadyStateGain {
+                filter_gain: k,
+                predictor_gain: a * k,
+                predicted_covariance: p,
+                filtered_covariance: pf,
+                iterations: it,
+            });
+        }
+    }
+    Err(EstimationError::NotConverged {
+        iterations: max_iterations,
+        change,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::dmatrix;
+
+    #[test]
+    fn model_from_state_space_checks_shape_and_sampling() {
+        let ss = StateSpace::new_discrete(
+            dmatrix![1.0, 0.1; 0.0, 1.0],
+            dmatrix![0.0; 0.1],
+            dmatrix![1.0, 0.0],
+            dmatrix![0.0],
+            0.1,
+        )
+        .unwrap();
+        let m = LinearDiscreteModel::<2, 1, 1>::from_state_space(&ss).unwrap();
+        assert_eq!(m.a[(0, 1)], 0.1);
+        assert_eq!(m.b[(1, 0)], 0.1);
+        assert!(matches!(
+            LinearDiscreteModel::<3, 1, 1>::from_state_space(&ss),
+            Err(EstimationError::Shape {
+                name: "A",
+                rows: 2,
+                expected_rows: 3,
+                ..
+            })
+        ));
+        let mut cont = ss.clone();
+        cont.dt = None;
+        assert_eq!(
+            LinearDiscreteModel::<2, 1, 1>::from_state_space(&cont),
+            Err(EstimationError::NotDiscrete)
+        );
+    }
+
+    /// `A` singular: a predictor gain cannot be turned back into a filter gain.
+    #[test]
+    fn filter_gain_from_predictor_needs_invertible_a() {
+        let a = SMatrix::<f64, 2, 2>::new(1.0, 2.0, 2.0, 4.0);
+        let l = SMatrix::<f64, 2, 1>::new(0.1, 0.2);
+        assert_eq!(
+            filter_gain_from_predictor(&a, &l),
+            Err(EstimationError::SingularMatrix { name: "A" })
+        );
+    }
+}

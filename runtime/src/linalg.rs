@@ -14,6 +14,9 @@
 pub mod balance;
 mod care;
 pub mod check;
+mod dare;
+pub mod discretize;
+pub mod expm;
 pub mod lyapunov;
 pub mod pbh;
 pub mod riccati;
@@ -22,6 +25,9 @@ pub mod sign;
 
 pub use care::{care, care_with_cross};
 pub use check::MatrixError;
+pub use dare::{dare, dare_with_cross};
+pub use discretize::{DiscretizeError, c2d_zoh, van_loan};
+pub use expm::{ExpmError, expm};
 pub use lyapunov::{LyapunovError, MAX_LYAPUNOV_ORDER, dlyap, lyap};
 pub use pbh::{
     Domain, Mode, PbhError, controllability_matrix, controllability_rank, is_detectable,

@@ -9,7 +9,7 @@
 
 use nalgebra::DMatrix;
 
-use crate::linalg::{Riccati, RiccatiError, care_with_cross};
+use crate::linalg::{Riccati, RiccatiError, care_with_cross, dare_with_cross};
 
 /// Continuous LQR: `K` (with `u = −Kx`), `X` and the eigenvalues of `A − BK` in a [`Riccati`].
 pub fn lqr(
@@ -30,4 +30,25 @@ pub fn lqr_with_cross(
     n: &DMatrix<f64>,
 ) -> Result<Riccati, RiccatiError> {
     care_with_cross(a, b, q, r, Some(n))
+}
+
+/// Discrete LQR: `K = (R + BᵀXB)⁻¹BᵀXA` (with `u[k] = −K x[k]`), `X` and the eigenvalues of `A − BK`.
+pub fn dlqr(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+) -> Result<Riccati, RiccatiError> {
+    dare_with_cross(a, b, q, r, None)
+}
+
+/// Discrete LQR with the cross weight `N` (cost term `2xᵀNu`).
+pub fn dlqr_with_cross(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+    n: &DMatrix<f64>,
+) -> Result<Riccati, RiccatiError> {
+    dare_with_cross(a, b, q, r, Some(n))
 }

@@ -227,7 +227,6 @@ impl Problem {
 }
 
 /// A Riccati problem in balanced coordinates: `X = α D⁻¹ X̃ D⁻¹`.
-#[allow(dead_code)] // `b` and `r` are used by the discrete solver.
 pub(crate) struct Scaled {
     pub a: DMatrix<f64>,
     pub b: DMatrix<f64>,

@@ -305,3 +305,62 @@ fn undetectable_mode_is_named() {
         other => panic!("expected NotDetectable, got {other:?}"),
     }
 }
+
+/// A stiff system whose slow mode (−0.01) is stable but uncontrollable next to a fast one (−10⁸): it must be
+/// accepted (stabilisable), and X follows by hand: x₁₁ = q₁/(2·0.01) = 50 (a Lyapunov equation, the input
+/// cannot act on it), x₂₂ the positive root of −2·10⁸ x − x² + 1 = 0, i.e. 1/(10⁸ + √(10¹⁶ + 1)).
+#[test]
+fn stiff_stable_uncontrollable_mode_is_accepted() {
+    let a = DMatrix::from_row_slice(2, 2, &[-0.01, 0.0, 0.0, -1e8]);
+    let b = DMatrix::from_row_slice(2, 1, &[0.0, 1.0]);
+    let sol = care(&a, &b, &DMatrix::identity(2, 2), &DMatrix::identity(1, 1)).unwrap();
+    let x22 = 1.0 / (1e8 + (1e16f64 + 1.0).sqrt());
+    assert!((sol.x[(0, 0)] - 50.0).abs() < 1e-12 * 50.0);
+    assert!((sol.x[(1, 1)] - x22).abs() < 1e-12 * x22);
+    assert!(sol.x[(0, 1)].abs() < 1e-15);
+    assert!((sol.k[(0, 1)] - x22).abs() < 1e-12 * x22);
+}
+
+mod random {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn residual_of(
+        a: &DMatrix<f64>,
+        b: &DMatrix<f64>,
+        q: &DMatrix<f64>,
+        r: &DMatrix<f64>,
+        x: &DMatrix<f64>,
+    ) -> f64 {
+        let r_inv = r.clone().try_inverse().unwrap();
+        let xbrbx = x * b * &r_inv * b.transpose() * x;
+        let res = a.transpose() * x + x * a - &xbrbx + q;
+        res.norm() / (2.0 * (x * a).norm() + xbrbx.norm() + q.norm())
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// For generic (almost surely controllable) 4-state, 2-input systems, the returned X satisfies the CARE
+        /// (residual recomputed here), is symmetric positive semidefinite, and A − BK is Hurwitz.
+        #[test]
+        fn generic_systems_satisfy_the_equation(
+            a_entries in prop::collection::vec(-2.0f64..2.0, 16),
+            b_entries in prop::collection::vec(-1.0f64..1.0, 8),
+            m_entries in prop::collection::vec(-1.0f64..1.0, 16),
+            r_scale in 0.01f64..100.0,
+        ) {
+            let a = DMatrix::from_row_slice(4, 4, &a_entries);
+            let b = DMatrix::from_row_slice(4, 2, &b_entries);
+            let m = DMatrix::from_row_slice(4, 4, &m_entries);
+            let q = m.transpose() * &m + DMatrix::identity(4, 4) * 0.1;
+            let r = DMatrix::from_row_slice(2, 2, &[1.0, 0.3, 0.3, 2.0]) * r_scale;
+            let sol = care(&a, &b, &q, &r).unwrap();
+            prop_assert!(residual_of(&a, &b, &q, &r, &sol.x) < 1e-12);
+            prop_assert!((&sol.x - sol.x.transpose()).amax() <= 1e-14 * sol.x.amax());
+            let min_eig = sol.x.clone().symmetric_eigen().eigenvalues.min();
+            prop_assert!(min_eig > -1e-12 * sol.x.amax());
+            let closed = &a - &b * &sol.k;
+            prop_assert!(closed.complex_eigenvalues().iter().all(|l| l.re < 0.0));
+        }
+    }
+}

@@ -128,3 +128,38 @@ fn unstabilizable_and_undetectable_are_named() {
         other => panic!("expected NotDetectable, got {other:?}"),
     }
 }
+
+mod random {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// Generic 4-state, 2-input discrete systems (possibly unstable, |λ| up to about 2): X satisfies the DARE
+        /// (residual recomputed here), is symmetric, and A − BK is Schur stable.
+        #[test]
+        fn generic_systems_satisfy_the_equation(
+            a_entries in prop::collection::vec(-1.0f64..1.0, 16),
+            b_entries in prop::collection::vec(-1.0f64..1.0, 8),
+            m_entries in prop::collection::vec(-1.0f64..1.0, 16),
+            r_scale in 0.01f64..100.0,
+        ) {
+            let a = DMatrix::from_row_slice(4, 4, &a_entries);
+            let b = DMatrix::from_row_slice(4, 2, &b_entries);
+            let m = DMatrix::from_row_slice(4, 4, &m_entries);
+            let q = m.transpose() * &m + DMatrix::identity(4, 4) * 0.1;
+            let r = DMatrix::from_row_slice(2, 2, &[1.0, 0.3, 0.3, 2.0]) * r_scale;
+            let sol = dare(&a, &b, &q, &r).unwrap();
+            let x = &sol.x;
+            let s = &r + b.transpose() * x * &b;
+            let correction = a.transpose() * x * &b * s.try_inverse().unwrap() * b.transpose() * x * &a;
+            let atxa = a.transpose() * x * &a;
+            let res = &atxa - x - &correction + &q;
+            let rel = res.norm() / (atxa.norm() + x.norm() + correction.norm() + q.norm());
+            prop_assert!(rel < 1e-12, "relative residual {rel:e}");
+            prop_assert!((x - x.transpose()).amax() <= 1e-14 * x.amax());
+            let closed = &a - &b * &sol.k;
+            prop_assert!(closed.complex_eigenvalues().iter().all(|l| l.norm() < 1.0));
+        }
+    }
+}

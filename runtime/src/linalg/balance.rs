@@ -48,3 +48,18 @@ pub fn power_of_two(x: f64) -> f64 {
     let e = x.log2().round().clamp(-1000.0, 1000.0);
     2f64.powi(e as i32)
 }
+
+/// The Frobenius norm of the balanced `D⁻¹ A D`: the magnitude that eigenvalue errors scale with, free of the
+/// units chosen for the states.
+pub fn balanced_norm(a: &DMatrix<f64>) -> f64 {
+    let d = balancing_scales(a);
+    let n = a.nrows();
+    let mut sum = 0.0;
+    for j in 0..n {
+        for i in 0..n {
+            let v = a[(i, j)] * d[j] / d[i];
+            sum += v * v;
+        }
+    }
+    sum.sqrt()
+}

@@ -121,7 +121,7 @@ pub fn dare_with_cross(
     let closed_loop_eigenvalues = eigenvalues(&(a - b * &k))?;
     if let Some(&eigenvalue) = closed_loop_eigenvalues
         .iter()
-        .find(|l| !Domain::Discrete.is_stable(**l, 1.0))
+        .find(|l| !Domain::Discrete.is_stable(**l, 0.0))
     {
         return Err(RiccatiError::ClosedLoopUnstable { eigenvalue });
     }

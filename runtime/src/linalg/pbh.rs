@@ -13,7 +13,7 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 
-use super::balance::balancing_scales;
+use super::balance::{balanced_norm, balancing_scales};
 use super::check::{self, MatrixError};
 use super::schur::{SchurError, eigenvalues};
 
@@ -28,12 +28,15 @@ pub enum Domain {
 }
 
 impl Domain {
-    /// Whether `λ` is asymptotically stable in this domain, with a margin of `1e-9` (relative to `scale` in
-    /// continuous time) so that modes on the stability boundary count as unstable.
+    /// Whether `λ` is asymptotically stable in this domain with a margin, so that modes on the stability
+    /// boundary (computed with rounding error) count as unstable: `Re λ < −1e-12 · max(1, scale)` in continuous
+    /// time, where `scale` is the norm of the balanced matrix the eigenvalue came from (eigenvalue errors are
+    /// proportional to it), and `|λ| < 1 − 1e-12 · max(1, scale)` in discrete time (pass `scale = 1`).
     pub fn is_stable(self, lambda: Complex<f64>, scale: f64) -> bool {
+        let margin = 1e-12 * scale.max(1.0);
         match self {
-            Domain::Continuous => lambda.re < -1e-9 * scale.max(1.0),
-            Domain::Discrete => lambda.norm() < 1.0 - 1e-9,
+            Domain::Continuous => lambda.re < -margin,
+            Domain::Discrete => lambda.norm() < 1.0 - margin,
         }
     }
 }
@@ -154,7 +157,7 @@ pub fn unstabilizable_mode(
     b: &DMatrix<f64>,
     domain: Domain,
 ) -> Result<Option<Mode>, PbhError> {
-    let scale = a.norm();
+    let scale = stability_scale(a, domain);
     Ok(uncontrollable_modes(a, b)?
         .into_iter()
         .find(|m| !domain.is_stable(m.eigenvalue, scale)))
@@ -166,7 +169,7 @@ pub fn undetectable_mode(
     c: &DMatrix<f64>,
     domain: Domain,
 ) -> Result<Option<Mode>, PbhError> {
-    let scale = a.norm();
+    let scale = stability_scale(a, domain);
     Ok(unobservable_modes(a, c)?
         .into_iter()
         .find(|m| !domain.is_stable(m.eigenvalue, scale)))
@@ -241,4 +244,12 @@ pub fn observability_rank(
     rel_tol: f64,
 ) -> Result<usize, PbhError> {
     numerical_rank(&observability_matrix(a, c)?, rel_tol)
+}
+
+/// The `scale` argument of [`Domain::is_stable`] for eigenvalues of `a`.
+pub fn stability_scale(a: &DMatrix<f64>, domain: Domain) -> f64 {
+    match domain {
+        Domain::Continuous => balanced_norm(a),
+        Domain::Discrete => 1.0,
+    }
 }

@@ -193,10 +193,12 @@ impl Problem {
         (self.n <= DIRECTION_MAX_ORDER).then_some(v)
     }
 
-    /// After a failed solve: names the least controllable or least observable non-stable mode when it is nearly
-    /// rank deficient (margin below `1e-6`), else reports non-convergence.
+    /// After a failed solve: names the least controllable or least observable mode on or near the stability
+    /// boundary (within `10⁴` times the margin of the precondition check, as a defective eigenvalue is only
+    /// computed to about `√ε`) when it is nearly rank deficient (PBH margin below `1e-6`), else reports
+    /// non-convergence.
     pub fn diagnose(&self, domain: Domain, residual: f64, iterations: usize) -> RiccatiError {
-        let scale = self.a.norm();
+        let scale = 1e4 * pbh::stability_scale(&self.a, domain);
         let worst = |modes: Result<Vec<pbh::Mode>, PbhError>| {
             modes.ok().and_then(|ms| {
                 ms.into_iter()

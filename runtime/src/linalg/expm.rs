@@ -4,9 +4,15 @@
 //! For `‖A‖₁ ≤ θₘ` the diagonal Padé approximant `rₘ` of degree `m ∈ {3, 5, 7, 9}` is accurate to unit
 //! roundoff in exact arithmetic; otherwise `A` is scaled by `2⁻ˢ` so that `‖2⁻ˢA‖₁ ≤ θ₁₃`, `r₁₃` is evaluated
 //! and squared `s` times. Cost: about `6 + s` matrix products and one LU solve, `O(n³)`.
+//!
+//! Models in physical units are badly scaled (stiffness over inertia of 10⁸ next to unit entries), which makes
+//! `‖A‖₁` far larger than the spectral radius, forces many squarings and loses accuracy with each. So `A` is
+//! first balanced by an exact power-of-two diagonal similarity, `e^A = D e^{D⁻¹AD} D⁻¹` (see
+//! [`super::balance`]), whenever that reduces `‖A‖₁`.
 
 use nalgebra::DMatrix;
 
+use super::balance::balancing_scales;
 use super::check::{self, MatrixError};
 
 /// Why the exponential could not be computed.
@@ -64,7 +70,22 @@ const B13: [f64; 14] = [
 
 /// `e^A` for a square, finite `A`.
 pub fn expm(a: &DMatrix<f64>) -> Result<DMatrix<f64>, ExpmError> {
-    let n = check::square("A", a)?;
+    check::square("A", a)?;
+    let d = balancing_scales(a);
+    let balanced = DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| a[(i, j)] * d[j] / d[i]);
+    if one_norm(&balanced) < one_norm(a) {
+        let e = expm_unbalanced(&balanced)?;
+        Ok(DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| {
+            e[(i, j)] * d[i] / d[j]
+        }))
+    } else {
+        expm_unbalanced(a)
+    }
+}
+
+/// Higham's algorithm on a validated square matrix.
+fn expm_unbalanced(a: &DMatrix<f64>) -> Result<DMatrix<f64>, ExpmError> {
+    let n = a.nrows();
     let norm = one_norm(a);
     let identity = DMatrix::<f64>::identity(n, n);
     let a2 = a * a;

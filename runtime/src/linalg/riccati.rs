@@ -49,7 +49,8 @@ pub enum RiccatiError {
     #[error("order {n} exceeds the limit {max} of the Riccati solver")]
     TooLarge { n: usize, max: usize },
     #[error(
-        "(A, B) is not stabilisable: the mode with eigenvalue {eigenvalue} cannot be moved by the input (direction {direction:?})"
+        "not stabilisable: the mode with eigenvalue {eigenvalue} is not stable and cannot be moved by the input (for an estimator: is not excited by the process noise){}",
+        format_direction(.direction)
     )]
     NotStabilizable {
         eigenvalue: Complex<f64>,
@@ -57,7 +58,8 @@ pub enum RiccatiError {
         direction: Option<DVector<Complex<f64>>>,
     },
     #[error(
-        "(Q, A) is not detectable: the mode with eigenvalue {eigenvalue} is not stable and not weighted by Q (direction {direction:?})"
+        "not detectable: the mode with eigenvalue {eigenvalue} is not stable and is invisible to the state weight Q (for an estimator: to the measurements C){}",
+        format_direction(.direction)
     )]
     NotDetectable {
         eigenvalue: Complex<f64>,
@@ -78,6 +80,36 @@ pub enum RiccatiError {
     Svd,
     #[error(transparent)]
     Lyapunov(#[from] LyapunovError),
+}
+
+/// `"; state direction [a, b, …]"` with real entries when the direction is real up to a common phase, else
+/// complex entries; empty without a direction.
+fn format_direction(direction: &Option<DVector<Complex<f64>>>) -> String {
+    let Some(d) = direction else {
+        return String::new();
+    };
+    // Rotate so that the largest entry is real and positive, then print real parts if that makes it real.
+    let pivot = d
+        .iter()
+        .copied()
+        .max_by(|a, b| a.norm().total_cmp(&b.norm()));
+    let phase = match pivot {
+        Some(p) if p.norm() > 0.0 => p.conj() / p.norm(),
+        _ => Complex::new(1.0, 0.0),
+    };
+    let rotated: Vec<Complex<f64>> = d.iter().map(|z| z * phase).collect();
+    let real = rotated.iter().all(|z| z.im.abs() <= 1e-12);
+    let entries: Vec<String> = rotated
+        .iter()
+        .map(|z| {
+            if real {
+                format!("{:.4e}", z.re)
+            } else {
+                format!("{:.4e}{:+.4e}i", z.re, z.im)
+            }
+        })
+        .collect();
+    format!("; state direction [{}]", entries.join(", "))
 }
 
 /// Systems up to this order get the state direction of an offending mode in the errors.

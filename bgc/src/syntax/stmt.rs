@@ -6,7 +6,7 @@ use super::parser::{Fail, PResult, Parser};
 use crate::diagnostic::Diagnostic;
 use crate::span::Span;
 
-type Docs = Vec<(String, Span)>;
+type Docs = Vec<(String, Span, bool)>;
 
 impl<'a> Parser<'a> {
     /// Parses one statement; on a syntax error records it, skips the statement and returns `None`.
@@ -527,5 +527,5 @@ fn same_node(a: &NodeRef, b: &NodeRef) -> bool {
 }
 
 fn doc_text(docs: Docs) -> Vec<String> {
-    docs.into_iter().map(|(t, _)| t).collect()
+    docs.into_iter().map(|(t, _, _)| t).collect()
 }

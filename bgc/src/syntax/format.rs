@@ -448,12 +448,20 @@ pub fn unit(u: &UnitExpr) -> String {
     }
 }
 
-/// A number in the shortest decimal form that reads back as the same `f64` (`2`, `0.5`, `1e-7`, `1.5e300`).
+/// A number in a form that reads back as the same `f64`: decimal from 0.001 up to a million (`2`, `0.5`, `3000`,
+/// `0.00119`), otherwise the shorter of decimal and scientific (`3.06e-4`, `1e-7`, `1e6`, `1.5e300`).
 pub fn number(v: f64) -> String {
-    let s = format!("{v:?}");
-    match s.strip_suffix(".0") {
-        Some(short) => short.to_string(),
-        None => s,
+    // Both `Display` and `LowerExp` print the fewest significant digits that read back exactly.
+    let decimal = format!("{v}");
+    let magnitude = v.abs();
+    if v == 0.0 || (1e-3..1e6).contains(&magnitude) {
+        return decimal;
+    }
+    let scientific = format!("{v:e}");
+    if scientific.len() < decimal.len() {
+        scientific
+    } else {
+        decimal
     }
 }
 

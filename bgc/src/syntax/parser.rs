@@ -157,6 +157,7 @@ impl<'a> Parser<'a> {
                 start: self.text.len() as u32,
                 end: self.text.len() as u32,
                 value: 0.0,
+                unterminated: false,
             })
     }
 
@@ -277,6 +278,12 @@ impl<'a> Parser<'a> {
             return Ok(());
         }
         let t = self.peek();
+        let after_unterminated =
+            self.pos > 0 && self.toks.get(self.pos - 1).is_some_and(|p| p.unterminated);
+        if after_unterminated && (self.starts_line(t) || matches!(t.kind, Tok::RBrace | Tok::Eof)) {
+            // The unterminated string swallowed the rest of its line, `;` included; it is reported already.
+            return Ok(());
+        }
         if self.starts_line(t) || matches!(t.kind, Tok::RBrace | Tok::Eof) {
             let end = self.prev_end();
             let found = self.describe(t);

@@ -226,7 +226,7 @@ impl<'a> Parser<'a> {
             if !kind.is_field() {
                 self.diags.push(
                     Diagnostic::error(
-                        "BG0118",
+                        "BG0117",
                         format!("a `{}` element has no port count", kind.keyword()),
                     )
                     .with_primary(n.1, "only fields take a port count")
@@ -239,7 +239,7 @@ impl<'a> Parser<'a> {
         } else if kind.is_field() {
             self.diags.push(
                 Diagnostic::error(
-                    "BG0118",
+                    "BG0117",
                     format!("the `{}` field needs its number of ports", kind.keyword()),
                 )
                 .with_primary(name.span, "the port count should follow this name")

@@ -173,10 +173,10 @@ proptest! {
 fn every_truncation_of_every_seed_is_handled() {
     for s in seeds() {
         for cut in 0..=s.len() {
-            if s.is_char_boundary(cut) {
-                if let Err(e) = check_bytes(&s.as_bytes()[..cut]) {
-                    panic!("truncation at {cut}: {e}");
-                }
+            if s.is_char_boundary(cut)
+                && let Err(e) = check_bytes(&s.as_bytes()[..cut])
+            {
+                panic!("truncation at {cut}: {e}");
             }
         }
     }

@@ -16,6 +16,8 @@ mod suggest;
 #[cfg(test)]
 mod format_tests;
 #[cfg(test)]
+mod snapshot_tests;
+#[cfg(test)]
 mod tests;
 
 pub use decode::decode;

@@ -435,6 +435,10 @@ impl<'a> Parser<'a> {
             let t = self.peek();
             match t.kind {
                 Tok::Eof => break,
+                Tok::Semi => {
+                    // An empty statement has no meaning.
+                    self.bump();
+                }
                 Tok::Ident if matches!(self.tok_text(t), "model" | "component") => {
                     let docs = self.take_docs();
                     items.push(Item::Model(self.model(docs)));

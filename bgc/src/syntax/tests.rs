@@ -289,6 +289,22 @@ fn deep_nesting_is_an_error_not_a_crash() {
     assert_eq!(codes(&src), vec!["BG0105"]);
     let src = format!("model m {{ output y [1] = {}1; }}", "-".repeat(10_000));
     assert_eq!(codes(&src), vec!["BG0105"]);
+    let src = format!("model m {{ output y [1] = {}1; }}", "2 ^ ".repeat(10_000));
+    assert_eq!(codes(&src), vec!["BG0105"]);
+    // A long chain builds a deep tree too.
+    let src = format!("model m {{ output y [1] = {}1; }}", "x + ".repeat(10_000));
+    assert_eq!(codes(&src), vec!["BG0105"]);
+    let src = format!("model m {{ output y [1] = {}1; }}", "x * ".repeat(10_000));
+    assert_eq!(codes(&src), vec!["BG0105"]);
+    // Within the limit, all is well: 150 terms, 150 parentheses.
+    let src = format!("model m {{ output y [1] = {}1; }}", "x + ".repeat(150));
+    assert!(codes(&src).is_empty());
+    let src = format!(
+        "model m {{ output y [1] = {}1{}; }}",
+        "(".repeat(150),
+        ")".repeat(150)
+    );
+    assert!(codes(&src).is_empty());
 }
 
 /// The ```bg blocks of docs/language.md. A block without a `model`, `component` or `import` at its top level is a

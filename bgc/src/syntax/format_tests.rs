@@ -101,6 +101,17 @@ fn minimal_parentheses_keep_the_tree() {
 }
 
 #[test]
+fn an_index_in_a_parameter_default_keeps_its_parentheses() {
+    let out = check_round_trip(
+        "model m {\n    param a = (e[1]) * 2 + (-f[2]) [1];\n    param b = n [1];\n}\n",
+    );
+    assert_eq!(
+        out,
+        "model m {\n    param a = (e[1] * 2 + -f[2]) [1];\n    param b = n [1];\n}\n"
+    );
+}
+
+#[test]
 fn numbers_round_trip_exactly() {
     let cases = [
         ("12", "12"),
@@ -118,6 +129,9 @@ fn numbers_round_trip_exactly() {
         ("0.30000000000000004", "0.30000000000000004"),
         ("123456789012345678", "123456789012345680"),
         ("1e300", "1e300"),
+        ("12.", "12"),
+        ("1.e5", "100000"),
+        ("1E+7", "1e7"),
     ];
     for (src, want) in cases {
         let out = check_round_trip(&format!("model m {{\n    param a = {src} [1];\n}}\n"));

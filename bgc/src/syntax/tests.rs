@@ -421,6 +421,16 @@ fn crlf_line_endings() {
 }
 
 #[test]
+fn missing_semicolon_before_a_statement_on_the_same_line() {
+    let src = "model m { param a = 1 [kg] param b = 2 [kg]; }";
+    let (file, diags) = parse(FileId(0), src);
+    assert_eq!(diags.len(), 1);
+    let end = "model m { param a = 1 [kg]".len();
+    assert_eq!(diags[0].primary_span().map(|s| s.range()), Some(end..end));
+    assert_eq!(body_of(&file).len(), 2);
+}
+
+#[test]
 fn keyword_as_name_is_reported_and_the_statement_kept() {
     let (file, diags) = parse(FileId(0), "model m { param bond = 1 [1]; C R = 1; }");
     let c: Vec<&str> = diags.iter().map(|d| d.code.0).collect();

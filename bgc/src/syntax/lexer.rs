@@ -242,7 +242,8 @@ impl<'a> Lexer<'a> {
 
     fn run(&mut self) {
         let text = self.text;
-        let mut rest = text;
+        // A byte-order mark, which some editors write at the start of UTF-8 files, is not text.
+        let mut rest = text.strip_prefix('\u{feff}').unwrap_or(text);
         while !rest.is_empty() {
             let start = text.len() - rest.len();
             if let Ok((r, ws)) = whitespace(rest) {

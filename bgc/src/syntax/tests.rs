@@ -497,18 +497,16 @@ fn decode_points_at_the_first_bad_byte() {
     use super::decode;
     assert_eq!(decode(FileId(3), b"model m {}"), Ok("model m {}"));
     // 0xC3 0x28: a two-byte sequence broken by its second byte; the error covers the first byte only.
-    let d = decode(FileId(3), b"ab\xC3\x28cd").err().expect("an error");
+    let d = decode(FileId(3), b"ab\xC3\x28cd").expect_err("an error");
     assert_eq!(d.code.0, "BG0100");
     assert_eq!(
         d.primary_span(),
         Some(crate::span::Span::new(FileId(3), 2, 3))
     );
     // A sequence cut short by the end of the file runs to the end.
-    let d = decode(FileId(0), "é".as_bytes().get(..1).unwrap_or(&[]))
-        .err()
-        .expect("an error");
+    let d = decode(FileId(0), "é".as_bytes().get(..1).unwrap_or(&[])).expect_err("an error");
     assert_eq!(d.primary_span().map(|s| s.range()), Some(0..1));
-    let d = decode(FileId(0), b"ab\xE2\x82").err().expect("an error");
+    let d = decode(FileId(0), b"ab\xE2\x82").expect_err("an error");
     assert_eq!(d.primary_span().map(|s| s.range()), Some(2..4));
 }
 

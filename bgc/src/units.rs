@@ -42,12 +42,12 @@ impl Dim {
     }
 
     /// The product of two dimensions, or `None` if an exponent leaves the range of `i8`.
-    pub fn mul(self, other: Dim) -> Option<Dim> {
+    pub fn checked_mul(self, other: Dim) -> Option<Dim> {
         self.combine(other, |a, b| a.checked_add(b))
     }
 
     /// The quotient of two dimensions, or `None` if an exponent leaves the range of `i8`.
-    pub fn div(self, other: Dim) -> Option<Dim> {
+    pub fn checked_div(self, other: Dim) -> Option<Dim> {
         self.combine(other, |a, b| a.checked_sub(b))
     }
 
@@ -74,8 +74,8 @@ impl Dim {
 
     fn combine(self, other: Dim, op: impl Fn(i8, i8) -> Option<i8>) -> Option<Dim> {
         let mut out = [0i8; 7];
-        for i in 0..7 {
-            out[i] = op(self.0[i], other.0[i])?;
+        for ((o, &a), &b) in out.iter_mut().zip(self.0.iter()).zip(other.0.iter()) {
+            *o = op(a, b)?;
         }
         Some(Dim(out))
     }
@@ -102,16 +102,16 @@ impl Unit {
         Unit { dim, scale: 1.0 }
     }
 
-    pub fn mul(self, other: Unit) -> Option<Unit> {
+    pub fn checked_mul(self, other: Unit) -> Option<Unit> {
         Some(Unit::new(
-            self.dim.mul(other.dim)?,
+            self.dim.checked_mul(other.dim)?,
             self.scale * other.scale,
         ))
     }
 
-    pub fn div(self, other: Unit) -> Option<Unit> {
+    pub fn checked_div(self, other: Unit) -> Option<Unit> {
         Some(Unit::new(
-            self.dim.div(other.dim)?,
+            self.dim.checked_div(other.dim)?,
             self.scale / other.scale,
         ))
     }
@@ -247,7 +247,7 @@ pub fn parse_unit(u: &UnitExpr) -> Result<Unit, UnitError> {
             })?;
             let p = power.checked_mul(sign).ok_or(UnitError::Overflow)?;
             let factor = base.powi(p).ok_or(UnitError::Overflow)?;
-            out = out.mul(factor).ok_or(UnitError::Overflow)?;
+            out = out.checked_mul(factor).ok_or(UnitError::Overflow)?;
         }
     }
     Ok(out)
@@ -301,7 +301,7 @@ impl fmt::Display for Dim {
         let mut best: (u32, Option<(&str, i8)>, Dim) = (self.weight(), None, *self);
         for (name, d) in DISPLAY_DERIVED {
             for p in [1i8, -1] {
-                let Some(rest) = d.powi(i32::from(p)).and_then(|dp| self.div(dp)) else {
+                let Some(rest) = d.powi(i32::from(p)).and_then(|dp| self.checked_div(dp)) else {
                     continue;
                 };
                 // A derived unit may only shorten the base units present: `m/s^2` must not read `N/kg`.
@@ -456,7 +456,7 @@ pub fn storage_parameter_unit(
         (K::R, Domain::Hydraulic) => "Pa s/m^3",
         _ => "K^2/W",
     };
-    Some((num.div(den)?, text))
+    Some((num.checked_div(den)?, text))
 }
 
 #[cfg(test)]
@@ -559,8 +559,8 @@ mod tests {
     fn arithmetic_and_square_root() {
         let n = Unit::si(D_N);
         let m = Unit::si(D_M);
-        assert_eq!(n.mul(m).map(|u| u.dim), Some(D_J));
-        assert_eq!(n.div(m).and_then(|u| u.mul(m)), Some(n));
+        assert_eq!(n.checked_mul(m).map(|u| u.dim), Some(D_J));
+        assert_eq!(n.checked_div(m).and_then(|u| u.checked_mul(m)), Some(n));
         assert_eq!(m.powi(3).map(|u| u.dim), Some(D_M3));
         assert_eq!(
             m.powi(-2).and_then(|u| u.sqrt()).map(|u| u.dim),
@@ -597,10 +597,10 @@ mod tests {
         for d in Domain::ALL {
             let u = domain_units(d);
             // effort x flow is a power, in every domain.
-            assert_eq!(u.effort.mul(u.flow), Some(watt), "{d:?}");
+            assert_eq!(u.effort.checked_mul(u.flow), Some(watt), "{d:?}");
             // p = integral of e dt, q = integral of f dt.
-            assert_eq!(u.effort.mul(second), Some(u.momentum), "{d:?}");
-            assert_eq!(u.flow.mul(second), Some(u.displacement), "{d:?}");
+            assert_eq!(u.effort.checked_mul(second), Some(u.momentum), "{d:?}");
+            assert_eq!(u.flow.checked_mul(second), Some(u.displacement), "{d:?}");
         }
         // The conventional texts parse to the same dimensions.
         for d in Domain::ALL {

@@ -7,15 +7,19 @@
 pub mod ast;
 mod decode;
 mod expr;
+mod format;
 mod lexer;
 mod parser;
 mod stmt;
 mod suggest;
 
 #[cfg(test)]
+mod format_tests;
+#[cfg(test)]
 mod tests;
 
 pub use decode::decode;
+pub use format::{format, format_source};
 pub use parser::{KEYWORDS, MAX_DEPTH};
 
 use crate::diagnostic::Diagnostic;

@@ -181,6 +181,26 @@ impl<'a> Parser<'a> {
             }
         }
         self.close(Tok::RParen, open, "the call")?;
+        if matches!(callee.name.as_str(), "e" | "f" | "p" | "q")
+            && let [arg] = args.as_mut_slice()
+        {
+            // `f((x))` names the same node as `f(x)`.
+            let node = match &arg.kind {
+                ExprKind::Name(n) => Some((n.clone(), None)),
+                ExprKind::Indexed(n, i) => Some((n.clone(), Some((*i, arg.span)))),
+                _ => None,
+            };
+            if let Some((name, port)) = node {
+                arg.kind = ExprKind::Node(NodeRef {
+                    path: vec![Ident {
+                        name,
+                        span: arg.span,
+                    }],
+                    port,
+                    span: arg.span,
+                });
+            }
+        }
         Ok(Expr {
             kind: ExprKind::Call(callee, args),
             span: self.span_from(start),

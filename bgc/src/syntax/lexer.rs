@@ -80,6 +80,8 @@ pub struct Token {
     pub end: u32,
     /// The value of a number token (0 for other tokens and for malformed numbers, which are already reported).
     pub value: f64,
+    /// A string literal without its closing quote (already reported); it ran to the end of its line.
+    pub unterminated: bool,
 }
 
 /// A `//` or `///` comment.
@@ -206,6 +208,7 @@ impl<'a> Lexer<'a> {
             start: start as u32,
             end: end as u32,
             value,
+            unterminated: false,
         });
         self.at_line_start = false;
     }
@@ -290,6 +293,7 @@ impl<'a> Lexer<'a> {
             start: end as u32,
             end: end as u32,
             value: 0.0,
+            unterminated: false,
         });
     }
 
@@ -417,6 +421,9 @@ impl<'a> Lexer<'a> {
                         .with_help("close the string with `\"` on the same line; write a quote inside it as `\\\"`"),
                 );
                 self.push(Tok::Str(index), start, start + len, 0.0);
+                if let Some(t) = self.out.tokens.last_mut() {
+                    t.unterminated = true;
+                }
                 rest.get(len..).unwrap_or("")
             }
         }

@@ -157,6 +157,7 @@ impl<'a> Parser<'a> {
                 start: self.text.len() as u32,
                 end: self.text.len() as u32,
                 value: 0.0,
+                unterminated: false,
             })
     }
 
@@ -277,6 +278,12 @@ impl<'a> Parser<'a> {
             return Ok(());
         }
         let t = self.peek();
+        let after_unterminated =
+            self.pos > 0 && self.toks.get(self.pos - 1).is_some_and(|p| p.unterminated);
+        if after_unterminated && (self.starts_line(t) || matches!(t.kind, Tok::RBrace | Tok::Eof)) {
+            // The unterminated string swallowed the rest of its line, `;` included; it is reported already.
+            return Ok(());
+        }
         if self.starts_line(t) || matches!(t.kind, Tok::RBrace | Tok::Eof) {
             let end = self.prev_end();
             let found = self.describe(t);
@@ -361,7 +368,7 @@ impl<'a> Parser<'a> {
 
     /// Takes the doc comments between the previous token and the current one. Earlier doc comments not taken by
     /// anything (inside a statement, say) are reported as documenting nothing.
-    pub(super) fn take_docs(&mut self) -> Vec<(String, Span)> {
+    pub(super) fn take_docs(&mut self) -> Vec<(String, Span, bool)> {
         let start = self.peek().start;
         let prev = self.prev_end();
         self.stray_docs_before(prev);
@@ -372,16 +379,16 @@ impl<'a> Parser<'a> {
             }
             let text = d.text.get(3..).unwrap_or("");
             let text = text.strip_prefix(' ').unwrap_or(text);
-            out.push((text.to_string(), self.span(d.start, d.end)));
+            out.push((text.to_string(), self.span(d.start, d.end), d.own_line));
             self.next_doc += 1;
         }
         out
     }
 
     /// Reports doc comments that precede something that takes no documentation, and keeps them as comments.
-    pub(super) fn reject_docs(&mut self, docs: Vec<(String, Span)>, what: &str) {
-        for (text, span) in docs {
-            self.stray_doc(text, span, what);
+    pub(super) fn reject_docs(&mut self, docs: Vec<(String, Span, bool)>, what: &str) {
+        for (text, span, own_line) in docs {
+            self.stray_doc(text, span, own_line, what);
         }
     }
 
@@ -393,12 +400,13 @@ impl<'a> Parser<'a> {
             let text = d.text.get(3..).unwrap_or("");
             let text = text.strip_prefix(' ').unwrap_or(text).to_string();
             let span = self.span(d.start, d.end);
+            let own_line = d.own_line;
             self.next_doc += 1;
-            self.stray_doc(text, span, "nothing");
+            self.stray_doc(text, span, own_line, "nothing");
         }
     }
 
-    fn stray_doc(&mut self, text: String, span: Span, what: &str) {
+    fn stray_doc(&mut self, text: String, span: Span, own_line: bool, what: &str) {
         self.diags.push(
             Diagnostic::warning("BG0114", format!("doc comment documents {what}"))
                 .with_primary(span, "this doc comment is not attached to a declaration")
@@ -415,7 +423,7 @@ impl<'a> Parser<'a> {
         self.comments.push(Comment {
             text,
             span,
-            own_line: true,
+            own_line,
         });
     }
 
@@ -515,7 +523,7 @@ impl<'a> Parser<'a> {
         }
     }
 
-    fn model(&mut self, docs: Vec<(String, Span)>) -> ast::ModelDecl {
+    fn model(&mut self, docs: Vec<(String, Span, bool)>) -> ast::ModelDecl {
         let kw = self.bump();
         let kind = if self.tok_text(kw) == "model" {
             ast::ModelKind::Model
@@ -543,7 +551,7 @@ impl<'a> Parser<'a> {
         };
         ast::ModelDecl {
             kind,
-            doc: docs.into_iter().map(|(t, _)| t).collect(),
+            doc: docs.into_iter().map(|(t, _, _)| t).collect(),
             name,
             body,
             span: self.span_from(kw.start),

@@ -6,7 +6,7 @@ use super::parser::{Fail, PResult, Parser};
 use crate::diagnostic::Diagnostic;
 use crate::span::Span;
 
-type Docs = Vec<(String, Span)>;
+type Docs = Vec<(String, Span, bool)>;
 
 impl<'a> Parser<'a> {
     /// Parses one statement; on a syntax error records it, skips the statement and returns `None`.
@@ -226,7 +226,7 @@ impl<'a> Parser<'a> {
             if !kind.is_field() {
                 self.diags.push(
                     Diagnostic::error(
-                        "BG0118",
+                        "BG0117",
                         format!("a `{}` element has no port count", kind.keyword()),
                     )
                     .with_primary(n.1, "only fields take a port count")
@@ -239,7 +239,7 @@ impl<'a> Parser<'a> {
         } else if kind.is_field() {
             self.diags.push(
                 Diagnostic::error(
-                    "BG0118",
+                    "BG0117",
                     format!("the `{}` field needs its number of ports", kind.keyword()),
                 )
                 .with_primary(name.span, "the port count should follow this name")
@@ -527,5 +527,5 @@ fn same_node(a: &NodeRef, b: &NodeRef) -> bool {
 }
 
 fn doc_text(docs: Docs) -> Vec<String> {
-    docs.into_iter().map(|(t, _)| t).collect()
+    docs.into_iter().map(|(t, _, _)| t).collect()
 }

@@ -290,3 +290,47 @@ fn deep_nesting_is_an_error_not_a_crash() {
     let src = format!("model m {{ output y [1] = {}1; }}", "-".repeat(10_000));
     assert_eq!(codes(&src), vec!["BG0105"]);
 }
+
+/// The ```bg blocks of docs/language.md. A block without a `model`, `component` or `import` at its top level is a
+/// fragment of a body and is checked inside a model.
+pub(super) fn language_examples() -> Vec<String> {
+    let doc = include_str!("../../../docs/language.md");
+    let mut out = Vec::new();
+    let mut current: Option<String> = None;
+    for line in doc.lines() {
+        match &mut current {
+            None if line.trim_start() == "```bg" => current = Some(String::new()),
+            None => {}
+            Some(block) if line.trim_start() == "```" => {
+                let top_level = block.lines().any(|l| {
+                    l.starts_with("model") || l.starts_with("component") || l.starts_with("import")
+                });
+                out.push(if top_level {
+                    block.clone()
+                } else {
+                    format!("model example {{\n{block}}}\n")
+                });
+                current = None;
+            }
+            Some(block) => {
+                block.push_str(line);
+                block.push('\n');
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn every_example_of_the_language_reference_parses() {
+    let examples = language_examples();
+    assert!(
+        examples.len() >= 13,
+        "found only {} examples",
+        examples.len()
+    );
+    for ex in &examples {
+        let (_, diags) = parse(FileId(0), ex);
+        assert!(diags.is_empty(), "{ex}\n{diags:#?}");
+    }
+}

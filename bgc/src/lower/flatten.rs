@@ -46,6 +46,7 @@ impl<'a> Builder<'a> {
             prefix,
             component,
             instance_span,
+            own_instance: overrides.as_ref().map(|o| o.instance.span),
             ..Default::default()
         });
         let sid = self.scopes.len() - 1;
@@ -728,8 +729,10 @@ impl<'a> Builder<'a> {
         port: &Ident,
         r: &NodeRef,
     ) -> Option<End> {
-        let scope = self.scopes.get(child)?;
+        let scope = self.scopes.get_mut(child)?;
         if let Some((end, _)) = scope.ports.get(&port.name) {
+            let end = *end;
+            scope.connected = true;
             if let Some((_, span)) = r.port {
                 self.diags.push(
                     Diagnostic::error("BG0205", "a component port has no index")
@@ -738,7 +741,7 @@ impl<'a> Builder<'a> {
                 );
                 return None;
             }
-            return Some(*end);
+            return Some(end);
         }
         let inst = walk.last().map(|i| i.name.as_str()).unwrap_or("");
         let (comp, comp_span) = scope.component.clone().unwrap_or_default();

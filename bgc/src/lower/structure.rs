@@ -20,8 +20,33 @@ use petgraph::visit::EdgeRef;
 
 impl Builder<'_> {
     pub fn check_structure(&mut self) {
+        // An instance none of whose ports is bonded is reported once, not through each of its nodes.
+        let mut loose: Vec<String> = Vec::new();
+        for scope in &self.scopes {
+            if let Some(span) = scope.own_instance
+                && !scope.connected
+                && !scope.broken
+                && !loose.iter().any(|p| scope.prefix.starts_with(p.as_str()))
+            {
+                let name = scope.prefix.trim_end_matches('.').to_string();
+                self.diags.push(
+                    Diagnostic::error("BG0306", format!("instance `{name}` is not connected"))
+                        .with_primary(span, "no bond goes to any of its ports")
+                        .with_help(format!(
+                            "bond one of its ports (`bond j -> {name}.PORT;`) or remove it"
+                        )),
+                );
+                loose.push(scope.prefix.clone());
+            }
+        }
         let nodes: Vec<NodeIndex> = self.model.graph.node_indices().collect();
         for n in nodes {
+            if loose
+                .iter()
+                .any(|p| self.model.graph[n].name.starts_with(p.as_str()))
+            {
+                continue;
+            }
             let incoming: Vec<EdgeIndex> = self
                 .model
                 .graph

@@ -50,6 +50,8 @@ pub(crate) struct Builder<'a> {
     pub pending_coords: Option<(usize, &'a CoordsDecl)>,
     /// Declarations whose unit could not be read: their dimension is left free to avoid follow-up errors.
     pub bad_units: Vec<super::scope::Entity>,
+    /// Nodes at the resolved end of a bond whose other end could not be resolved (already reported).
+    pub suspect_nodes: Vec<NodeIndex>,
     /// Whether the last unit read by `unit` was valid.
     pub last_unit_ok: bool,
     /// The components being instantiated, to catch a component that contains itself.
@@ -86,6 +88,7 @@ impl<'a> Builder<'a> {
             component_stack: Vec::new(),
             bad_units: Vec::new(),
             last_unit_ok: true,
+            suspect_nodes: Vec::new(),
         }
     }
 

@@ -496,9 +496,10 @@ impl<'a> Builder<'a> {
             let [tails, heads] = pair else { continue };
             for tail in tails {
                 for head in heads {
-                    let (Some(from), Some(to)) =
-                        (self.resolve_end(sid, tail), self.resolve_end(sid, head))
-                    else {
+                    let (from, to) = (self.resolve_end(sid, tail), self.resolve_end(sid, head));
+                    let (Some(from), Some(to)) = (from, to) else {
+                        // The other end lost a bond: do not also report its bond count.
+                        self.suspect_nodes.extend(from.or(to).map(|e| e.node));
                         continue;
                     };
                     if from.node == to.node {

@@ -733,3 +733,14 @@ model m { domain rotational; input tau [N m]; Se drive = tau; I r = 1; bond driv
         "spring_damper_rot spare;"
     );
 }
+
+#[test]
+fn a_misspelt_bond_end_does_not_cascade_into_bond_counts() {
+    // `wheel` would otherwise have one bond (BG0305).
+    let text = "model m { domain rotational; input tau [N m]; Se drive = tau; 1 wheel; I r = 1; bond drive -> wheel; bond wheel -> rotr; }";
+    let (_, diags, _) = lower_text(text);
+    assert_eq!(
+        diags.iter().map(|d| d.code.0).collect::<Vec<_>>(),
+        vec!["BG0203", "BG0306"]
+    );
+}

@@ -56,6 +56,8 @@ pub(crate) struct Builder<'a> {
     pub last_unit_ok: bool,
     /// The components being instantiated, to catch a component that contains itself.
     pub component_stack: Vec<String>,
+    /// Every component instantiated while building this model.
+    pub instantiated: Vec<String>,
 }
 
 impl<'a> Builder<'a> {
@@ -86,6 +88,7 @@ impl<'a> Builder<'a> {
             pending_vars: Vec::new(),
             pending_coords: None,
             component_stack: Vec::new(),
+            instantiated: Vec::new(),
             bad_units: Vec::new(),
             last_unit_ok: true,
             suspect_nodes: Vec::new(),

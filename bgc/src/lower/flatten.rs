@@ -476,6 +476,7 @@ impl<'a> Builder<'a> {
             return false;
         }
         self.component_stack.push(name.clone());
+        self.instantiated.push(name.clone());
         let prefix = format!("{}{}.", self.scopes[sid].prefix, inst.name.name);
         let child = self.instantiate(
             comp,

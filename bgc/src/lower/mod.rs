@@ -10,6 +10,7 @@
 //! counts, TF/GY and field port numbers), domain inference, element relations with unit and value checks,
 //! outputs/vars/coordinates, unused parameters.
 
+mod bonds;
 mod builder;
 mod consteval;
 mod domains;
@@ -17,9 +18,13 @@ mod elements;
 mod exprs;
 mod flatten;
 mod imports;
+mod references;
 mod scope;
+mod signals;
 mod structure;
 
+#[cfg(test)]
+mod fixture_tests;
 #[cfg(test)]
 mod tests;
 

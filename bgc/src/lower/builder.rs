@@ -33,6 +33,8 @@ pub(crate) struct ParamInfo {
     pub name_span: Span,
     /// The expression that gave its value (the default, or the instance's override).
     pub value_span: Span,
+    /// Its declared unit.
+    pub unit_span: Span,
 }
 
 pub(crate) struct Builder<'a> {

@@ -332,6 +332,14 @@ fn unit_mismatch_names_the_expected_unit_of_the_kind_and_domain() {
         "{}",
         d.message
     );
+    // The parameter's declared unit explains it.
+    let secondary: Vec<&str> = d
+        .labels
+        .iter()
+        .filter(|l| !l.primary)
+        .map(|l| l.message.as_str())
+        .collect();
+    assert_eq!(secondary, vec!["`k` is declared in N/m"]);
     // The same stiffness in a translational model is right.
     clean(
         "model m { domain translational; param k = 800 [N/m]; input F [N]; Se push = F; C spring = 1/k; bond push -> spring; }",
@@ -725,4 +733,63 @@ fn an_unused_component_of_the_root_file_is_still_checked() {
     // Its parameters' uses count: no BG0402 for a used one, BG0402 for an unused one.
     let text = "component c { domain rotational; param k = 1 [N m/rad]; param z = 1 [1]; 0 j; C s = 1/k; bond j -> s; port a = j; }";
     assert_eq!(codes(text), vec!["BG0402"]);
+}
+
+#[test]
+fn hints_named_bonds_and_modulated_elements() {
+    let m = clean(
+        r#"model m {
+    domain rotational;
+    param l = 0.3 [1];
+    input tau [N m];
+    Se drive = tau;
+    1 w1;
+    I a = 1;
+    MTF lever = l * cos(theta);
+    1 w2;
+    I b = 2;
+    C spring = 0.01;
+    bond drive -> w1 -> a;
+    bond w1 -> lever -> w2;
+    bond s1: w2 -> b stroke! w2;
+    bond w2 -> spring stroke spring;
+    var theta [rad] = int(f(w1));
+    output torque [N m] = e(s1);
+}"#,
+    );
+    let hints: Vec<Option<crate::ir::Hint>> = m.graph.edge_weights().map(|b| b.hint).collect();
+    assert_eq!(hints.iter().flatten().count(), 2);
+    let s1 = m
+        .graph
+        .edge_indices()
+        .find(|&e| m.graph[e].name.as_deref() == Some("s1"));
+    let s1 = s1.unwrap_or_default();
+    assert_eq!(
+        m.graph[s1].hint,
+        Some(crate::ir::Hint {
+            stroke_at_to: false,
+            fixed: true
+        })
+    );
+    let spring = m.node_by_name("spring").unwrap_or_default();
+    let to_spring = m.graph.edges_directed(spring, Direction::Incoming).next();
+    assert_eq!(
+        to_spring.and_then(|e| e.weight().hint),
+        Some(crate::ir::Hint {
+            stroke_at_to: true,
+            fixed: false
+        })
+    );
+    assert_eq!(m.outputs[0].value, Expr::Effort(Target::Bond(s1)));
+    // The modulus of the MTF depends on the integrated flow.
+    let lever = m.node_by_name("lever").unwrap_or_default();
+    let Relation::Modulus(Expr::Binary(_, _, cos)) = &m.graph[lever].relation else {
+        panic!("{:?}", m.graph[lever].relation);
+    };
+    assert_eq!(**cos, Expr::Call(crate::ir::Func::Cos, vec![Expr::Var(0)]));
+    // A plain TF may not depend on the state.
+    assert!(codes(
+        "model m { domain rotational; param l = 1 [1]; input tau [N m]; Se d = tau; TF g = l * f(a); I a = 1; I b = 1; 1 w; bond d -> w -> a; bond w -> g -> b; }"
+    )
+    .contains(&"BG0314"));
 }

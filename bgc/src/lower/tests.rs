@@ -793,3 +793,16 @@ fn hints_named_bonds_and_modulated_elements() {
     )
     .contains(&"BG0314"));
 }
+
+#[test]
+fn a_bond_between_two_two_ports_takes_the_default_domain() {
+    // The bond gear1 -> gear2 touches no junction or 1-port; the model's default decides it.
+    let m = clean(
+        "model m { domain rotational; input tau [N m]; Se d = tau; TF gear1 = 2; TF gear2 = 3; I load = 1; bond d -> gear1 -> gear2 -> load; }",
+    );
+    assert!(
+        m.graph
+            .edge_weights()
+            .all(|b| b.domain == Domain::Rotational)
+    );
+}

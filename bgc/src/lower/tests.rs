@@ -2,7 +2,7 @@
 //! per diagnostic code with its primary span.
 
 use super::*;
-use crate::diagnostic::{Severity, has_errors};
+use crate::diagnostic::has_errors;
 use crate::ir::{Domain, Expr, Relation, Target};
 use crate::syntax::ast::ElementKind;
 use petgraph::visit::EdgeRef;

@@ -31,7 +31,7 @@ mod report;
 mod scap;
 
 #[cfg(test)]
-mod test_model;
+pub(crate) mod test_model;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]

@@ -9,6 +9,7 @@ pub mod causality;
 pub mod diagnostic;
 pub mod draw;
 pub mod ir;
+pub mod lower;
 pub mod span;
 pub mod syntax;
 pub mod units;

@@ -103,15 +103,21 @@ impl Ctx<'_> {
             } else {
                 "flow"
             };
-            d = d.with_secondary(
-                self.node_span(n),
-                format!(
-                    "({}) `{}` sets the {var} on bond `{}`",
-                    i + 1,
-                    self.name(n),
-                    self.bond_name(b)
-                ),
+            let span = self.node_span(n);
+            let message = format!(
+                "({}) `{}` sets the {var} on bond `{}`",
+                i + 1,
+                self.name(n),
+                self.bond_name(b)
             );
+            // Paths that share their beginning are shown once.
+            if !d
+                .labels
+                .iter()
+                .any(|l| l.span == span && l.message == message)
+            {
+                d = d.with_secondary(span, message);
+            }
         }
         d
     }
@@ -321,8 +327,19 @@ fn conflict(cx: &Ctx, c: Conflict, hints_in_conflict: &mut BTreeSet<u32>) -> Dia
                 format!("more than one bond imposes its {what}")
             }
             Role::Zero | Role::One => format!("no bond imposes its {what}"),
-            Role::Transformer => "both ports impose their effort, or neither".to_string(),
-            _ => "both ports impose the same variable".to_string(),
+            Role::Transformer => {
+                let imposed = e
+                    .incident(c.node)
+                    .iter()
+                    .filter(|&&b| e.node_sets(c.node, b) == Some(false))
+                    .count();
+                if imposed >= 2 {
+                    "both of its ports have their effort imposed".to_string()
+                } else {
+                    "both of its ports have their flow imposed".to_string()
+                }
+            }
+            _ => "one of its ports has its effort imposed and the other its flow".to_string(),
         };
         Diagnostic::error(
             "BG0502",
@@ -479,6 +496,19 @@ fn derivative(cx: &Ctx, n: u32, b: u32, kind: StorageKind, a: &Assignment) -> Di
              causality"
                 .to_string(),
         ),
+        (None, Reason::FixedHint | Reason::PreferredHint, _) => {
+            let first = steps.first().map_or(b, |&(_, fb)| fb);
+            (
+                format!(
+                    "its {var} is imposed by the causality hint on bond `{}`{across}",
+                    cx.bond_name(first)
+                ),
+                format!(
+                    "this is what the hint asks for; remove or move the hint to let `{name}` take integral \
+                     causality"
+                ),
+            )
+        }
         (None, Reason::Storage(_), _) => (
             format!("its {var} is imposed by {}{across}", cx.describe(origin)),
             match kind {
@@ -499,13 +529,18 @@ fn derivative(cx: &Ctx, n: u32, b: u32, kind: StorageKind, a: &Assignment) -> Di
             format!(
                 "the source prescribes `{name}`'s {var}, so `{name}` adds no state and the source must be \
                  differentiable; if that is not intended, add a {} between `{}` and `{name}`, or drive it \
-                 with the dual source",
+                 with {} instead",
                 if kind == StorageKind::I {
                     "compliance"
                 } else {
                     "resistance or an inertia"
                 },
-                cx.name(origin)
+                cx.name(origin),
+                if kind == StorageKind::I {
+                    "an effort source"
+                } else {
+                    "a flow source"
+                },
             ),
         ),
         _ => (

@@ -10,7 +10,7 @@ use crate::ir::Model;
 use crate::span::Span;
 use crate::syntax::ast::ElementKind;
 use petgraph::graph::{EdgeIndex, NodeIndex};
-use std::collections::BTreeSet;
+use std::collections::{BTreeSet, HashMap};
 
 /// Longest causal path shown in full; longer ones keep their two ends.
 const PATH_SHOWN: usize = 12;
@@ -18,9 +18,59 @@ const PATH_SHOWN: usize = 12;
 struct Ctx<'a> {
     model: &'a Model,
     engine: &'a Engine,
+    /// Per bond: the first bond of its causal path.
+    first: Vec<u32>,
+    /// Per bond: the number of propagation steps from the first bond of its path.
+    depth: Vec<u32>,
+    /// Preferences that were overruled, by bond, with the conflict that overruled them.
+    fallbacks: HashMap<u32, Conflict>,
 }
 
-impl Ctx<'_> {
+impl<'a> Ctx<'a> {
+    /// Origins and depths of all causal paths, in one pass over the assignment order.
+    fn new(model: &'a Model, engine: &'a Engine, fallbacks: &[(u32, Conflict)]) -> Ctx<'a> {
+        let m = engine.ends.len();
+        let mut first: Vec<u32> = (0..m as u32).collect();
+        let mut depth = vec![0u32; m];
+        for &b in engine.order() {
+            if let Reason::Propagated { via, .. } = engine.reason[b as usize] {
+                first[b as usize] = first[via as usize];
+                depth[b as usize] = depth[via as usize] + 1;
+            }
+        }
+        Ctx {
+            model,
+            engine,
+            first,
+            depth,
+            fallbacks: fallbacks.iter().copied().collect(),
+        }
+    }
+
+    /// The causal path to a bond as `(position, deciding node, bond)`: the origin and at most [`PATH_SHOWN`] steps
+    /// before the bond, with the total number of steps.
+    fn path(&self, bond: u32) -> (Vec<(usize, u32, u32)>, usize) {
+        let total = self.depth[bond as usize] as usize + 1;
+        let tail = self.engine.path_to(bond, PATH_SHOWN);
+        let mut out = Vec::with_capacity(tail.len() + 1);
+        if tail.len() < total {
+            let f = self.first[bond as usize];
+            out.push((0, self.engine.origin_node(f), f));
+        }
+        let start = total - tail.len();
+        out.extend(
+            tail.iter()
+                .enumerate()
+                .map(|(i, &(n, b))| (start + i, n, b)),
+        );
+        (out, total)
+    }
+
+    /// The nodes along the path to a bond (as far as [`Ctx::path`] goes).
+    fn path_nodes(&self, bond: u32) -> Vec<u32> {
+        self.path(bond).0.iter().map(|&(_, n, _)| n).collect()
+    }
+
     fn node(&self, n: u32) -> NodeIndex {
         NodeIndex::new(n as usize)
     }
@@ -82,22 +132,16 @@ impl Ctx<'_> {
         format!("{what} `{}`", self.name(n))
     }
 
-    /// Secondary labels along a causal path, element by element.
-    fn path_labels(&self, mut d: Diagnostic, steps: &[(u32, u32)]) -> Diagnostic {
-        let shown: Vec<(usize, &(u32, u32))> = if steps.len() > PATH_SHOWN {
-            let tail = PATH_SHOWN / 2;
-            let mut v: Vec<_> = steps.iter().enumerate().take(PATH_SHOWN - tail).collect();
-            v.extend(steps.iter().enumerate().skip(steps.len() - tail));
+    /// Secondary labels along the causal path to a bond, element by element.
+    fn path_labels(&self, mut d: Diagnostic, bond: u32) -> Diagnostic {
+        let (steps, total) = self.path(bond);
+        if total > steps.len() {
             d = d.with_note(format!(
-                "the causal path has {} steps; {} in its middle are not shown",
-                steps.len(),
-                steps.len() - PATH_SHOWN
+                "the causal path has {total} steps; {} in its middle are not shown",
+                total - steps.len()
             ));
-            v
-        } else {
-            steps.iter().enumerate().collect()
-        };
-        for (i, &(n, b)) in shown {
+        }
+        for (i, n, b) in steps {
             let var = if self.engine.node_sets(n, b) == Some(true) {
                 "effort"
             } else {
@@ -124,10 +168,8 @@ impl Ctx<'_> {
 
     /// The origin of the causal path of a bond, with its reason.
     fn origin(&self, bond: u32) -> (u32, Reason) {
-        let steps = self.engine.path_to(bond);
-        let first = steps.first().map_or(bond, |&(_, b)| b);
-        let node = steps.first().map_or(0, |&(n, _)| n);
-        (node, self.engine.reason[first as usize])
+        let f = self.first[bond as usize];
+        (self.engine.origin_node(f), self.engine.reason[f as usize])
     }
 }
 
@@ -137,10 +179,7 @@ pub fn conclude(
     a: Assignment,
     loops: Vec<Vec<NodeIndex>>,
 ) -> (Causality, Vec<Diagnostic>) {
-    let cx = Ctx {
-        model,
-        engine: &a.engine,
-    };
+    let cx = Ctx::new(model, &a.engine, &a.fallbacks);
     let mut diags = Vec::new();
     let mut hints_in_conflict = BTreeSet::new();
 
@@ -169,7 +208,7 @@ pub fn conclude(
         if h.fixed && !h.honoured {
             diags.push(violated_hint(&cx, b));
         } else if !hints_in_conflict.contains(&b) {
-            diags.push(hint_note(&cx, b, h, &a));
+            diags.push(hint_note(&cx, b, h));
         }
     }
 
@@ -186,7 +225,7 @@ pub fn conclude(
             StorageForm::Derivative
         };
         if form == StorageForm::Derivative {
-            diags.push(derivative(&cx, n, b, kind, &a));
+            diags.push(derivative(&cx, n, b, kind));
         }
         storage.push(StorageCausality {
             node: NodeIndex::new(n as usize),
@@ -283,7 +322,7 @@ fn conflict(cx: &Ctx, c: Conflict, hints_in_conflict: &mut BTreeSet<u32>) -> Dia
     }
     let hint_bonds: Vec<u32> = bonds
         .iter()
-        .map(|&b| e.path_to(b).first().map_or(b, |&(_, first)| first))
+        .map(|&b| cx.first[b as usize])
         .filter(|&first| e.reason[first as usize] == Reason::FixedHint)
         .collect();
     let what = match role {
@@ -352,7 +391,7 @@ fn conflict(cx: &Ctx, c: Conflict, hints_in_conflict: &mut BTreeSet<u32>) -> Dia
         )
     };
     for &b in bonds.iter().take(3) {
-        d = cx.path_labels(d, &e.path_to(b));
+        d = cx.path_labels(d, b);
     }
     d
 }
@@ -360,7 +399,6 @@ fn conflict(cx: &Ctx, c: Conflict, hints_in_conflict: &mut BTreeSet<u32>) -> Dia
 /// A source whose bond the rest of the graph assigns against it.
 fn forced_source(cx: &Ctx, c: Conflict, role: Role, hints: &mut BTreeSet<u32>) -> Diagnostic {
     let e = cx.engine;
-    let steps = e.path_to(c.bond);
     let (origin, reason) = cx.origin(c.bond);
     let mine = if role == Role::EffortSource {
         "effort"
@@ -373,7 +411,7 @@ fn forced_source(cx: &Ctx, c: Conflict, role: Role, hints: &mut BTreeSet<u32>) -
         (role, e.roles.get(neighbour as usize)),
         (Role::EffortSource, Some(Role::Zero)) | (Role::FlowSource, Some(Role::One))
     );
-    let mut d = if matches!(reason, Reason::Source(_)) && shared {
+    let d = if matches!(reason, Reason::Source(_)) && shared {
         Diagnostic::error(
             "BG0501",
             format!(
@@ -390,8 +428,8 @@ fn forced_source(cx: &Ctx, c: Conflict, role: Role, hints: &mut BTreeSet<u32>) -
              imposes its variable on its own element",
         )
     } else {
-        if let (Reason::FixedHint, Some(&(_, first))) = (reason, steps.first()) {
-            hints.insert(first);
+        if reason == Reason::FixedHint {
+            hints.insert(cx.first[c.bond as usize]);
         }
         Diagnostic::error(
             "BG0503",
@@ -407,13 +445,11 @@ fn forced_source(cx: &Ctx, c: Conflict, role: Role, hints: &mut BTreeSet<u32>) -
              imposes it, or add a storage or resistive element between them"
         ))
     };
-    d = cx.path_labels(d, &steps);
-    d
+    cx.path_labels(d, c.bond)
 }
 
 /// BG0541 for a fixed hint the final causality does not meet.
 fn violated_hint(cx: &Ctx, b: u32) -> Diagnostic {
-    let steps = cx.engine.path_to(b);
     let (origin, _) = cx.origin(b);
     let d = Diagnostic::error(
         "BG0541",
@@ -425,11 +461,11 @@ fn violated_hint(cx: &Ctx, b: u32) -> Diagnostic {
     )
     .with_primary(cx.bond_span(b), "fixed hint violated")
     .with_help("remove the hint, change it to a preference (`stroke`), or move the stroke to the other end");
-    cx.path_labels(d, &steps)
+    cx.path_labels(d, b)
 }
 
 /// BG0540 for a hint that was honoured or overruled.
-fn hint_note(cx: &Ctx, b: u32, h: &HintOutcome, a: &Assignment) -> Diagnostic {
+fn hint_note(cx: &Ctx, b: u32, h: &HintOutcome) -> Diagnostic {
     let kind = if h.fixed { "fixed" } else { "preferred" };
     if h.honoured {
         return Diagnostic::note_diag(
@@ -450,7 +486,7 @@ fn hint_note(cx: &Ctx, b: u32, h: &HintOutcome, a: &Assignment) -> Diagnostic {
         ),
     )
     .with_primary(cx.bond_span(b), "overruled");
-    if let Some(&(_, c)) = a.fallbacks.iter().find(|(fb, _)| *fb == b) {
+    if let Some(c) = cx.fallbacks.get(&b) {
         d = d.with_note(format!(
             "the hinted causality would over-determine {}",
             cx.describe(c.node)
@@ -458,34 +494,33 @@ fn hint_note(cx: &Ctx, b: u32, h: &HintOutcome, a: &Assignment) -> Diagnostic {
     } else {
         let (origin, _) = cx.origin(b);
         d = d.with_note(format!("{} decides the other way", cx.describe(origin)));
-        d = cx.path_labels(d, &cx.engine.path_to(b));
+        d = cx.path_labels(d, b);
     }
     d.with_help("make it fixed (`stroke!`) to turn it into a requirement, or remove it")
 }
 
 /// BG0510 for a storage port in derivative causality.
-fn derivative(cx: &Ctx, n: u32, b: u32, kind: StorageKind, a: &Assignment) -> Diagnostic {
-    let e = cx.engine;
+fn derivative(cx: &Ctx, n: u32, b: u32, kind: StorageKind) -> Diagnostic {
     let (what, var) = match kind {
         StorageKind::I => ("inertia", "flow"),
         StorageKind::C => ("compliance", "effort"),
     };
     let name = cx.name(n);
-    let steps = e.path_to(b);
     let (origin, reason) = cx.origin(b);
-    let through: Vec<String> = steps
-        .iter()
+    let through: Vec<String> = cx
+        .path_nodes(b)
+        .into_iter()
         .skip(1)
-        .map(|&(m, _)| m)
         .filter(|&m| m != n && m != origin)
         .map(|m| cx.describe(m))
         .collect();
-    let across = if through.is_empty() {
-        String::new()
-    } else {
-        format!(" across {}", through.join(", "))
+    let shortened = cx.path(b).1 > cx.path(b).0.len();
+    let across = match (through.is_empty(), shortened) {
+        (true, _) => String::new(),
+        (false, false) => format!(" across {}", through.join(", ")),
+        (false, true) => format!(" across ..., {}", through.join(", ")),
     };
-    let fallback = a.fallbacks.iter().find(|(fb, _)| *fb == b).map(|&(_, c)| c);
+    let fallback = cx.fallbacks.get(&b).copied();
     let (imposer, help) = match (fallback, reason, cx.kind(origin)) {
         (Some(c), _, _) => (
             format!(
@@ -497,7 +532,7 @@ fn derivative(cx: &Ctx, n: u32, b: u32, kind: StorageKind, a: &Assignment) -> Di
                 .to_string(),
         ),
         (None, Reason::FixedHint | Reason::PreferredHint, _) => {
-            let first = steps.first().map_or(b, |&(_, fb)| fb);
+            let first = cx.first[b as usize];
             (
                 format!(
                     "its {var} is imposed by the causality hint on bond `{}`{across}",
@@ -557,7 +592,7 @@ fn derivative(cx: &Ctx, n: u32, b: u32, kind: StorageKind, a: &Assignment) -> Di
         "the model stays usable: `{name}` contributes no independent state"
     ))
     .with_help(help);
-    cx.path_labels(d, &steps)
+    cx.path_labels(d, b)
 }
 
 /// BG0520 for an algebraic loop.
@@ -648,5 +683,5 @@ fn inverted_law(cx: &Ctx, n: u32, b: u32, prefers_sets: bool) -> Diagnostic {
     .with_primary(cx.node_span(n), "law used the other way round")
     .with_note(format!("{} decides its causality", cx.describe(origin)))
     .with_help("write the law in the other form if it has a closed-form inverse");
-    cx.path_labels(d, &cx.engine.path_to(b))
+    cx.path_labels(d, b)
 }

@@ -442,3 +442,43 @@ fn preferred_hint_does_not_push_storage_into_derivative_causality() {
         "{note:#?}"
     );
 }
+
+#[test]
+fn long_causal_paths_are_shortened() {
+    // A rigid chain Se -> 1 -> I -> TF -> 1 -> I -> TF ...: the first inertia is integral, every later one is
+    // imposed through all the transformers before it. Each warning shows the origin and the last steps only, so the
+    // findings stay linear in size.
+    let stages = 300;
+    let mut b = Builder::new("rigid_chain");
+    let se = b.node(K::Se, "tau");
+    let mut prev = se;
+    for k in 0..stages {
+        let j = b.node(K::One, &format!("j{k}"));
+        let i = b.node(K::I, &format!("J{k}"));
+        b.chain(&[prev, j, i]);
+        let tf = b.node(K::TF, &format!("g{k}"));
+        b.bond(j, tf);
+        prev = tf;
+    }
+    let end = b.node(K::One, "end");
+    let r = b.node(K::R, "load");
+    b.chain(&[prev, end, r]);
+    let (m, _) = b.finish();
+    let (c, d) = analyse(&m);
+    assert_eq!(c.independent_states(), 1);
+    assert_eq!(d.len(), stages - 1);
+    let last = d.last().unwrap();
+    assert!(
+        last.message.contains("`J299`") && last.message.contains("inertia `J0`"),
+        "{}",
+        last.message
+    );
+    assert!(last.labels.len() <= 14, "{}", last.labels.len());
+    assert!(
+        last.notes
+            .iter()
+            .any(|n| n.contains("in its middle are not shown"))
+    );
+    // The origin is still the first secondary label.
+    assert_eq!(last.labels[1].span, span_of(&m, "J0"));
+}

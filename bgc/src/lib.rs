@@ -8,5 +8,6 @@
 pub mod diagnostic;
 pub mod ir;
 pub mod span;
+pub mod symbolic;
 pub mod syntax;
 pub mod units;

@@ -143,3 +143,38 @@ fn singular_and_oversized_systems_are_refused() {
         })
     );
 }
+
+#[test]
+fn general_4x4_leaves_no_residual() {
+    // The largest accepted system, fully symbolic: check A x = b at random values of its 20 symbols.
+    let a: Vec<Vec<Expr>> = (0..4)
+        .map(|i| (0..4).map(|j| p(&format!("a{i}{j}"))).collect())
+        .collect();
+    let b: Vec<Expr> = (0..4).map(|i| p(&format!("b{i}"))).collect();
+    let sol = solve_linear(&a, &b);
+    let Ok(sol) = sol else {
+        panic!("4x4 solve failed: {sol:?}");
+    };
+    let mut rng = Rng(17);
+    for _ in 0..20 {
+        let mut env: BTreeMap<Symbol, f64> = BTreeMap::new();
+        for i in 0..4 {
+            for j in 0..4 {
+                // Diagonally dominant, so the system is well conditioned.
+                let v = rng.uniform(-1.0, 1.0) + if i == j { 5.0 } else { 0.0 };
+                env.insert(Symbol::param(format!("a{i}{j}")), v);
+            }
+            env.insert(Symbol::param(format!("b{i}")), rng.uniform(-1.0, 1.0));
+        }
+        let x: Vec<f64> = sol.x.iter().map(|x| eval_at(x, &env)).collect();
+        for (row, rhs) in a.iter().zip(&b) {
+            let lhs: f64 = row
+                .iter()
+                .zip(&x)
+                .map(|(aij, xj)| eval_at(aij, &env) * xj)
+                .sum();
+            let rhs = eval_at(rhs, &env);
+            assert!((lhs - rhs).abs() < 1e-12, "residual {}", lhs - rhs);
+        }
+    }
+}

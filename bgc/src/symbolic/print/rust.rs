@@ -9,7 +9,7 @@
 //! NaN while bgc's propagate it. The generated code must define the helpers once; [`RUST_HELPERS`] is their source.
 //!
 //! Constants print as Rust's shortest round-trip `f64` literals (`2.0`, `0.1`, `1e-7`), with an `_f64` suffix when
-//! they are the receiver of a method call (`2.0_f64.powf(x)`), and `f64::INFINITY`, `f64::NEG_INFINITY`,
+//! they are the receiver of a method call (`2.0_f64.powf(x)`, `(-2.0_f64).powf(x)`), and `f64::INFINITY`, `f64::NEG_INFINITY`,
 //! `f64::NAN` for non-finite values. Symbol names come from the caller's closure and must be Rust expressions that
 //! bind at least as tightly as a method call (a path, a field access `p.J_m` or an index `x[0]`).
 
@@ -78,8 +78,10 @@ impl RustPrinter<'_> {
 
     /// `e` as the receiver of a method call.
     fn receiver(&self, e: &Expr) -> String {
+        // A literal receiver needs its type spelled out: `2.0.sqrt()` does not compile, `2.0_f64.sqrt()` does.
         match e.as_const() {
             Some(c) if c.is_finite() && c >= 0.0 => format!("{}_f64", rust_number(c)),
+            Some(c) if c.is_finite() => format!("({}_f64)", rust_number(c)),
             _ => self.wrapped(e, ATOM),
         }
     }

@@ -117,6 +117,17 @@ fn rust_forms_the_code_generators_rely_on() {
     assert_eq!(to_rust(&c(0.1), &rust_name), "0.1");
     assert_eq!(to_rust(&c(2.0).pow(&x), &rust_name), "2.0_f64.powf(x[0])");
     assert_eq!(to_rust(&c(1e-7).pow(&x), &rust_name), "1e-7_f64.powf(x[0])");
+    assert_eq!(
+        to_rust(&c(-2.0).pow(&x), &rust_name),
+        "(-2.0_f64).powf(x[0])"
+    );
+    assert_eq!(
+        to_rust(&c(f64::NAN).pow(&x), &rust_name),
+        "f64::NAN.powf(x[0])"
+    );
+    // Rust accepts these literal forms and reads back the same values.
+    assert_eq!((-2.0_f64).powf(3.0), -8.0);
+    assert_eq!(1e-7_f64.sqrt(), 1e-7f64.sqrt());
 }
 
 #[test]

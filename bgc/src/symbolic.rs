@@ -7,6 +7,26 @@
 //! `a*b + c == c + b*a`. The form is canonical, not a normal form for all identities: `2*(x + y) - 2*x` does not
 //! become `2*y` unless [`Expr::expand`] is asked for.
 //!
+//! # Simplification on construction (details in `symbolic/build.rs`)
+//! Sums and products are flattened, sorted by a total deterministic order, like terms and like factors collected
+//! (`2*x + 3*x = 5*x`, `x*x = x^2`), constants folded; `x + 0 = x`, `x*1 = x`, `x*0 = 0`, `x^0 = 1`, `x^1 = x`,
+//! `(x^a)^n = x^(a*n)` and `(x*y)^n = x^n*y^n` for integer `n`; `a - b = a + (-1)*b`, `a/b = a*b^(-1)`,
+//! `sqrt(x) = x^0.5`; a numeric coefficient times a single sum is distributed (`-(a - b) = b - a`), and a sum inside
+//! a product has its sign taken out. Calls with constant arguments are folded.
+//!
+//! NaN caveat: the rules are those of generic computer algebra. The simplified form equals the original wherever
+//! the original is finite, but may be finite where the original is NaN or infinite: `x*0 = 0`, `x - x = 0` and
+//! `x/x = 1` although `inf*0`, `inf - inf` and `0/0` are NaN; `sqrt(x)^2 = x` although the left side is NaN for
+//! `x < 0`. A NaN constant absorbs a whole sum or product. Signs of zeros are not kept (`-0` is stored as `0`).
+//!
+//! Derivatives ([`Expr::diff`]): `d|u| = sign(u) du`; `d sign(u) = 0` (exact away from `u = 0`);
+//! `d min(a, b) = (1 - s)/2 da + (1 + s)/2 db` and `d max(a, b) = (1 + s)/2 da + (1 - s)/2 db` with
+//! `s = sign(a - b)`, i.e. the derivative of the active argument and the mean of both where `a = b`.
+//!
+//! Evaluation and generated code share conventions: `sign(0) = 0`, `min`/`max` propagate NaN, `x^n` for integer
+//! constants is `powi`, `x^0.5` is `sqrt`; sums and products are computed in the order they print, so
+//! [`Expr::eval`] and the code printed by [`to_rust`] give the same bits.
+//!
 //! # Representation
 //! Nodes are shared behind `Arc` with a cached structural hash, rather than interned in an arena. Expressions here
 //! are small (element laws, state equations of a few dozen states), so hash-consing would save little memory, while

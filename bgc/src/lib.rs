@@ -11,5 +11,6 @@ pub mod draw;
 pub mod ir;
 pub mod lower;
 pub mod span;
+pub mod symbolic;
 pub mod syntax;
 pub mod units;

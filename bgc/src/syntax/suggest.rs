@@ -1,0 +1,49 @@
+//! "Did you mean" suggestions for misspelt keywords.
+
+use super::parser::KEYWORDS;
+
+/// The keyword `word` is most likely a misspelling of: one edit away (two for words of six letters or more), case
+/// ignored. Element kinds are left out: short words like `C` are one edit away from too many names.
+pub fn keyword_like(word: &str) -> Option<&'static str> {
+    if word.len() > 32 {
+        return None;
+    }
+    let lower = word.to_ascii_lowercase();
+    KEYWORDS
+        .iter()
+        .copied()
+        .filter(|k| k.len() > 3)
+        .map(|k| (k, edit_distance(&lower, k)))
+        .filter(|(k, d)| *k != word && *d <= if k.len() >= 6 { 2 } else { 1 })
+        .min_by_key(|(_, d)| *d)
+        .map(|(k, _)| k)
+}
+
+/// Levenshtein distance over bytes.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b = b.as_bytes();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.bytes().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            let subst = prev[j] + usize::from(ca != *cb);
+            cur[j + 1] = subst.min(prev[j + 1] + 1).min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn misspelt_keywords_are_recognised() {
+        assert_eq!(keyword_like("parm"), Some("param"));
+        assert_eq!(keyword_like("ouput"), Some("output"));
+        assert_eq!(keyword_like("Bond"), Some("bond"));
+        assert_eq!(keyword_like("spring_damper"), None);
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+    }
+}

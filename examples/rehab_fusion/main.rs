@@ -16,10 +16,18 @@ use bgc_workspace::rehab::RehabError;
 use bgc_workspace::rehab::experiment::{
     DEG2_PER_RAD2, Figures, SegmentRun, Setup, run_leg, run_rig,
 };
+use bgc_workspace::rehab::pipeline::ImuFilterTuning;
 use bgc_workspace::rehab::plant::{pendulum_rig, rehab_leg};
 use serde::Serialize;
 use std::path::PathBuf;
 use std::process::ExitCode;
+
+/// The paper's orderings of E (Eqs. 30, 33 and 35).
+const PAPER_ORDER: [&str; 3] = [
+    "vision > IMU > fusion",
+    "vision > IMU > fusion",
+    "IMU > vision > fusion",
+];
 
 /// The paper's E values (Eqs. 32 and 34), vision / IMU / fusion [deg²].
 const PAPER_THIGH: [f64; 3] = [100.59, 91.33, 27.06];
@@ -78,6 +86,9 @@ struct SegmentReport {
     figures_deg2: Figures,
     paper_deg2: Option<[f64; 3]>,
     fusion_beats_both: bool,
+    /// The sources by decreasing E, and the paper's order.
+    order: String,
+    paper_order: &'static str,
     frames_delivered: usize,
     frames_captured: usize,
     samples_in_window: usize,
@@ -92,6 +103,8 @@ struct Report {
     rig_variances_deg2: [f64; 2],
     /// Rig-measured accelerometer-angle variance, the IMU filter's R [deg²].
     rig_accel_variance_deg2: f64,
+    /// The IMU filter as calibrated on the rig (its R is the measured accelerometer-angle variance) [rad²].
+    imu_filter: ImuFilterTuning,
     /// Weights of Eq. 27 for the IMU and the vision.
     weights: [f64; 2],
     /// Fused variance of Eq. 25 [deg²].
@@ -99,9 +112,23 @@ struct Report {
     segments: Vec<SegmentReport>,
 }
 
-fn segment_report(run: &SegmentRun, window: (f64, f64), paper: Option<[f64; 3]>) -> SegmentReport {
+fn segment_report(
+    run: &SegmentRun,
+    window: (f64, f64),
+    paper: Option<[f64; 3]>,
+    paper_order: &'static str,
+) -> SegmentReport {
     let f = run.figures;
+    let mut by_e = [
+        ("vision", f.e_vision),
+        ("IMU", f.e_imu),
+        ("fusion", f.e_fusion),
+    ];
+    by_e.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let order = by_e.map(|(name, _)| name).join(" > ");
     SegmentReport {
+        order,
+        paper_order,
         name: run.name,
         figures_deg2: f,
         paper_deg2: paper,
@@ -159,16 +186,18 @@ fn print_report(r: &Report) {
     for s in &r.segments {
         let f = s.figures_deg2;
         println!(
-            "{:<8} E_fusion < min(E_IMU, E_vision): {} ({:.2} < {:.2}); ratio E_fusion/min = {:.2}; \
-             {} of {} frames delivered, {} samples in the window",
+            "{:<8} E_fusion < min(E_IMU, E_vision): {} ({:.2} < {:.2}, ratio {:.2}); order {} (paper: {})",
             s.name,
             if s.fusion_beats_both { "yes" } else { "NO" },
             f.e_fusion,
             f.e_imu.min(f.e_vision),
             f.e_fusion / f.e_imu.min(f.e_vision),
-            s.frames_delivered,
-            s.frames_captured,
-            s.samples_in_window
+            s.order,
+            s.paper_order,
+        );
+        println!(
+            "{:<8} {} of {} frames delivered, {} IMU samples in the window",
+            "", s.frames_delivered, s.frames_captured, s.samples_in_window
         );
     }
 }
@@ -197,12 +226,13 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         leg_setup,
         rig_variances_deg2: rig.variances.map(|v| v * DEG2_PER_RAD2),
         rig_accel_variance_deg2: rig.accel_variance * DEG2_PER_RAD2,
+        imu_filter: rig.calibration.filter,
         weights: rig.weights,
         fused_variance_deg2: rig.fused_variance * DEG2_PER_RAD2,
         segments: vec![
-            segment_report(&rig.segment, rig_setup.window, None),
-            segment_report(thigh, leg_setup.window, Some(PAPER_THIGH)),
-            segment_report(calf, leg_setup.window, Some(PAPER_CALF)),
+            segment_report(&rig.segment, rig_setup.window, None, PAPER_ORDER[0]),
+            segment_report(thigh, leg_setup.window, Some(PAPER_THIGH), PAPER_ORDER[1]),
+            segment_report(calf, leg_setup.window, Some(PAPER_CALF), PAPER_ORDER[2]),
         ],
     };
     print_report(&report);

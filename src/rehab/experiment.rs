@@ -57,7 +57,7 @@ impl Setup {
             camera: CameraSpec {
                 frame_rate: 20.0,
                 latency: 0.06,
-                pixel_noise: 1.5,
+                pixel_noise: 2.5,
                 scale: 600.0,
                 lost_probability: 0.05,
             },

@@ -237,7 +237,8 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     };
     print_report(&report);
 
-    std::fs::create_dir_all(&args.out)?;
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     let out = |name: &str| args.out.join(name);
     let full = (0.0, rig_setup.t_end);
     plots::draw(
@@ -298,7 +299,8 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     )?;
     println!("\nplots in {}", args.out.display());
     if let Some(path) = &args.json {
-        std::fs::write(path, serde_json::to_string_pretty(&report)?)?;
+        std::fs::write(path, serde_json::to_string_pretty(&report)?)
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         println!("figures in {}", path.display());
     }
     Ok(())

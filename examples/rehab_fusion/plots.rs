@@ -156,6 +156,17 @@ pub fn draw(
     grid: (usize, usize),
     window: (f64, f64),
     y_label: &str,
+) -> Result<(), String> {
+    draw_panels(path, panels, grid, window, y_label)
+        .map_err(|e| format!("cannot draw {}: {e}", path.display()))
+}
+
+fn draw_panels(
+    path: &Path,
+    panels: &[(String, Vec<Curve>)],
+    grid: (usize, usize),
+    window: (f64, f64),
+    y_label: &str,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let (rows, cols) = grid;
     let width = if cols == 1 { 900 } else { 640 * cols as u32 };

@@ -156,12 +156,11 @@ fn record(truth: &Truth, segment: usize, setup: &Setup, seed: u64) -> Result<Rec
         &setup.imu,
         &mut stream(seed, segment, 1),
     )?;
-    let frames = capture_frames(truth, segment, &setup.camera, &mut stream(seed, segment, 2))?;
-    let t_end = truth.times.last().copied().unwrap_or(0.0);
+    let capture = capture_frames(truth, segment, &setup.camera, &mut stream(seed, segment, 2))?;
     Ok(Recorded {
         samples,
-        frames,
-        frames_captured: (t_end * setup.camera.frame_rate).floor() as usize,
+        frames: capture.frames,
+        frames_captured: capture.captured,
     })
 }
 

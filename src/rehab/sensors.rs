@@ -153,13 +153,22 @@ pub fn sample_imu(
     Ok(out)
 }
 
-/// The camera frames of segment `segment` that reach the fusion node, in arrival order.
+/// What the camera gave over a run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Capture {
+    /// The frames that reach the fusion node, in arrival order.
+    pub frames: Vec<Frame>,
+    /// The number of frames captured, lost ones included.
+    pub captured: usize,
+}
+
+/// The camera frames of segment `segment` over the whole run.
 pub fn capture_frames(
     truth: &Truth,
     segment: usize,
     spec: &CameraSpec,
     rng: &mut Rng,
-) -> Result<Vec<Frame>, RehabError> {
+) -> Result<Capture, RehabError> {
     spec.check()?;
     let length = truth
         .segments
@@ -193,5 +202,8 @@ pub fn capture_frames(
             });
         }
     }
-    Ok(out)
+    Ok(Capture {
+        frames: out,
+        captured: j,
+    })
 }

@@ -226,19 +226,24 @@ pub fn leg_truth(
     let thigh_acc = derivative(&thigh_rate, dt);
     let calf_acc = derivative(&calf_rate, dt);
     let n = times.len();
-    let mut knee_pos = Vec::with_capacity(n);
-    let mut knee_acc = Vec::with_capacity(n);
-    for i in 0..n {
-        let s = SegmentState {
-            angle: thigh[i],
-            rate: thigh_rate[i],
-            accel: thigh_acc[i],
-            pivot_pos: [0.0, 0.0],
-            pivot_acc: [0.0, 0.0],
-        };
-        knee_pos.push(s.point(geometry.thigh_length));
-        knee_acc.push(s.point_acc(geometry.thigh_length));
-    }
+    let (knee_pos, knee_acc): (Vec<[f64; 2]>, Vec<[f64; 2]>) = thigh
+        .iter()
+        .zip(&thigh_rate)
+        .zip(&thigh_acc)
+        .map(|((&angle, &rate), &accel)| {
+            let s = SegmentState {
+                angle,
+                rate,
+                accel,
+                pivot_pos: [0.0, 0.0],
+                pivot_acc: [0.0, 0.0],
+            };
+            (
+                s.point(geometry.thigh_length),
+                s.point_acc(geometry.thigh_length),
+            )
+        })
+        .unzip();
     Ok(Truth {
         times,
         segments: vec![

@@ -394,3 +394,32 @@ fn bad_settings_are_refused_with_their_name() {
         Err(RehabError::BadSetting { name: "t_end", .. })
     ));
 }
+
+/// Noise-free markers at the knee and the ankle give back the calf's angle (the knee itself moving with the thigh),
+/// and each frame arrives `latency` after its capture.
+#[test]
+fn noise_free_markers_give_the_segment_angle() {
+    let truth = leg_truth(&rehab_leg(), LegGeometry::default(), 3.0, 1e-3);
+    let Ok(truth) = truth else {
+        panic!("{truth:?}")
+    };
+    let camera = CameraSpec {
+        frame_rate: 25.0,
+        latency: 0.05,
+        pixel_noise: 0.0,
+        scale: 600.0,
+        lost_probability: 0.0,
+    };
+    let capture = capture_frames(&truth, 1, &camera, &mut Rng::new(9));
+    let Ok(capture) = capture else {
+        panic!("{capture:?}")
+    };
+    assert_eq!(capture.frames.len(), capture.captured);
+    assert!(capture.captured >= 74 && capture.captured <= 75);
+    for f in &capture.frames {
+        let angle = truth
+            .state(1, f.arrival - camera.latency)
+            .map_or(f64::NAN, |s| s.angle);
+        assert!((f.angle - angle).abs() < 1e-9, "t = {}", f.arrival);
+    }
+}

@@ -1,1 +1,3 @@
 //! Workspace root: integration tests and examples.
+
+pub mod rehab;

@@ -804,3 +804,16 @@ fn a_bond_between_two_two_ports_takes_the_default_domain() {
             .all(|b| b.domain == Domain::Rotational)
     );
 }
+
+#[test]
+fn library_and_model_files_are_in_canonical_layout() {
+    for (name, text) in [("std.bg", STD_SOURCE), ("back_support.bg", BACK_SUPPORT)] {
+        let (tree, diags) = crate::syntax::parse(FileId(0), text);
+        assert!(diags.is_empty(), "{name}: {diags:?}");
+        assert_eq!(
+            crate::syntax::format(&tree),
+            text,
+            "{name} is not formatted"
+        );
+    }
+}

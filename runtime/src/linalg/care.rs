@@ -1,0 +1,149 @@
+//! The continuous-time algebraic Riccati equation
+//!
+//! `AᵀX + XA − (XB + N) R⁻¹ (BᵀX + Nᵀ) + Q = 0`, `K = R⁻¹(BᵀX + Nᵀ)`,
+//!
+//! for the stabilising solution `X = Xᵀ ≥ 0` (all eigenvalues of `A − BK` in the open left half plane).
+//!
+//! Method: validate the inputs and the PBH conditions ((A, B) stabilisable, (Q̃, Ã) detectable), reduce the cross
+//! term and balance (see [`super::riccati`]); compute `W = sign(H)` of the Hamiltonian `H = [Ã, −G; −Q̃, −Ãᵀ]`
+//! ([`super::sign`]), whose stable invariant subspace `[I; X]` is the null space of `W + I`, giving `X` as the
+//! least-squares solution of `[W₁₂; W₂₂ + I] X = −[W₁₁ + I; W₂₁]`; then Newton–Kleinman refinement in correction
+//! form: `(Ã − GX)ᵀ Δ + Δ (Ã − GX) + Res(X) = 0`, `X ← X + Δ`, until the residual stops decreasing. The final
+//! relative residual `‖Res(X)‖ / (‖ÃᵀX‖ + ‖XÃ‖ + ‖XGX‖ + ‖Q̃‖)` (Frobenius norms, original coordinates) must
+//! be below [`RICCATI_TOLERANCE`] and `A − BK` must be stable, else an error is returned.
+
+use nalgebra::DMatrix;
+
+use super::lyapunov::{lyap, symmetrize};
+use super::pbh::Domain;
+use super::riccati::{Problem, RICCATI_TOLERANCE, Riccati, RiccatiError, Scaled, finite_solution};
+use super::schur::eigenvalues;
+use super::sign::hamiltonian_sign;
+
+/// Newton–Kleinman steps at most.
+const MAX_NEWTON_STEPS: usize = 30;
+
+/// Solves `AᵀX + XA − XBR⁻¹BᵀX + Q = 0`; see the module docs.
+///
+/// `Q` must be symmetric positive semidefinite, `R` symmetric positive definite.
+pub fn care(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+) -> Result<Riccati, RiccatiError> {
+    care_with_cross(a, b, q, r, None)
+}
+
+/// Solves the CARE with the cross weight `N` of the cost `∫ xᵀQx + 2xᵀNu + uᵀRu dt`; `[Q N; Nᵀ R]` must be
+/// positive semidefinite.
+pub fn care_with_cross(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+    n: Option<&DMatrix<f64>>,
+) -> Result<Riccati, RiccatiError> {
+    let p = Problem::new(a, b, q, r, n)?;
+    p.check_modes(Domain::Continuous)?;
+    let s = Scaled::new(&p);
+    let nn = p.n;
+
+    let mut h = DMatrix::<f64>::zeros(2 * nn, 2 * nn);
+    h.view_mut((0, 0), (nn, nn)).copy_from(&s.a);
+    h.view_mut((0, nn), (nn, nn)).copy_from(&(-&s.g));
+    h.view_mut((nn, 0), (nn, nn)).copy_from(&(-&s.q));
+    h.view_mut((nn, nn), (nn, nn))
+        .copy_from(&(-s.a.transpose()));
+    let Some((w, sign_iterations)) = hamiltonian_sign(&h) else {
+        return Err(p.diagnose(Domain::Continuous, f64::INFINITY, 0));
+    };
+    let mut lhs = DMatrix::<f64>::zeros(2 * nn, nn);
+    lhs.view_mut((0, 0), (nn, nn))
+        .copy_from(&w.view((0, nn), (nn, nn)));
+    lhs.view_mut((nn, 0), (nn, nn))
+        .copy_from(&(w.view((nn, nn), (nn, nn)) + DMatrix::<f64>::identity(nn, nn)));
+    let mut rhs = DMatrix::<f64>::zeros(2 * nn, nn);
+    rhs.view_mut((0, 0), (nn, nn))
+        .copy_from(&(-(w.view((0, 0), (nn, nn)) + DMatrix::<f64>::identity(nn, nn))));
+    rhs.view_mut((nn, 0), (nn, nn))
+        .copy_from(&(-w.view((nn, 0), (nn, nn))));
+    let qr = lhs.qr();
+    let qtb = qr.q().transpose() * rhs;
+    let Some(x0) = qr.r().solve_upper_triangular(&qtb) else {
+        return Err(p.diagnose(Domain::Continuous, f64::INFINITY, sign_iterations));
+    };
+    let mut xs = symmetrize(&x0);
+    finite_solution(&xs, sign_iterations)?;
+
+    // Newton–Kleinman refinement in the scaled coordinates; keep the best iterate.
+    let mut res = residual(&s.a, &s.g, &s.q, &xs);
+    let mut rel = relative(&res, &s.a, &s.g, &s.q, &xs);
+    let mut steps = 0;
+    while steps < MAX_NEWTON_STEPS && rel > 1e-15 {
+        let closed = &s.a - &s.g * &xs;
+        let Ok(delta) = lyap(&closed.transpose(), &res) else {
+            break;
+        };
+        let candidate = symmetrize(&(&xs + delta));
+        let cand_res = residual(&s.a, &s.g, &s.q, &candidate);
+        let cand_rel = relative(&cand_res, &s.a, &s.g, &s.q, &candidate);
+        if cand_rel.is_nan() || cand_rel >= rel {
+            break;
+        }
+        steps += 1;
+        xs = candidate;
+        res = cand_res;
+        rel = cand_rel;
+    }
+
+    let x = s.unscale(&xs);
+    finite_solution(&x, sign_iterations + steps)?;
+    let g = p.g();
+    let rel_orig = relative(&residual(&p.a, &g, &p.q, &x), &p.a, &g, &p.q, &x);
+    if rel_orig.is_nan() || rel_orig > RICCATI_TOLERANCE {
+        return Err(p.diagnose(Domain::Continuous, rel_orig, sign_iterations + steps));
+    }
+    let k = &p.r_inv * (p.b.transpose() * &x + &p.n_t);
+    let closed_loop_eigenvalues = eigenvalues(&(a - b * &k))?;
+    // A stabilising X puts the closed loop clearly inside; only rounding-level margins are tolerated here.
+    if let Some(&eigenvalue) = closed_loop_eigenvalues
+        .iter()
+        .find(|l| !Domain::Continuous.is_stable(**l, 0.0))
+    {
+        return Err(RiccatiError::ClosedLoopUnstable { eigenvalue });
+    }
+    Ok(Riccati {
+        x,
+        k,
+        closed_loop_eigenvalues,
+        relative_residual: rel_orig,
+        refinement_steps: steps,
+    })
+}
+
+/// `AᵀX + XA − XGX + Q`.
+fn residual(
+    a: &DMatrix<f64>,
+    g: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    x: &DMatrix<f64>,
+) -> DMatrix<f64> {
+    symmetrize(&(a.transpose() * x + x * a - x * g * x + q))
+}
+
+fn relative(
+    res: &DMatrix<f64>,
+    a: &DMatrix<f64>,
+    g: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    x: &DMatrix<f64>,
+) -> f64 {
+    let xa = x * a;
+    let denom = 2.0 * xa.norm() + (x * g * x).norm() + q.norm();
+    if denom > 0.0 {
+        res.norm() / denom
+    } else {
+        res.norm()
+    }
+}

@@ -1,0 +1,182 @@
+//! Precondition checks shared by the solvers: shapes, finiteness, symmetry and definiteness.
+//!
+//! Every public solver validates its inputs with these functions before doing any arithmetic, so that bad input
+//! is reported by name and position instead of propagating NaNs or panicking inside nalgebra.
+
+use nalgebra::DMatrix;
+
+/// Why an input matrix was refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum MatrixError {
+    #[error("matrix {name} is {rows}x{cols}, expected {expected_rows}x{expected_cols}")]
+    Shape {
+        name: &'static str,
+        rows: usize,
+        cols: usize,
+        expected_rows: usize,
+        expected_cols: usize,
+    },
+    #[error("matrix {name} is {rows}x{cols}, expected a square matrix")]
+    NotSquare {
+        name: &'static str,
+        rows: usize,
+        cols: usize,
+    },
+    #[error("matrix {name} is empty")]
+    Empty { name: &'static str },
+    #[error("matrix {name} has a non-finite entry {value} at ({row}, {col})")]
+    NonFinite {
+        name: &'static str,
+        row: usize,
+        col: usize,
+        value: f64,
+    },
+    #[error(
+        "matrix {name} is not symmetric: entries ({row}, {col}) and ({col}, {row}) differ by {difference}"
+    )]
+    NotSymmetric {
+        name: &'static str,
+        row: usize,
+        col: usize,
+        difference: f64,
+    },
+    #[error("matrix {name} is not positive definite: its smallest eigenvalue is {min_eigenvalue}")]
+    NotPositiveDefinite {
+        name: &'static str,
+        min_eigenvalue: f64,
+    },
+    #[error(
+        "matrix {name} is not positive semidefinite: its smallest eigenvalue is {min_eigenvalue}"
+    )]
+    NotPositiveSemidefinite {
+        name: &'static str,
+        min_eigenvalue: f64,
+    },
+    #[error("{what} is not a positive finite number: {value}")]
+    BadScalar { what: &'static str, value: f64 },
+}
+
+/// Refuses an empty matrix or one with a NaN or infinite entry.
+pub fn finite(name: &'static str, m: &DMatrix<f64>) -> Result<(), MatrixError> {
+    if m.is_empty() {
+        return Err(MatrixError::Empty { name });
+    }
+    for j in 0..m.ncols() {
+        for i in 0..m.nrows() {
+            let value = m[(i, j)];
+            if !value.is_finite() {
+                return Err(MatrixError::NonFinite {
+                    name,
+                    row: i,
+                    col: j,
+                    value,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a non-square matrix (and checks finiteness); returns the size.
+pub fn square(name: &'static str, m: &DMatrix<f64>) -> Result<usize, MatrixError> {
+    if m.nrows() != m.ncols() {
+        return Err(MatrixError::NotSquare {
+            name,
+            rows: m.nrows(),
+            cols: m.ncols(),
+        });
+    }
+    finite(name, m)?;
+    Ok(m.nrows())
+}
+
+/// Refuses a matrix whose shape is not `rows x cols` (and checks finiteness).
+pub fn shape(
+    name: &'static str,
+    m: &DMatrix<f64>,
+    rows: usize,
+    cols: usize,
+) -> Result<(), MatrixError> {
+    if m.nrows() != rows || m.ncols() != cols {
+        return Err(MatrixError::Shape {
+            name,
+            rows: m.nrows(),
+            cols: m.ncols(),
+            expected_rows: rows,
+            expected_cols: cols,
+        });
+    }
+    finite(name, m)
+}
+
+/// Refuses a matrix that is not symmetric to a relative tolerance of `1e-10` of its largest entry; this admits
+/// weights that were assembled with rounding error but not a transposed or mistyped matrix.
+pub fn symmetric(name: &'static str, m: &DMatrix<f64>) -> Result<(), MatrixError> {
+    let scale = m.amax();
+    let tolerance = 1e-10 * scale;
+    for j in 0..m.ncols() {
+        for i in 0..j {
+            let difference = (m[(i, j)] - m[(j, i)]).abs();
+            if difference > tolerance {
+                return Err(MatrixError::NotSymmetric {
+                    name,
+                    row: i,
+                    col: j,
+                    difference,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The smallest eigenvalue of the symmetric part of `m`.
+fn min_symmetric_eigenvalue(m: &DMatrix<f64>) -> f64 {
+    let sym = (m + m.transpose()) * 0.5;
+    match nalgebra::SymmetricEigen::try_new(sym, f64::EPSILON, 10_000) {
+        Some(eig) => eig
+            .eigenvalues
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min),
+        None => f64::NAN,
+    }
+}
+
+/// Refuses a symmetric matrix that is not positive definite. Eigenvalues below `1e-14` times the largest are
+/// treated as zero, so a numerically singular weight is refused too.
+pub fn positive_definite(name: &'static str, m: &DMatrix<f64>) -> Result<(), MatrixError> {
+    symmetric(name, m)?;
+    let min_eigenvalue = min_symmetric_eigenvalue(m);
+    if min_eigenvalue.is_finite() && min_eigenvalue > 1e-14 * m.amax() {
+        Ok(())
+    } else {
+        Err(MatrixError::NotPositiveDefinite {
+            name,
+            min_eigenvalue,
+        })
+    }
+}
+
+/// Refuses a symmetric matrix with an eigenvalue below `-1e-12` times its largest entry.
+pub fn positive_semidefinite(name: &'static str, m: &DMatrix<f64>) -> Result<(), MatrixError> {
+    symmetric(name, m)?;
+    let min_eigenvalue = min_symmetric_eigenvalue(m);
+    if min_eigenvalue.is_finite() && min_eigenvalue >= -1e-12 * m.amax() {
+        Ok(())
+    } else {
+        Err(MatrixError::NotPositiveSemidefinite {
+            name,
+            min_eigenvalue,
+        })
+    }
+}
+
+/// Refuses a scalar that is not positive and finite (a sample time, for instance).
+pub fn positive_scalar(what: &'static str, value: f64) -> Result<(), MatrixError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(MatrixError::BadScalar { what, value })
+    }
+}

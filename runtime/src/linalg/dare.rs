@@ -1,0 +1,169 @@
+//! The discrete-time algebraic Riccati equation
+//!
+//! `AᵀXA − X − (AᵀXB + N)(R + BᵀXB)⁻¹(BᵀXA + Nᵀ) + Q = 0`, `K = (R + BᵀXB)⁻¹(BᵀXA + Nᵀ)`,
+//!
+//! for the stabilising solution `X = Xᵀ ≥ 0` (all eigenvalues of `A − BK` inside the unit circle).
+//!
+//! Method: validate the inputs and the PBH conditions, reduce the cross term and balance (see
+//! [`super::riccati`]); the structure-preserving doubling algorithm (SDA, Chu, Fan, Lin & Wang 2004) on the
+//! symplectic pencil, which needs no inverse of `A`:
+//!
+//! `A₀ = Ã, G₀ = BR⁻¹Bᵀ, H₀ = Q̃`; with `W = I + GₖHₖ`:
+//! `Aₖ₊₁ = Aₖ W⁻¹ Aₖ`, `Gₖ₊₁ = Gₖ + Aₖ W⁻¹ Gₖ Aₖᵀ`, `Hₖ₊₁ = Hₖ + Aₖᵀ Hₖ W⁻¹ Aₖ`,
+//!
+//! where `Hₖ → X` quadratically; then Hewer's (Newton's) refinement in correction form
+//! `(Ã − BK)ᵀ Δ (Ã − BK) − Δ + Res(X) = 0`, `X ← X + Δ`, while the residual decreases. The relative residual
+//! `‖Res(X)‖ / (‖ÃᵀXÃ‖ + ‖X‖ + ‖ÃᵀXB(R + BᵀXB)⁻¹BᵀXÃ‖ + ‖Q̃‖)` must be below [`RICCATI_TOLERANCE`] and
+//! `A − BK` stable, else an error is returned.
+
+use nalgebra::DMatrix;
+
+use super::lyapunov::{dlyap, symmetrize};
+use super::pbh::Domain;
+use super::riccati::{Problem, RICCATI_TOLERANCE, Riccati, RiccatiError, Scaled, finite_solution};
+use super::schur::eigenvalues;
+
+/// Doubling steps at most (each squares the convergence factor).
+const MAX_DOUBLING_STEPS: usize = 100;
+/// Hewer steps at most.
+const MAX_HEWER_STEPS: usize = 30;
+
+/// Solves `AᵀXA − X − AᵀXB(R + BᵀXB)⁻¹BᵀXA + Q = 0`; see the module docs.
+pub fn dare(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+) -> Result<Riccati, RiccatiError> {
+    dare_with_cross(a, b, q, r, None)
+}
+
+/// Solves the DARE with the cross weight `N` of the cost `Σ xᵀQx + 2xᵀNu + uᵀRu`.
+pub fn dare_with_cross(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+    n: Option<&DMatrix<f64>>,
+) -> Result<Riccati, RiccatiError> {
+    let p = Problem::new(a, b, q, r, n)?;
+    p.check_modes(Domain::Discrete)?;
+    let s = Scaled::new(&p);
+    let nn = p.n;
+    let identity = DMatrix::<f64>::identity(nn, nn);
+
+    let (mut ak, mut gk, mut hk) = (s.a.clone(), s.g.clone(), s.q.clone());
+    let mut doubling = 0;
+    let mut converged = false;
+    while doubling < MAX_DOUBLING_STEPS {
+        doubling += 1;
+        let lu = (&identity + &gk * &hk).lu();
+        let (Some(w_a), Some(w_g)) = (lu.solve(&ak), lu.solve(&gk)) else {
+            return Err(p.diagnose(Domain::Discrete, f64::INFINITY, doubling));
+        };
+        let h_next = symmetrize(&(&hk + ak.transpose() * &hk * &w_a));
+        let g_next = symmetrize(&(&gk + &ak * w_g * ak.transpose()));
+        let a_next = &ak * w_a;
+        if !h_next.iter().all(|v| v.is_finite()) {
+            return Err(p.diagnose(Domain::Discrete, f64::INFINITY, doubling));
+        }
+        let change = (&h_next - &hk).norm() / h_next.norm().max(f64::MIN_POSITIVE);
+        hk = h_next;
+        gk = g_next;
+        ak = a_next;
+        if change <= 1e-14 {
+            converged = true;
+            break;
+        }
+    }
+    if !converged {
+        return Err(p.diagnose(Domain::Discrete, f64::INFINITY, doubling));
+    }
+    let mut xs = hk;
+    finite_solution(&xs, doubling)?;
+
+    // Hewer refinement in the scaled coordinates; keep the best iterate.
+    let Some(mut eval) = Evaluation::new(&s.a, &s.b, &s.q, &s.r, &xs) else {
+        return Err(p.diagnose(Domain::Discrete, f64::INFINITY, doubling));
+    };
+    let mut steps = 0;
+    while steps < MAX_HEWER_STEPS && eval.relative > 1e-15 {
+        let closed = &s.a - &s.b * &eval.gain;
+        let Ok(delta) = dlyap(&closed.transpose(), &eval.residual) else {
+            break;
+        };
+        let candidate = symmetrize(&(&xs + delta));
+        let Some(next) = Evaluation::new(&s.a, &s.b, &s.q, &s.r, &candidate) else {
+            break;
+        };
+        if next.relative.is_nan() || next.relative >= eval.relative {
+            break;
+        }
+        steps += 1;
+        xs = candidate;
+        eval = next;
+    }
+
+    let x = s.unscale(&xs);
+    finite_solution(&x, doubling + steps)?;
+    let Some(orig) = Evaluation::new(&p.a, &p.b, &p.q, &p.r, &x) else {
+        return Err(RiccatiError::Singular { what: "R + BᵀXB" });
+    };
+    if orig.relative.is_nan() || orig.relative > RICCATI_TOLERANCE {
+        return Err(p.diagnose(Domain::Discrete, orig.relative, doubling + steps));
+    }
+    // K for the original (cross-weighted) problem: (R + BᵀXB)⁻¹(BᵀXA + Nᵀ).
+    let btx = p.b.transpose() * &x;
+    let k = (&p.r + &btx * &p.b)
+        .lu()
+        .solve(&(&btx * a + &p.n_t))
+        .ok_or(RiccatiError::Singular { what: "R + BᵀXB" })?;
+    let closed_loop_eigenvalues = eigenvalues(&(a - b * &k))?;
+    if let Some(&eigenvalue) = closed_loop_eigenvalues
+        .iter()
+        .find(|l| !Domain::Discrete.is_stable(**l, 0.0))
+    {
+        return Err(RiccatiError::ClosedLoopUnstable { eigenvalue });
+    }
+    Ok(Riccati {
+        x,
+        k,
+        closed_loop_eigenvalues,
+        relative_residual: orig.relative,
+        refinement_steps: steps,
+    })
+}
+
+/// The DARE residual at `X` with the gain `K = (R + BᵀXB)⁻¹BᵀXA` of the problem without cross term.
+struct Evaluation {
+    residual: DMatrix<f64>,
+    relative: f64,
+    gain: DMatrix<f64>,
+}
+
+impl Evaluation {
+    fn new(
+        a: &DMatrix<f64>,
+        b: &DMatrix<f64>,
+        q: &DMatrix<f64>,
+        r: &DMatrix<f64>,
+        x: &DMatrix<f64>,
+    ) -> Option<Evaluation> {
+        let btx = b.transpose() * x;
+        let gain = (r + &btx * b).lu().solve(&(&btx * a))?;
+        let atxa = a.transpose() * x * a;
+        let correction = symmetrize(&((btx * a).transpose() * &gain));
+        let residual = symmetrize(&(&atxa - x - &correction + q));
+        let denom = atxa.norm() + x.norm() + correction.norm() + q.norm();
+        let relative = if denom > 0.0 {
+            residual.norm() / denom
+        } else {
+            residual.norm()
+        };
+        Some(Evaluation {
+            residual,
+            relative,
+            gain,
+        })
+    }
+}

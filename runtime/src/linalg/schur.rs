@@ -1,0 +1,58 @@
+//! Real Schur decomposition and eigenvalues without panics.
+//!
+//! nalgebra's `Schur::try_new` returns `None` when the QR iteration does not converge; these wrappers turn that
+//! into an error value and split the quasi-triangular factor into its 1x1 and 2x2 diagonal blocks.
+
+use nalgebra::{Complex, DMatrix, Schur};
+
+/// The QR iteration of the real Schur decomposition did not converge.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("the real Schur decomposition of a {n}x{n} matrix did not converge")]
+pub struct SchurError {
+    pub n: usize,
+}
+
+/// `a = u t uᵀ` with `u` orthogonal and `t` upper quasi-triangular.
+pub fn real_schur(a: &DMatrix<f64>) -> Result<(DMatrix<f64>, DMatrix<f64>), SchurError> {
+    let n = a.nrows();
+    if n != a.ncols() {
+        return Err(SchurError { n });
+    }
+    Schur::try_new(a.clone(), f64::EPSILON, 1000 * n.max(10))
+        .map(|s| s.unpack())
+        .ok_or(SchurError { n })
+}
+
+/// The eigenvalues of a square matrix, in the order of the diagonal of its real Schur form.
+pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, SchurError> {
+    let n = a.nrows();
+    if n != a.ncols() {
+        return Err(SchurError { n });
+    }
+    Schur::try_new(a.clone(), f64::EPSILON, 1000 * n.max(10))
+        .map(|s| s.complex_eigenvalues().iter().copied().collect())
+        .ok_or(SchurError { n })
+}
+
+/// The diagonal blocks of an upper quasi-triangular matrix as `(start, size)` with size 1 or 2.
+///
+/// nalgebra sets deflated subdiagonal entries to exactly zero, so any non-zero subdiagonal entry starts a 2x2
+/// block; two consecutive non-zero subdiagonal entries mean `t` is not quasi-triangular.
+pub fn diagonal_blocks(t: &DMatrix<f64>) -> Result<Vec<(usize, usize)>, SchurError> {
+    let n = t.nrows();
+    let mut blocks = Vec::new();
+    let mut j = 0;
+    while j < n {
+        if j + 1 < n && t[(j + 1, j)] != 0.0 {
+            if j + 2 < n && t[(j + 2, j + 1)] != 0.0 {
+                return Err(SchurError { n });
+            }
+            blocks.push((j, 2));
+            j += 2;
+        } else {
+            blocks.push((j, 1));
+            j += 1;
+        }
+    }
+    Ok(blocks)
+}

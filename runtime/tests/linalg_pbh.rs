@@ -1,0 +1,104 @@
+//! PBH tests, stabilisability, detectability and the Kalman rank helpers on systems with known modes.
+
+use bgc_runtime::linalg::{
+    Domain, controllability_matrix, controllability_rank, is_detectable, is_stabilizable,
+    observability_rank, uncontrollable_modes, unobservable_modes,
+};
+use nalgebra::{Complex, DMatrix};
+
+/// A = diag(−1, 2, −3) rotated by a Householder reflection H, C = [1 0 1] H: the mode λ = 2 (direction H e₂)
+/// is unobservable by construction, the others are observable.
+#[test]
+fn known_unobservable_real_mode() {
+    let v = nalgebra::dvector![1.0, -1.0, 2.0];
+    let h: DMatrix<f64> = DMatrix::identity(3, 3) - &v * v.transpose() * (2.0 / v.norm_squared());
+    let a = &h * DMatrix::from_diagonal(&nalgebra::dvector![-1.0, 2.0, -3.0]) * &h;
+    let c = DMatrix::from_row_slice(1, 3, &[1.0, 0.0, 1.0]) * &h;
+    let modes = unobservable_modes(&a, &c).unwrap();
+    assert_eq!(modes.len(), 1);
+    let mode = &modes[0];
+    assert!((mode.eigenvalue - Complex::new(2.0, 0.0)).norm() < 1e-12);
+    // The direction is ±H e₂ (up to a complex phase): |⟨d, H e₂⟩| = 1.
+    let he2 = h.column(1).map(|x| Complex::new(x, 0.0));
+    assert!((mode.direction.dotc(&he2).norm() - 1.0).abs() < 1e-12);
+    assert!(!is_detectable(&a, &c, Domain::Continuous).unwrap());
+    assert_eq!(observability_rank(&a, &c, 1e-10).unwrap(), 2);
+    // Observing state 2 of the diagonal coordinates as well makes it detectable.
+    let c2 = DMatrix::from_row_slice(2, 3, &[1.0, 0.0, 1.0, 0.0, 1.0, 0.0]) * &h;
+    assert!(unobservable_modes(&a, &c2).unwrap().is_empty());
+    assert!(is_detectable(&a, &c2, Domain::Continuous).unwrap());
+    assert_eq!(observability_rank(&a, &c2, 1e-10).unwrap(), 3);
+}
+
+/// An undamped oscillator (λ = ±i) next to a stable mode, measured only on the stable mode: the oscillator is
+/// unobservable and, lying on the imaginary axis, undetectable; in discrete time with |λ| = 0.5 for the pair it
+/// would be detectable.
+#[test]
+fn unobservable_complex_pair() {
+    let a = DMatrix::from_row_slice(3, 3, &[0.0, 1.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0, -1.0]);
+    let c = DMatrix::from_row_slice(1, 3, &[0.0, 0.0, 1.0]);
+    let modes = unobservable_modes(&a, &c).unwrap();
+    assert_eq!(modes.len(), 1, "one of each conjugate pair is reported");
+    let mode = &modes[0];
+    assert!((mode.eigenvalue.re).abs() < 1e-12 && (mode.eigenvalue.im - 1.0).abs() < 1e-12);
+    // A v = λ v and C v = 0.
+    let ac = a.map(|x| Complex::new(x, 0.0));
+    let residual = &ac * &mode.direction - &mode.direction * mode.eigenvalue;
+    assert!(residual.norm() < 1e-12);
+    assert!(mode.direction[2].norm() < 1e-12);
+    assert!(!is_detectable(&a, &c, Domain::Continuous).unwrap());
+    let a_slow = DMatrix::from_row_slice(3, 3, &[0.0, 0.5, 0.0, -0.5, 0.0, 0.0, 0.0, 0.0, 0.9]);
+    assert!(is_detectable(&a_slow, &c, Domain::Discrete).unwrap());
+}
+
+/// Two identical integrators driven by one input: the mode λ = 0 has an uncontrollable direction (1, −1)/√2.
+#[test]
+fn uncontrollable_mode_and_ranks() {
+    let a = DMatrix::<f64>::zeros(2, 2);
+    let b = DMatrix::from_row_slice(2, 1, &[1.0, 1.0]);
+    let modes = uncontrollable_modes(&a, &b).unwrap();
+    assert!(!modes.is_empty());
+    let w = &modes[0].direction;
+    // wᴴ B = 0 and |w₀| = |w₁| = 1/√2.
+    assert!((w[0] + w[1]).norm() < 1e-12);
+    assert!((w[0].norm() - 0.5f64.sqrt()).abs() < 1e-12);
+    assert!(!is_stabilizable(&a, &b, Domain::Continuous).unwrap());
+    assert_eq!(controllability_rank(&a, &b, 1e-10).unwrap(), 1);
+    // The double integrator is controllable: [B AB] = [[0, 1], [1, 0]].
+    let a = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, 0.0, 0.0]);
+    let b = DMatrix::from_row_slice(2, 1, &[0.0, 1.0]);
+    assert_eq!(
+        controllability_matrix(&a, &b).unwrap(),
+        DMatrix::from_row_slice(2, 2, &[0.0, 1.0, 1.0, 0.0])
+    );
+    assert!(uncontrollable_modes(&a, &b).unwrap().is_empty());
+    assert!(is_stabilizable(&a, &b, Domain::Discrete).unwrap());
+}
+
+/// The stiff back-support plant (stiffness/inertia ratios of 3·10⁸) with motor-torque input is controllable
+/// and, measured by motor velocity and human-side torque (C' of the paper, Sec. 4), observable: the rank
+/// decisions must not be fooled by the scaling.
+#[test]
+fn back_support_plant_is_controllable_and_observable() {
+    let (jm, jg, rg, kg) = (3.06e-4, 0.40e-4, 160.0, 2.64e4);
+    let (jsi, jse, ks) = (1e-4, 1.19e-3, 3.38e4);
+    let (bg, dg, keh) = (0.65, 6.0, 1125.0);
+    let j = jm + jg;
+    #[rustfmt::skip]
+    let a = DMatrix::from_row_slice(6, 6, &[
+        0.0, 1.0, 0.0, 0.0, 0.0, 0.0,
+        -kg / (j * rg * rg), -(bg + dg) / (j * rg * rg), kg / (j * rg), dg / (j * rg), 0.0, 0.0,
+        0.0, 0.0, 0.0, 1.0, 0.0, 0.0,
+        kg / (jsi * rg), dg / (jsi * rg), -(kg + ks) / jsi, -dg / jsi, ks / jsi, 0.0,
+        0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+        0.0, 0.0, ks / jse, 0.0, -(keh + ks) / jse, 0.0,
+    ]);
+    let b = DMatrix::from_row_slice(6, 1, &[0.0, 1.0 / j, 0.0, 0.0, 0.0, 0.0]);
+    let c = DMatrix::from_row_slice(
+        2,
+        6,
+        &[0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, keh, 0.0],
+    );
+    assert!(uncontrollable_modes(&a, &b).unwrap().is_empty());
+    assert!(unobservable_modes(&a, &c).unwrap().is_empty());
+}

@@ -1,23 +1,93 @@
-//! The back-support exoskeleton of Shojaei Barjuei et al. (Designs 2020, 4, 53) end to end.
-fn main() {
-    let cfg = bgc_workspace::back_support::scenario::ScenarioConfig::paper();
-    let t0 = std::time::Instant::now();
-    match bgc_workspace::back_support::study(&cfg) {
-        Ok(s) => {
-            let mc = &s.model_check;
-            println!("model check {} {} {} {}", mc.max_torque_difference, mc.max_velocity_difference, mc.max_torque_difference_as_printed, mc.max_velocity_difference_as_printed);
-            println!("single {:?}\nrepro {:?}\ndouble {:?}", s.lqr.single.k, s.lqr.single_reproducing.k, s.lqr.double.k);
-            for c in &s.seven_state { println!("{} det {} modes {:?} lqe {:?}", c.name, c.detectable, c.unobservable.iter().map(|m| m.eigenvalue).collect::<Vec<_>>(), c.lqe.as_ref().err().map(|e| e.to_string())); }
-            println!("obs L {}", s.observer.continuous.l);
-            println!("M {}", s.observer.discrete.filter_gain);
-            let r = &s.scenario;
-            println!("peak {} at {} mse yb {} mse wm {} true {}", r.peak_motor_torque, r.peak_time, r.human_torque_mse, r.motor_velocity_mse, r.motor_velocity_mse_true);
-            let rb = &s.robustness;
-            println!("obs loop {:?}", rb.observer_loop);
-            println!("sf loop {:?}", rb.state_feedback_loop);
-            println!("dist dc {} peak {} at {} Hz bw {:?}", rb.disturbance_dc_gain, rb.disturbance_peak_gain, rb.disturbance_peak_frequency_hz, rb.rejection_bandwidth_hz);
+//! The back-support exoskeleton of Shojaei Barjuei, Caldwell & Ortiz (Designs 2020, 4, 53) end to end: model
+//! check (Sec. 5.1), LQR with single and double integral action (Eqs. 10–17), observer (Eqs. 4–9), lifting
+//! scenario at 1 kHz with noise (Sec. 5.2), margins and disturbance rejection, beside the paper's figures.
+//!
+//! ```text
+//! cargo run --release --example back_support -- [--json PATH] [--out DIR]
+//! ```
+//!
+//! Prints a summary table; `--json PATH` writes the figures; SVG plots go to `--out DIR` (default
+//! `target/exo/back_support/`). The computations live in `bgc_workspace::back_support`.
+
+mod plots;
+mod report;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use bgc_workspace::back_support::{scenario::ScenarioConfig, study};
+
+struct Args {
+    json: Option<PathBuf>,
+    out: PathBuf,
+}
+
+const USAGE: &str = "usage: back_support [--json PATH] [--out DIR]";
+
+fn parse_args() -> Result<Option<Args>, String> {
+    let mut args = Args {
+        json: None,
+        out: PathBuf::from("target/exo/back_support"),
+    };
+    let mut it = std::env::args().skip(1);
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--json" => {
+                args.json = Some(PathBuf::from(it.next().ok_or("--json needs a path")?));
+            }
+            "--out" => args.out = PathBuf::from(it.next().ok_or("--out needs a directory")?),
+            "-h" | "--help" => return Ok(None),
+            other => return Err(format!("unknown argument `{other}`")),
         }
-        Err(e) => eprintln!("error: {e}"),
     }
-    println!("{:?}", t0.elapsed());
+    Ok(Some(args))
+}
+
+fn main() -> ExitCode {
+    let args = match parse_args() {
+        Ok(Some(a)) => a,
+        Ok(None) => {
+            println!("{USAGE}");
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            eprintln!("error: {e}\n{USAGE}");
+            return ExitCode::from(2);
+        }
+    };
+    let cfg = ScenarioConfig::paper();
+    let s = match study(&cfg) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    report::print_table(&s);
+    if let Some(path) = &args.json {
+        let text = match serde_json::to_string_pretty(&report::json(&s)) {
+            Ok(t) => t,
+            Err(e) => {
+                eprintln!("error: cannot serialise the figures: {e}");
+                return ExitCode::FAILURE;
+            }
+        };
+        if let Err(e) = std::fs::write(path, text + "\n") {
+            eprintln!("error: cannot write {}: {e}", path.display());
+            return ExitCode::FAILURE;
+        }
+        println!("figures written to {}", path.display());
+    }
+    if let Err(e) = std::fs::create_dir_all(&args.out) {
+        eprintln!("error: cannot create {}: {e}", args.out.display());
+        return ExitCode::FAILURE;
+    }
+    match report::plots(&s, &args.out) {
+        Ok(files) => println!("{} plots written to {}", files, args.out.display()),
+        Err(e) => {
+            eprintln!("error: plotting failed: {e}");
+            return ExitCode::FAILURE;
+        }
+    }
+    ExitCode::SUCCESS
 }

@@ -111,9 +111,8 @@ pub fn design(model: &DesignModel, q: &[f64], r: f64) -> Result<LqrDesign, BackS
 
 /// The designs of Eqs. 14–15 and the single design that reproduces Eqs. 16–17.
 pub fn designs(model: &DesignModel) -> Result<LqrDesigns, BackSupportError> {
-    let weights = |tail: &[f64]| -> Vec<f64> {
-        STATE_WEIGHTS.iter().chain(tail).copied().collect()
-    };
+    let weights =
+        |tail: &[f64]| -> Vec<f64> { STATE_WEIGHTS.iter().chain(tail).copied().collect() };
     Ok(LqrDesigns {
         single: design(model, &weights(&[PRINTED_Z_WEIGHT]), CONTROL_WEIGHT)?,
         single_reproducing: design(model, &weights(&[REPRODUCING_Z_WEIGHT]), CONTROL_WEIGHT)?,

@@ -40,9 +40,13 @@ pub enum BackSupportError {
         reason: &'static str,
     },
     /// The plant does not leave the rigid rotation with the trunk force-free (relative residual).
-    NotRigidInvariant { residual: f64 },
+    NotRigidInvariant {
+        residual: f64,
+    },
     /// An inconsistent setting of the study.
-    Setup { what: &'static str },
+    Setup {
+        what: &'static str,
+    },
     StateSpace(StateSpaceError),
     Simulation(SimError),
     Design(DesignError),

@@ -48,7 +48,11 @@ pub struct ModelCheck {
 
 /// The inputs `[τ_m, θ̇_h]` of the check at time `t`, on the segment that starts at `segment_start`.
 fn input(segment_start: f64) -> impl Fn(f64) -> SVector<f64, 2> {
-    let trunk = if segment_start >= TRUNK_START { TRUNK_VELOCITY } else { 0.0 };
+    let trunk = if segment_start >= TRUNK_START {
+        TRUNK_VELOCITY
+    } else {
+        0.0
+    };
     move |_t| SVector::<f64, 2>::new(MOTOR_TORQUE, trunk)
 }
 
@@ -63,14 +67,27 @@ fn run<M: ContinuousModel<7, 2, 3>>(
     let x0 = SVector::<f64, 7>::zeros();
     let a = simulate_open_loop(model, 0.0, &x0, input(0.0), first, solver)?;
     let x_switch = match a.states.last() {
-        Some(x) if first.last().is_some_and(|&t| (t - TRUNK_START).abs() < 1e-12) => *x,
+        Some(x)
+            if first
+                .last()
+                .is_some_and(|&t| (t - TRUNK_START).abs() < 1e-12) =>
+        {
+            *x
+        }
         _ => {
             return Err(BackSupportError::Setup {
                 what: "the model check's output grid must contain the trunk start time",
             });
         }
     };
-    let b = simulate_open_loop(model, TRUNK_START, &x_switch, input(TRUNK_START), second, solver)?;
+    let b = simulate_open_loop(
+        model,
+        TRUNK_START,
+        &x_switch,
+        input(TRUNK_START),
+        second,
+        solver,
+    )?;
     // The outputs at the switch time are those of the first segment (trunk still at rest).
     Ok(a.outputs
         .iter()

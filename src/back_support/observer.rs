@@ -144,6 +144,10 @@ pub struct ObserverDesign {
     pub r_d: DMatrix<f64>,
     /// The discrete steady-state Kalman filter.
     pub discrete: DiscreteKalman,
+    /// The steady-state variances of the filtered estimates' errors the filter predicts (`Z` of
+    /// [`DiscreteKalman`]): human torque `C_b Z C_bᵀ` (N² m²) and motor velocity `Z₂₂` (rad²/s²).
+    pub predicted_human_torque_variance: f64,
+    pub predicted_motor_velocity_variance: f64,
 }
 
 /// Continuous and discrete observers on the 6-state design model (module docs).
@@ -166,6 +170,9 @@ pub fn design(
     let q_d = &d.b * &q_in * d.b.transpose();
     let r_d = noise.measurement_variances();
     let discrete = dlqe(&d.a, &d.b, &ss.c, &q_in, &r_d)?;
+    let predicted_human_torque_variance =
+        (&model.c_b * &discrete.z * model.c_b.transpose())[(0, 0)];
+    let predicted_motor_velocity_variance = discrete.z[(1, 1)];
     Ok(ObserverDesign {
         noise: *noise,
         sample_time,
@@ -176,6 +183,8 @@ pub fn design(
         q_d: (&q_d + q_d.transpose()) * 0.5,
         r_d,
         discrete,
+        predicted_human_torque_variance,
+        predicted_motor_velocity_variance,
     })
 }
 

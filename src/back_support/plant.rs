@@ -129,7 +129,13 @@ impl ContinuousModel<NX, NU, NY> for Plant {
         *dx = self.a * x + self.b * u;
     }
 
-    fn outputs(&self, _t: f64, x: &SVector<f64, NX>, u: &SVector<f64, NU>, y: &mut SVector<f64, NY>) {
+    fn outputs(
+        &self,
+        _t: f64,
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, NU>,
+        y: &mut SVector<f64, NY>,
+    ) {
         *y = self.c * x + self.d * u;
     }
 

@@ -23,7 +23,7 @@
 use nalgebra::DMatrix;
 
 use bgc_runtime::analysis::{
-    StabilityMargins, dc_gain, loop_at_plant_input, logspace, peak_gain, siso_response,
+    StabilityMargins, dc_gain, logspace, loop_at_plant_input, peak_gain, siso_response,
     stability_margins,
 };
 use bgc_runtime::statespace::StateSpace;
@@ -81,7 +81,11 @@ fn gains(lqr: &LqrDesign) -> Result<(DMatrix<f64>, f64, f64), BackSupportError> 
             what: "the robustness analysis needs a double-integral design (8 gains)",
         });
     }
-    Ok((DMatrix::from_row_slice(1, 6, &lqr.k[..6]), lqr.k[6], lqr.k[7]))
+    Ok((
+        DMatrix::from_row_slice(1, 6, &lqr.k[..6]),
+        lqr.k[6],
+        lqr.k[7],
+    ))
 }
 
 /// The closed loop from the trunk velocity to the estimated torque on the body (module docs).

@@ -12,9 +12,11 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use bgc_runtime::estimation::{EstimationError, KalmanFilter, LinearDiscreteModel};
 use bgc_runtime::estimation::kalman::fixed_from_dynamic;
-use bgc_runtime::sim::{SampledController, SampledLoopConfig, SolverOptions, simulate_sampled_loop};
+use bgc_runtime::estimation::{EstimationError, KalmanFilter, LinearDiscreteModel};
+use bgc_runtime::sim::{
+    SampledController, SampledLoopConfig, SolverOptions, simulate_sampled_loop,
+};
 
 use super::BackSupportError;
 use super::lqr::LqrDesign;
@@ -253,10 +255,13 @@ pub fn run(
         .map(|y| y[output::MOTOR_VELOCITY])
         .collect();
     let motor_velocity_estimate: Vec<f64> = controller.estimates.iter().map(|x| x[1]).collect();
-    let (peak_index, peak) = motor_torque
-        .iter()
-        .enumerate()
-        .fold((0, 0.0_f64), |(bi, bv), (i, v)| if v.abs() > bv { (i, v.abs()) } else { (bi, bv) });
+    let (peak_index, peak) =
+        motor_torque
+            .iter()
+            .enumerate()
+            .fold((0, 0.0_f64), |(bi, bv), (i, v)| {
+                if v.abs() > bv { (i, v.abs()) } else { (bi, bv) }
+            });
     Ok(ScenarioResult {
         peak_motor_torque: peak,
         peak_time: times.get(peak_index).copied().unwrap_or(0.0),

@@ -7,7 +7,7 @@
 //! - [`care`], [`care_with_cross`], [`dare`], [`dare_with_cross`]: stabilising solutions of the algebraic Riccati
 //!   equations, with balancing, a structured base solver and Newton (Kleinman/Hewer) refinement.
 //! - [`lyap`], [`dlyap`]: Lyapunov equations (Bartels–Stewart).
-//! - [`expm`], [`c2d_zoh`], [`van_loan`]: matrix exponential, zero-order-hold discretisation, discrete
+//! - [`expm()`], [`c2d_zoh`], [`van_loan`]: matrix exponential, zero-order-hold discretisation, discrete
 //!   process-noise covariance.
 //! - [`pbh`]: PBH tests naming uncontrollable/unobservable modes, stabilisability, detectability, Kalman ranks.
 

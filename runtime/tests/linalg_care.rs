@@ -478,3 +478,25 @@ mod random {
         }
     }
 }
+
+/// Degenerate weights: with Q = 0 and a stable A the optimal control is u = 0 (X = 0, K = 0); with Q = 0 and an
+/// unstable scalar A = a > 0, B = 1, R = 1 the stabilising solution is the minimum-energy one, but (Q, A) is not
+/// detectable, which these solvers refuse by contract.
+#[test]
+fn zero_state_weight() {
+    let a = DMatrix::from_row_slice(2, 2, &[-1.0, 0.5, 0.0, -2.0]);
+    let b = DMatrix::from_row_slice(2, 1, &[0.0, 1.0]);
+    let sol = care(&a, &b, &DMatrix::zeros(2, 2), &DMatrix::identity(1, 1)).unwrap();
+    assert_eq!(sol.x.amax(), 0.0);
+    assert_eq!(sol.k.amax(), 0.0);
+    let err = care(
+        &DMatrix::from_element(1, 1, 2.0),
+        &DMatrix::from_element(1, 1, 1.0),
+        &DMatrix::zeros(1, 1),
+        &DMatrix::identity(1, 1),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, RiccatiError::NotDetectable { eigenvalue, .. } if (eigenvalue.re - 2.0).abs() < 1e-12)
+    );
+}

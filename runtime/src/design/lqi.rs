@@ -18,7 +18,10 @@
 //!
 //! The gain is the LQR gain of the augmented system, `u = −K [x; z₁; z₂] = −K_x x − K_z₁ z₁ − K_z₂ z₂`, for the
 //! weights `Q` (size `n + p` or `n + 2p`) and `R`; the reference `r` enters only the integrators and is zero in
-//! the design. Sign conventions:
+//! the design. In closed loop `ẋ_aug = (A_aug − B_aug K) x_aug + E r` with `E = [0; I; 0]` (the `τ_ref` column
+//! of Eq. 10). Single action removes the steady-state error of `y_I` for constant references and
+//! disturbances; double action also for ramps (the paper's motivation: the trunk angle ramps while the trunk
+//! moves at constant velocity). Sign conventions:
 //!
 //! - This is MATLAB's `lqi` convention (`ż = r − y`, `u = −K[x; z]`): with it the integral gains of a plant
 //!   whose output rises with `u` come out negative, as the paper's `F'ᵢ_z = −3.16`, `F_iz = −70.71` (Eq. 17).

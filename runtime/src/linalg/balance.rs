@@ -63,3 +63,32 @@ pub fn balanced_norm(a: &DMatrix<f64>) -> f64 {
     }
     sum.sqrt()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A two-state model in mismatched units (10⁸ against 10⁻⁴ couplings): balancing makes the off-diagonal
+    /// entries comparable, uses only powers of two and keeps the eigenvalues (trace and determinant).
+    #[test]
+    fn balancing_equalises_couplings_exactly() {
+        let a = DMatrix::from_row_slice(2, 2, &[-1.0, 1e8, -1e-4, -2.0]);
+        let d = balancing_scales(&a);
+        for s in d.iter() {
+            assert_eq!(s.log2().fract(), 0.0, "scale {s} is not a power of two");
+        }
+        let b = DMatrix::from_fn(2, 2, |i, j| a[(i, j)] * d[j] / d[i]);
+        let ratio = (b[(0, 1)] / b[(1, 0)]).abs();
+        assert!((0.25..=4.0).contains(&ratio), "off-diagonal ratio {ratio}");
+        assert_eq!(b.trace(), a.trace());
+        assert!((b.determinant() - a.determinant()).abs() < 1e-12 * a.determinant().abs());
+        assert!(balanced_norm(&a) < 1e3);
+    }
+
+    #[test]
+    fn power_of_two_rounds_in_log_scale() {
+        assert_eq!(power_of_two(1.0), 1.0);
+        assert_eq!(power_of_two(3.0), 4.0);
+        assert_eq!(power_of_two(0.3), 0.25);
+    }
+}

@@ -180,3 +180,65 @@ pub fn positive_scalar(what: &'static str, value: f64) -> Result<(), MatrixError
         Err(MatrixError::BadScalar { what, value })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn symmetry_tolerates_rounding_but_not_mistakes() {
+        let rounding = DMatrix::from_row_slice(2, 2, &[1e12, 1.0 + 1e-6, 1.0, 1.0]);
+        assert!(symmetric("Q", &rounding).is_ok());
+        let mistake = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 0.0, 1.0]);
+        assert_eq!(
+            symmetric("Q", &mistake),
+            Err(MatrixError::NotSymmetric {
+                name: "Q",
+                row: 0,
+                col: 1,
+                difference: 2.0
+            })
+        );
+    }
+
+    /// [[1, 2], [2, 1]] has eigenvalues 3 and −1; [[1, 1], [1, 1]] has 2 and 0.
+    #[test]
+    fn definiteness() {
+        let indefinite = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+        match positive_semidefinite("Q", &indefinite) {
+            Err(MatrixError::NotPositiveSemidefinite { min_eigenvalue, .. }) => {
+                assert!((min_eigenvalue + 1.0).abs() < 1e-12)
+            }
+            other => panic!("{other:?}"),
+        }
+        let singular = DMatrix::from_row_slice(2, 2, &[1.0, 1.0, 1.0, 1.0]);
+        assert!(positive_semidefinite("Q", &singular).is_ok());
+        assert!(matches!(
+            positive_definite("R", &singular),
+            Err(MatrixError::NotPositiveDefinite { name: "R", .. })
+        ));
+        assert!(positive_definite("R", &DMatrix::from_element(1, 1, 1e12)).is_ok());
+    }
+
+    #[test]
+    fn shapes_and_values() {
+        assert_eq!(
+            square("A", &DMatrix::zeros(0, 0)),
+            Err(MatrixError::Empty { name: "A" })
+        );
+        assert!(matches!(
+            shape("B", &DMatrix::zeros(3, 1), 2, 1),
+            Err(MatrixError::Shape {
+                name: "B",
+                rows: 3,
+                cols: 1,
+                expected_rows: 2,
+                expected_cols: 1
+            })
+        ));
+        assert!(matches!(
+            positive_scalar("sample time", f64::NAN),
+            Err(MatrixError::BadScalar { .. })
+        ));
+    }
+}

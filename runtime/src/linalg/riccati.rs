@@ -19,8 +19,9 @@ use super::lyapunov::LyapunovError;
 use super::pbh::{self, Domain, PbhError};
 use super::schur::SchurError;
 
-/// The largest state dimension the Riccati solvers accept (bounded by the `O(n⁴)` Lyapunov solver of the
-/// Newton refinement).
+/// The largest state dimension the Riccati solvers accept. The cost is dominated by `O(n⁴)` parts: the PBH
+/// checks (one SVD of an `(n + m) x n` complex matrix per eigenvalue) and the Lyapunov solves of the Newton
+/// refinement; the 8-state design takes about 0.2 ms, a 100-state one about 0.5 s in an optimised build.
 pub const MAX_RICCATI_ORDER: usize = super::lyapunov::MAX_LYAPUNOV_ORDER;
 
 /// Relative residual above which a Riccati solution is refused (see [`Riccati::relative_residual`]).

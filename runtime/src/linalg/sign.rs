@@ -67,3 +67,29 @@ fn restore_hamiltonian(z: &mut DMatrix<f64>, n: usize) {
     z.view_mut((n, 0), (n, n))
         .copy_from(&((&z21 + z21.transpose()) * 0.5));
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// For the scalar Riccati problem, H = [a, −g; −q, −a] satisfies H² = (a² + gq) I, so by hand
+    /// sign(H) = H / √(a² + gq).
+    #[test]
+    fn scalar_hamiltonian_sign_is_h_over_its_modulus() {
+        let (a, g, q) = (-3.0, 0.5, 200.0);
+        let h = DMatrix::from_row_slice(2, 2, &[a, -g, -q, -a]);
+        let (w, iterations) = hamiltonian_sign(&h).unwrap();
+        let expected = &h / (a * a + g * q).sqrt();
+        assert!((w - expected).amax() < 1e-14);
+        assert!(iterations < 10);
+    }
+
+    /// Eigenvalues on the imaginary axis (H = [0, 1; −1, 0], λ = ±i) have no sign: the iteration must fail
+    /// rather than return a matrix.
+    #[test]
+    fn imaginary_axis_eigenvalues_fail() {
+        let h = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -1.0, 0.0]);
+        assert!(hamiltonian_sign(&h).is_none());
+        assert!(hamiltonian_sign(&DMatrix::zeros(3, 3)).is_none());
+    }
+}

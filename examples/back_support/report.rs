@@ -230,6 +230,8 @@ pub fn print_table(s: &Study) {
         "5. Loop broken at the plant input, double-integral LQR + continuous observer (Eq. 9)"
     );
     margins_rows(&rb.observer_loop, true);
+    println!("   sampled loop at 1 kHz: the scenario's Kalman filter + LQR, zero-order-hold plant");
+    margins_rows(&rb.sampled_loop, false);
     println!("   same loop with the full state measured (LQR alone)");
     margins_rows(&rb.state_feedback_loop, false);
     println!("   trunk velocity → estimated human torque (closed loop)");
@@ -314,6 +316,7 @@ pub fn json(s: &Study) -> Value {
                           s.observer.noise.motor_velocity, s.observer.noise.sensor_torque],
         },
         "margins": margins_json(&rb.observer_loop),
+        "sampled_margins": margins_json(&rb.sampled_loop),
         "state_feedback_margins": margins_json(&rb.state_feedback_loop),
         "disturbance": {
             "dc_gain": rb.disturbance_dc_gain,

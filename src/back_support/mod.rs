@@ -128,7 +128,7 @@ pub fn study(cfg: &scenario::ScenarioConfig) -> Result<Study, BackSupportError> 
     let seven_state = observer::seven_state_check(&plant, &cfg.noise, cfg.sample_time)?;
     let obs = observer::design(&model, &cfg.noise, cfg.sample_time)?;
     let run = scenario::run(&p, &plant, &model, &lqr.double, &obs, cfg)?;
-    let robustness = robustness::analyse(&model, &lqr.double, &obs.continuous.l)?;
+    let robustness = robustness::analyse(&model, &lqr.double, &obs.continuous.l, &obs)?;
     Ok(Study {
         params: p,
         model_check: check,

@@ -11,6 +11,16 @@
 //! python-control's `stability_margins` (`bgc_runtime::analysis`). For comparison, the loop of the LQR with
 //! the full state measured, `K (sI − A_aug)⁻¹ B_aug`, is reported too.
 //!
+//! The controller that actually runs (the scenario's) is sampled at `T`: the current-estimate Kalman filter
+//! with its innovation gain `M`, the LQR on `x̂[k|k]` and forward-Euler integrators. With the prior estimate
+//! `x̂⁻` as its state, `x̂[k|k] = (I − M C) x̂⁻ + M y`, it reads
+//!
+//! `x̂⁻' = A_d x̂[k|k] + B_d τ_m`, `z' = z − T C_b x̂[k|k]`, `(∫z)' = ∫z + T z`,
+//! `τ_m = −K_x x̂[k|k] − K_z z − K_∫z ∫z`,
+//!
+//! and its loop with the zero-order-hold plant `(A_d, B_d, [C_v; C_t])` is analysed the same way
+//! ([`sampled_controller`]); its delay margin counts the half-sample delay of the hold.
+//!
 //! The disturbance path is the closed loop from the true trunk velocity (entering plant and observer, Eq. 8)
 //! to the estimated torque on the body `ŷ_b = C_b x̂ − d_eh θ̇_h`, state `[δ; x̂; z; ∫z]`. With two integrators
 //! of the torque error its DC gain is zero: a constant trunk velocity is rejected completely, and "the first
@@ -30,6 +40,7 @@ use bgc_runtime::statespace::StateSpace;
 
 use super::BackSupportError;
 use super::lqr::LqrDesign;
+use super::observer::ObserverDesign;
 use super::plant::DesignModel;
 
 /// The frequency-domain figures of the design.
@@ -37,6 +48,8 @@ use super::plant::DesignModel;
 pub struct Robustness {
     /// Margins of the observer-based loop broken at the plant input.
     pub observer_loop: StabilityMargins,
+    /// Margins of the sampled loop at the plant input (controller of the scenario, zero-order-hold plant).
+    pub sampled_loop: StabilityMargins,
     /// Margins of the full-state LQR loop broken at the plant input.
     pub state_feedback_loop: StabilityMargins,
     /// `|T(0)|` of the disturbance path (N m per rad/s).
@@ -86,6 +99,45 @@ fn gains(lqr: &LqrDesign) -> Result<(DMatrix<f64>, f64, f64), BackSupportError> 
         lqr.k[6],
         lqr.k[7],
     ))
+}
+
+/// The sampled controller of the module docs, from `[y_v; y_t]` to `τ_m`, for the zero-order-hold model
+/// `(a_d, b_d)` of `(A₁, B_m)` at sample time `dt` and the innovation gain `m`.
+pub fn sampled_controller(
+    model: &DesignModel,
+    lqr: &LqrDesign,
+    a_d: &DMatrix<f64>,
+    b_d: &DMatrix<f64>,
+    m: &DMatrix<f64>,
+    dt: f64,
+) -> Result<StateSpace, BackSupportError> {
+    let (kx, kz, kzz) = gains(lqr)?;
+    // x̂[k|k] = E x̂⁻ + M y with E = I − M C.
+    let e = DMatrix::<f64>::identity(6, 6) - m * &model.c_meas;
+    // τ_m = −K_x E x̂⁻ − K_z z − K_∫z ∫z − K_x M y.
+    let mut c = DMatrix::zeros(1, 8);
+    c.view_mut((0, 0), (1, 6)).copy_from(&(-(&kx * &e)));
+    c[(0, 6)] = -kz;
+    c[(0, 7)] = -kzz;
+    let d = -(&kx * m);
+    // x̂⁻' = A_d (E x̂⁻ + M y) + B_d τ_m.
+    let mut a = DMatrix::zeros(8, 8);
+    a.view_mut((0, 0), (6, 8)).copy_from(&(b_d * &c));
+    let a_e = a_d * &e;
+    let mut top = a.view((0, 0), (6, 6)).clone_owned();
+    top += &a_e;
+    a.view_mut((0, 0), (6, 6)).copy_from(&top);
+    let mut b = DMatrix::zeros(8, 2);
+    b.view_mut((0, 0), (6, 2)).copy_from(&(a_d * m + b_d * &d));
+    // z' = z − T C_b (E x̂⁻ + M y), (∫z)' = ∫z + T z.
+    a.view_mut((6, 0), (1, 6))
+        .copy_from(&(&model.c_b * &e * -dt));
+    a[(6, 6)] = 1.0;
+    a[(7, 6)] = dt;
+    a[(7, 7)] = 1.0;
+    b.view_mut((6, 0), (1, 2))
+        .copy_from(&(&model.c_b * m * -dt));
+    Ok(StateSpace::new_discrete(a, b, c, d, dt)?)
 }
 
 /// The closed loop from the trunk velocity to the estimated torque on the body (module docs).
@@ -159,11 +211,13 @@ fn ratio_crossing(
     Ok(None)
 }
 
-/// Margins and disturbance rejection of the double-integral design with the continuous observer gain `l`.
+/// Margins and disturbance rejection of the double-integral design with the continuous observer gain `l`, and
+/// the margins of the sampled loop of `observer`'s discrete filter.
 pub fn analyse(
     model: &DesignModel,
     lqr: &LqrDesign,
     l: &DMatrix<f64>,
+    observer: &ObserverDesign,
 ) -> Result<Robustness, BackSupportError> {
     let plant = StateSpace::new(
         model.a.clone(),
@@ -173,6 +227,24 @@ pub fn analyse(
     )?;
     let ctl = controller(model, lqr, l)?;
     let observer_loop = stability_margins(&loop_at_plant_input(&plant, &ctl)?)?;
+    let dt = observer.sample_time;
+    let b_d = observer.b_d.columns(0, 1).clone_owned();
+    let plant_d = StateSpace::new_discrete(
+        observer.a_d.clone(),
+        b_d.clone(),
+        model.c_meas.clone(),
+        DMatrix::zeros(2, 1),
+        dt,
+    )?;
+    let ctl_d = sampled_controller(
+        model,
+        lqr,
+        &observer.a_d,
+        &b_d,
+        &observer.discrete.filter_gain,
+        dt,
+    )?;
+    let sampled_loop = stability_margins(&loop_at_plant_input(&plant_d, &ctl_d)?)?;
     let (kx, kz, kzz) = gains(lqr)?;
     let mut a_aug = DMatrix::zeros(8, 8);
     a_aug.view_mut((0, 0), (6, 6)).copy_from(&model.a);
@@ -196,6 +268,7 @@ pub fn analyse(
     let (peak, peak_w) = peak_gain(&path)?;
     Ok(Robustness {
         observer_loop,
+        sampled_loop,
         state_feedback_loop,
         disturbance_dc_gain: dc_gain(&path)?[(0, 0)].abs(),
         disturbance_peak_gain: peak,

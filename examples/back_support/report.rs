@@ -18,8 +18,21 @@ fn db(gain: Option<f64>) -> Option<f64> {
         .map(|g| 20.0 * g.log10())
 }
 
+fn four(v: Option<f64>) -> String {
+    v.map_or("n/a".to_string(), |g| format!("{g:.4}"))
+}
+
 fn gains(k: &[f64]) -> String {
-    let v: Vec<String> = k.iter().map(|g| format!("{g:.4}")).collect();
+    let v: Vec<String> = k
+        .iter()
+        .map(|g| {
+            if g.abs() >= 0.01 {
+                format!("{g:.4}")
+            } else {
+                format!("{g:.2e}")
+            }
+        })
+        .collect();
     format!("[{}]", v.join(" "))
 }
 
@@ -100,7 +113,7 @@ pub fn print_table(s: &Study) {
     );
     row(
         "single, Eq. 14: K_z",
-        format!("{:.4}", l.single.outer_integral_gain()),
+        four(l.single.outer_integral_gain()),
         &format!("F'_iz = {PAPER_SINGLE_INTEGRAL_GAIN}"),
     );
     row(
@@ -110,7 +123,7 @@ pub fn print_table(s: &Study) {
     );
     row(
         "single, q_z = 1e13: K_z",
-        format!("{:.4}", l.single_reproducing.outer_integral_gain()),
+        four(l.single_reproducing.outer_integral_gain()),
         "−3.16 reproduced",
     );
     row(
@@ -126,9 +139,9 @@ pub fn print_table(s: &Study) {
     row(
         "√(q_z/r): single Eq. 14, Eq. 15 outer",
         format!(
-            "{:.4}, {:.4}",
-            l.single.outer_gain_from_weights(),
-            l.double.outer_gain_from_weights()
+            "{}, {}",
+            four(l.single.outer_gain_from_weights()),
+            four(l.double.outer_gain_from_weights())
         ),
         "3.16, 70.71 printed",
     );

@@ -59,19 +59,22 @@ pub struct LqrDesign {
 }
 
 impl LqrDesign {
-    /// The state part `K_x` (6 entries).
+    /// The state part `K_x` (the first six entries; fewer if `k` is shorter).
     pub fn state_gain(&self) -> &[f64] {
-        &self.k[..6]
+        &self.k[..self.k.len().min(6)]
     }
 
     /// The gain of the outermost integrator (`z` for single, `∫z` for double action).
-    pub fn outer_integral_gain(&self) -> f64 {
-        self.k[self.k.len() - 1]
+    pub fn outer_integral_gain(&self) -> Option<f64> {
+        self.k.get(6..).and_then(|tail| tail.last().copied())
     }
 
     /// `√(q_outer / r)`: the magnitude the outer integral gain must have (module docs).
-    pub fn outer_gain_from_weights(&self) -> f64 {
-        (self.q[self.q.len() - 1] / self.r).sqrt()
+    pub fn outer_gain_from_weights(&self) -> Option<f64> {
+        self.q
+            .get(6..)
+            .and_then(|tail| tail.last())
+            .map(|q| (q / self.r).sqrt())
     }
 }
 

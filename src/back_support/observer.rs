@@ -188,13 +188,12 @@ pub fn design(
     })
 }
 
-/// The rigid-rotation direction normalised to `θ_m = 1`, for printing a mode direction.
+/// A mode direction normalised to `θ_m = 1` (unchanged if its `θ_m` entry is zero), for printing.
 pub fn normalised_direction(mode: &Mode) -> Vec<Complex<f64>> {
-    let pivot = mode.direction[0];
-    if pivot.norm() == 0.0 {
-        return mode.direction.iter().copied().collect();
+    match mode.direction.iter().next() {
+        Some(&pivot) if pivot.norm() > 0.0 => mode.direction.iter().map(|z| z / pivot).collect(),
+        _ => mode.direction.iter().copied().collect(),
     }
-    mode.direction.iter().map(|z| z / pivot).collect()
 }
 
 /// The direction expected for the unobservable rigid rotation, normalised to `θ_m = 1`.

@@ -120,13 +120,11 @@ pub fn sampled_controller(
     c[(0, 6)] = -kz;
     c[(0, 7)] = -kzz;
     let d = -(&kx * m);
-    // x̂⁻' = A_d (E x̂⁻ + M y) + B_d τ_m.
+    // x̂⁻' = A_d (E x̂⁻ + M y) + B_d τ_m = (A_d E + B_d C) [x̂⁻; ·] + B_d (−K_z z − K_∫z ∫z) + (A_d M + B_d D) y.
     let mut a = DMatrix::zeros(8, 8);
     a.view_mut((0, 0), (6, 8)).copy_from(&(b_d * &c));
-    let a_e = a_d * &e;
-    let mut top = a.view((0, 0), (6, 6)).clone_owned();
-    top += &a_e;
-    a.view_mut((0, 0), (6, 6)).copy_from(&top);
+    let top_left = a.view((0, 0), (6, 6)) + a_d * &e;
+    a.view_mut((0, 0), (6, 6)).copy_from(&top_left);
     let mut b = DMatrix::zeros(8, 2);
     b.view_mut((0, 0), (6, 2)).copy_from(&(a_d * m + b_d * &d));
     // z' = z − T C_b (E x̂⁻ + M y), (∫z)' = ∫z + T z.

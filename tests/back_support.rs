@@ -4,6 +4,7 @@
 //! ```python
 //! import numpy as np, scipy.linalg as sl
 //! from scipy.signal import cont2discrete
+//! np.set_printoptions(precision=17)
 //! Jm, Jg, rg, kg = 3.06e-4, 0.40e-4, 160.0, 2.64e4
 //! Jsi, Jse, ks = 1e-4, 1.19e-3, 3.38e4
 //! bg, dg, keh = 0.65, 6.0, 1125.0
@@ -32,19 +33,22 @@
 //!     if p == 2: A[7, 6] = 1
 //!     Bq = np.vstack([Bm, np.zeros((p, 1))]); Q = np.diag([1e5, 1e5, 1e7, 1e7, 1e7, 1e7] + qz)
 //!     X = sl.solve_continuous_are(A, Bq, Q, np.array([[1e12]])); return (Bq.T @ X / 1e12).ravel()
-//! for qz in ([5e13], [1e13], [5e13, 5e15]): print(lqi(qz))
+//! for qz in ([5e13], [1e13], [5e13, 5e15], [1e13, 5e15]): print(lqi(qz))
 //! # noise-free lifting scenario: exact ZOH plant, state feedback on the trunk-relative state
-//! K = lqi([5e13, 5e15]); Kx, kz, kzz = K[:6], K[6], K[7]
 //! A7 = a7(bg/rg**2); C7b = np.array([0, 0, 0, 0, keh, 0, -keh])
 //! Ad, Bd, *_ = cont2discrete((A7, B, C, np.zeros((2, 2))), 1e-3)
 //! v = np.array([rg, 0, 1, 0, 1, 0])
-//! x = np.zeros(7); z = zz = 0.0; us = []
-//! for k in range(1000):
-//!     t = k * 1e-3; delta = x[:6] - v * x[6]
-//!     yb = C7b @ x; u = -(Kx @ delta) - kz * z - kzz * zz; us.append(u)
-//!     zz += 1e-3 * z; z += 1e-3 * ((10.0 if 0.1 <= t + 1e-12 < 0.6 else 0.0) - yb)
-//!     x = Ad @ x + Bd @ np.array([u, 0.1])
-//! us = np.array(us); i = np.argmax(abs(us)); print(abs(us[i]), i * 1e-3)   # 0.606994512979 0.115
+//! for qz in ([5e13, 5e15], [1e13, 5e15]):
+//!     K = lqi(qz); Kx, kz, kzz = K[:6], K[6], K[7]
+//!     x = np.zeros(7); z = zz = 0.0; us = []
+//!     for k in range(1000):
+//!         t = k * 1e-3; delta = x[:6] - v * x[6]
+//!         yb = C7b @ x; u = -(Kx @ delta) - kz * z - kzz * zz; us.append(u)
+//!         zz += 1e-3 * z; z += 1e-3 * ((10.0 if 0.1 <= t + 1e-12 < 0.6 else 0.0) - yb)
+//!         x = Ad @ x + Bd @ np.array([u, 0.1])
+//!     us = np.array(us); i = np.argmax(abs(us))
+//!     print(abs(us[i]), i * 1e-3)        # 0.606994512979 0.115, and 0.463182219721 0.118
+//! K = lqi([5e13, 5e15]); Kx, kz, kzz = K[:6], K[6], K[7]
 //! # margins at the plant input with the continuous observer of Eq. 9 (python-control 0.10.2)
 //! import control as ct
 //! from scipy.optimize import brentq
@@ -132,6 +136,17 @@ fn lqr_gains_match_scipy_and_explain_the_printed_ones() {
     assert_close(&d.single.k, &single, 1e-8);
     assert_close(&d.single_reproducing.k, &reproducing, 1e-8);
     assert_close(&d.double.k, &double, 1e-8);
+    let double_reproducing = [
+        1.5437124909872226e+00,
+        3.2755474886206483e-02,
+        1.4445960729557246e+00,
+        8.3196855631300330e-05,
+        3.6830873213284335e-02,
+        1.2137406253899254e-03,
+        -6.6694676005198765e+00,
+        -7.0710678120139065e+01,
+    ];
+    assert_close(&d.double_reproducing.k, &double_reproducing, 1e-8);
     // The outer integral gain is −√(q/r) for any plant: Eq. 14's q_z = 5e13 gives −7.07, not Eq. 17's −3.16.
     assert!((d.single.outer_integral_gain().unwrap() + 50f64.sqrt()).abs() < 1e-9);
     assert!((d.double.outer_integral_gain().unwrap() + 5000f64.sqrt()).abs() < 1e-9);
@@ -252,6 +267,14 @@ fn lifting_scenario_peak_torque_and_estimation_errors() {
     assert!((run.peak_time - 0.115).abs() < 1e-9);
     // The filter starts at the true state and sees no noise: it tracks to solver accuracy.
     assert!(run.human_torque_mse < 1e-10, "{}", run.human_torque_mse);
+    // With q_z = 1e13 (the weight Eqs. 16–17 imply) the peak stays inside the paper's ±0.56 N m.
+    let run = scenario::run(&p, &plant, &model, &designs.double_reproducing, &obs, &cfg).unwrap();
+    assert!(
+        (run.peak_motor_torque - 0.463182219721).abs() < 1e-5,
+        "{}",
+        run.peak_motor_torque
+    );
+    assert!((run.peak_time - 0.118).abs() < 1e-9);
 
     // The paper's scenario with noise (1 s).
     let run = scenario::run(

@@ -137,6 +137,16 @@ pub fn print_table(s: &Study) {
         &format!("F_iz = {PAPER_DOUBLE_INTEGRAL_GAIN}"),
     );
     row(
+        "double, q_z = 1e13: K_x",
+        gains(l.double_reproducing.state_gain()),
+        "",
+    );
+    row(
+        "double, q_z = 1e13: K_z, K_∫z",
+        gains(l.double_reproducing.k.get(6..).unwrap_or(&[])),
+        "",
+    );
+    row(
         "√(q_z/r): single Eq. 14, Eq. 15 outer",
         format!(
             "{}, {}",
@@ -209,6 +219,12 @@ pub fn print_table(s: &Study) {
         "peak |τ_m|",
         format!("{:.3} N m at {:.3} s", r.peak_motor_torque, r.peak_time),
         "within ±0.56 N m",
+    );
+    let q = &s.scenario_reproducing;
+    row(
+        "  same with q_z = 1e13 in Eq. 15",
+        format!("{:.3} N m at {:.3} s", q.peak_motor_torque, q.peak_time),
+        "",
     );
     row(
         "MSE of estimated human torque",
@@ -315,6 +331,7 @@ pub fn json(s: &Study) -> Value {
         "lqr_single": lqr_json(&s.lqr.single),
         "lqr_single_reproducing_eq16": lqr_json(&s.lqr.single_reproducing),
         "lqr_double": lqr_json(&s.lqr.double),
+        "lqr_double_qz_1e13": lqr_json(&s.lqr.double_reproducing),
         "paper_gains": {
             "F_ix": PAPER_STATE_GAIN,
             "F_iz_single": PAPER_SINGLE_INTEGRAL_GAIN,
@@ -339,6 +356,7 @@ pub fn json(s: &Study) -> Value {
         },
         "peak_tau_m": r.peak_motor_torque,
         "peak_tau_m_time_s": r.peak_time,
+        "peak_tau_m_qz_1e13": s.scenario_reproducing.peak_motor_torque,
         "tau_h_estimation_mse": r.human_torque_mse,
         "omega_m_estimation_mse": r.motor_velocity_mse,
         "omega_m_estimation_mse_true": r.motor_velocity_mse_true,

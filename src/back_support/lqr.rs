@@ -18,6 +18,10 @@
 //!   `q_z = 10¹³` the design reproduces all of Eq. 16 to its two printed decimals, so Eq. 14's `5·10¹³` is a
 //!   misprint for `10¹³` (or the gains were computed with other weights than those printed).
 //!
+//! If the same misprint affects Eq. 15, its design is [`LqrDesigns::double_reproducing`]; the example runs the
+//! scenario with both (with `q_z = 10¹³` the peak motor torque stays inside the paper's ±0.56 N m, with the
+//! printed `5·10¹³` it does not).
+//!
 //! Eq. 13 writes the double-integral law with the single design's `F'_ix`, `F'_iz`; the LQR of Eq. 12 gives
 //! its own state and inner-integral gains (reported by [`LqrDesigns::double`]).
 
@@ -78,7 +82,7 @@ impl LqrDesign {
     }
 }
 
-/// The three designs the example reports.
+/// The designs the example reports.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LqrDesigns {
     /// Single integral action with the weights printed in Eq. 14.
@@ -87,6 +91,8 @@ pub struct LqrDesigns {
     pub single_reproducing: LqrDesign,
     /// Double integral action with the weights of Eq. 15 (used in the scenario).
     pub double: LqrDesign,
+    /// Double integral action with Eq. 15's `q_z` replaced by the `10¹³` that Eqs. 16–17 imply.
+    pub double_reproducing: LqrDesign,
 }
 
 /// One design: `q` is the diagonal of `Q`, its length selects single (7) or double (8) action.
@@ -112,7 +118,7 @@ pub fn design(model: &DesignModel, q: &[f64], r: f64) -> Result<LqrDesign, BackS
     })
 }
 
-/// The designs of Eqs. 14–15 and the single design that reproduces Eqs. 16–17.
+/// The designs of Eqs. 14–15, and both again with the `q_z = 10¹³` that reproduces Eqs. 16–17.
 pub fn designs(model: &DesignModel) -> Result<LqrDesigns, BackSupportError> {
     let weights =
         |tail: &[f64]| -> Vec<f64> { STATE_WEIGHTS.iter().chain(tail).copied().collect() };
@@ -122,6 +128,11 @@ pub fn designs(model: &DesignModel) -> Result<LqrDesigns, BackSupportError> {
         double: design(
             model,
             &weights(&[PRINTED_Z_WEIGHT, OUTER_Z_WEIGHT]),
+            CONTROL_WEIGHT,
+        )?,
+        double_reproducing: design(
+            model,
+            &weights(&[REPRODUCING_Z_WEIGHT, OUTER_Z_WEIGHT]),
             CONTROL_WEIGHT,
         )?,
     })

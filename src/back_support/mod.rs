@@ -114,7 +114,10 @@ pub struct Study {
     pub lqr: lqr::LqrDesigns,
     pub seven_state: Vec<observer::SevenStateCase>,
     pub observer: observer::ObserverDesign,
+    /// The scenario with the double design of Eq. 15.
     pub scenario: scenario::ScenarioResult,
+    /// The scenario with the double design with `q_z = 10¹³` ([`lqr::LqrDesigns::double_reproducing`]).
+    pub scenario_reproducing: scenario::ScenarioResult,
     pub robustness: robustness::Robustness,
 }
 
@@ -128,6 +131,7 @@ pub fn study(cfg: &scenario::ScenarioConfig) -> Result<Study, BackSupportError> 
     let seven_state = observer::seven_state_check(&plant, &cfg.noise, cfg.sample_time)?;
     let obs = observer::design(&model, &cfg.noise, cfg.sample_time)?;
     let run = scenario::run(&p, &plant, &model, &lqr.double, &obs, cfg)?;
+    let run_reproducing = scenario::run(&p, &plant, &model, &lqr.double_reproducing, &obs, cfg)?;
     let robustness = robustness::analyse(&model, &lqr.double, &obs.continuous.l, &obs)?;
     Ok(Study {
         params: p,
@@ -136,6 +140,7 @@ pub fn study(cfg: &scenario::ScenarioConfig) -> Result<Study, BackSupportError> 
         seven_state,
         observer: obs,
         scenario: run,
+        scenario_reproducing: run_reproducing,
         robustness,
     })
 }

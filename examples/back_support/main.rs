@@ -9,8 +9,10 @@
 //! Prints a summary table; `--json PATH` writes the figures; SVG plots go to `--out DIR` (default
 //! `target/exo/back_support/`). The computations live in `bgc_workspace::back_support`.
 
+mod charts;
+mod figures;
 mod plots;
-mod report;
+mod table;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -63,9 +65,9 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    report::print_table(&s);
+    table::print_table(&s);
     if let Some(path) = &args.json {
-        let text = match serde_json::to_string_pretty(&report::json(&s)) {
+        let text = match serde_json::to_string_pretty(&figures::json(&s)) {
             Ok(t) => t,
             Err(e) => {
                 eprintln!("error: cannot serialise the figures: {e}");
@@ -82,7 +84,7 @@ fn main() -> ExitCode {
         eprintln!("error: cannot create {}: {e}", args.out.display());
         return ExitCode::FAILURE;
     }
-    match report::plots(&s, &args.out) {
+    match charts::plots(&s, &args.out) {
         Ok(files) => println!("{} plots written to {}", files, args.out.display()),
         Err(e) => {
             eprintln!("error: plotting failed: {e}");

@@ -110,8 +110,8 @@ pub fn seven_state_check(
         DMatrix::from_fn(2, 7, |i, j| plant.c[(if i == 0 { r0 } else { r1 }, j)])
     };
     let cases = [
-        ("measured [C_v; C_t]", rows(0, 1)),
-        ("printed [C_v; C_b] (Eq. 6)", rows(0, 2)),
+        ("[C_v; C_t] (measured)", rows(0, 1)),
+        ("[C_v; C_b] (text, Eq. 6)", rows(0, 2)),
     ];
     cases
         .into_iter()

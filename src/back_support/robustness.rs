@@ -19,7 +19,7 @@
 //! `τ_m = −K_x x̂[k|k] − K_z z − K_∫z ∫z`,
 //!
 //! and its loop with the zero-order-hold plant `(A_d, B_d, [C_v; C_t])` is analysed the same way
-//! ([`sampled_controller`]); its delay margin counts the half-sample delay of the hold.
+//! ([`sampled_controller`]); its frequency response includes the sampling and the hold.
 //!
 //! The disturbance path is the closed loop from the true trunk velocity (entering plant and observer, Eq. 8)
 //! to the estimated torque on the body `ŷ_b = C_b x̂ − d_eh θ̇_h`, state `[δ; x̂; z; ∫z]`. With two integrators

@@ -193,5 +193,59 @@ pub fn plots(s: &Study, dir: &Path) -> Result<usize, Box<dyn std::error::Error>>
         }],
     )?;
     count += 1;
+    nyquist(s, dir)?;
+    count += 1;
     Ok(count)
+}
+
+/// Fig. 14 analog: the Nyquist curve of the observer-based loop at the plant input near −1, with the unit
+/// circle; points farther than 3 from the origin are left out (the double integrator sends the curve to
+/// infinity at low frequency).
+fn nyquist(s: &Study, dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    let rb = &s.robustness;
+    // Contiguous runs of points inside the window, drawn as separate curves so that no line jumps across.
+    let mut runs: Vec<(Vec<f64>, Vec<f64>)> = vec![(Vec::new(), Vec::new())];
+    let points = 4000;
+    for i in 0..=points {
+        let w = 10f64.powf(-1.0 + 6.0 * i as f64 / points as f64);
+        let l = siso_response(&rb.loop_at_input, w)?;
+        match runs.last_mut() {
+            Some(run) if l.norm() <= 3.0 => {
+                run.0.push(l.re);
+                run.1.push(l.im);
+            }
+            Some(run) if !run.0.is_empty() => runs.push((Vec::new(), Vec::new())),
+            _ => {}
+        }
+    }
+    let circle = 360;
+    let cx: Vec<f64> = (0..=circle)
+        .map(|k| (2.0 * std::f64::consts::PI * k as f64 / circle as f64).cos())
+        .collect();
+    let cy: Vec<f64> = (0..=circle)
+        .map(|k| (2.0 * std::f64::consts::PI * k as f64 / circle as f64).sin())
+        .collect();
+    let (mx, my) = (vec![-1.0, -1.0], vec![-0.05, 0.05]);
+    plots::draw(
+        &dir.join("fig14_nyquist.svg"),
+        &[Panel {
+            title: "Fig. 14 analog: Nyquist curve at the plant input near −1 (ω > 0)",
+            x_label: "Re L(jω)",
+            y_label: "Im L(jω)",
+            series: runs
+                .iter()
+                .enumerate()
+                .map(|(i, (re, im))| {
+                    let label = if i == 0 { "L(jω), LQR + observer" } else { "" };
+                    line(label, re, im, BLUE_)
+                })
+                .chain([
+                    dashed("unit circle", &cx, &cy, GREY),
+                    line("critical point −1", &mx, &my, RED_),
+                ])
+                .collect(),
+            log_x: false,
+        }],
+    )?;
+    Ok(())
 }

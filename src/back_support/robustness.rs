@@ -59,6 +59,8 @@ pub struct Robustness {
     pub disturbance_peak_frequency_hz: f64,
     /// The rejection bandwidth (Hz), if the ratio crosses −3 dB in the scanned range.
     pub rejection_bandwidth_hz: Option<f64>,
+    /// The observer-based loop transfer at the plant input (for Nyquist plots).
+    pub loop_at_input: StateSpace,
     /// The disturbance path as a model (for Bode plots).
     pub disturbance_path: StateSpace,
     /// The uncontrolled disturbance path `(A₁, B_h, C_b, d_b)`.
@@ -224,7 +226,8 @@ pub fn analyse(
         DMatrix::zeros(2, 1),
     )?;
     let ctl = controller(model, lqr, l)?;
-    let observer_loop = stability_margins(&loop_at_plant_input(&plant, &ctl)?)?;
+    let loop_at_input = loop_at_plant_input(&plant, &ctl)?;
+    let observer_loop = stability_margins(&loop_at_input)?;
     let dt = observer.sample_time;
     let b_d = observer.b_d.columns(0, 1).clone_owned();
     let plant_d = StateSpace::new_discrete(
@@ -272,6 +275,7 @@ pub fn analyse(
         disturbance_peak_gain: peak,
         disturbance_peak_frequency_hz: peak_w / (2.0 * std::f64::consts::PI),
         rejection_bandwidth_hz: ratio_crossing(&path, &open, -3.0)?,
+        loop_at_input,
         disturbance_path: path,
         open_loop_disturbance_path: open,
     })

@@ -290,15 +290,15 @@ impl<'a> Parser<'a> {
         {
             let end = self.prev_end();
             let found = self.describe(t);
-            self.diags.push(
-                Diagnostic::error(
-                    "BG0101",
-                    format!("expected `;` after {what}, found {found}"),
-                )
-                .with_primary(self.span(end, end), "expected `;` here")
-                .with_secondary(self.tok_span(t), "the next statement starts here")
-                .with_help("end every statement with `;`"),
-            );
+            let mut d = Diagnostic::error(
+                "BG0101",
+                format!("expected `;` after {what}, found {found}"),
+            )
+            .with_primary(self.span(end, end), "expected `;` here");
+            if self.is_statement_keyword(t) || (self.starts_line(t) && t.kind == Tok::Ident) {
+                d = d.with_secondary(self.tok_span(t), "the next statement starts here");
+            }
+            self.diags.push(d.with_help("end every statement with `;`"));
             return Ok(());
         }
         Err(self.expected(&format!("`;` after {what}"), "end every statement with `;`"))
@@ -540,17 +540,30 @@ impl<'a> Parser<'a> {
         let word = self.tok_text(kw);
         let name = match self.expect_name(&format!("the name of the {word}")) {
             Ok(n) => n,
-            Err(Fail) => Ident {
-                name: String::new(),
-                span: self.span(kw.end, kw.end),
-            },
+            Err(Fail) => {
+                // `model 3 { ... }`: step over the bad name so the body is still read.
+                if !self.at(Tok::LBrace) && self.nth(1).kind == Tok::LBrace {
+                    self.bump();
+                }
+                Ident {
+                    name: String::new(),
+                    span: self.span(kw.end, kw.end),
+                }
+            }
         };
         let body = match self.eat(Tok::LBrace) {
             Some(open) => self.block_body(open, word),
             None => {
                 let _ = self.expected(
                     &format!("`{{` to open the body of the {word}"),
-                    &format!("write `{word} {} {{ ... }}`", name.name),
+                    &format!(
+                        "write `{word} {} {{ ... }}`",
+                        if name.name.is_empty() {
+                            "NAME"
+                        } else {
+                            &name.name
+                        }
+                    ),
                 );
                 self.recover();
                 Vec::new()

@@ -6,8 +6,9 @@
 //! cargo run --release --example back_support -- [--json PATH] [--out DIR]
 //! ```
 //!
-//! Prints a summary table; `--json PATH` writes the figures; SVG plots go to `--out DIR` (default
-//! `target/exo/back_support/`). The computations live in `bgc_workspace::back_support`.
+//! Prints a summary table; `--json PATH` writes the figures; SVG plots (analogs of Figs. 10–11 and 14–20) go
+//! to `--out DIR` (default `target/exo/back_support/`). The computations live in
+//! `bgc_workspace::back_support`.
 
 mod charts;
 mod figures;

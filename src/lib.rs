@@ -1,3 +1,7 @@
 //! Workspace root: integration tests and examples.
+//!
+//! - [`back_support`]: the back-support exoskeleton study behind the `back_support` example.
+//! - [`rehab`]: the rehabilitation-exoskeleton measurement study (IMU, vision and their fusion).
 
+pub mod back_support;
 pub mod rehab;

@@ -75,7 +75,15 @@ fn expected_span(bytes: &[u8], where_: &str) -> Span {
 
 #[test]
 fn every_invalid_fixture_gives_its_code_at_the_expected_place() {
-    let files = fixtures("invalid");
+    // The syntax stage's fixtures are the BG01xx ones; later stages' fixtures parse cleanly by design.
+    let files: Vec<_> = fixtures("invalid")
+        .into_iter()
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("BG01"))
+        })
+        .collect();
     assert!(files.len() >= 20, "only {} invalid fixtures", files.len());
     let mut codes_seen = std::collections::BTreeSet::new();
     for path in files {

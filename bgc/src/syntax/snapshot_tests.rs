@@ -221,6 +221,10 @@ fn invalid_fixture_diagnostics() {
             .and_then(|s| s.to_str())
             .unwrap_or("fixture")
             .to_string();
+        // The syntax stage's fixtures are the BG01xx ones; later stages' fixtures parse cleanly by design.
+        if !name.starts_with("BG01") {
+            continue;
+        }
         let mut sources = SourceMap::new();
         let diags = match decode(FileId(0), &bytes) {
             Ok(text) => {

@@ -3,8 +3,10 @@
 //! The "backbone" (junctions, two-ports, fields, and 1-ports not hanging on a junction) is laid out left to right
 //! in layers: the power direction of the bonds gives a longest-path layering (after reversing the back edges of a
 //! depth-first search so that it is acyclic), bonds spanning several layers get dummy points, and the order within
-//! each layer is improved by barycentric sweeps. Each 1-port attached to a junction (its satellites) is placed
-//! above or below that junction, alternately, so that storage, resistors and sources sit next to the junction
+//! each layer is improved by barycentric sweeps. Heights follow the neighbours' mean, with the node on the longest
+//! chain of each layer kept in place, so that the main chain of junctions is drawn on one straight line. Each
+//! 1-port attached to a junction (its satellites) is placed beside it (a source, on a free side) or above or below
+//! it, alternately, so that storage, resistors and sources sit next to the junction
 //! they belong to, as drawn in textbooks. Every backbone node owns a cell as wide as its satellites: bonds between
 //! layers leave a cell horizontally, so they never run through another element.
 
@@ -258,11 +260,50 @@ pub fn layout(model: &Model) -> Layout {
         x += l + r + COL_GAP;
     }
 
+    // The longest chain through each slot: in each layer the slot on the longest chain is the anchor that keeps
+    // the height it wants, so that the main chain of junctions is drawn straight and branches go around it.
+    let total_slots = n + dummy_layer.len();
+    let mut down = vec![0usize; total_slots];
+    let mut up = vec![0usize; total_slots];
+    for layer_slots in slots.iter().rev() {
+        for &s in layer_slots {
+            down[key(s)] = succs[key(s)]
+                .iter()
+                .map(|&t| down[key(t)] + 1)
+                .max()
+                .unwrap_or(0);
+        }
+    }
+    for layer_slots in &slots {
+        for &s in layer_slots {
+            up[key(s)] = preds[key(s)]
+                .iter()
+                .map(|&t| up[key(t)] + 1)
+                .max()
+                .unwrap_or(0);
+        }
+    }
+    let anchor: Vec<Option<usize>> = slots
+        .iter()
+        .map(|layer_slots| {
+            (0..layer_slots.len()).max_by_key(|&k| {
+                let s = layer_slots[k];
+                // Ties go to the node with more bonds (the one with more hanging on it), then to the first.
+                let degree = match s {
+                    Slot::Node(v) => g.neighbors_undirected(NodeIndex::new(v)).count(),
+                    Slot::Dummy(_) => 0,
+                };
+                (up[key(s)] + down[key(s)], degree, std::cmp::Reverse(k))
+            })
+        })
+        .collect();
+
     // Vertical positions: towards the neighbours' mean, left to right then right to left, without overlap.
     let mut y_node = vec![0.0f64; n];
     let mut y_dummy = vec![0.0f64; dummy_layer.len()];
+    // The last pass goes left to right, so that the power flow's main chain ends up straight.
     for pass in 0..4 {
-        let forward = pass % 2 == 0;
+        let forward = pass % 2 == 1;
         let order: Vec<usize> = if forward {
             (0..layers_count).collect()
         } else {
@@ -295,7 +336,7 @@ pub fn layout(model: &Model) -> Layout {
                 };
                 wanted.push(want);
             }
-            // Place in order, pushing down to avoid overlap, then centre the block on what was wanted.
+            // Place in order, pushing down to avoid overlap, then shift the block so the anchor is where it wants.
             let mut placed = Vec::new();
             for (k, &s) in slots[l].iter().enumerate() {
                 let ext = cell(s, &nodes);
@@ -303,12 +344,9 @@ pub fn layout(model: &Model) -> Layout {
                 prev_bottom = y + ext.d;
                 placed.push(y);
             }
-            let shift = if placed.is_empty() {
-                0.0
-            } else {
-                let want_mean = wanted.iter().sum::<f64>() / wanted.len() as f64;
-                let got_mean = placed.iter().sum::<f64>() / placed.len() as f64;
-                want_mean - got_mean
+            let shift = match anchor[l] {
+                Some(k) => wanted[k] - placed[k],
+                None => 0.0,
             };
             for (k, &s) in slots[l].iter().enumerate() {
                 let y = placed[k] + shift;

@@ -1,8 +1,10 @@
-//! Parsing throughput on a generated model of 100,000 elements and 100,000 bonds.
+//! Parsing and lowering throughput on a generated model of 100,000 elements and 100,000 bonds.
 //!
 //! Run with `cargo bench -p bgc --bench parse -- --quick`.
 
-use bgc::span::FileId;
+use bgc::diagnostic::has_errors;
+use bgc::lower::{MemoryLoader, lower};
+use bgc::span::{FileId, SourceMap};
 use bgc::syntax::{format, parse};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::fmt::Write;
@@ -17,13 +19,14 @@ fn model() -> String {
     let mut s = String::with_capacity(ELEMENTS * 60);
     s.push_str("/// A generated ladder.\nmodel ladder {\n    domain translational;\n");
     s.push_str("    param m = 0.5 [kg] \"cell mass\";\n    param k = 2.5e3 [N/m];\n    param d = 1.5 [N s/m];\n");
+    s.push_str("    param c3 = 0.1 [N s^3/m^3] \"cubic damping\";\n");
     s.push_str("    input F [N];\n    Se push = F;\n");
     for i in 0..cells {
         let _ = writeln!(s, "    // cell {i}");
         let _ = writeln!(s, "    1 v{i};");
         let _ = writeln!(s, "    I m{i} = m * (1 + {i} / {cells});");
         if i % 100 == 0 {
-            let _ = writeln!(s, "    R d{i} {{ e = d * f + 0.1 * f ^ 3; }}");
+            let _ = writeln!(s, "    R d{i} {{ e = d * f + c3 * f ^ 3; }}");
         } else {
             let _ = writeln!(s, "    R d{i} = d;");
         }
@@ -65,6 +68,26 @@ fn bench(c: &mut Criterion) {
     group.throughput(Throughput::Bytes(src.len() as u64));
     group.bench_function("format_100k_elements_bytes", |b| {
         b.iter(|| format(black_box(&tree)))
+    });
+    group.finish();
+
+    // The whole front end: parse, resolve names, infer domains, check units and build the bond graph.
+    let lower_once = |src: &str| {
+        let mut sources = SourceMap::new();
+        let id = sources.add("ladder.bg", src);
+        lower(&mut sources, id, &mut MemoryLoader::new())
+    };
+    let (models, diags) = lower_once(&src);
+    assert!(
+        !has_errors(&diags) && models.len() == 1,
+        "the generated model does not lower cleanly: {:?}",
+        diags.first()
+    );
+    let mut group = c.benchmark_group("front_end");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(ELEMENTS as u64));
+    group.bench_function("parse_and_lower_100k_elements", |b| {
+        b.iter(|| lower_once(black_box(&src)))
     });
     group.finish();
 }

@@ -1,1 +1,2 @@
 //! Workspace root: integration tests and examples.
+pub mod walking;

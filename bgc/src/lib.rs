@@ -7,6 +7,7 @@
 
 pub mod diagnostic;
 pub mod ir;
+pub mod lower;
 pub mod span;
 pub mod syntax;
 pub mod units;

@@ -17,6 +17,20 @@ pub struct Ident {
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct File {
     pub items: Vec<Item>,
+    /// Ordinary `//` comments (and doc comments that document nothing), in source order, for the formatter.
+    pub comments: Vec<Comment>,
+    /// Byte offsets of blank lines, so the formatter can keep the author's paragraphs.
+    pub blank_lines: Vec<u32>,
+}
+
+/// A `//` comment kept for the formatter; it has no meaning.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Comment {
+    /// The whole comment from its slashes, without the line break or trailing whitespace.
+    pub text: String,
+    pub span: Span,
+    /// Nothing but whitespace precedes it on its line (otherwise it trails code).
+    pub own_line: bool,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]

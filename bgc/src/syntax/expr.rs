@@ -1,0 +1,402 @@
+//! Expressions, units, node references and small integers.
+//!
+//! Expressions are parsed by precedence climbing over the grammar
+//!
+//! ```text
+//! expr    = term (("+" | "-") term)*
+//! term    = unary (("*" | "/") unary)*
+//! unary   = "-" unary | power
+//! power   = primary ("^" unary)?            (right-associative: a^b^c = a^(b^c); -a^2 = -(a^2))
+//! primary = NUMBER | NAME | NAME "[" INT "]" | NAME "(" args ")" | "(" expr ")"
+//! ```
+//!
+//! Binary chains are loops; nesting (parentheses, call arguments, unary minus, exponents) recurses. Both deepen the
+//! tree, and the depth of the tree is capped at [`MAX_DEPTH`] (`BG0105`), so neither the parser nor any later walk of
+//! an expression can overflow the stack.
+
+use super::ast::*;
+use super::lexer::{Tok, Token};
+use super::parser::{Fail, MAX_DEPTH, PResult, Parser};
+use crate::diagnostic::Diagnostic;
+use crate::span::Span;
+
+const EXPR_HELP: &str = "an expression is built from numbers, names, calls such as `f(x)` or `sin(x)`, parentheses \
+                         and the operators `+ - * / ^`";
+
+impl<'a> Parser<'a> {
+    /// An expression.
+    pub(super) fn expr(&mut self) -> PResult<Expr> {
+        self.expr_with(true)
+    }
+
+    /// An expression in which `name[...]` is not an index (a parameter's default, which its unit follows).
+    pub(super) fn expr_no_index(&mut self) -> PResult<Expr> {
+        self.expr_with(false)
+    }
+
+    fn enter(&mut self) -> PResult<()> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            let t = self.peek();
+            self.diags.push(
+                Diagnostic::error("BG0105", format!("expression nested too deeply (more than {MAX_DEPTH} levels)"))
+                    .with_primary(self.tok_span(t), "nesting limit reached here")
+                    .with_help("split the expression using parameters or outputs, or remove redundant parentheses"),
+            );
+            self.depth -= 1;
+            return Err(Fail);
+        }
+        Ok(())
+    }
+
+    fn leave(&mut self) {
+        self.depth = self.depth.saturating_sub(1);
+    }
+
+    fn expr_with(&mut self, index: bool) -> PResult<Expr> {
+        self.enter()?;
+        let r = self.additive(index);
+        self.leave();
+        r
+    }
+
+    fn additive(&mut self, index: bool) -> PResult<Expr> {
+        self.chain(index, Self::term, |t| match t {
+            Tok::Plus => Some(BinOp::Add),
+            Tok::Minus => Some(BinOp::Sub),
+            _ => None,
+        })
+    }
+
+    fn term(&mut self, index: bool) -> PResult<Expr> {
+        self.chain(index, Self::unary, |t| match t {
+            Tok::Star => Some(BinOp::Mul),
+            Tok::Slash => Some(BinOp::Div),
+            _ => None,
+        })
+    }
+
+    /// A left-associative chain `x op x op x ...`. Each operator deepens the tree by one level, so each counts
+    /// against the nesting limit: a chain of thousands of terms would otherwise build a tree too deep to walk.
+    fn chain(
+        &mut self,
+        index: bool,
+        operand: fn(&mut Self, bool) -> PResult<Expr>,
+        operator: fn(Tok) -> Option<BinOp>,
+    ) -> PResult<Expr> {
+        let mut levels = 0;
+        let result = (|| {
+            let mut lhs = operand(self, index)?;
+            while let Some(op) = operator(self.peek().kind) {
+                self.enter()?;
+                levels += 1;
+                self.bump();
+                let rhs = operand(self, index)?;
+                lhs = binary(op, lhs, rhs);
+            }
+            Ok(lhs)
+        })();
+        self.depth = self.depth.saturating_sub(levels);
+        result
+    }
+
+    fn unary(&mut self, index: bool) -> PResult<Expr> {
+        if let Some(minus) = self.eat(Tok::Minus) {
+            self.enter()?;
+            let operand = self.unary(index);
+            self.leave();
+            let operand = operand?;
+            let span = self.tok_span(minus).to(operand.span);
+            return Ok(Expr {
+                kind: ExprKind::Neg(Box::new(operand)),
+                span,
+            });
+        }
+        if self.at(Tok::Plus) {
+            return Err(self.expected(
+                "an expression",
+                "there is no unary `+`; write the operand alone",
+            ));
+        }
+        self.power(index)
+    }
+
+    fn power(&mut self, index: bool) -> PResult<Expr> {
+        let base = self.primary(index)?;
+        if self.eat(Tok::Caret).is_none() {
+            return Ok(base);
+        }
+        self.enter()?;
+        let exponent = self.unary(index);
+        self.leave();
+        Ok(binary(BinOp::Pow, base, exponent?))
+    }
+
+    fn primary(&mut self, index: bool) -> PResult<Expr> {
+        let t = self.peek();
+        match t.kind {
+            Tok::Number => {
+                self.bump();
+                Ok(Expr {
+                    kind: ExprKind::Number(t.value),
+                    span: self.tok_span(t),
+                })
+            }
+            Tok::LParen => {
+                self.bump();
+                let inner = self.expr()?;
+                self.close(Tok::RParen, t, "the parenthesis")?;
+                // The parentheses are not kept in the tree, but the span covers them.
+                Ok(Expr {
+                    kind: inner.kind,
+                    span: self.span_from(t.start),
+                })
+            }
+            Tok::Ident => {
+                let name = self.expect_name("an expression")?;
+                if let Some(open) = self.eat(Tok::LParen) {
+                    return self.call(name, open);
+                }
+                if index && self.at(Tok::LBracket) {
+                    let open = self.bump();
+                    let (i, _) = self.positive_int("an index")?;
+                    self.close(Tok::RBracket, open, "the index")?;
+                    return Ok(Expr {
+                        kind: ExprKind::Indexed(name.name, i),
+                        span: self.span_from(t.start),
+                    });
+                }
+                Ok(Expr {
+                    kind: ExprKind::Name(name.name),
+                    span: name.span,
+                })
+            }
+            _ => Err(self.expected("an expression", EXPR_HELP)),
+        }
+    }
+
+    /// The arguments of a call, after its `(`. The single argument of `e`, `f`, `p` or `q` that is written as a node
+    /// (`x`, `inst.x`, `field[2]`) becomes [`ExprKind::Node`].
+    fn call(&mut self, callee: Ident, open: Token) -> PResult<Expr> {
+        let start = callee.span.start;
+        let mut args = Vec::new();
+        if matches!(callee.name.as_str(), "e" | "f" | "p" | "q") && self.node_then_rparen() {
+            let node = self.node_ref()?;
+            let span = node.span;
+            args.push(Expr {
+                kind: ExprKind::Node(node),
+                span,
+            });
+        } else if !self.at(Tok::RParen) {
+            args.push(self.expr()?);
+            while self.eat(Tok::Comma).is_some() {
+                args.push(self.expr()?);
+            }
+        }
+        self.close(Tok::RParen, open, "the call")?;
+        if matches!(callee.name.as_str(), "e" | "f" | "p" | "q")
+            && let [arg] = args.as_mut_slice()
+        {
+            // `f((x))` names the same node as `f(x)`.
+            let node = match &arg.kind {
+                ExprKind::Name(n) => Some((n.clone(), None)),
+                ExprKind::Indexed(n, i) => Some((n.clone(), Some((*i, arg.span)))),
+                _ => None,
+            };
+            if let Some((name, port)) = node {
+                arg.kind = ExprKind::Node(NodeRef {
+                    path: vec![Ident {
+                        name,
+                        span: arg.span,
+                    }],
+                    port,
+                    span: arg.span,
+                });
+            }
+        }
+        Ok(Expr {
+            kind: ExprKind::Call(callee, args),
+            span: self.span_from(start),
+        })
+    }
+
+    /// The tokens ahead are a node reference followed by `)`.
+    fn node_then_rparen(&self) -> bool {
+        let mut k = 0;
+        if self.nth(k).kind != Tok::Ident {
+            return false;
+        }
+        k += 1;
+        while self.nth(k).kind == Tok::Dot && self.nth(k + 1).kind == Tok::Ident {
+            k += 2;
+        }
+        if self.nth(k).kind == Tok::LBracket
+            && self.nth(k + 1).kind == Tok::Number
+            && self.nth(k + 2).kind == Tok::RBracket
+        {
+            k += 3;
+        }
+        self.nth(k).kind == Tok::RParen
+    }
+
+    /// `NAME(.NAME)*([INT])?`
+    pub(super) fn node_ref(&mut self) -> PResult<NodeRef> {
+        let start = self.peek().start;
+        let mut path =
+            vec![self.expect_name("a node (an element, a junction, `inst.port` or `field[i]`)")?];
+        while self.eat(Tok::Dot).is_some() {
+            path.push(self.expect_name("a port name after `.`")?);
+        }
+        let mut port = None;
+        if let Some(open) = self.eat(Tok::LBracket) {
+            port = Some(self.positive_int("a port number")?);
+            self.close(Tok::RBracket, open, "the port number")?;
+        }
+        Ok(NodeRef {
+            path,
+            port,
+            span: self.span_from(start),
+        })
+    }
+
+    /// A closing bracket matching `open`; when missing, the error shows where the bracket was opened.
+    pub(super) fn close(&mut self, kind: Tok, open: Token, what: &str) -> PResult<Token> {
+        if let Some(t) = self.eat(kind) {
+            return Ok(t);
+        }
+        let t = self.peek();
+        let found = self.describe(t);
+        let want = kind.describe();
+        self.diags.push(
+            Diagnostic::error(
+                "BG0101",
+                format!("expected {want} to close {what}, found {found}"),
+            )
+            .with_primary(self.tok_span(t), format!("expected {want}"))
+            .with_secondary(self.tok_span(open), "opened here")
+            .with_help(format!("add the missing {want}")),
+        );
+        Err(Fail)
+    }
+
+    /// A positive integer written with digits only (a port count, an index, a port number).
+    pub(super) fn positive_int(&mut self, what: &str) -> PResult<(u32, Span)> {
+        let t = self.peek();
+        if t.kind != Tok::Number {
+            return Err(self.expected(what, "write a whole number such as `1` or `2`"));
+        }
+        self.bump();
+        let span = self.tok_span(t);
+        let text = self.tok_text(t);
+        match text.parse::<u32>() {
+            Ok(n) if n >= 1 && text.bytes().all(|b| b.is_ascii_digit()) => Ok((n, span)),
+            _ => {
+                self.diags.push(
+                    Diagnostic::error(
+                        "BG0115",
+                        format!("{what} must be a positive whole number, found `{text}`"),
+                    )
+                    .with_primary(span, "not a positive whole number")
+                    .with_help("ports and indices count from 1 and are written with digits only"),
+                );
+                Err(Fail)
+            }
+        }
+    }
+
+    /// `[N m/rad]`, `[kg m^2]`, `[1]`, `[1/s]`: factors with optional integer powers, one optional `/`, everything
+    /// after which is the denominator.
+    pub(super) fn unit(&mut self) -> PResult<UnitExpr> {
+        let open = self.expect(
+            Tok::LBracket,
+            "a unit in brackets",
+            "write the unit after the name, as in `[N m]`, `[m/s^2]` or `[1]` for dimensionless",
+        )?;
+        let mut numerator = Vec::new();
+        let mut denominator = Vec::new();
+        let mut one = None;
+        if self.at(Tok::Number) {
+            let t = self.bump();
+            if self.tok_text(t) != "1" {
+                return Err(self.bad_unit(
+                    self.tok_span(t),
+                    "a number in a unit can only be `1`, as in `[1]` or `[1/s]`",
+                ));
+            }
+            one = Some(t);
+        }
+        if one.is_none() {
+            self.unit_factors(&mut numerator)?;
+        }
+        if self.eat(Tok::Slash).is_some() {
+            self.unit_factors(&mut denominator)?;
+            if denominator.is_empty() {
+                return Err(
+                    self.expected("a unit after `/`", "write the denominator, as in `[m/s]`")
+                );
+            }
+        }
+        if numerator.is_empty() && one.is_none() && self.at(Tok::RBracket) {
+            let t = self.peek();
+            return Err(self.bad_unit(
+                self.tok_span(open).to(self.tok_span(t)),
+                "an empty unit: write `[1]` for a dimensionless quantity",
+            ));
+        }
+        self.close(Tok::RBracket, open, "the unit")?;
+        Ok(UnitExpr {
+            numerator,
+            denominator,
+            span: self.span_from(open.start),
+        })
+    }
+
+    fn unit_factors(&mut self, out: &mut Vec<(String, i32)>) -> PResult<()> {
+        while self.at(Tok::Ident) {
+            let t = self.bump();
+            let symbol = self.tok_text(t).to_string();
+            let mut power = 1;
+            if self.eat(Tok::Caret).is_some() {
+                let negative = self.eat(Tok::Minus).is_some();
+                let p = self.peek();
+                let text = self.tok_text(p);
+                let parsed = if p.kind == Tok::Number && text.bytes().all(|b| b.is_ascii_digit()) {
+                    text.parse::<i32>().ok().filter(|v| *v != 0)
+                } else {
+                    None
+                };
+                match parsed {
+                    Some(v) => {
+                        self.bump();
+                        power = if negative { -v } else { v };
+                    }
+                    None => {
+                        return Err(self.bad_unit(
+                            self.tok_span(p),
+                            "a unit's power is a non-zero whole number, as in `m^2` or `s^-1`",
+                        ));
+                    }
+                }
+            }
+            out.push((symbol, power));
+        }
+        Ok(())
+    }
+
+    fn bad_unit(&mut self, span: Span, help: &str) -> Fail {
+        self.diags.push(
+            Diagnostic::error("BG0116", "malformed unit")
+                .with_primary(span, "not a unit")
+                .with_help(help.to_string()),
+        );
+        Fail
+    }
+}
+
+fn binary(op: BinOp, lhs: Expr, rhs: Expr) -> Expr {
+    let span = lhs.span.to(rhs.span);
+    Expr {
+        kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
+        span,
+    }
+}

@@ -1,0 +1,435 @@
+//! The lexer: text to tokens, comments and lexical diagnostics.
+//!
+//! Each token class is recognised by a small nom parser over `&str`; the driver loop turns what they recognise into
+//! [`Token`]s with byte spans. Lexing never fails: a malformed literal becomes a token plus a diagnostic, and a
+//! character that starts no token is reported (runs of them as one diagnostic) and skipped. Comments do not enter
+//! the token stream; they are returned separately so that the parser can attach doc comments and the formatter can
+//! print ordinary ones back. Lexing is a single left-to-right pass, so it takes time linear in the input.
+
+use crate::diagnostic::Diagnostic;
+use crate::span::{FileId, Span};
+use nom::branch::alt;
+use nom::bytes::complete::{tag, take_while, take_while1};
+use nom::character::complete::{char, digit0, digit1, one_of};
+use nom::combinator::{opt, recognize};
+use nom::{IResult, Parser};
+
+/// The class of a token. Literal values live beside the tokens (see [`Lexed`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Tok {
+    Ident,
+    /// A number literal; its value is in [`Token::value`].
+    Number,
+    /// A string literal; its unescaped text is `Lexed::strings[index]`.
+    Str(u32),
+    LBrace,
+    RBrace,
+    LParen,
+    RParen,
+    LBracket,
+    RBracket,
+    Semi,
+    Comma,
+    Eq,
+    Colon,
+    Dot,
+    Arrow,
+    Plus,
+    Minus,
+    Star,
+    Slash,
+    Caret,
+    Bang,
+    Eof,
+}
+
+impl Tok {
+    /// How the token class is named in "expected ..." messages.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Tok::Ident => "a name",
+            Tok::Number => "a number",
+            Tok::Str(_) => "a string",
+            Tok::LBrace => "`{`",
+            Tok::RBrace => "`}`",
+            Tok::LParen => "`(`",
+            Tok::RParen => "`)`",
+            Tok::LBracket => "`[`",
+            Tok::RBracket => "`]`",
+            Tok::Semi => "`;`",
+            Tok::Comma => "`,`",
+            Tok::Eq => "`=`",
+            Tok::Colon => "`:`",
+            Tok::Dot => "`.`",
+            Tok::Arrow => "`->`",
+            Tok::Plus => "`+`",
+            Tok::Minus => "`-`",
+            Tok::Star => "`*`",
+            Tok::Slash => "`/`",
+            Tok::Caret => "`^`",
+            Tok::Bang => "`!`",
+            Tok::Eof => "the end of the file",
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Token {
+    pub kind: Tok,
+    pub start: u32,
+    pub end: u32,
+    /// The value of a number token (0 for other tokens and for malformed numbers, which are already reported).
+    pub value: f64,
+    /// A string literal without its closing quote (already reported); it ran to the end of its line.
+    pub unterminated: bool,
+}
+
+/// A `//` or `///` comment.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RawComment {
+    /// The whole comment, from the slashes to the end of the line, trailing whitespace removed.
+    pub text: String,
+    pub start: u32,
+    pub end: u32,
+    /// `///` (but not `////`): documentation of the next declaration.
+    pub doc: bool,
+    /// Nothing but whitespace precedes the comment on its line.
+    pub own_line: bool,
+}
+
+/// The lexer's output.
+#[derive(Clone, Debug, Default)]
+pub struct Lexed {
+    /// The tokens, always ending with one [`Tok::Eof`].
+    pub tokens: Vec<Token>,
+    pub strings: Vec<String>,
+    pub comments: Vec<RawComment>,
+    /// Byte offsets of the starts of blank lines, so the formatter can keep paragraphs apart.
+    pub blank_lines: Vec<u32>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+fn is_ident_start(c: char) -> bool {
+    c.is_ascii_alphabetic() || c == '_' || is_micro(c)
+}
+
+fn is_ident_continue(c: char) -> bool {
+    c.is_ascii_alphanumeric() || c == '_' || is_micro(c)
+}
+
+/// The micro sign and the Greek small mu, both accepted as the SI prefix `µ` in units.
+pub fn is_micro(c: char) -> bool {
+    c == '\u{b5}' || c == '\u{3bc}'
+}
+
+fn ident(i: &str) -> IResult<&str, &str> {
+    recognize((take_while1(is_ident_start), take_while(is_ident_continue))).parse(i)
+}
+
+/// `12`, `0.5`, `.5`, `12.`, with an optional exponent part; the exponent's digits are optional here so that `1e`
+/// is recognised (and then reported) as one malformed number rather than a number and a name.
+fn number(i: &str) -> IResult<&str, &str> {
+    recognize((
+        alt((
+            recognize((digit1, opt((char('.'), digit0)))),
+            recognize((char('.'), digit1)),
+        )),
+        opt((one_of("eE"), opt(one_of("+-")), digit0)),
+    ))
+    .parse(i)
+}
+
+fn line_comment(i: &str) -> IResult<&str, &str> {
+    recognize((tag("//"), take_while(|c| c != '\n'))).parse(i)
+}
+
+fn whitespace(i: &str) -> IResult<&str, &str> {
+    take_while1(|c: char| c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\u{c}').parse(i)
+}
+
+fn punct(i: &str) -> IResult<&str, Tok> {
+    if let Ok((rest, _)) = tag::<&str, &str, nom::error::Error<&str>>("->").parse(i) {
+        return Ok((rest, Tok::Arrow));
+    }
+    let (rest, c) = one_of("{}()[];,=:.+-*/^!").parse(i)?;
+    let kind = match c {
+        '{' => Tok::LBrace,
+        '}' => Tok::RBrace,
+        '(' => Tok::LParen,
+        ')' => Tok::RParen,
+        '[' => Tok::LBracket,
+        ']' => Tok::RBracket,
+        ';' => Tok::Semi,
+        ',' => Tok::Comma,
+        '=' => Tok::Eq,
+        ':' => Tok::Colon,
+        '.' => Tok::Dot,
+        '+' => Tok::Plus,
+        '-' => Tok::Minus,
+        '*' => Tok::Star,
+        '/' => Tok::Slash,
+        '^' => Tok::Caret,
+        _ => Tok::Bang,
+    };
+    Ok((rest, kind))
+}
+
+struct Lexer<'a> {
+    file: FileId,
+    text: &'a str,
+    out: Lexed,
+    /// Start of a run of invalid characters not yet reported.
+    junk: Option<(usize, usize)>,
+    /// Whether only whitespace has been seen since the last newline.
+    at_line_start: bool,
+}
+
+/// Splits `text` into tokens. See the module documentation.
+pub fn lex(file: FileId, text: &str) -> Lexed {
+    let mut out = Lexed::default();
+    // About one token per six bytes in typical models; reserving avoids repeated growth of a large vector.
+    out.tokens.reserve(text.len() / 6 + 1);
+    let mut lx = Lexer {
+        file,
+        text,
+        out,
+        junk: None,
+        at_line_start: true,
+    };
+    lx.run();
+    lx.out
+}
+
+impl<'a> Lexer<'a> {
+    fn span(&self, start: usize, end: usize) -> Span {
+        Span::new(self.file, start, end)
+    }
+
+    fn push(&mut self, kind: Tok, start: usize, end: usize, value: f64) {
+        self.out.tokens.push(Token {
+            kind,
+            start: start as u32,
+            end: end as u32,
+            value,
+            unterminated: false,
+        });
+        self.at_line_start = false;
+    }
+
+    fn flush_junk(&mut self) {
+        if let Some((start, end)) = self.junk.take() {
+            let shown: String = self
+                .text
+                .get(start..end)
+                .unwrap_or("")
+                .chars()
+                .take(1)
+                .collect();
+            let msg = if end - start == shown.len() {
+                format!("invalid character {shown:?}")
+            } else {
+                "invalid characters".to_string()
+            };
+            self.out.diagnostics.push(
+                Diagnostic::error("BG0104", msg)
+                    .with_primary(self.span(start, end), "not part of the language")
+                    .with_help(
+                        "names are ASCII letters, digits and `_`; text belongs in a \"string\"; comments start with `//`",
+                    ),
+            );
+        }
+    }
+
+    fn run(&mut self) {
+        let text = self.text;
+        // A byte-order mark, which some editors write at the start of UTF-8 files, is not text.
+        let mut rest = text.strip_prefix('\u{feff}').unwrap_or(text);
+        while !rest.is_empty() {
+            let start = text.len() - rest.len();
+            if let Ok((r, ws)) = whitespace(rest) {
+                self.flush_junk();
+                self.note_whitespace(start, ws);
+                rest = r;
+                continue;
+            }
+            if let Ok((r, c)) = line_comment(rest) {
+                self.flush_junk();
+                self.comment(start, c);
+                rest = r;
+                continue;
+            }
+            if let Ok((r, _)) = ident(rest) {
+                self.flush_junk();
+                self.push(Tok::Ident, start, text.len() - r.len(), 0.0);
+                rest = r;
+                continue;
+            }
+            if let Ok((r, n)) = number(rest) {
+                self.flush_junk();
+                rest = self.number(start, n, r);
+                continue;
+            }
+            if rest.starts_with('"') {
+                self.flush_junk();
+                rest = self.string(start, rest);
+                continue;
+            }
+            if let Ok((r, kind)) = punct(rest) {
+                self.flush_junk();
+                self.push(kind, start, text.len() - r.len(), 0.0);
+                rest = r;
+                continue;
+            }
+            // Nothing starts here: extend the current run of invalid characters by one character.
+            let width = rest.chars().next().map(char::len_utf8).unwrap_or(1);
+            let end = start + width;
+            self.junk = Some(match self.junk {
+                Some((s, _)) => (s, end),
+                None => (start, end),
+            });
+            self.at_line_start = false;
+            rest = rest.get(width..).unwrap_or("");
+        }
+        self.flush_junk();
+        let end = text.len();
+        self.out.tokens.push(Token {
+            kind: Tok::Eof,
+            start: end as u32,
+            end: end as u32,
+            value: 0.0,
+            unterminated: false,
+        });
+    }
+
+    /// Records blank lines: a newline followed by only whitespace and another newline.
+    fn note_whitespace(&mut self, start: usize, ws: &str) {
+        let mut newlines = 0;
+        for (i, c) in ws.char_indices() {
+            if c == '\n' {
+                newlines += 1;
+                self.at_line_start = true;
+                if newlines == 2 {
+                    self.out.blank_lines.push((start + i) as u32);
+                }
+            }
+        }
+    }
+
+    fn comment(&mut self, start: usize, c: &str) {
+        let doc = c.starts_with("///") && !c.starts_with("////");
+        self.out.comments.push(RawComment {
+            text: c.trim_end().to_string(),
+            start: start as u32,
+            end: (start + c.len()) as u32,
+            doc,
+            own_line: self.at_line_start,
+        });
+        self.at_line_start = false;
+    }
+
+    /// Checks a recognised number: malformed continuations (`1.2.3`, `1e`, `2x`) and non-finite values.
+    fn number(&mut self, start: usize, n: &'a str, r: &'a str) -> &'a str {
+        // A number glued to more digits, dots or letters is one malformed literal, not several tokens.
+        let glued = r
+            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '.' || c == '_'))
+            .unwrap_or(r.len());
+        let (tail, rest) = r.split_at(glued);
+        let end = start + n.len() + tail.len();
+        let span = self.span(start, end);
+        let literal = self.text.get(start..end).unwrap_or(n);
+        let exponent_without_digits = n.ends_with(['e', 'E', '+', '-']);
+        if !tail.is_empty() || exponent_without_digits {
+            let (msg, help) = if tail.starts_with('.') || n.matches('.').count() > 1 {
+                (
+                    format!("malformed number `{literal}`: more than one decimal point"),
+                    "a number has at most one `.`, as in `1.25`",
+                )
+            } else if exponent_without_digits {
+                (
+                    format!("malformed number `{literal}`: the exponent has no digits"),
+                    "write the exponent's digits, as in `1e3` or `2.5E-4`",
+                )
+            } else {
+                (
+                    format!("malformed number `{literal}`"),
+                    "separate a number from a name by a space or an operator, as in `2*x`; units go in brackets, as in `2 [kg]`",
+                )
+            };
+            self.out.diagnostics.push(
+                Diagnostic::error("BG0103", msg)
+                    .with_primary(span, "not a valid number")
+                    .with_help(help),
+            );
+            self.push(Tok::Number, start, end, 0.0);
+            return rest;
+        }
+        match n.parse::<f64>() {
+            Ok(v) if v.is_finite() => self.push(Tok::Number, start, end, v),
+            _ => {
+                self.out.diagnostics.push(
+                    Diagnostic::error("BG0103", format!("number `{literal}` is not finite"))
+                        .with_primary(span, "too large to be represented as a 64-bit float")
+                        .with_help("numbers must be finite; the largest is about 1.8e308"),
+                );
+                self.push(Tok::Number, start, end, 0.0);
+            }
+        }
+        rest
+    }
+
+    /// Lexes a string starting at `rest` (which starts with `"`). A string ends at its closing quote; a line break
+    /// or the end of the file before it makes it unterminated.
+    fn string(&mut self, start: usize, rest: &'a str) -> &'a str {
+        let mut value = String::new();
+        let mut chars = rest.char_indices().skip(1);
+        let mut end = None;
+        while let Some((i, c)) = chars.next() {
+            match c {
+                '"' => {
+                    end = Some(i + 1);
+                    break;
+                }
+                '\n' | '\r' => break,
+                '\\' => match chars.next() {
+                    Some((_, '"')) => value.push('"'),
+                    Some((_, '\\')) => value.push('\\'),
+                    Some((j, other)) if other != '\n' && other != '\r' => {
+                        let esc = self.span(start + i, start + j + other.len_utf8());
+                        self.out.diagnostics.push(
+                            Diagnostic::error(
+                                "BG0112",
+                                format!("unknown escape `\\{other}` in a string"),
+                            )
+                            .with_primary(esc, "not an escape")
+                            .with_help("the escapes are `\\\"` (a quote) and `\\\\` (a backslash)"),
+                        );
+                        value.push(other);
+                    }
+                    _ => break,
+                },
+                c => value.push(c),
+            }
+        }
+        let index = self.out.strings.len() as u32;
+        self.out.strings.push(value);
+        match end {
+            Some(len) => {
+                self.push(Tok::Str(index), start, start + len, 0.0);
+                rest.get(len..).unwrap_or("")
+            }
+            None => {
+                let len = rest.find(['\n', '\r']).unwrap_or(rest.len());
+                self.out.diagnostics.push(
+                    Diagnostic::error("BG0102", "unterminated string")
+                        .with_primary(self.span(start, start + len), "this string has no closing `\"`")
+                        .with_help("close the string with `\"` on the same line; write a quote inside it as `\\\"`"),
+                );
+                self.push(Tok::Str(index), start, start + len, 0.0);
+                if let Some(t) = self.out.tokens.last_mut() {
+                    t.unterminated = true;
+                }
+                rest.get(len..).unwrap_or("")
+            }
+        }
+    }
+}

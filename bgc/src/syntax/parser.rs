@@ -1,0 +1,629 @@
+//! The parser's core: the token cursor, error reporting and recovery, doc comments, files and blocks.
+//!
+//! The parser reads the lexer's tokens by recursive descent. A parse function returns `Err(Fail)` after it has
+//! recorded a diagnostic; the statement (or law, or item) that contains it then skips to a synchronisation point
+//! (the next `;` or the `}` closing the enclosing block, at the same brace depth, or a statement keyword that starts a
+//! line) and parsing continues, so one run reports many errors and the tree keeps every statement that parsed.
+//! Expression nesting is counted and capped at [`MAX_DEPTH`], so no input can overflow the stack. Every loop
+//! consumes at least one token per turn, so parsing is linear in the number of tokens.
+
+use super::ast::{self, Comment, Ident, Item};
+use super::lexer::{self, RawComment, Tok, Token};
+use crate::diagnostic::Diagnostic;
+use crate::span::{FileId, Span};
+
+/// The deepest nesting of expressions (parentheses, unary minus, powers, call arguments) the parser accepts.
+pub const MAX_DEPTH: usize = 200;
+
+/// Words that cannot be used as names.
+pub const KEYWORDS: &[&str] = &[
+    "model",
+    "component",
+    "param",
+    "input",
+    "output",
+    "var",
+    "bond",
+    "port",
+    "import",
+    "domain",
+    "coords",
+    "hint",
+    "stroke",
+    "Se",
+    "Sf",
+    "MSe",
+    "MSf",
+    "C",
+    "I",
+    "R",
+    "TF",
+    "GY",
+    "MTF",
+    "MGY",
+    "CF",
+    "RF",
+    "IF",
+];
+
+/// Keywords that begin a statement or an item; recovery stops before one that starts a line.
+const STATEMENT_KEYWORDS: &[&str] = &[
+    "model",
+    "component",
+    "import",
+    "param",
+    "input",
+    "output",
+    "var",
+    "bond",
+    "port",
+    "domain",
+    "coords",
+    "Se",
+    "Sf",
+    "MSe",
+    "MSf",
+    "C",
+    "I",
+    "R",
+    "TF",
+    "GY",
+    "MTF",
+    "MGY",
+    "CF",
+    "RF",
+    "IF",
+];
+
+pub fn is_keyword(s: &str) -> bool {
+    KEYWORDS.contains(&s)
+}
+
+/// A diagnostic has been recorded; the caller recovers.
+#[derive(Debug)]
+pub struct Fail;
+
+pub type PResult<T> = Result<T, Fail>;
+
+pub struct Parser<'a> {
+    pub(super) file: FileId,
+    pub(super) text: &'a str,
+    pub(super) toks: Vec<Token>,
+    pub(super) strings: Vec<String>,
+    pub(super) pos: usize,
+    pub(super) diags: Vec<Diagnostic>,
+    pub(super) depth: usize,
+    docs: Vec<RawComment>,
+    next_doc: usize,
+    comments: Vec<Comment>,
+}
+
+/// Parses a whole file. See [`crate::syntax::parse`].
+pub fn parse_file(file: FileId, text: &str) -> (ast::File, Vec<Diagnostic>) {
+    let lexed = lexer::lex(file, text);
+    let (docs, plain): (Vec<RawComment>, Vec<RawComment>) =
+        lexed.comments.into_iter().partition(|c| c.doc);
+    let comments = plain
+        .into_iter()
+        .map(|c| Comment {
+            text: c.text,
+            span: Span::new(file, c.start as usize, c.end as usize),
+            own_line: c.own_line,
+        })
+        .collect();
+    let mut p = Parser {
+        file,
+        text,
+        toks: lexed.tokens,
+        strings: lexed.strings,
+        pos: 0,
+        diags: lexed.diagnostics,
+        depth: 0,
+        docs,
+        next_doc: 0,
+        comments,
+    };
+    let items = p.items();
+    p.stray_docs_before(u32::MAX);
+    let mut comments = std::mem::take(&mut p.comments);
+    comments.sort_by_key(|c| c.span.start);
+    let mut diags = p.diags;
+    diags.sort_by_key(|d| d.primary_span().map(|s| s.start).unwrap_or(0));
+    (
+        ast::File {
+            items,
+            comments,
+            blank_lines: lexed.blank_lines,
+        },
+        diags,
+    )
+}
+
+impl<'a> Parser<'a> {
+    // ----- the cursor -----
+
+    pub(super) fn peek(&self) -> Token {
+        self.nth(0)
+    }
+
+    /// The token `k` places ahead (the end-of-file token beyond the end).
+    pub(super) fn nth(&self, k: usize) -> Token {
+        let last = self.toks.len().saturating_sub(1);
+        self.toks
+            .get((self.pos + k).min(last))
+            .copied()
+            .unwrap_or(Token {
+                kind: Tok::Eof,
+                start: self.text.len() as u32,
+                end: self.text.len() as u32,
+                value: 0.0,
+                unterminated: false,
+            })
+    }
+
+    pub(super) fn bump(&mut self) -> Token {
+        let t = self.peek();
+        if t.kind != Tok::Eof {
+            self.pos += 1;
+        }
+        t
+    }
+
+    pub(super) fn at(&self, kind: Tok) -> bool {
+        self.peek().kind == kind
+    }
+
+    pub(super) fn eat(&mut self, kind: Tok) -> Option<Token> {
+        if self.at(kind) {
+            Some(self.bump())
+        } else {
+            None
+        }
+    }
+
+    pub(super) fn tok_text(&self, t: Token) -> &'a str {
+        self.text
+            .get(t.start as usize..t.end as usize)
+            .unwrap_or("")
+    }
+
+    /// The current token is the name `word`.
+    pub(super) fn at_word(&self, word: &str) -> bool {
+        let t = self.peek();
+        t.kind == Tok::Ident && self.tok_text(t) == word
+    }
+
+    pub(super) fn span(&self, start: u32, end: u32) -> Span {
+        Span::new(self.file, start as usize, end as usize)
+    }
+
+    pub(super) fn tok_span(&self, t: Token) -> Span {
+        self.span(t.start, t.end)
+    }
+
+    /// End of the last consumed token.
+    pub(super) fn prev_end(&self) -> u32 {
+        if self.pos == 0 {
+            0
+        } else {
+            self.toks.get(self.pos - 1).map(|t| t.end).unwrap_or(0)
+        }
+    }
+
+    /// From `start` to the end of the last consumed token.
+    pub(super) fn span_from(&self, start: u32) -> Span {
+        self.span(start, self.prev_end().max(start))
+    }
+
+    /// The token is the first on its line.
+    pub(super) fn starts_line(&self, t: Token) -> bool {
+        let before = self.pos_before(t);
+        self.text
+            .get(before as usize..t.start as usize)
+            .is_some_and(|gap| gap.contains('\n'))
+            || before == 0
+    }
+
+    /// End of the token before `t` (assumes `t` is the current token or later).
+    fn pos_before(&self, t: Token) -> u32 {
+        let idx = self.toks.partition_point(|x| x.start < t.start);
+        if idx == 0 {
+            0
+        } else {
+            self.toks.get(idx - 1).map(|x| x.end).unwrap_or(0)
+        }
+    }
+
+    pub(super) fn is_statement_keyword(&self, t: Token) -> bool {
+        t.kind == Tok::Ident && STATEMENT_KEYWORDS.contains(&self.tok_text(t))
+    }
+
+    // ----- diagnostics -----
+
+    /// How a token is named in messages.
+    pub(super) fn describe(&self, t: Token) -> String {
+        let text = self.tok_text(t);
+        match t.kind {
+            Tok::Ident if is_keyword(text) => format!("keyword `{text}`"),
+            Tok::Ident => format!("`{}`", shorten(text)),
+            Tok::Number => format!("number `{}`", shorten(text)),
+            Tok::Str(_) => "a string".to_string(),
+            other => other.describe().to_string(),
+        }
+    }
+
+    /// Records "expected X, found Y" at the current token.
+    pub(super) fn expected(&mut self, what: &str, help: &str) -> Fail {
+        let t = self.peek();
+        let found = self.describe(t);
+        let d = Diagnostic::error("BG0101", format!("expected {what}, found {found}"))
+            .with_primary(self.tok_span(t), format!("expected {what}"))
+            .with_help(help.to_string());
+        self.diags.push(d);
+        Fail
+    }
+
+    pub(super) fn expect(&mut self, kind: Tok, what: &str, help: &str) -> PResult<Token> {
+        match self.eat(kind) {
+            Some(t) => Ok(t),
+            None => Err(self.expected(what, help)),
+        }
+    }
+
+    /// Expects the `;` that ends a statement. When the next token begins a new line or a statement, closes a block or
+    /// ends the file, the statement is complete and only the `;` is missing: the error points just after the statement and parsing
+    /// goes on as if the `;` were there.
+    pub(super) fn expect_semi(&mut self, what: &str) -> PResult<()> {
+        if self.eat(Tok::Semi).is_some() {
+            return Ok(());
+        }
+        let t = self.peek();
+        let after_unterminated =
+            self.pos > 0 && self.toks.get(self.pos - 1).is_some_and(|p| p.unterminated);
+        if after_unterminated && (self.starts_line(t) || matches!(t.kind, Tok::RBrace | Tok::Eof)) {
+            // The unterminated string swallowed the rest of its line, `;` included; it is reported already.
+            return Ok(());
+        }
+        if self.starts_line(t)
+            || self.is_statement_keyword(t)
+            || matches!(t.kind, Tok::RBrace | Tok::Eof)
+        {
+            let end = self.prev_end();
+            let found = self.describe(t);
+            self.diags.push(
+                Diagnostic::error(
+                    "BG0101",
+                    format!("expected `;` after {what}, found {found}"),
+                )
+                .with_primary(self.span(end, end), "expected `;` here")
+                .with_secondary(self.tok_span(t), "the next statement starts here")
+                .with_help("end every statement with `;`"),
+            );
+            return Ok(());
+        }
+        Err(self.expected(&format!("`;` after {what}"), "end every statement with `;`"))
+    }
+
+    /// Reads a name being declared or referred to. A keyword or a name with non-ASCII letters is reported but
+    /// accepted, so that the rest of the statement is still checked.
+    pub(super) fn expect_name(&mut self, what: &str) -> PResult<Ident> {
+        let t = self.peek();
+        if t.kind != Tok::Ident {
+            return Err(self.expected(
+                what,
+                "a name is a letter or `_` followed by letters, digits and `_`",
+            ));
+        }
+        self.bump();
+        let text = self.tok_text(t);
+        let span = self.tok_span(t);
+        if is_keyword(text) {
+            self.diags.push(
+                Diagnostic::error(
+                    "BG0109",
+                    format!("keyword `{text}` cannot be used as a name"),
+                )
+                .with_primary(span, "this is a keyword")
+                .with_help(format!(
+                    "choose another name, such as `{text}_1` or `my_{text}`"
+                )),
+            );
+        } else if !text.is_ascii() {
+            self.diags.push(
+                Diagnostic::error("BG0104", format!("name `{text}` has a non-ASCII character"))
+                    .with_primary(span, "names are ASCII")
+                    .with_help(
+                        "names are ASCII letters, digits and `_` (`µ` is only a unit prefix)",
+                    ),
+            );
+        }
+        Ok(Ident {
+            name: text.to_string(),
+            span,
+        })
+    }
+
+    /// Skips to the end of a failed statement: past the next `;`, or before the `}` that closes the enclosing block, a
+    /// statement keyword that starts a line, or the end of the file. Braces opened while skipping are skipped whole.
+    pub(super) fn recover(&mut self) {
+        let mut depth = 0usize;
+        loop {
+            let t = self.peek();
+            match t.kind {
+                Tok::Eof => return,
+                Tok::Semi if depth == 0 => {
+                    self.bump();
+                    return;
+                }
+                Tok::RBrace if depth == 0 => return,
+                Tok::RBrace => depth -= 1,
+                Tok::LBrace => depth += 1,
+                Tok::Ident if depth == 0 && self.is_statement_keyword(t) && self.starts_line(t) => {
+                    return;
+                }
+                _ => {}
+            }
+            self.bump();
+        }
+    }
+
+    // ----- doc comments -----
+
+    /// Takes the doc comments between the previous token and the current one. Earlier doc comments not taken by
+    /// anything (inside a statement, say) are reported as documenting nothing.
+    pub(super) fn take_docs(&mut self) -> Vec<(String, Span, bool)> {
+        let start = self.peek().start;
+        let prev = self.prev_end();
+        self.stray_docs_before(prev);
+        let mut out = Vec::new();
+        while let Some(d) = self.docs.get(self.next_doc) {
+            if d.start >= start {
+                break;
+            }
+            let text = d.text.get(3..).unwrap_or("");
+            let text = text.strip_prefix(' ').unwrap_or(text);
+            out.push((text.to_string(), self.span(d.start, d.end), d.own_line));
+            self.next_doc += 1;
+        }
+        out
+    }
+
+    /// Reports doc comments that precede something that takes no documentation, and keeps them as comments.
+    pub(super) fn reject_docs(&mut self, docs: Vec<(String, Span, bool)>, what: &str) {
+        for (text, span, own_line) in docs {
+            self.stray_doc(text, span, own_line, what);
+        }
+    }
+
+    fn stray_docs_before(&mut self, limit: u32) {
+        while let Some(d) = self.docs.get(self.next_doc) {
+            if d.start >= limit {
+                break;
+            }
+            let text = d.text.get(3..).unwrap_or("");
+            let text = text.strip_prefix(' ').unwrap_or(text).to_string();
+            let span = self.span(d.start, d.end);
+            let own_line = d.own_line;
+            self.next_doc += 1;
+            self.stray_doc(text, span, own_line, "nothing");
+        }
+    }
+
+    fn stray_doc(&mut self, text: String, span: Span, own_line: bool, what: &str) {
+        self.diags.push(
+            Diagnostic::warning("BG0114", format!("doc comment documents {what}"))
+                .with_primary(span, "this doc comment is not attached to a declaration")
+                .with_help(
+                    "put `///` comments right before a model, component, param, input, output, var, element or \
+                     instance; use `//` for other comments",
+                ),
+        );
+        let text = if text.is_empty() {
+            "//".to_string()
+        } else {
+            format!("// {text}")
+        };
+        self.comments.push(Comment {
+            text,
+            span,
+            own_line,
+        });
+    }
+
+    // ----- items -----
+
+    fn items(&mut self) -> Vec<Item> {
+        let mut items = Vec::new();
+        loop {
+            let t = self.peek();
+            match t.kind {
+                Tok::Eof => break,
+                Tok::Semi => {
+                    // An empty statement has no meaning.
+                    self.bump();
+                }
+                Tok::Ident if matches!(self.tok_text(t), "model" | "component") => {
+                    let docs = self.take_docs();
+                    items.push(Item::Model(self.model(docs)));
+                }
+                Tok::Ident if self.tok_text(t) == "import" => {
+                    let docs = self.take_docs();
+                    self.reject_docs(docs, "an import");
+                    if let Some(import) = self.import() {
+                        items.push(Item::Import(import));
+                    }
+                }
+                Tok::RBrace | Tok::RParen | Tok::RBracket => {
+                    self.bump();
+                    self.diags.push(
+                        Diagnostic::error("BG0111", format!("unmatched {}", t.kind.describe()))
+                            .with_primary(self.tok_span(t), "this closes nothing")
+                            .with_help(
+                                "remove it, or add the opening bracket it was meant to close",
+                            ),
+                    );
+                }
+                _ => {
+                    let help = if self.is_statement_keyword(t) || t.kind == Tok::Number {
+                        "statements belong inside a `model NAME { ... }` or `component NAME { ... }`"
+                    } else {
+                        "a file holds `import \"FILE\";` lines and `model` and `component` declarations"
+                    };
+                    let _ = self.expected("`model`, `component` or `import`", help);
+                    self.skip_to_item();
+                }
+            }
+        }
+        items
+    }
+
+    /// Skips junk at the top level up to the next `model`, `component` or `import` outside braces.
+    fn skip_to_item(&mut self) {
+        let mut depth = 0usize;
+        self.bump();
+        loop {
+            let t = self.peek();
+            match t.kind {
+                Tok::Eof => return,
+                Tok::LBrace => depth += 1,
+                Tok::RBrace => depth = depth.saturating_sub(1),
+                Tok::Ident
+                    if depth == 0
+                        && matches!(self.tok_text(t), "model" | "component" | "import") =>
+                {
+                    return;
+                }
+                _ => {}
+            }
+            self.bump();
+        }
+    }
+
+    fn import(&mut self) -> Option<ast::Import> {
+        let kw = self.bump();
+        let result = (|| {
+            let t = self.peek();
+            let path = match t.kind {
+                Tok::Str(i) => {
+                    self.bump();
+                    self.strings.get(i as usize).cloned().unwrap_or_default()
+                }
+                _ => {
+                    return Err(self.expected(
+                        "the path of the imported file as a string",
+                        "write `import \"std.bg\";` or a path relative to this file",
+                    ));
+                }
+            };
+            self.expect_semi("the import")?;
+            Ok(path)
+        })();
+        match result {
+            Ok(path) => Some(ast::Import {
+                path,
+                span: self.span_from(kw.start),
+            }),
+            Err(Fail) => {
+                self.recover();
+                None
+            }
+        }
+    }
+
+    fn model(&mut self, docs: Vec<(String, Span, bool)>) -> ast::ModelDecl {
+        let kw = self.bump();
+        let kind = if self.tok_text(kw) == "model" {
+            ast::ModelKind::Model
+        } else {
+            ast::ModelKind::Component
+        };
+        let word = self.tok_text(kw);
+        let name = match self.expect_name(&format!("the name of the {word}")) {
+            Ok(n) => n,
+            Err(Fail) => Ident {
+                name: String::new(),
+                span: self.span(kw.end, kw.end),
+            },
+        };
+        let body = match self.eat(Tok::LBrace) {
+            Some(open) => self.block_body(open, word),
+            None => {
+                let _ = self.expected(
+                    &format!("`{{` to open the body of the {word}"),
+                    &format!("write `{word} {} {{ ... }}`", name.name),
+                );
+                self.recover();
+                Vec::new()
+            }
+        };
+        ast::ModelDecl {
+            kind,
+            doc: docs.into_iter().map(|(t, _, _)| t).collect(),
+            name,
+            body,
+            span: self.span_from(kw.start),
+        }
+    }
+
+    /// The statements of a model or component body, up to and including its `}`.
+    fn block_body(&mut self, open: Token, word: &str) -> Vec<ast::Stmt> {
+        let mut body = Vec::new();
+        loop {
+            let t = self.peek();
+            match t.kind {
+                Tok::RBrace => {
+                    self.bump();
+                    break;
+                }
+                Tok::Eof => {
+                    self.unclosed(open, t, word);
+                    break;
+                }
+                Tok::Ident if matches!(self.tok_text(t), "model" | "component" | "import") => {
+                    self.unclosed(open, t, word);
+                    break;
+                }
+                Tok::Semi => {
+                    // An empty statement has no meaning.
+                    self.bump();
+                }
+                _ => {
+                    if let Some(s) = self.statement() {
+                        body.push(s);
+                    }
+                }
+            }
+        }
+        body
+    }
+
+    /// Reports a block whose `}` is missing when `found` (end of file or something that cannot be inside it) is met.
+    pub(super) fn unclosed(&mut self, open: Token, found: Token, what: &str) {
+        let found_desc = self.describe(found);
+        let at = if found.kind == Tok::Eof {
+            self.span(found.start, found.end)
+        } else {
+            self.tok_span(found)
+        };
+        self.diags.push(
+            Diagnostic::error(
+                "BG0106",
+                format!("unclosed `{{` of the {what}: expected `}}`, found {found_desc}"),
+            )
+            .with_primary(at, "expected `}` before this")
+            .with_secondary(self.tok_span(open), "this `{` is never closed")
+            .with_help(format!("close the {what} with `}}`")),
+        );
+    }
+}
+
+/// A token's text cut short for messages (a megabyte-long name should not fill the screen).
+fn shorten(s: &str) -> String {
+    const MAX: usize = 40;
+    if s.chars().count() <= MAX {
+        s.to_string()
+    } else {
+        let cut: String = s.chars().take(MAX).collect();
+        format!("{cut}...")
+    }
+}

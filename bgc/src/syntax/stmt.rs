@@ -1,0 +1,545 @@
+//! Statements of model and component bodies: declarations, elements, instances, bonds and ports.
+
+use super::ast::*;
+use super::lexer::Tok;
+use super::parser::{Fail, PResult, Parser};
+use crate::diagnostic::Diagnostic;
+use crate::span::Span;
+
+type Docs = Vec<(String, Span, bool)>;
+
+impl<'a> Parser<'a> {
+    /// Parses one statement; on a syntax error records it, skips the statement and returns `None`.
+    pub(super) fn statement(&mut self) -> Option<Stmt> {
+        let start_pos = self.pos;
+        let docs = self.take_docs();
+        match self.statement_inner(docs) {
+            Ok(s) => Some(s),
+            Err(Fail) => {
+                self.recover();
+                if self.pos == start_pos {
+                    self.bump();
+                }
+                None
+            }
+        }
+    }
+
+    fn statement_inner(&mut self, docs: Docs) -> PResult<Stmt> {
+        let t = self.peek();
+        let start = t.start;
+        if t.kind == Tok::Number {
+            let text = self.tok_text(t);
+            return match ElementKind::from_keyword(text) {
+                Some(kind) => self.element(docs, kind).map(Stmt::Element),
+                None => Err(self.expected(
+                    "a statement",
+                    "a junction is `0 NAME;` or `1 NAME;`; other statements start with a keyword",
+                )),
+            };
+        }
+        if t.kind != Tok::Ident {
+            return Err(self.expected(
+                "a statement",
+                "statements are declarations (`param`, `input`, `output`, `var`), elements, instances, `bond`, \
+                 `port`, `domain` and `coords`",
+            ));
+        }
+        let word = self.tok_text(t);
+        if let Some(kind) = ElementKind::from_keyword(word) {
+            return self.element(docs, kind).map(Stmt::Element);
+        }
+        let docs = match word {
+            "domain" | "coords" | "bond" | "port" => {
+                self.reject_docs(docs, &format!("a `{word}` statement"));
+                Vec::new()
+            }
+            _ => docs,
+        };
+        let stmt = match word {
+            "domain" => {
+                self.bump();
+                let domain = self.expect_name("a domain name")?;
+                self.expect_semi("the domain")?;
+                Stmt::Domain(DomainStmt {
+                    domain,
+                    span: self.span_from(start),
+                })
+            }
+            "param" => Stmt::Param(self.param(docs)?),
+            "input" => {
+                self.bump();
+                let name = self.expect_name("the name of the input")?;
+                let unit = self.unit()?;
+                let description = self.description();
+                self.expect_semi("the input")?;
+                Stmt::Input(InputDecl {
+                    doc: doc_text(docs),
+                    name,
+                    unit,
+                    description,
+                    span: self.span_from(start),
+                })
+            }
+            "output" => {
+                self.bump();
+                let name = self.expect_name("the name of the output")?;
+                let unit = self.unit()?;
+                self.expect(
+                    Tok::Eq,
+                    "`=` and the output's expression",
+                    "write `output NAME [UNIT] = EXPR;`",
+                )?;
+                let value = self.expr()?;
+                let description = self.description();
+                self.expect_semi("the output")?;
+                Stmt::Output(OutputDecl {
+                    doc: doc_text(docs),
+                    name,
+                    unit,
+                    value,
+                    description,
+                    span: self.span_from(start),
+                })
+            }
+            "var" => Stmt::Var(self.var(docs)?),
+            "coords" => {
+                self.bump();
+                let open = self.expect(
+                    Tok::LBracket,
+                    "`[` to open the list of coordinates",
+                    "write `coords [x1, x2, ...];`",
+                )?;
+                let mut coords = vec![self.expr()?];
+                while self.eat(Tok::Comma).is_some() {
+                    coords.push(self.expr()?);
+                }
+                self.close(Tok::RBracket, open, "the list of coordinates")?;
+                self.expect_semi("the coordinates")?;
+                Stmt::Coords(CoordsDecl {
+                    coords,
+                    span: self.span_from(start),
+                })
+            }
+            "bond" => Stmt::Bond(self.bond()?),
+            "port" => {
+                self.bump();
+                let name = self.expect_name("the name of the port")?;
+                self.expect(
+                    Tok::Eq,
+                    "`=` and the node the port names",
+                    "write `port NAME = NODE;`",
+                )?;
+                let target = self.node_ref()?;
+                self.expect_semi("the port")?;
+                Stmt::Port(PortDecl {
+                    name,
+                    target,
+                    span: self.span_from(start),
+                })
+            }
+            _ if super::parser::is_keyword(word) => {
+                return Err(self.expected(
+                    "a statement",
+                    "`model`, `component` and `import` belong at the top level of a file",
+                ));
+            }
+            _ => Stmt::Instance(self.instance(docs)?),
+        };
+        Ok(stmt)
+    }
+
+    /// `param NAME = EXPR [UNIT] ["description"];`
+    fn param(&mut self, docs: Docs) -> PResult<ParamDecl> {
+        let start = self.bump().start;
+        let name = self.expect_name("the name of the parameter")?;
+        self.expect(
+            Tok::Eq,
+            "`=` and the parameter's default value",
+            "write `param NAME = VALUE [UNIT];`",
+        )?;
+        // The default is followed by its unit in brackets, so `n [1]` must not read as an index.
+        let default = self.expr_no_index()?;
+        let unit = self.unit()?;
+        let description = self.description();
+        self.expect_semi("the parameter")?;
+        Ok(ParamDecl {
+            doc: doc_text(docs),
+            name,
+            default,
+            unit,
+            description,
+            span: self.span_from(start),
+        })
+    }
+
+    /// `var NAME [UNIT] = int(FLOW);`
+    fn var(&mut self, docs: Docs) -> PResult<VarDecl> {
+        let start = self.bump().start;
+        let name = self.expect_name("the name of the integrated flow")?;
+        let unit = self.unit()?;
+        self.expect(
+            Tok::Eq,
+            "`=` and `int(FLOW)`",
+            "write `var NAME [UNIT] = int(f(x));`",
+        )?;
+        if !self.at_word("int") {
+            return Err(self.expected(
+                "`int(...)`",
+                "a `var` is the integral of a flow: `var NAME [UNIT] = int(f(x));`",
+            ));
+        }
+        self.bump();
+        let open = self.expect(Tok::LParen, "`(` after `int`", "write `int(f(x))`")?;
+        let integrand = self.expr()?;
+        self.close(Tok::RParen, open, "the argument of `int`")?;
+        self.expect_semi("the var")?;
+        Ok(VarDecl {
+            doc: doc_text(docs),
+            name,
+            unit,
+            integrand,
+            span: self.span_from(start),
+        })
+    }
+
+    /// An optional description string.
+    fn description(&mut self) -> Option<String> {
+        match self.peek().kind {
+            Tok::Str(i) => {
+                self.bump();
+                Some(self.strings.get(i as usize).cloned().unwrap_or_default())
+            }
+            _ => None,
+        }
+    }
+
+    /// `KIND NAME[(n)] [: DOMAIN] [= EXPR | { LAW; ... }];`
+    fn element(&mut self, docs: Docs, kind: ElementKind) -> PResult<ElementDecl> {
+        let kw = self.bump();
+        let kind_span = self.tok_span(kw);
+        let name = self.expect_name(&format!("the name of the `{}` element", kind.keyword()))?;
+        let mut ports = None;
+        if let Some(open) = self.eat(Tok::LParen) {
+            let n = self.positive_int("the number of ports")?;
+            self.close(Tok::RParen, open, "the port count")?;
+            if !kind.is_field() {
+                self.diags.push(
+                    Diagnostic::error(
+                        "BG0117",
+                        format!("a `{}` element has no port count", kind.keyword()),
+                    )
+                    .with_primary(n.1, "only fields take a port count")
+                    .with_help(
+                        "only the multiport fields `CF`, `RF` and `IF` are written `KIND NAME(n)`",
+                    ),
+                );
+            }
+            ports = Some(n);
+        } else if kind.is_field() {
+            self.diags.push(
+                Diagnostic::error(
+                    "BG0117",
+                    format!("the `{}` field needs its number of ports", kind.keyword()),
+                )
+                .with_primary(name.span, "the port count should follow this name")
+                .with_help(format!(
+                    "write `{} {}(2) {{ ... }}` for a two-port field",
+                    kind.keyword(),
+                    name.name
+                )),
+            );
+        }
+        let domain = if self.eat(Tok::Colon).is_some() {
+            Some(self.expect_name("a domain name after `:`")?)
+        } else {
+            None
+        };
+        let body = if self.eat(Tok::Eq).is_some() {
+            let value = self.expr()?;
+            self.expect_semi("the element")?;
+            ElementBody::Value(value)
+        } else if let Some(open) = self.eat(Tok::LBrace) {
+            let laws = self.laws(open);
+            self.eat(Tok::Semi);
+            ElementBody::Laws(laws)
+        } else {
+            if !self.at(Tok::Semi) {
+                let t = self.peek();
+                if !(self.starts_line(t) || t.kind == Tok::RBrace) {
+                    return Err(self.expected(
+                        "`=`, `{` or `;`",
+                        "an element is `KIND NAME = VALUE;`, `KIND NAME { LAW; ... }` or, for a junction, `KIND NAME;`",
+                    ));
+                }
+            }
+            self.expect_semi("the element")?;
+            ElementBody::None
+        };
+        Ok(ElementDecl {
+            doc: doc_text(docs),
+            kind,
+            kind_span,
+            name,
+            ports,
+            domain,
+            body,
+            span: self.span_from(kw.start),
+        })
+    }
+
+    /// The laws of an element, after its `{`, up to and including the `}`.
+    fn laws(&mut self, open: super::lexer::Token) -> Vec<Law> {
+        let mut laws = Vec::new();
+        loop {
+            let t = self.peek();
+            match t.kind {
+                Tok::RBrace => {
+                    self.bump();
+                    break;
+                }
+                Tok::Semi => {
+                    self.bump();
+                }
+                Tok::Eof => {
+                    self.unclosed(open, t, "element's laws");
+                    break;
+                }
+                Tok::Ident if self.is_statement_keyword(t) && self.starts_line(t) => {
+                    self.unclosed(open, t, "element's laws");
+                    break;
+                }
+                _ => {
+                    let start_pos = self.pos;
+                    let docs = self.take_docs();
+                    self.reject_docs(docs, "a law");
+                    match self.law() {
+                        Ok(l) => laws.push(l),
+                        Err(Fail) => {
+                            self.recover();
+                            if self.pos == start_pos {
+                                self.bump();
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        laws
+    }
+
+    /// `LHS[i, j] = EXPR;`
+    fn law(&mut self) -> PResult<Law> {
+        let start = self.peek().start;
+        let lhs = self.expect_name("a law such as `e = ...`")?;
+        let mut indices = Vec::new();
+        if let Some(open) = self.eat(Tok::LBracket) {
+            indices.push(self.positive_int("an index")?);
+            while self.eat(Tok::Comma).is_some() {
+                indices.push(self.positive_int("an index")?);
+            }
+            self.close(Tok::RBracket, open, "the indices")?;
+        }
+        self.expect(
+            Tok::Eq,
+            "`=` in the law",
+            "a law is `VARIABLE = EXPR;`, as in `e = k*q;`",
+        )?;
+        let rhs = self.expr()?;
+        self.expect_semi("the law")?;
+        Ok(Law {
+            lhs,
+            indices,
+            rhs,
+            span: self.span_from(start),
+        })
+    }
+
+    /// `COMPONENT NAME(p = EXPR, ...);` (the parentheses may be left out when nothing is overridden).
+    fn instance(&mut self, docs: Docs) -> PResult<InstanceDecl> {
+        let start = self.peek().start;
+        let component = self.expect_name("a statement")?;
+        if self.peek().kind != Tok::Ident {
+            let help = match super::suggest::keyword_like(&component.name) {
+                Some(kw) => format!("did you mean the keyword `{kw}`?"),
+                None => "an instance of a component is `COMPONENT NAME(PARAM = VALUE, ...);`"
+                    .to_string(),
+            };
+            return Err(self.expected(
+                &format!("an instance name after `{}`", component.name),
+                &help,
+            ));
+        }
+        let name = self.expect_name("the name of the instance")?;
+        if !matches!(self.peek().kind, Tok::LParen | Tok::Semi)
+            && let Some(kw) = super::suggest::keyword_like(&component.name)
+        {
+            // `parm k = 1 [kg];` reads as an instance `k` of a component `parm`; the misspelling is the error.
+            self.diags.push(
+                Diagnostic::error(
+                    "BG0101",
+                    format!("expected a statement, found `{}`", component.name),
+                )
+                .with_primary(component.span, "not a keyword")
+                .with_help(format!("did you mean the keyword `{kw}`?")),
+            );
+            return Err(Fail);
+        }
+        let mut overrides = Vec::new();
+        if let Some(open) = self.eat(Tok::LParen) {
+            if !self.at(Tok::RParen) {
+                loop {
+                    let p = self.expect_name("a parameter name to override")?;
+                    self.expect(
+                        Tok::Eq,
+                        "`=` after the parameter name",
+                        "an override is `PARAM = VALUE`",
+                    )?;
+                    let v = self.expr()?;
+                    overrides.push((p, v));
+                    if self.eat(Tok::Comma).is_none() {
+                        break;
+                    }
+                }
+            }
+            self.close(Tok::RParen, open, "the overrides")?;
+        }
+        self.expect_semi("the instance")?;
+        Ok(InstanceDecl {
+            doc: doc_text(docs),
+            component,
+            name,
+            overrides,
+            span: self.span_from(start),
+        })
+    }
+
+    /// `bond [LABEL:] a -> b -> c, d [stroke[!] NODE];`
+    fn bond(&mut self) -> PResult<BondStmt> {
+        let start = self.bump().start;
+        let mut label = None;
+        if self.peek().kind == Tok::Ident && self.nth(1).kind == Tok::Colon {
+            label = Some(self.expect_name("the bond's name")?);
+            self.bump();
+        }
+        let mut chain = vec![self.node_group()?];
+        if !self.at(Tok::Arrow) {
+            return Err(self.expected(
+                "`->`",
+                "a bond joins two nodes: `bond a -> b;` (power flows from a to b)",
+            ));
+        }
+        while self.eat(Tok::Arrow).is_some() {
+            chain.push(self.node_group()?);
+        }
+        let mut hint = None;
+        if self.at_word("stroke") {
+            let kw = self.bump();
+            let fixed = self.eat(Tok::Bang).is_some();
+            let at = self.node_ref()?;
+            hint = Some(CausalHint {
+                at,
+                fixed,
+                span: self.span_from(kw.start),
+            });
+        }
+        self.expect_semi("the bond")?;
+        let bond = BondStmt {
+            label,
+            chain,
+            hint,
+            span: self.span_from(start),
+        };
+        self.check_bond_shape(&bond);
+        Ok(bond)
+    }
+
+    /// One node or a comma-separated fan-out.
+    fn node_group(&mut self) -> PResult<Vec<NodeRef>> {
+        let mut group = vec![self.node_ref()?];
+        while self.eat(Tok::Comma).is_some() {
+            group.push(self.node_ref()?);
+        }
+        Ok(group)
+    }
+
+    /// Fan-outs only at the end; labels and hints only on single bonds; a hint at one of the bond's ends.
+    fn check_bond_shape(&mut self, bond: &BondStmt) {
+        let last = bond.chain.len().saturating_sub(1);
+        for group in bond.chain.iter().take(last) {
+            if let (Some(first), Some(end)) = (group.first(), group.last())
+                && group.len() > 1
+            {
+                self.diags.push(
+                    Diagnostic::error("BG0110", "a fan-out must end the chain")
+                        .with_primary(first.span.to(end.span), "this fan-out is followed by `->`")
+                        .with_help("split the statement: `bond a -> b, c;` then one `bond` per continuing chain"),
+                );
+            }
+        }
+        let single = bond.chain.len() == 2 && bond.chain.iter().all(|g| g.len() == 1);
+        if single {
+            if let Some(h) = &bond.hint {
+                let ends: Vec<&NodeRef> = bond.chain.iter().flatten().collect();
+                if !ends.iter().any(|n| same_node(n, &h.at)) {
+                    let mut d = Diagnostic::error(
+                        "BG0113",
+                        "the causal stroke must be at one of the bond's ends",
+                    )
+                    .with_primary(h.at.span, "not an end of this bond");
+                    for n in ends {
+                        d = d.with_secondary(n.span, "an end of the bond");
+                    }
+                    self.diags.push(
+                        d.with_help("name one of the two nodes the bond joins after `stroke`"),
+                    );
+                }
+            }
+            return;
+        }
+        let what = if bond.chain.len() > 2 {
+            "a chain"
+        } else {
+            "a fan-out"
+        };
+        let whole = bond
+            .chain
+            .first()
+            .and_then(|g| g.first())
+            .zip(bond.chain.last().and_then(|g| g.last()))
+            .map(|(a, b)| a.span.to(b.span));
+        if let Some(label) = &bond.label {
+            let mut d =
+                Diagnostic::error("BG0110", format!("a bond name cannot be given to {what}"))
+                    .with_primary(label.span, "this names several bonds");
+            if let Some(w) = whole {
+                d = d.with_secondary(w, format!("{what} of several bonds"));
+            }
+            self.diags
+                .push(d.with_help("name a single bond: write it as its own `bond NAME: a -> b;`"));
+        }
+        if let Some(h) = &bond.hint {
+            let mut d = Diagnostic::error(
+                "BG0110",
+                format!("a causality hint cannot be given to {what}"),
+            )
+            .with_primary(h.span, "this hint would apply to several bonds");
+            if let Some(w) = whole {
+                d = d.with_secondary(w, format!("{what} of several bonds"));
+            }
+            self.diags
+                .push(d.with_help("give the hint on a single bond: `bond a -> b stroke b;`"));
+        }
+    }
+}
+
+/// Two node references name the same node (their spans aside).
+fn same_node(a: &NodeRef, b: &NodeRef) -> bool {
+    a.port.map(|p| p.0) == b.port.map(|p| p.0)
+        && a.path.len() == b.path.len()
+        && a.path.iter().zip(&b.path).all(|(x, y)| x.name == y.name)
+}
+
+fn doc_text(docs: Docs) -> Vec<String> {
+    docs.into_iter().map(|(t, _, _)| t).collect()
+}

@@ -1,0 +1,521 @@
+//! Unit tests of the parser: one or more per construct.
+
+use super::ast::*;
+use super::parse;
+use crate::diagnostic::Diagnostic;
+use crate::span::FileId;
+
+fn parse_ok(text: &str) -> File {
+    let (file, diags) = parse(FileId(0), text);
+    let errors: Vec<&Diagnostic> = diags.iter().filter(|d| d.is_error()).collect();
+    assert!(errors.is_empty(), "unexpected errors: {errors:#?}");
+    file
+}
+
+fn body(text: &str) -> Vec<Stmt> {
+    let src = format!("model m {{\n{text}\n}}\n");
+    let file = parse_ok(&src);
+    match file.items.into_iter().next() {
+        Some(Item::Model(m)) => m.body,
+        other => panic!("expected a model, got {other:?}"),
+    }
+}
+
+fn one(text: &str) -> Stmt {
+    let mut b = body(text);
+    assert_eq!(b.len(), 1, "{b:#?}");
+    b.remove(0)
+}
+
+fn codes(text: &str) -> Vec<&'static str> {
+    parse(FileId(0), text).1.iter().map(|d| d.code.0).collect()
+}
+
+/// An expression printed fully parenthesised, to check precedence and associativity.
+fn show(e: &Expr) -> String {
+    match &e.kind {
+        ExprKind::Number(v) => format!("{v}"),
+        ExprKind::Name(n) => n.clone(),
+        ExprKind::Indexed(n, i) => format!("{n}[{i}]"),
+        ExprKind::Call(f, args) => {
+            let a: Vec<String> = args.iter().map(show).collect();
+            format!("{}({})", f.name, a.join(", "))
+        }
+        ExprKind::Node(n) => {
+            let p: Vec<&str> = n.path.iter().map(|i| i.name.as_str()).collect();
+            match n.port {
+                Some((i, _)) => format!("<{}[{i}]>", p.join(".")),
+                None => format!("<{}>", p.join(".")),
+            }
+        }
+        ExprKind::Neg(x) => format!("(-{})", show(x)),
+        ExprKind::Binary(op, a, b) => {
+            let o = match op {
+                BinOp::Add => "+",
+                BinOp::Sub => "-",
+                BinOp::Mul => "*",
+                BinOp::Div => "/",
+                BinOp::Pow => "^",
+            };
+            format!("({} {o} {})", show(a), show(b))
+        }
+    }
+}
+
+fn output_expr(src: &str) -> String {
+    match one(&format!("output y [1] = {src};")) {
+        Stmt::Output(o) => show(&o.value),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn empty_input_and_only_comments_give_an_empty_file() {
+    assert!(parse_ok("").items.is_empty());
+    let f = parse_ok("// one\n// two\n");
+    assert!(f.items.is_empty());
+    assert_eq!(f.comments.len(), 2);
+    assert_eq!(f.comments[0].text, "// one");
+}
+
+#[test]
+fn precedence_and_associativity() {
+    assert_eq!(output_expr("1 + 2 * 3"), "(1 + (2 * 3))");
+    assert_eq!(output_expr("1 - 2 - 3"), "((1 - 2) - 3)");
+    assert_eq!(output_expr("a / b / c"), "((a / b) / c)");
+    assert_eq!(output_expr("a ^ b ^ c"), "(a ^ (b ^ c))");
+    assert_eq!(output_expr("-a ^ 2"), "(-(a ^ 2))");
+    assert_eq!(output_expr("-a * b"), "((-a) * b)");
+    assert_eq!(output_expr("2 ^ -x"), "(2 ^ (-x))");
+    assert_eq!(output_expr("(1 + 2) * 3"), "((1 + 2) * 3)");
+    assert_eq!(
+        output_expr("atan2(y, x) + f(sensor.spring)"),
+        "(atan2(y, x) + f(<sensor.spring>))"
+    );
+    assert_eq!(output_expr("e(leg[2]) * e[1]"), "(e(<leg[2]>) * e[1])");
+    assert_eq!(output_expr("f(a + b)"), "f((a + b))");
+}
+
+#[test]
+fn numbers() {
+    assert_eq!(
+        output_expr("12 + 0.5 + .5 + 3.06e-4 + 1E6"),
+        "((((12 + 0.5) + 0.5) + 0.0003060) + 1000000)".replace("0.0003060", "0.000306")
+    );
+    assert_eq!(codes("model m { param a = 1e999 [1]; }"), vec!["BG0103"]);
+    assert_eq!(codes("model m { param a = 1.2.3 [1]; }"), vec!["BG0103"]);
+    assert_eq!(codes("model m { param a = 1e [1]; }"), vec!["BG0103"]);
+}
+
+#[test]
+fn declarations() {
+    match one("/// mass\nparam m = 2 [kg] \"moving mass\";") {
+        Stmt::Param(p) => {
+            assert_eq!(p.doc, vec!["mass".to_string()]);
+            assert_eq!(p.name.name, "m");
+            assert_eq!(p.default.kind, ExprKind::Number(2.0));
+            assert_eq!(p.unit.numerator, vec![("kg".to_string(), 1)]);
+            assert_eq!(p.description.as_deref(), Some("moving mass"));
+        }
+        other => panic!("{other:?}"),
+    }
+    match one("param r = n [1];") {
+        Stmt::Param(p) => {
+            assert_eq!(p.default.kind, ExprKind::Name("n".into()));
+            assert!(p.unit.numerator.is_empty() && p.unit.denominator.is_empty());
+        }
+        other => panic!("{other:?}"),
+    }
+    match one("input tau [N m/rad] \"torque\";") {
+        Stmt::Input(i) => {
+            assert_eq!(i.unit.numerator, vec![("N".into(), 1), ("m".into(), 1)]);
+            assert_eq!(i.unit.denominator, vec![("rad".into(), 1)]);
+        }
+        other => panic!("{other:?}"),
+    }
+    match one("output a [m/s^2] = e(x) + 1;") {
+        Stmt::Output(o) => assert_eq!(o.unit.denominator, vec![("s".into(), 2)]),
+        other => panic!("{other:?}"),
+    }
+    match one("var th [rad] = int(f(rotor));") {
+        Stmt::Var(v) => assert_eq!(show(&v.integrand), "f(<rotor>)"),
+        other => panic!("{other:?}"),
+    }
+    match one("coords [th, f(rotor), p(m) - q(c)];") {
+        Stmt::Coords(c) => assert_eq!(c.coords.len(), 3),
+        other => panic!("{other:?}"),
+    }
+    match one("domain rotational;") {
+        Stmt::Domain(d) => assert_eq!(d.domain.name, "rotational"),
+        other => panic!("{other:?}"),
+    }
+    match one("port a = shaft.b;") {
+        Stmt::Port(p) => assert_eq!(p.target.path.len(), 2),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn elements() {
+    let b = body(
+        "Se push = F;\nI rotor : rotational = J;\n0 j;\n1 v;\nR fr { e = b0*sign(f) + b2*f; }\n\
+         IF leg(2) { mass[1,2] = c; mass[2,2] = c; }\nRF b(2) { e[1] = r*f[1]; e[2] = r*f[2]; };",
+    );
+    assert_eq!(b.len(), 7);
+    let kinds: Vec<ElementKind> = b
+        .iter()
+        .map(|s| match s {
+            Stmt::Element(e) => e.kind,
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    use ElementKind::*;
+    assert_eq!(kinds, vec![Se, I, Zero, One, R, IF, RF]);
+    match &b[1] {
+        Stmt::Element(e) => assert_eq!(
+            e.domain.as_ref().map(|d| d.name.as_str()),
+            Some("rotational")
+        ),
+        _ => unreachable!(),
+    }
+    match &b[5] {
+        Stmt::Element(e) => {
+            assert_eq!(e.ports.map(|p| p.0), Some(2));
+            match &e.body {
+                ElementBody::Laws(l) => {
+                    assert_eq!(l[0].lhs.name, "mass");
+                    assert_eq!(
+                        l[0].indices.iter().map(|i| i.0).collect::<Vec<_>>(),
+                        vec![1, 2]
+                    );
+                }
+                other => panic!("{other:?}"),
+            }
+        }
+        _ => unreachable!(),
+    }
+}
+
+#[test]
+fn instances() {
+    match one("spring_damper shaft(k = 500, d = 0.5);") {
+        Stmt::Instance(i) => {
+            assert_eq!(i.component.name, "spring_damper");
+            assert_eq!(i.name.name, "shaft");
+            assert_eq!(i.overrides.len(), 2);
+            assert_eq!(i.overrides[1].0.name, "d");
+        }
+        other => panic!("{other:?}"),
+    }
+    match one("gearbox g;") {
+        Stmt::Instance(i) => assert!(i.overrides.is_empty()),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn bonds() {
+    match one("bond motor -> j1 -> gear -> rotor, fric;") {
+        Stmt::Bond(b) => {
+            let sizes: Vec<usize> = b.chain.iter().map(Vec::len).collect();
+            assert_eq!(sizes, vec![1, 1, 1, 2]);
+        }
+        other => panic!("{other:?}"),
+    }
+    match one("bond s1: j2 -> spring stroke! spring;") {
+        Stmt::Bond(b) => {
+            assert_eq!(b.label.map(|l| l.name), Some("s1".into()));
+            let h = b.hint.expect("hint");
+            assert!(h.fixed);
+            assert_eq!(h.at.path[0].name, "spring");
+        }
+        other => panic!("{other:?}"),
+    }
+    match one("bond leg[2] -> coupling.a;") {
+        Stmt::Bond(b) => {
+            assert_eq!(b.chain[0][0].port.map(|p| p.0), Some(2));
+            assert_eq!(b.chain[1][0].path.len(), 2);
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(codes("model m { bond a, b -> c; }"), vec!["BG0110"]);
+    assert_eq!(codes("model m { bond s: a -> b -> c; }"), vec!["BG0110"]);
+    assert_eq!(
+        codes("model m { bond a -> b, c stroke b; }"),
+        vec!["BG0110"]
+    );
+    assert_eq!(codes("model m { bond a -> b stroke c; }"), vec!["BG0113"]);
+}
+
+#[test]
+fn imports_models_and_components() {
+    let f = parse_ok("import \"std.bg\";\n/// doc\ncomponent c { port a = j; }\nmodel m { }\n");
+    assert_eq!(f.items.len(), 3);
+    match &f.items[0] {
+        Item::Import(i) => assert_eq!(i.path, "std.bg"),
+        other => panic!("{other:?}"),
+    }
+    match &f.items[1] {
+        Item::Model(m) => {
+            assert_eq!(m.kind, ModelKind::Component);
+            assert_eq!(m.doc, vec!["doc".to_string()]);
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn recovery_reports_several_errors() {
+    let src = "model m {\n    param a = ;\n    param b = 2 [kg];\n    input c [N;\n    output d [1] = 1 +;\n    R r = 1;\n}\n";
+    let (file, diags) = parse(FileId(0), src);
+    assert_eq!(
+        diags.iter().filter(|d| d.is_error()).count(),
+        3,
+        "{diags:#?}"
+    );
+    match &file.items[0] {
+        Item::Model(m) => assert_eq!(m.body.len(), 2),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn deep_nesting_is_an_error_not_a_crash() {
+    let src = format!(
+        "model m {{ output y [1] = {}1{}; }}",
+        "(".repeat(10_000),
+        ")".repeat(10_000)
+    );
+    assert_eq!(codes(&src), vec!["BG0105"]);
+    let src = format!("model m {{ output y [1] = {}1; }}", "-".repeat(10_000));
+    assert_eq!(codes(&src), vec!["BG0105"]);
+    let src = format!("model m {{ output y [1] = {}1; }}", "2 ^ ".repeat(10_000));
+    assert_eq!(codes(&src), vec!["BG0105"]);
+    // A long chain builds a deep tree too.
+    let src = format!("model m {{ output y [1] = {}1; }}", "x + ".repeat(10_000));
+    assert_eq!(codes(&src), vec!["BG0105"]);
+    let src = format!("model m {{ output y [1] = {}1; }}", "x * ".repeat(10_000));
+    assert_eq!(codes(&src), vec!["BG0105"]);
+    // Within the limit, all is well: 150 terms, 150 parentheses.
+    let src = format!("model m {{ output y [1] = {}1; }}", "x + ".repeat(150));
+    assert!(codes(&src).is_empty());
+    let src = format!(
+        "model m {{ output y [1] = {}1{}; }}",
+        "(".repeat(150),
+        ")".repeat(150)
+    );
+    assert!(codes(&src).is_empty());
+}
+
+/// The ```bg blocks of docs/language.md. A block without a `model`, `component` or `import` at its top level is a
+/// fragment of a body and is checked inside a model.
+pub(super) fn language_examples() -> Vec<String> {
+    let doc = include_str!("../../../docs/language.md");
+    let mut out = Vec::new();
+    let mut current: Option<String> = None;
+    for line in doc.lines() {
+        match &mut current {
+            None if line.trim_start() == "```bg" => current = Some(String::new()),
+            None => {}
+            Some(block) if line.trim_start() == "```" => {
+                let top_level = block.lines().any(|l| {
+                    l.starts_with("model") || l.starts_with("component") || l.starts_with("import")
+                });
+                out.push(if top_level {
+                    block.clone()
+                } else {
+                    format!("model example {{\n{block}}}\n")
+                });
+                current = None;
+            }
+            Some(block) => {
+                block.push_str(line);
+                block.push('\n');
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn every_example_of_the_language_reference_parses() {
+    let examples = language_examples();
+    assert!(
+        examples.len() >= 13,
+        "found only {} examples",
+        examples.len()
+    );
+    for ex in &examples {
+        let (_, diags) = parse(FileId(0), ex);
+        assert!(diags.is_empty(), "{ex}\n{diags:#?}");
+    }
+}
+
+#[test]
+fn megabyte_long_line() {
+    let stmt = "param p = 1 [kg]; ";
+    let n = 1_000_000 / stmt.len();
+    let mut src = String::from("model m { ");
+    for i in 0..n {
+        src.push_str(&stmt.replace("p =", &format!("p{i} =")));
+    }
+    src.push('}');
+    assert!(src.len() > 1_000_000);
+    assert_eq!(body_of(&parse_ok(&src)).len(), n);
+    // One name a megabyte long.
+    let long = "x".repeat(1 << 20);
+    let f = parse_ok(&format!("model m {{ input {long} [1]; }}"));
+    match &body_of(&f)[0] {
+        Stmt::Input(i) => assert_eq!(i.name.name.len(), 1 << 20),
+        other => panic!("{other:?}"),
+    }
+}
+
+fn body_of(f: &File) -> &[Stmt] {
+    match f.items.first() {
+        Some(Item::Model(m)) => &m.body,
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn binary_junk_is_one_diagnostic_per_run() {
+    let junk: String = (0..100_000)
+        .map(|i| char::from(b"#$%&?@`|~\x01"[i % 10]))
+        .collect();
+    let (file, diags) = parse(FileId(0), &junk);
+    assert!(file.items.is_empty());
+    assert_eq!(diags.len(), 1, "{:?}", &diags[..diags.len().min(3)]);
+    assert_eq!(diags[0].code.0, "BG0104");
+    assert_eq!(diags[0].primary_span().map(|s| s.range()), Some(0..100_000));
+    // Junk between two models is reported and the models are kept.
+    let (file, diags) = parse(FileId(0), "model a {}\n@@@ junk ###\nmodel b {}\n");
+    assert_eq!(file.items.len(), 2);
+    let c: Vec<&str> = diags.iter().map(|d| d.code.0).collect();
+    assert_eq!(c, vec!["BG0104", "BG0101", "BG0104"]);
+}
+
+#[test]
+fn crlf_line_endings() {
+    let src = "/// Doc.\r\nmodel m {\r\n    param a = 1 [kg]; // c\r\n    bond a -> b;\r\n}\r\n";
+    let f = parse_ok(src);
+    match &f.items[0] {
+        Item::Model(m) => {
+            assert_eq!(m.doc, vec!["Doc.".to_string()]);
+            assert_eq!(m.body.len(), 2);
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(f.comments[0].text, "// c");
+    // A missing `;` before a CRLF line break is found as before an LF one.
+    let (_, d) = parse(
+        FileId(0),
+        "model m {\r\n    param a = 1 [kg]\r\n    param b = 2 [kg];\r\n}\r\n",
+    );
+    assert_eq!(d.len(), 1);
+    let end_of_unit = "model m {\r\n    param a = 1 [kg]".len();
+    assert_eq!(
+        d[0].primary_span().map(|s| s.range()),
+        Some(end_of_unit..end_of_unit)
+    );
+}
+
+#[test]
+fn missing_semicolon_before_a_statement_on_the_same_line() {
+    let src = "model m { param a = 1 [kg] param b = 2 [kg]; }";
+    let (file, diags) = parse(FileId(0), src);
+    assert_eq!(diags.len(), 1);
+    let end = "model m { param a = 1 [kg]".len();
+    assert_eq!(diags[0].primary_span().map(|s| s.range()), Some(end..end));
+    assert_eq!(body_of(&file).len(), 2);
+}
+
+#[test]
+fn keyword_as_name_is_reported_and_the_statement_kept() {
+    let (file, diags) = parse(FileId(0), "model m { param bond = 1 [1]; C R = 1; }");
+    let c: Vec<&str> = diags.iter().map(|d| d.code.0).collect();
+    assert_eq!(c, vec!["BG0109", "BG0109"]);
+    assert_eq!(body_of(&file).len(), 2);
+}
+
+#[test]
+fn misspelt_keyword_gets_a_suggestion() {
+    let (_, diags) = parse(FileId(0), "model m { parm k = 1 [1]; }");
+    assert_eq!(diags.len(), 1);
+    assert_eq!(
+        diags[0].help.as_deref(),
+        Some("did you mean the keyword `param`?")
+    );
+}
+
+#[test]
+fn unclosed_paren_points_at_the_opening() {
+    let src = "model m { output y [1] = (1 + 2; }";
+    let (_, diags) = parse(FileId(0), src);
+    assert_eq!(diags.len(), 1);
+    let d = &diags[0];
+    assert_eq!(d.code.0, "BG0101");
+    assert_eq!(d.primary_span().map(|s| s.range()), Some(31..32));
+    let secondary: Vec<_> = d
+        .labels
+        .iter()
+        .filter(|l| !l.primary)
+        .map(|l| l.span.range())
+        .collect();
+    assert_eq!(secondary, vec![25..26]);
+}
+
+#[test]
+fn unclosed_law_block_stops_at_the_next_statement() {
+    let src = "model m {\n    R r { e = f;\n    param k = 1 [1];\n}\n";
+    let (file, diags) = parse(FileId(0), src);
+    let c: Vec<&str> = diags.iter().map(|d| d.code.0).collect();
+    assert_eq!(c, vec!["BG0106"]);
+    assert_eq!(body_of(&file).len(), 2);
+}
+
+#[test]
+fn spans_are_byte_ranges() {
+    let src = "model m {\n    param µk = 1 [µm];\n    output y [1] = 2 * x;\n}\n";
+    let (file, diags) = parse(FileId(0), src);
+    // `µk` is not a name (non-ASCII); `µm` is a unit.
+    assert_eq!(
+        diags.iter().map(|d| d.code.0).collect::<Vec<_>>(),
+        vec!["BG0104"]
+    );
+    let y = match &body_of(&file)[1] {
+        Stmt::Output(o) => o.clone(),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(&src[y.span.range()], "output y [1] = 2 * x;");
+    assert_eq!(&src[y.value.span.range()], "2 * x");
+    assert_eq!(&src[y.unit.span.range()], "[1]");
+}
+
+#[test]
+fn decode_points_at_the_first_bad_byte() {
+    use super::decode;
+    assert_eq!(decode(FileId(3), b"model m {}"), Ok("model m {}"));
+    // 0xC3 0x28: a two-byte sequence broken by its second byte; the error covers the first byte only.
+    let d = decode(FileId(3), b"ab\xC3\x28cd").expect_err("an error");
+    assert_eq!(d.code.0, "BG0100");
+    assert_eq!(
+        d.primary_span(),
+        Some(crate::span::Span::new(FileId(3), 2, 3))
+    );
+    // A sequence cut short by the end of the file runs to the end.
+    let d = decode(FileId(0), "é".as_bytes().get(..1).unwrap_or(&[])).expect_err("an error");
+    assert_eq!(d.primary_span().map(|s| s.range()), Some(0..1));
+    let d = decode(FileId(0), b"ab\xE2\x82").expect_err("an error");
+    assert_eq!(d.primary_span().map(|s| s.range()), Some(2..4));
+}
+
+#[test]
+fn byte_order_mark_is_ignored() {
+    let f = parse_ok("\u{feff}model m { param a = 1 [kg]; }");
+    assert_eq!(body_of(&f).len(), 1);
+    match &body_of(&f)[0] {
+        Stmt::Param(p) => assert_eq!(p.name.span.range(), 19..20),
+        other => panic!("{other:?}"),
+    }
+}

@@ -391,17 +391,16 @@ fn dual_ukf_masses_converge_on_a_noise_free_run() {
     cfg.wearer.torso_mass = 0.0;
     let out = run(&cfg).unwrap_or_else(|e| panic!("{e}"));
     let truth = LegSegments::paper_subject().masses();
-    for i in 0..3 {
+    for (i, &m) in truth.iter().enumerate() {
         assert!(
-            (cfg.estimator.initial_masses[i] / truth[i] - 1.2).abs() < 1e-12,
+            (cfg.estimator.initial_masses[i] / m - 1.2).abs() < 1e-12,
             "initial mass {i} not 20 % off"
         );
         let estimate = out.masses.final_mean[i];
         assert!(
-            (estimate - truth[i]).abs() < 0.01 * truth[i],
-            "m{} = {estimate} kg, true {} kg",
-            i + 1,
-            truth[i]
+            (estimate - m).abs() < 0.01 * m,
+            "m{} = {estimate} kg, true {m} kg",
+            i + 1
         );
     }
 }

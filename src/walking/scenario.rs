@@ -11,8 +11,9 @@
 //! initial guess):
 //!
 //! - Table 7: per joint, the mean position innovation (residual), the mean of its normalised
-//!   autocorrelation over lags 1–20 (the runtime's `FilterHealth`), the mean state error `x − x̂` for
-//!   position and velocity and the percentage of filter steps on which it exceeded `√P_ii`;
+//!   autocorrelation over lags 1–20 (the runtime's `FilterHealth`), the mean state error `x − x̂` (with `x`
+//!   the wearer's joint angles and speeds, which the filter estimates) for position and velocity and the
+//!   percentage of filter steps on which it exceeded `√P_ii`;
 //! - Table 9: per joint, the RMS difference between the reference (the filter's prediction) and the leg's
 //!   actual position and velocity, over all 1 ms samples.
 
@@ -197,6 +198,7 @@ impl WalkingConfig {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct FilterSample {
     pub t: f64,
+    /// The wearer's joint angles and speeds, which the filter estimates.
     pub q_true: [f64; 3],
     pub qd_true: [f64; 3],
     pub q_measured: [f64; 3],
@@ -549,7 +551,9 @@ pub fn run(cfg: &WalkingConfig) -> Result<WalkingRun, WalkingError> {
     let mut filter = Vec::with_capacity(pending_filter.len());
     for p in &pending_filter {
         let t = p.k as f64 * cfg.control_period;
-        let Some(x) = truth(p.k) else { continue };
+        // The filter estimates the wearer's motion (it reads the wearer's joint angles and the gait torque).
+        let w = wearer.intended(t);
+        let x = join(&w.q, &w.qd);
         let err = (x - p.estimate) / DEG;
         if t >= cfg.warmup {
             health

@@ -459,3 +459,116 @@ fn closed_loop_figures_within_bounds() {
         );
     }
 }
+
+/// The synthetic wearer's analytic velocities and accelerations are the derivatives of its angles (central
+/// differences, across the once-a-second blends of rate and excursion too), the ranges are those of normal
+/// gait (hip about ±20°, knee 0–60°, ankle within ±15°, with the 4 % excursion variation on top), and the
+/// right foot is down 62 % of each cycle.
+#[test]
+fn synthetic_wearer_kinematics_are_consistent_and_realistic() {
+    let wearer = Wearer::new(&WearerConfig {
+        duration: 10.0,
+        ..WearerConfig::default()
+    });
+    let deg = 180.0 / std::f64::consts::PI;
+    let h = 1e-5;
+    let (mut lo, mut hi) = (Vector3::repeat(f64::MAX), Vector3::repeat(f64::MIN));
+    let mut stance = 0usize;
+    let n = 9000;
+    for k in 0..n {
+        let t = 0.5 + k as f64 * 1e-3;
+        let w = wearer.intended(t);
+        let (p, m) = (wearer.intended(t + h), wearer.intended(t - h));
+        let qd = (p.q - m.q) / (2.0 * h);
+        let qdd = (p.qd - m.qd) / (2.0 * h);
+        assert!(
+            (qd - w.qd).abs().max() < 1e-6 * w.qd.abs().max().max(1.0),
+            "q̇ at t = {t}"
+        );
+        assert!(
+            (qdd - w.qdd).abs().max() < 1e-5 * w.qdd.abs().max().max(1.0),
+            "q̈ at t = {t}"
+        );
+        lo = lo.inf(&(w.q * deg));
+        hi = hi.sup(&(w.q * deg));
+        stance += usize::from(wearer.right_in_stance(t));
+    }
+    assert!(
+        lo[0] > -17.0 && hi[0] < 12.0,
+        "ankle {:.1}..{:.1}°",
+        lo[0],
+        hi[0]
+    );
+    assert!(
+        lo[1] > 0.0 && hi[1] < 65.0 && hi[1] > 55.0,
+        "knee {:.1}..{:.1}°",
+        lo[1],
+        hi[1]
+    );
+    assert!(
+        lo[2] > -16.0 && lo[2] < -10.0 && hi[2] > 20.0 && hi[2] < 25.0,
+        "hip {:.1}..{:.1}°",
+        lo[2],
+        hi[2]
+    );
+    let fraction = stance as f64 / n as f64;
+    assert!(
+        (fraction - STANCE_FRACTION).abs() < 0.02,
+        "stance fraction {fraction}"
+    );
+    // The cycle varies: the phase after 9 s is not exactly 9 cycles, but close.
+    let (phi, _, _) = wearer.phase(9.5);
+    assert!(
+        (phi - 9.5).abs() > 1e-3 && (phi - 9.5).abs() < 0.3,
+        "phase {phi}"
+    );
+}
+
+/// Settings out of their domain are refused with the setting's name, not a panic.
+#[test]
+fn bad_settings_are_refused() {
+    use bgc_workspace::walking::scenario::WalkingError;
+    let refused = |cfg: WalkingConfig| match run(&cfg) {
+        Err(WalkingError::Setting { name, .. }) => name.to_string(),
+        Err(WalkingError::Estimation { source, .. }) => format!("{source}"),
+        other => panic!("accepted: {:?}", other.map(|r| r.table9)),
+    };
+    let base = WalkingConfig::paper(3.0);
+    assert_eq!(
+        refused(WalkingConfig {
+            control_period: 0.0,
+            ..base
+        }),
+        "control_period"
+    );
+    assert_eq!(
+        refused(WalkingConfig {
+            filter_decimation: 0,
+            ..base
+        }),
+        "filter_decimation"
+    );
+    assert_eq!(
+        refused(WalkingConfig {
+            duration: f64::NAN,
+            ..base
+        }),
+        "duration"
+    );
+    assert_eq!(
+        refused(WalkingConfig {
+            impedance_frequency: -1.0,
+            ..base
+        }),
+        "impedance_frequency"
+    );
+    let mut cfg = base;
+    cfg.estimator.forgetting = 1.5;
+    assert!(refused(cfg).contains("lambda_RLS"));
+    let mut cfg = base;
+    cfg.estimator.initial_masses[2] = 0.0;
+    assert!(refused(cfg).contains("initial_masses"));
+    let mut cfg = base;
+    cfg.estimator.torque_error_std[0] = f64::INFINITY;
+    assert!(refused(cfg).contains("torque_error_std"));
+}

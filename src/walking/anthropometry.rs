@@ -30,8 +30,8 @@
 //! `b₀ tanh(q̇/ε)`. We take `ε = 0.05 rad/s` (2.9 °/s): an order of magnitude below walking joint speeds
 //! (1–6 rad/s), so the friction reaches its full level within the first percent of a swing, while the
 //! regularised slope `b₀/ε` (43 N m s/rad at the hip, 106 at the knee) keeps the fastest friction time
-//! constant, about `I/(b₀/ε)` ≈ 2 ms for the shank about the knee, above the 1 ms sub-step of the filter's
-//! explicit integrator. Table 8 prints the damping slopes with a minus sign (the regression of actuating
+//! constant, about `I/(b₀/ε)` ≈ 3 ms for the shank and foot about the knee, above the 1 ms sub-step of
+//! the filter's explicit integrator. Table 8 prints the damping slopes with a minus sign (the regression of actuating
 //! torque against velocity); as a friction torque on the left of Eq. (1) they are dissipative, so we use
 //! their magnitudes, per rad/s (the table gives no velocity unit; per deg/s would be a 1600 N m s/rad
 //! damper). Stiffness slopes are per degree in Table 8 and are converted to per radian. The ankle is passive

@@ -137,6 +137,24 @@ impl DualEstimator {
                 reason: "the torque observation error must be finite and positive",
             });
         }
+        if let Some(&m) = cfg
+            .initial_masses
+            .iter()
+            .find(|m| !(m.is_finite() && **m > 0.0))
+        {
+            return Err(EstimationError::InvalidSetting {
+                name: "initial_masses",
+                value: m,
+                reason: "link masses must be finite and positive",
+            });
+        }
+        if !(cfg.min_mass_fraction > 0.0 && cfg.min_mass_fraction <= 1.0) {
+            return Err(EstimationError::InvalidSetting {
+                name: "min_mass_fraction",
+                value: cfg.min_mass_fraction,
+                reason: "the mass floor must be a fraction in (0, 1] of the initial masses",
+            });
+        }
         let d2 = DEG * DEG;
         let units = [d2, d2, d2, d2, d2, d2];
         let q = diag6(&cfg.process_noise, units);

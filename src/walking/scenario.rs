@@ -364,6 +364,14 @@ pub fn run(cfg: &WalkingConfig) -> Result<WalkingRun, WalkingError> {
             reason: "the run must be finite and longer than the warm-up",
         });
     }
+    let positive = |v: f64| v.is_finite() && v > 0.0;
+    if !(positive(cfg.impedance_frequency) && positive(cfg.impedance_damping_ratio)) {
+        return Err(WalkingError::Setting {
+            name: "impedance_frequency",
+            value: cfg.impedance_frequency,
+            reason: "the impedance target needs a positive natural frequency and damping ratio",
+        });
+    }
     let segments = LegSegments::paper_subject();
     let friction = LegFriction::table8_right();
     let wearer = Wearer::new(&cfg.wearer);

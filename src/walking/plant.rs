@@ -30,7 +30,7 @@
 use super::anthropometry::{LegFriction, LegSegments};
 use super::dynamics::LegDynamics;
 use super::wearer::Wearer;
-use bgc_runtime::model::ContinuousModel;
+use bgc_runtime::model::{ContinuousModel, ParamError, Parametric};
 use nalgebra::{SVector, Vector3, Vector6};
 
 /// Splits a state `[q, q̇]`.
@@ -92,6 +92,35 @@ impl LegModel {
         let k3 = self.derivative(&(x + k2 * (h / 2.0)), u);
         let k4 = self.derivative(&(x + k3 * h), u);
         x + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h / 6.0)
+    }
+}
+
+/// The link masses `[m₁, m₂, m₃]` (foot, shank, thigh) by index, for the runtime's parameter estimators.
+impl Parametric for LegModel {
+    fn param_names(&self) -> &'static [&'static str] {
+        &["m1_foot", "m2_shank", "m3_thigh"]
+    }
+
+    fn param(&self, index: usize) -> Option<f64> {
+        self.dynamics.segments.masses().get(index).copied()
+    }
+
+    fn set_param(&mut self, index: usize, value: f64) -> Result<(), ParamError> {
+        let name = *self
+            .param_names()
+            .get(index)
+            .ok_or(ParamError::NoSuchParam { index })?;
+        if !(value.is_finite() && value > 0.0) {
+            return Err(ParamError::NonPhysical {
+                name,
+                value,
+                reason: "a link mass must be finite and positive",
+            });
+        }
+        let mut m = self.dynamics.segments.masses();
+        m[index] = value;
+        self.dynamics.segments = self.dynamics.segments.with_masses(m);
+        Ok(())
     }
 }
 

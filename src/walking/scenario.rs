@@ -93,7 +93,9 @@ pub struct SensorNoise {
 }
 
 impl SensorNoise {
-    /// The paper's position noise (`P_n = 0.8 deg²`), and plausible values for the others.
+    /// The paper's position noise (`P_n = 0.8 deg²`); the paper gives none for the other sensors: 0.1 N m
+    /// for the torque sensors, 0.01° for the motor encoders and 0.1°/s for the joint speed from motor rpm
+    /// (joint side of a geared motor), 5 N for the insoles.
     pub fn paper() -> Self {
         SensorNoise {
             position_deg: 0.8f64.sqrt(),
@@ -150,9 +152,11 @@ impl WalkingConfig {
     /// The paper's filter settings: initial state `[84, −175, 0]°` in the paper's sensor convention (hip
     /// from the horizontal, knee as a negative included angle), which is hip 6° and knee 5° of flexion and
     /// the ankle neutral in ours; `P_v = diag(0.8, 1, 1, 1, 1, 1)`, `P_n = diag(0.8, …)` (deg², (deg/s)²
-    /// per filter period); `α = 10⁻³`, `β = 2`, `κ = 0`. The paper gives no initial covariance; ours covers
-    /// the initial guess's error (20° in position, 100°/s in velocity, one standard deviation). The masses
-    /// start `mass_error` too heavy.
+    /// per filter period, in our state order ankle, knee, hip); `α = 10⁻³`, `β = 2`, `κ = 0`. The paper gives no
+    /// initial covariance; ours covers the initial guess's error (20° in position, 100°/s in velocity, one
+    /// standard deviation). The masses start `mass_error` too heavy; `λ_RLS = 0.8` per 10 ms step (a memory
+    /// of about 50 ms, short enough to follow the torso load on and off within a stance phase; the paper
+    /// does not print its value). The sensor noise is [`SensorNoise::paper`].
     pub fn paper(duration: f64) -> Self {
         let segments = LegSegments::paper_subject();
         let mass_error = 0.2;
@@ -175,7 +179,7 @@ impl WalkingConfig {
                 alpha: 1e-3,
                 beta: 2.0,
                 kappa: 0.0,
-                process_noise: [0.8, 1.0, 1.0, 100.0, 1.0, 1.0],
+                process_noise: [0.8, 1.0, 1.0, 1.0, 1.0, 1.0],
                 measurement_noise: [0.8; 3],
                 initial_state: [0.0, 5.0, 6.0, 0.0, 0.0, 0.0],
                 initial_covariance: [400.0, 400.0, 400.0, 1e4, 1e4, 1e4],

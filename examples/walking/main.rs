@@ -125,15 +125,17 @@ fn print_tables(r: &WalkingRun, cfg: &WalkingConfig) {
     println!();
     println!("Table 9. Trajectory tracking: reference (dual UKF prediction) vs the exoskeleton");
     println!(
-        "{:<14}{:>20}{:>24}",
-        "", "position RMSE (°)", "velocity RMSE (°/s)"
+        "{:<14}{:>20}{:>24}{:>30}",
+        "", "position RMSE (°)", "velocity RMSE (°/s)", "exo vs wearer (°; °/s)"
     );
     for row in &r.table9 {
         println!(
-            "{:<14}{:>20.4}{:>24.4}",
+            "{:<14}{:>20.4}{:>24.4}{:>20.4}; {:<8.4}",
             format!("{} ours", row.joint),
             row.position_rmse_deg,
-            row.velocity_rmse_deg_s
+            row.velocity_rmse_deg_s,
+            row.wearer_position_rmse_deg,
+            row.wearer_velocity_rmse_deg_s
         );
         if let Some((_, v)) = PAPER_TABLE9.iter().find(|(j, _)| *j == row.joint) {
             println!(

@@ -267,12 +267,15 @@ pub struct JointHealth {
     pub velocity_outside_one_sigma_percent: f64,
 }
 
-/// Table 9 row.
+/// Table 9 row: the reference (filter prediction) against the exoskeleton, and, for context, the
+/// exoskeleton against the wearer's own motion.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct JointTracking {
     pub joint: &'static str,
     pub position_rmse_deg: f64,
     pub velocity_rmse_deg_s: f64,
+    pub wearer_position_rmse_deg: f64,
+    pub wearer_velocity_rmse_deg_s: f64,
 }
 
 /// How the masses came out.
@@ -489,9 +492,10 @@ pub fn run(cfg: &WalkingConfig) -> Result<WalkingRun, WalkingError> {
             torque_buffer.clear();
         }
         let (right, left) = wearer.insoles(t);
+        // Force-sensing insoles read no negative force.
         let mut noisy = |g: GrfSample| GrfSample {
-            heel: g.heel + n.insole * insole_rng.normal(),
-            ball: g.ball + n.insole * insole_rng.normal(),
+            heel: (g.heel + n.insole * insole_rng.normal()).max(0.0),
+            ball: (g.ball + n.insole * insole_rng.normal()).max(0.0),
         };
         let (right, left) = (noisy(right), noisy(left));
         let step = supervisor.update(right, left);
@@ -610,6 +614,8 @@ pub fn run(cfg: &WalkingConfig) -> Result<WalkingRun, WalkingError> {
     let mut control_samples = Vec::with_capacity(pending_control.len());
     let mut sq_pos = [0.0; 3];
     let mut sq_vel = [0.0; 3];
+    let mut sq_pos_w = [0.0; 3];
+    let mut sq_vel_w = [0.0; 3];
     let mut counted = 0usize;
     let mut peak = [0.0f64; 3];
     for p in &pending_control {
@@ -617,10 +623,13 @@ pub fn run(cfg: &WalkingConfig) -> Result<WalkingRun, WalkingError> {
         let Some(x) = truth(p.k) else { continue };
         let q = x.fixed_rows::<3>(0).into_owned();
         let qd = x.fixed_rows::<3>(3).into_owned();
+        let intended = wearer.intended(t);
         if t >= cfg.warmup {
             for j in 0..3 {
                 sq_pos[j] += ((p.reference.q[j] - q[j]) / DEG).powi(2);
                 sq_vel[j] += ((p.reference.qd[j] - qd[j]) / DEG).powi(2);
+                sq_pos_w[j] += ((intended.q[j] - q[j]) / DEG).powi(2);
+                sq_vel_w[j] += ((intended.qd[j] - qd[j]) / DEG).powi(2);
                 peak[j] = peak[j].max(p.actuator[j].abs());
             }
             counted += 1;
@@ -631,7 +640,7 @@ pub fn run(cfg: &WalkingConfig) -> Result<WalkingRun, WalkingError> {
             qd_reference: deg3(&p.reference.qd),
             q: deg3(&q),
             qd: deg3(&qd),
-            q_intended: deg3(&wearer.intended(t).q),
+            q_intended: deg3(&intended.q),
             actuator_torque: [p.actuator[0], p.actuator[1], p.actuator[2]],
             human_torque: [p.human_torque[0], p.human_torque[1], p.human_torque[2]],
             state: p.state,
@@ -646,6 +655,8 @@ pub fn run(cfg: &WalkingConfig) -> Result<WalkingRun, WalkingError> {
             joint: JOINTS[j],
             position_rmse_deg: (sq_pos[j] / denominator).sqrt(),
             velocity_rmse_deg_s: (sq_vel[j] / denominator).sqrt(),
+            wearer_position_rmse_deg: (sq_pos_w[j] / denominator).sqrt(),
+            wearer_velocity_rmse_deg_s: (sq_vel_w[j] / denominator).sqrt(),
         })
         .collect();
 

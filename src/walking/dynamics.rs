@@ -8,7 +8,10 @@
 //!
 //! `q = [θ₁, θ₂, θ₃]` = ankle dorsiflexion, knee flexion, hip flexion (rad), the paper's order. The chain is
 //! rooted at the hip (Eq. 1's swing leg, pivoted at a hip that does not accelerate); Eq. (2) keeps the same
-//! coordinates and terms for stance, adds the torso mass to the thigh and the ground reaction as `−Jᵀ F`.
+//! coordinates and terms for stance ("all terms are as defined in Eq. (1)"), adds the torso mass to the
+//! thigh ([`LegDynamics::with_thigh_load`]) and the ground reaction as `−Jᵀ F` ([`LegDynamics::ankle_jacobian`]):
+//! the ground pivots the stance leg through that contact force. (Re-rooting the chain at the ankle with the
+//! torso lumped on the thigh would leave nothing distal to the hip joint, a singular `M(q)`.)
 //! Absolute link angles, counter-clockwise from the downward vertical with the subject facing `+x`:
 //!
 //! ```text

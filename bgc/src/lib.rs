@@ -5,9 +5,12 @@
 //! IR of [`ir`], and later stages analyse causality and derive equations. No stage prints or touches files; the CLI
 //! (`src/main.rs`) and the build-script API do.
 
+pub mod causality;
 pub mod diagnostic;
+pub mod draw;
 pub mod ir;
 pub mod lower;
 pub mod span;
+pub mod symbolic;
 pub mod syntax;
 pub mod units;

@@ -81,13 +81,10 @@ impl Builder<'_> {
                     } else {
                         (u.flow, u.flow_text, "a flow")
                     };
-                    self.expect_unit(
-                        q,
-                        want,
-                        v.span,
-                        &format!("{text} ({what} in the {} domain)", d.name()),
-                        &name,
-                    );
+                    let expected = format!("{text} ({what} in the {} domain)", d.name());
+                    if self.expect_unit(q, want, v.span, &expected, &name) {
+                        self.explain_units(&expr);
+                    }
                 }
                 Some(Relation::Source(expr))
             }
@@ -107,13 +104,10 @@ impl Builder<'_> {
                         K::I => "an inertia",
                         _ => "a resistance",
                     };
-                    self.expect_unit(
-                        q,
-                        want,
-                        v.span,
-                        &format!("{text} ({what} in the {} domain)", d.name()),
-                        &name,
-                    );
+                    let expected = format!("{text} ({what} in the {} domain)", d.name());
+                    if self.expect_unit(q, want, v.span, &expected, &name) {
+                        self.explain_units(&expr);
+                    }
                 }
                 self.check_value(kind, &name, &expr, v.span);
                 Some(Relation::Linear(expr))
@@ -145,7 +139,9 @@ impl Builder<'_> {
                     };
                     if let Some(want) = num.checked_div(uo.flow) {
                         let text = format!("{want} ({what}, {} to {})", din.name(), dout.name());
-                        self.expect_unit(q, want, v.span, &text, &name);
+                        if self.expect_unit(q, want, v.span, &text, &name) {
+                            self.explain_units(&expr);
+                        }
                     }
                 }
                 if matches!(kind, K::TF | K::GY) {
@@ -197,9 +193,9 @@ impl Builder<'_> {
     }
 
     /// BG0303 when a value's dimension is not the one its place needs.
-    pub fn expect_unit(&mut self, q: Q, want: Dim, span: Span, expected: &str, name: &str) {
+    pub fn expect_unit(&mut self, q: Q, want: Dim, span: Span, expected: &str, name: &str) -> bool {
         if q.fits(want) {
-            return;
+            return false;
         }
         self.diags.push(
             Diagnostic::error(
@@ -212,6 +208,33 @@ impl Builder<'_> {
             .with_primary(span, format!("this is in {}", q.dim()))
             .with_help(format!("the value must be in {expected}")),
         );
+        true
+    }
+
+    /// Adds to the last diagnostic a secondary label at the declared unit of each parameter `expr` uses.
+    fn explain_units(&mut self, expr: &ir::Expr) {
+        let mut used = Vec::new();
+        params_of(expr, &mut used);
+        let labels: Vec<(Span, String)> = used
+            .into_iter()
+            .filter_map(|id| {
+                let p = self.model.params.get(id)?;
+                let info = self.params.get(id)?;
+                Some((
+                    info.unit_span,
+                    format!("`{}` is declared in {}", p.name, p.unit_text),
+                ))
+            })
+            .collect();
+        if let Some(d) = self.diags.last_mut() {
+            for (span, msg) in labels {
+                d.labels.push(crate::diagnostic::Label {
+                    span,
+                    message: msg,
+                    primary: false,
+                });
+            }
+        }
     }
 
     /// BG0401: the value with the parameters at their defaults must be physical.

@@ -140,7 +140,8 @@ impl Builder<'_> {
             }
             return Some((ir::Expr::Time, Q::Dim(Dim::new(0, 0, 1, 0, 0, 0, 0))));
         }
-        if let (Some(host), None) = (cx.host, found)
+        // Inside laws, `e`, `f`, `p`, `q` are the element's own variables, whatever else has those names.
+        if let Some(host) = cx.host
             && let Some(var) = port_var(name)
         {
             return self.law_var(host, var, None, e);

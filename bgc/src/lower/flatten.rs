@@ -376,6 +376,7 @@ impl<'a> Builder<'a> {
             used,
             name_span: p.name.span,
             value_span: expr.span,
+            unit_span: p.unit.span,
         });
     }
 

@@ -128,12 +128,11 @@ pub fn lower(
         diags.extend(b.diags.into_iter().filter(|d| d.code.0 != "BG0311"));
     }
     // A component instantiated twice reports its own problems twice; keep one of each.
-    let mut unique: Vec<Diagnostic> = Vec::with_capacity(diags.len());
-    for d in diags {
-        if !unique.contains(&d) {
-            unique.push(d);
-        }
-    }
+    let mut seen = std::collections::HashSet::new();
+    let unique: Vec<Diagnostic> = diags
+        .into_iter()
+        .filter(|d| seen.insert((d.code, d.message.clone(), d.primary_span())))
+        .collect();
     (models, unique)
 }
 

@@ -23,6 +23,7 @@ pub fn format(file: &File) -> String {
         indent: 0,
         last_end: 0,
         block_start: true,
+        pending: Vec::new(),
     };
     p.file(file);
     p.out
@@ -47,6 +48,9 @@ struct Printer<'f> {
     last_end: u32,
     /// Nothing has been printed yet in the current block (no blank line goes there).
     block_start: bool,
+    /// Comments moved out of a statement that did not fit at the end of its line; they go on their own lines
+    /// before whatever comes next, exactly where a reformatting finds them.
+    pending: Vec<&'f Comment>,
 }
 
 impl Printer<'_> {
@@ -72,8 +76,15 @@ impl Printer<'_> {
         self.last_end = self.last_end.max(end);
     }
 
-    /// Prints, on their own lines, the comments that start before `before`.
+    /// Prints, on their own lines, the pending comments and the comments that start before `before`.
     fn leading(&mut self, before: u32) {
+        for c in std::mem::take(&mut self.pending) {
+            self.begin_unit(c.span.start);
+            self.pad();
+            self.out.push_str(&c.text);
+            self.out.push('\n');
+            self.end_unit(c.span.end);
+        }
         while let Some(c) = self.comments.get(self.next_comment) {
             if c.span.start >= before {
                 break;
@@ -87,11 +98,13 @@ impl Printer<'_> {
         }
     }
 
-    /// Ends the line of a construct spanning to `end`, whose next sibling starts at `next`: comments inside the construct
-    /// and one comment trailing it on its line go at the end of the line, further ones on the lines after it.
+    /// Ends the line of a construct spanning to `end`, whose next sibling starts at `next`: of the comments inside the
+    /// construct and the one trailing it on its line, the first goes at the end of the line and the others become
+    /// pending (printed on their own lines before the next thing).
     fn finish_line(&mut self, end: u32, next: u32) {
+        let comments = self.comments;
         let mut moved = Vec::new();
-        while let Some(c) = self.comments.get(self.next_comment) {
+        while let Some(c) = comments.get(self.next_comment) {
             if c.span.start < end {
                 moved.push(c);
                 self.next_comment += 1;
@@ -99,7 +112,7 @@ impl Printer<'_> {
                 break;
             }
         }
-        if let Some(c) = self.comments.get(self.next_comment)
+        if let Some(c) = comments.get(self.next_comment)
             && !c.own_line
             && c.span.start < next
         {
@@ -113,12 +126,7 @@ impl Printer<'_> {
         }
         self.out.push('\n');
         self.end_unit(end);
-        for c in iter {
-            self.pad();
-            self.out.push_str(&c.text);
-            self.out.push('\n');
-            self.end_unit(c.span.end);
-        }
+        self.pending.extend(iter);
     }
 
     fn docs(&mut self, doc: &[String]) {
@@ -137,10 +145,7 @@ impl Printer<'_> {
     fn file(&mut self, file: &File) {
         let mut prev_was_model = false;
         for (i, item) in file.items.iter().enumerate() {
-            let span = match item {
-                Item::Import(im) => im.span,
-                Item::Model(m) => m.span,
-            };
+            let span = item.span();
             let is_model = matches!(item, Item::Model(_));
             if i > 0 && (is_model || prev_was_model) && !self.out.ends_with("\n\n") {
                 // Models and components are always set apart by a blank line.
@@ -152,10 +157,7 @@ impl Printer<'_> {
             let next = file
                 .items
                 .get(i + 1)
-                .map(|it| match it {
-                    Item::Import(im) => im.span.start,
-                    Item::Model(m) => m.span.start,
-                })
+                .map(|it| it.span().start)
                 .unwrap_or(u32::MAX);
             match item {
                 Item::Import(im) => {
@@ -194,11 +196,7 @@ impl Printer<'_> {
         self.indent += 1;
         self.block_start = true;
         for (i, s) in m.body.iter().enumerate() {
-            let next_stmt = m
-                .body
-                .get(i + 1)
-                .map(|s| stmt_span(s).start)
-                .unwrap_or(close);
+            let next_stmt = m.body.get(i + 1).map(|s| s.span().start).unwrap_or(close);
             self.statement(s, next_stmt);
         }
         self.leading(close);
@@ -208,7 +206,7 @@ impl Printer<'_> {
     }
 
     fn statement(&mut self, s: &Stmt, next: u32) {
-        let span = stmt_span(s);
+        let span = s.span();
         self.leading(span.start);
         self.begin_unit(span.start);
         let line = match s {
@@ -339,21 +337,6 @@ impl Printer<'_> {
                 self.finish_line(e.span.end, next);
             }
         }
-    }
-}
-
-fn stmt_span(s: &Stmt) -> crate::span::Span {
-    match s {
-        Stmt::Domain(x) => x.span,
-        Stmt::Param(x) => x.span,
-        Stmt::Input(x) => x.span,
-        Stmt::Output(x) => x.span,
-        Stmt::Var(x) => x.span,
-        Stmt::Coords(x) => x.span,
-        Stmt::Element(x) => x.span,
-        Stmt::Instance(x) => x.span,
-        Stmt::Bond(x) => x.span,
-        Stmt::Port(x) => x.span,
     }
 }
 

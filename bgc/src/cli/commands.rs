@@ -1,0 +1,258 @@
+//! The subcommands. Each returns the process status; all printing happens here.
+
+use super::io::{FsLoader, read_source, stderr, stderrln, stdout, stdoutln};
+use super::{DiagFormat, DrawFormat, ReportFormat, Status};
+use bgc::diagnostic::{Diagnostic, Severity, has_errors, render};
+use bgc::span::SourceMap;
+use std::path::{Path, PathBuf};
+
+/// `bgc check FILE...`
+pub fn check(files: &[PathBuf], format: DiagFormat, color: bool) -> Status {
+    let mut sources = SourceMap::new();
+    let mut all_diags: Vec<Diagnostic> = Vec::new();
+    let mut status = Status::Ok;
+    let mut summaries = Vec::new();
+    for path in files {
+        let (id, decode_diag) = match read_source(&mut sources, path) {
+            Ok(x) => x,
+            Err(e) => {
+                stderrln(&format!("error: cannot read {}: {e}", path.display()));
+                status = Status::UsageOrIo;
+                continue;
+            }
+        };
+        if let Some(d) = decode_diag {
+            all_diags.push(d);
+            continue;
+        }
+        let (models, mut diags) = bgc::lower::lower(&mut sources, id, &mut FsLoader);
+        if !has_errors(&diags) {
+            for m in &models {
+                diags.extend(bgc::causality::analyse(m).1);
+            }
+        }
+        if !has_errors(&diags) {
+            for m in &models {
+                summaries.push(format!(
+                    "{}: model `{}`: {} elements and junctions, {} bonds, {} parameters",
+                    path.display(),
+                    m.name,
+                    m.graph.node_count(),
+                    m.graph.edge_count(),
+                    m.params.len()
+                ));
+            }
+        }
+        all_diags.extend(diags);
+    }
+    emit(&sources, &all_diags, format, color);
+    if format == DiagFormat::Text {
+        for s in &summaries {
+            stdoutln(s);
+        }
+        if !all_diags.is_empty() {
+            stderrln(&count_line(&all_diags));
+        }
+    }
+    if has_errors(&all_diags) && status == Status::Ok {
+        status = Status::InputErrors;
+    }
+    status
+}
+
+/// `bgc fmt [--check] FILE...`
+pub fn fmt(files: &[PathBuf], check_only: bool, color: bool) -> Status {
+    let mut status = Status::Ok;
+    for path in files {
+        match fmt_one(path, check_only, color) {
+            Ok(true) => {}
+            Ok(false) => {
+                if status == Status::Ok {
+                    status = Status::InputErrors;
+                }
+            }
+            Err(e) => {
+                stderrln(&format!("error: {}: {e}", path.display()));
+                status = Status::UsageOrIo;
+            }
+        }
+    }
+    status
+}
+
+/// Formats one file; `Ok(false)` when it has syntax errors or, with `--check`, is not formatted.
+fn fmt_one(path: &Path, check_only: bool, color: bool) -> std::io::Result<bool> {
+    let mut sources = SourceMap::new();
+    let (id, decode_diag) = read_source(&mut sources, path)?;
+    if let Some(d) = decode_diag {
+        stderr(&render::to_text(&sources, &[d], color));
+        return Ok(false);
+    }
+    let text = sources.get(id).map(|f| f.text.clone()).unwrap_or_default();
+    let (ast, diags) = bgc::syntax::parse(id, &text);
+    if has_errors(&diags) {
+        stderr(&render::to_text(&sources, &diags, color));
+        stderrln(&format!(
+            "{}: not formatted: the file has syntax errors",
+            path.display()
+        ));
+        return Ok(false);
+    }
+    let formatted = bgc::syntax::format(&ast);
+    if formatted == text {
+        return Ok(true);
+    }
+    if check_only {
+        stdoutln(&format!("{}: not in the canonical layout", path.display()));
+        return Ok(false);
+    }
+    std::fs::write(path, formatted)?;
+    Ok(true)
+}
+
+fn emit(sources: &SourceMap, diags: &[Diagnostic], format: DiagFormat, color: bool) {
+    match format {
+        DiagFormat::Text => stderr(&render::to_text(sources, diags, color)),
+        DiagFormat::Json => {
+            let v = render::to_json_value(sources, diags);
+            stdoutln(&serde_json::to_string_pretty(&v).unwrap_or_else(|_| "[]".into()));
+        }
+    }
+}
+
+fn count_line(diags: &[Diagnostic]) -> String {
+    let errors = diags
+        .iter()
+        .filter(|d| d.severity == Severity::Error)
+        .count();
+    let warnings = diags
+        .iter()
+        .filter(|d| d.severity == Severity::Warning)
+        .count();
+    format!(
+        "{errors} error{}, {warnings} warning{}",
+        if errors == 1 { "" } else { "s" },
+        if warnings == 1 { "" } else { "s" }
+    )
+}
+
+/// A file through the front end: its sources, the one model asked for, and what the front end said.
+struct Loaded {
+    sources: SourceMap,
+    model: bgc::ir::Model,
+    diags: Vec<Diagnostic>,
+}
+
+/// Reads, parses and lowers `path` and picks one model (the one named, or the only one). Prints the diagnostics
+/// and returns the status to exit with when the file cannot be used.
+fn load_one(path: &Path, wanted: Option<&str>, color: bool) -> Result<Loaded, Status> {
+    let mut sources = SourceMap::new();
+    let (id, decode_diag) = match read_source(&mut sources, path) {
+        Ok(x) => x,
+        Err(e) => {
+            stderrln(&format!("error: cannot read {}: {e}", path.display()));
+            return Err(Status::UsageOrIo);
+        }
+    };
+    if let Some(d) = decode_diag {
+        stderr(&render::to_text(&sources, &[d], color));
+        return Err(Status::InputErrors);
+    }
+    let (models, diags) = bgc::lower::lower(&mut sources, id, &mut FsLoader);
+    if has_errors(&diags) {
+        stderr(&render::to_text(&sources, &diags, color));
+        stderrln(&count_line(&diags));
+        return Err(Status::InputErrors);
+    }
+    let names: Vec<&str> = models.iter().map(|m| m.name.as_str()).collect();
+    let index = match (wanted, models.len()) {
+        (_, 0) => {
+            stderrln(&format!("error: {} declares no model", path.display()));
+            return Err(Status::InputErrors);
+        }
+        (None, 1) => 0,
+        (None, _) => {
+            stderrln(&format!(
+                "error: {} declares several models ({}); choose one with --model",
+                path.display(),
+                names.join(", ")
+            ));
+            return Err(Status::UsageOrIo);
+        }
+        (Some(w), _) => match names.iter().position(|n| *n == w) {
+            Some(i) => i,
+            None => {
+                stderrln(&format!(
+                    "error: {} has no model `{w}`; it declares {}",
+                    path.display(),
+                    names.join(", ")
+                ));
+                return Err(Status::UsageOrIo);
+            }
+        },
+    };
+    let model = models.into_iter().nth(index).ok_or(Status::InputErrors)?;
+    Ok(Loaded {
+        sources,
+        model,
+        diags,
+    })
+}
+
+/// `bgc causality FILE`
+pub fn causality(path: &Path, wanted: Option<&str>, format: ReportFormat, color: bool) -> Status {
+    let loaded = match load_one(path, wanted, color) {
+        Ok(l) => l,
+        Err(s) => return s,
+    };
+    let (result, causal_diags) = bgc::causality::analyse(&loaded.model);
+    let mut diags = loaded.diags;
+    diags.extend(causal_diags);
+    match format {
+        ReportFormat::Text => {
+            stdout(&bgc::causality::to_text(&loaded.model, &result));
+            stderr(&render::to_text(&loaded.sources, &diags, color));
+        }
+        ReportFormat::Json => {
+            let diag_json = render::to_json_value(&loaded.sources, &diags);
+            let v = bgc::causality::to_json(&loaded.model, &result, diag_json);
+            stdoutln(&serde_json::to_string_pretty(&v).unwrap_or_else(|_| "{}".into()));
+        }
+    }
+    if has_errors(&diags) {
+        Status::InputErrors
+    } else {
+        Status::Ok
+    }
+}
+
+/// `bgc draw FILE [-o OUT]`
+pub fn draw(
+    path: &Path,
+    wanted: Option<&str>,
+    output: Option<&Path>,
+    format: DrawFormat,
+    color: bool,
+) -> Status {
+    let loaded = match load_one(path, wanted, color) {
+        Ok(l) => l,
+        Err(s) => return s,
+    };
+    // A drawing is most useful exactly when causality has problems, so they are drawn (highlighted), not refused.
+    let (result, causal_diags) = bgc::causality::analyse(&loaded.model);
+    stderr(&render::to_text(&loaded.sources, &causal_diags, color));
+    let text = match format {
+        DrawFormat::Svg => bgc::draw::svg(&loaded.model, Some(&result)),
+        DrawFormat::Dot => bgc::draw::dot(&loaded.model, Some(&result)),
+    };
+    match output {
+        Some(out) => {
+            if let Err(e) = std::fs::write(out, text) {
+                stderrln(&format!("error: cannot write {}: {e}", out.display()));
+                return Status::UsageOrIo;
+            }
+        }
+        None => stdout(&text),
+    }
+    Status::Ok
+}

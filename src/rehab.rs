@@ -1,0 +1,18 @@
+//! The measurement system of a rehabilitation exoskeleton (Yang et al., Sensors 2018, 18, 2588): IMU and vision
+//! angle measurements of a pendulum test rig and of an exoskeleton's thigh and calf, each IMU's angle from the
+//! Kalman filter of Eqs. 5–6, and the minimum-variance fusion of Eqs. 22–27 with weights measured on the rig.
+//!
+//! - [`plant`]: the plants, one function per `.bg` model ([`plant::pendulum_rig`], [`plant::rehab_leg`]).
+//! - [`truth`]: the true motion of the instrumented segments from a simulation of the plants.
+//! - [`sensors`]: the synthetic IMU and camera.
+//! - [`pipeline`]: the estimation chain and the error measure E (Eq. 28).
+//! - [`experiment`]: the rig run and the exoskeleton test with their sensor set-ups.
+
+pub mod error;
+pub mod experiment;
+pub mod pipeline;
+pub mod plant;
+pub mod sensors;
+pub mod truth;
+
+pub use error::RehabError;

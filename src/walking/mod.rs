@@ -9,11 +9,13 @@
 //! - [`plant`]: the leg as a runtime `ContinuousModel`, alone and worn by the wearer;
 //! - [`wearer`]: the synthetic wearer (trajectories, insoles, torso load, human torque);
 //! - [`estimator`]: the dual UKF;
-//! - [`scenario`]: the closed loop and the figures of Tables 7 and 9.
+//! - [`scenario`]: the closed loop, its settings and records, and the figures of Tables 7 and 9.
 
 pub mod anthropometry;
+mod config;
 pub mod dynamics;
 pub mod estimator;
 pub mod plant;
+mod records;
 pub mod scenario;
 pub mod wearer;

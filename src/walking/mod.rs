@@ -1,0 +1,21 @@
+//! The lower-limb walking exoskeleton of Sado et al. (2018), end to end: the coupled human–exoskeleton leg
+//! (Eqs. 1–5, Tables 1 and 8), the dual UKF that generates the wearer's trajectory and learns the link
+//! masses (Eqs. 6–27), the impedance controller (Eqs. 28–29) and the gait supervisor (Eq. 30, Tables 2–3),
+//! run against a synthetic wearer.
+//!
+//! - [`anthropometry`]: segment parameters and joint friction;
+//! - [`dynamics`]: the hand-derived Euler–Lagrange model `M(q)`, `C(q, q̇)`, `G(q)` (the reference that the
+//!   model generated from `models/walking_leg.bg` will be tested against; until then it is the plant);
+//! - [`plant`]: the leg as a runtime `ContinuousModel`, alone and worn by the wearer;
+//! - [`wearer`]: the synthetic wearer (trajectories, insoles, torso load, human torque);
+//! - [`estimator`]: the dual UKF;
+//! - [`scenario`]: the closed loop, its settings and records, and the figures of Tables 7 and 9.
+
+pub mod anthropometry;
+mod config;
+pub mod dynamics;
+pub mod estimator;
+pub mod plant;
+mod records;
+pub mod scenario;
+pub mod wearer;

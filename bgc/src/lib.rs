@@ -10,6 +10,7 @@ pub mod diagnostic;
 pub mod draw;
 pub mod equations;
 pub mod ir;
+pub mod lower;
 pub mod span;
 pub mod syntax;
 pub mod units;

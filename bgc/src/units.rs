@@ -304,8 +304,9 @@ impl fmt::Display for Dim {
                 let Some(rest) = d.powi(i32::from(p)).and_then(|dp| self.checked_div(dp)) else {
                     continue;
                 };
-                // A derived unit may only shorten the base units present: `m/s^2` must not read `N/kg`.
-                let introduces = (0..7).any(|i| self.0[i] == 0 && rest.0[i] != 0);
+                // A derived unit must not bring in a mass the dimension does not have: `m/s^2` must not read
+                // `N/kg` (but a compliance `kg^-1 s^2` reads `m/N`).
+                let introduces = self.0[1] == 0 && rest.0[1] != 0;
                 let w = rest.weight() + 1;
                 if !introduces && w < best.0 {
                     best = (w, Some((name, p)), rest);
@@ -588,6 +589,9 @@ mod tests {
         assert_eq!(D_V.to_string(), "V");
         assert_eq!(D_OHM.to_string(), "Ohm");
         assert_eq!(Dim::new(1, 0, -2, 0, 0, 0, 0).to_string(), "m/s^2");
+        assert_eq!(Dim::new(0, -1, 2, 0, 0, 0, 0).to_string(), "m/N");
+        assert_eq!(Dim::new(-4, 1, -1, 0, 0, 0, 0).to_string(), "Pa s/m^3");
+        assert_eq!(Dim::new(1, 1, -2, -1, 0, 0, 0).to_string(), "N/A");
     }
 
     #[test]

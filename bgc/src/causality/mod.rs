@@ -36,6 +36,8 @@ pub(crate) mod test_model;
 mod tests;
 #[cfg(test)]
 mod tests_findings;
+#[cfg(test)]
+mod tests_props;
 
 pub use report::{to_json, to_text};
 

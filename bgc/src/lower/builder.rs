@@ -1,0 +1,137 @@
+//! The state of lowering one model: the IR under construction plus what the checks need beside it.
+
+use super::scope::{End, Scope};
+use crate::diagnostic::Diagnostic;
+use crate::ir::{self, Domain, OutputId, VarId};
+use crate::span::Span;
+use crate::syntax::ast::{CoordsDecl, ElementDecl, ModelDecl, OutputDecl, VarDecl};
+use petgraph::graph::{DiGraph, EdgeIndex, NodeIndex};
+use std::collections::HashMap;
+
+/// What lowering knows about a node beyond the IR.
+pub(crate) struct NodeInfo<'a> {
+    pub scope: usize,
+    pub decl: &'a ElementDecl,
+    /// The domain written on the element (`I rotor : rotational`).
+    pub explicit_domain: Option<(Domain, Span)>,
+    /// The domain of its bonds once inferred (for TF/GY and fields, see `bond_domain`).
+    pub domain: Option<Domain>,
+}
+
+/// What lowering knows about a bond beyond the IR.
+pub(crate) struct BondInfo {
+    pub from: End,
+    pub to: End,
+    /// Set by domain inference; None when it failed.
+    pub domain: Option<Domain>,
+}
+
+/// What lowering knows about a parameter beyond the IR.
+pub(crate) struct ParamInfo {
+    pub used: bool,
+    /// The parameter's name in its declaration.
+    pub name_span: Span,
+    /// The expression that gave its value (the default, or the instance's override).
+    pub value_span: Span,
+}
+
+pub(crate) struct Builder<'a> {
+    pub decls: &'a HashMap<String, &'a ModelDecl>,
+    pub diags: Vec<Diagnostic>,
+    pub model: ir::Model,
+    pub scopes: Vec<Scope>,
+    pub nodes: Vec<NodeInfo<'a>>,
+    pub bonds: Vec<BondInfo>,
+    pub params: Vec<ParamInfo>,
+    /// The bond on each port of each field, filled by the structure checks.
+    pub field_bonds: HashMap<(NodeIndex, u32), EdgeIndex>,
+    pub pending_outputs: Vec<(OutputId, usize, &'a OutputDecl)>,
+    pub pending_vars: Vec<(VarId, usize, &'a VarDecl)>,
+    pub pending_coords: Option<(usize, &'a CoordsDecl)>,
+    /// Declarations whose unit could not be read: their dimension is left free to avoid follow-up errors.
+    pub bad_units: Vec<super::scope::Entity>,
+    /// Whether the last unit read by `unit` was valid.
+    pub last_unit_ok: bool,
+    /// The components being instantiated, to catch a component that contains itself.
+    pub component_stack: Vec<String>,
+}
+
+impl<'a> Builder<'a> {
+    pub fn new(decls: &'a HashMap<String, &'a ModelDecl>, decl: &'a ModelDecl) -> Self {
+        Builder {
+            decls,
+            diags: Vec::new(),
+            model: ir::Model {
+                name: decl.name.name.clone(),
+                doc: decl.doc.clone(),
+                graph: DiGraph::new(),
+                params: Vec::new(),
+                inputs: Vec::new(),
+                outputs: Vec::new(),
+                vars: Vec::new(),
+                coords: None,
+                spans: ir::SpanTable {
+                    model: decl.span,
+                    ..Default::default()
+                },
+            },
+            scopes: Vec::new(),
+            nodes: Vec::new(),
+            bonds: Vec::new(),
+            params: Vec::new(),
+            field_bonds: HashMap::new(),
+            pending_outputs: Vec::new(),
+            pending_vars: Vec::new(),
+            pending_coords: None,
+            component_stack: Vec::new(),
+            bad_units: Vec::new(),
+            last_unit_ok: true,
+        }
+    }
+
+    pub fn node_info(&self, n: NodeIndex) -> Option<&NodeInfo<'a>> {
+        self.nodes.get(n.index())
+    }
+
+    /// The domain of the bond on a node's port: the only bond of a 1-port, any bond of a junction, the input (0)
+    /// or output (1) bond of a TF/GY, the bond on a field's port.
+    pub fn port_domain(&self, n: NodeIndex, port: u32) -> Option<Domain> {
+        let info = self.node_info(n)?;
+        let kind = info.decl.kind;
+        if kind.is_field() {
+            let e = self.field_bonds.get(&(n, port))?;
+            return self.bonds.get(e.index())?.domain;
+        }
+        if kind.is_two_port() {
+            use petgraph::Direction;
+            let dir = if port == 0 {
+                Direction::Incoming
+            } else {
+                Direction::Outgoing
+            };
+            let e = self.model.graph.edges_directed(n, dir).next()?;
+            use petgraph::visit::EdgeRef;
+            return self.bonds.get(e.id().index())?.domain;
+        }
+        info.domain
+    }
+
+    /// The span of a node's declaration (its name).
+    pub fn node_name_span(&self, n: NodeIndex) -> Span {
+        self.model
+            .spans
+            .node_names
+            .get(n.index())
+            .copied()
+            .unwrap_or_default()
+    }
+
+    pub fn bond_span(&self, e: EdgeIndex) -> Span {
+        self.model
+            .spans
+            .bonds
+            .get(e.index())
+            .copied()
+            .unwrap_or_default()
+    }
+}

@@ -1,0 +1,828 @@
+//! Name resolution and dimension inference of expressions.
+//!
+//! An expression is resolved in a scope and a context (what it may use) into an [`ir::Expr`] together with its
+//! dimension. A bare number has no fixed unit ([`Q::Free`]): it takes whatever unit its place needs, so `1/k`,
+//! `TF gear = 160` and `2*m` are all fine. Dimensions are checked as they combine: sums and `min`/`max`/`atan2`
+//! need equal dimensions (BG0310), `sin`, `exp`, ... need dimensionless arguments (BG0309), and a quantity with a
+//! dimension may only be raised to a constant whole power (or a half power when every exponent is even).
+
+use super::builder::Builder;
+use super::consteval::{eval, is_literal};
+use super::scope::{Entity, closest};
+use crate::diagnostic::Diagnostic;
+use crate::ir::{self, Func, PortVar, Target};
+use crate::syntax::ast::{self, BinOp, ElementKind, ExprKind, NodeRef};
+use crate::units::{Dim, domain_units};
+use petgraph::graph::NodeIndex;
+
+/// The dimension of an expression: known, or free (a pure number that adapts to its place).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Q {
+    Free,
+    Dim(Dim),
+}
+
+impl Q {
+    /// The dimension, treating a free number as dimensionless.
+    pub fn dim(self) -> Dim {
+        match self {
+            Q::Free => Dim::NONE,
+            Q::Dim(d) => d,
+        }
+    }
+
+    /// True when this can stand where `want` is needed.
+    pub fn fits(self, want: Dim) -> bool {
+        match self {
+            Q::Free => true,
+            Q::Dim(d) => d == want,
+        }
+    }
+}
+
+/// What an expression may use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Allow {
+    /// Numbers, `pi` and earlier parameters of its scope: parameter defaults and overrides.
+    Constant,
+    /// Constants and parameters: the values of C, I, R, TF, GY.
+    Parameters,
+    /// Parameters, inputs and `t`: the values of Se and Sf.
+    Signals,
+    /// Everything that is known at run time; outputs with index below the bound when given.
+    States { outputs_before: Option<usize> },
+}
+
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Cx {
+    pub scope: usize,
+    pub allow: Allow,
+    /// The element whose laws these are: its bare `e`, `f`, `p`, `q` (or `e[i]` ... for a field) are in scope.
+    pub host: Option<NodeIndex>,
+    /// "a parameter default", "the value of a `C`": for messages.
+    pub what: &'static str,
+}
+
+impl Builder<'_> {
+    /// Resolves `e`. Errors are reported; `None` means the expression is unusable (and its dimension unknown).
+    pub fn expr(&mut self, e: &ast::Expr, cx: Cx) -> Option<(ir::Expr, Q)> {
+        match &e.kind {
+            ExprKind::Number(v) => Some((ir::Expr::Const(*v), Q::Free)),
+            ExprKind::Name(name) => self.name(name, e, cx),
+            ExprKind::Indexed(name, i) => self.indexed(name, *i, e, cx),
+            ExprKind::Node(r) => {
+                self.diags.push(
+                    Diagnostic::error("BG0201", "a node is not a value")
+                        .with_primary(r.span, "this names a node")
+                        .with_help("use `e(x)`, `f(x)`, `p(x)` or `q(x)` for its variables"),
+                );
+                None
+            }
+            ExprKind::Neg(a) => {
+                let (a, q) = self.expr(a, cx)?;
+                Some((ir::Expr::Neg(Box::new(a)), q))
+            }
+            ExprKind::Binary(op, a, b) => self.binary(*op, a, b, e, cx),
+            ExprKind::Call(f, args) => self.call(f, args, e, cx),
+        }
+    }
+
+    fn not_allowed(&mut self, e: &ast::Expr, found: &str, cx: Cx) {
+        let (may, help) = match cx.allow {
+            Allow::Constant => (
+                "numbers, `pi` and earlier parameters",
+                "a parameter's value is fixed before the model runs",
+            ),
+            Allow::Parameters => (
+                "numbers and parameters",
+                "use the modulated kind (`MTF`, `MGY`) or a law in braces for a value that varies",
+            ),
+            Allow::Signals => (
+                "parameters, inputs and `t`",
+                "use `MSe` or `MSf` for a source that depends on the state",
+            ),
+            Allow::States { .. } => (
+                "parameters, inputs, `t`, states, integrated flows and earlier outputs",
+                "an output may only use outputs declared before it",
+            ),
+        };
+        self.diags.push(
+            Diagnostic::error("BG0314", format!("{} cannot use {found}", cx.what))
+                .with_primary(e.span, format!("{} may only use {may}", cx.what))
+                .with_help(help),
+        );
+    }
+
+    /// The dimension of a declared name; free when its unit could not be read (already reported).
+    fn declared(&self, entity: Entity, d: Dim) -> Q {
+        if self.bad_units.contains(&entity) {
+            Q::Free
+        } else {
+            Q::Dim(d)
+        }
+    }
+
+    fn mark_used(&mut self, id: usize) {
+        if let Some(p) = self.params.get_mut(id) {
+            p.used = true;
+        }
+    }
+
+    fn name(&mut self, name: &str, e: &ast::Expr, cx: Cx) -> Option<(ir::Expr, Q)> {
+        if name == "pi" {
+            return Some((ir::Expr::Const(std::f64::consts::PI), Q::Free));
+        }
+        let found = self.scopes.get(cx.scope).and_then(|s| s.get(name));
+        if name == "t" && found.is_none() {
+            if !matches!(cx.allow, Allow::Signals | Allow::States { .. }) {
+                self.not_allowed(e, "the time `t`", cx);
+                return None;
+            }
+            return Some((ir::Expr::Time, Q::Dim(Dim::new(0, 0, 1, 0, 0, 0, 0))));
+        }
+        if let (Some(host), None) = (cx.host, found)
+            && let Some(var) = port_var(name)
+        {
+            return self.law_var(host, var, None, e);
+        }
+        match found {
+            Some(Entity::Param(id)) => {
+                self.mark_used(id);
+                let d = self
+                    .model
+                    .params
+                    .get(id)
+                    .map(|p| p.unit.dim)
+                    .unwrap_or_default();
+                Some((ir::Expr::Param(id), self.declared(Entity::Param(id), d)))
+            }
+            Some(Entity::Input(id)) => {
+                if matches!(cx.allow, Allow::Constant | Allow::Parameters) {
+                    self.not_allowed(e, &format!("the input `{name}`"), cx);
+                    return None;
+                }
+                let d = self
+                    .model
+                    .inputs
+                    .get(id)
+                    .map(|p| p.unit.dim)
+                    .unwrap_or_default();
+                Some((ir::Expr::Input(id), self.declared(Entity::Input(id), d)))
+            }
+            Some(Entity::Output(id)) => {
+                let ok = matches!(cx.allow, Allow::States { outputs_before: Some(n) } if id < n);
+                if !ok {
+                    self.not_allowed(e, &format!("the output `{name}`"), cx);
+                    return None;
+                }
+                let d = self
+                    .model
+                    .outputs
+                    .get(id)
+                    .map(|p| p.unit.dim)
+                    .unwrap_or_default();
+                Some((ir::Expr::Output(id), self.declared(Entity::Output(id), d)))
+            }
+            Some(Entity::Var(id)) => {
+                if !matches!(cx.allow, Allow::States { .. }) {
+                    self.not_allowed(e, &format!("the integrated flow `{name}`"), cx);
+                    return None;
+                }
+                let d = self
+                    .model
+                    .vars
+                    .get(id)
+                    .map(|p| p.unit.dim)
+                    .unwrap_or_default();
+                Some((ir::Expr::Var(id), self.declared(Entity::Var(id), d)))
+            }
+            Some(other) => {
+                self.diags.push(
+                    Diagnostic::error(
+                        "BG0201",
+                        format!("`{name}` is {}, not a value", other.describe()),
+                    )
+                    .with_primary(e.span, "not a value")
+                    .with_help(format!(
+                        "write `e({name})` or `f({name})` for its effort or flow"
+                    )),
+                );
+                None
+            }
+            None => {
+                let mut d = Diagnostic::error("BG0201", format!("unknown name `{name}`"))
+                    .with_primary(e.span, "not declared in this scope");
+                let suggestion = self.scopes.get(cx.scope).and_then(|s| {
+                    s.suggest(name, |x| {
+                        matches!(
+                            x,
+                            Entity::Param(_)
+                                | Entity::Input(_)
+                                | Entity::Output(_)
+                                | Entity::Var(_)
+                        )
+                    })
+                });
+                d = match (suggestion, cx.allow) {
+                    (Some(c), _) => d.with_help(format!("did you mean `{c}`?")),
+                    (None, Allow::Constant) => d.with_help(
+                        "a parameter default may use only parameters declared before it",
+                    ),
+                    (None, _) => d.with_help("declare it as a `param`, `input`, `output` or `var`"),
+                };
+                self.diags.push(d);
+                None
+            }
+        }
+    }
+
+    fn indexed(&mut self, name: &str, i: u32, e: &ast::Expr, cx: Cx) -> Option<(ir::Expr, Q)> {
+        let var = port_var(name);
+        match (cx.host, var) {
+            (Some(host), Some(var)) => self.law_var(host, var, Some(i), e),
+            _ => {
+                self.diags.push(
+                    Diagnostic::error("BG0207", format!("`{name}[{i}]` is not defined here"))
+                        .with_primary(
+                            e.span,
+                            "only the laws of a field have indexed port variables",
+                        )
+                        .with_help("outside a field's laws, name a field port as `e(leg[1])`"),
+                );
+                None
+            }
+        }
+    }
+
+    /// `e`, `f`, `p`, `q` (or `e[i]` ...) inside the laws of `host`.
+    fn law_var(
+        &mut self,
+        host: NodeIndex,
+        var: PortVar,
+        index: Option<u32>,
+        e: &ast::Expr,
+    ) -> Option<(ir::Expr, Q)> {
+        let (kind, ports) = {
+            let n = &self.model.graph[host];
+            (n.kind, n.ports)
+        };
+        let letter = var_letter(var);
+        if kind.is_field() {
+            let Some(i) = index else {
+                self.diags.push(
+                    Diagnostic::error(
+                        "BG0207",
+                        format!("`{letter}` of a field needs a port index"),
+                    )
+                    .with_primary(e.span, "which port?")
+                    .with_help(format!("write `{letter}[i]` with i from 1 to {ports}")),
+                );
+                return None;
+            };
+            if i < 1 || i > ports {
+                self.diags.push(
+                    Diagnostic::error("BG0205", format!("port {i} is out of range"))
+                        .with_primary(e.span, format!("the field has ports 1 to {ports}"))
+                        .with_secondary(
+                            self.node_name_span(host),
+                            format!("declared with {ports} ports"),
+                        )
+                        .with_help("use an index between 1 and the port count"),
+                );
+                return None;
+            }
+            if var == PortVar::Momentum {
+                self.diags.push(
+                    Diagnostic::error("BG0207", "`p[i]` is not defined in a field's laws")
+                        .with_primary(e.span, "no momentum variable here")
+                        .with_help(
+                            "field laws use `e[i]`, `f[i]` and `q[i]` (the integral of `f[i]`)",
+                        ),
+                );
+                return None;
+            }
+            let q = self.var_dim(host, i - 1, var);
+            return Some((
+                ir::Expr::FieldPort {
+                    node: host,
+                    var,
+                    port: i - 1,
+                },
+                q,
+            ));
+        }
+        if index.is_some() {
+            self.diags.push(
+                Diagnostic::error(
+                    "BG0207",
+                    format!("`{letter}` of a `{}` has no index", kind.keyword()),
+                )
+                .with_primary(e.span, "only fields have indexed port variables")
+                .with_help(format!("write `{letter}`")),
+            );
+            return None;
+        }
+        let ok = match var {
+            PortVar::Effort | PortVar::Flow => true,
+            PortVar::Momentum => kind == ElementKind::I,
+            PortVar::Displacement => kind == ElementKind::C,
+        };
+        if !ok {
+            self.no_such_var(var, host, e.span);
+            return None;
+        }
+        let q = self.var_dim(host, 0, var);
+        let target = Target::Node(host);
+        Some((var_expr(var, target, host), q))
+    }
+
+    fn no_such_var(&mut self, var: PortVar, node: NodeIndex, span: crate::span::Span) {
+        let letter = var_letter(var);
+        let (kind, name) = {
+            let n = &self.model.graph[node];
+            (n.kind, n.name.clone())
+        };
+        let (what, help) = match var {
+            PortVar::Momentum => (
+                "a momentum",
+                "only an inertia `I` has a momentum `p`; use `f(x)` or `e(x)`",
+            ),
+            PortVar::Displacement => (
+                "a displacement",
+                "only a compliance `C` has a displacement `q`; use `f(x)` or `e(x)`",
+            ),
+            PortVar::Effort => (
+                "a single effort",
+                "a 1-junction has one common flow and a TF or GY two efforts: name a bond instead",
+            ),
+            PortVar::Flow => (
+                "a single flow",
+                "a 0-junction has one common effort and a TF or GY two flows: name a bond instead",
+            ),
+        };
+        self.diags.push(
+            Diagnostic::error(
+                "BG0207",
+                format!(
+                    "`{letter}({name})` is not defined: `{name}` is a {} and has no {what}",
+                    super::flatten::kind_name(kind)
+                ),
+            )
+            .with_primary(span, format!("no `{letter}` here"))
+            .with_help(help),
+        );
+    }
+
+    /// The dimension of a port variable; free when the domain is unknown (already reported).
+    fn var_dim(&self, node: NodeIndex, port: u32, var: PortVar) -> Q {
+        match self.port_domain(node, port) {
+            Some(d) => {
+                let u = domain_units(d);
+                Q::Dim(match var {
+                    PortVar::Effort => u.effort,
+                    PortVar::Flow => u.flow,
+                    PortVar::Momentum => u.momentum,
+                    PortVar::Displacement => u.displacement,
+                })
+            }
+            None => Q::Free,
+        }
+    }
+
+    fn binary(
+        &mut self,
+        op: BinOp,
+        a: &ast::Expr,
+        b: &ast::Expr,
+        e: &ast::Expr,
+        cx: Cx,
+    ) -> Option<(ir::Expr, Q)> {
+        let ra = self.expr(a, cx);
+        let rb = self.expr(b, cx);
+        let ((ea, qa), (eb, qb)) = (ra?, rb?);
+        let q = match op {
+            BinOp::Add | BinOp::Sub => self.same_dims(qa, qb, a, b, e, "added"),
+            BinOp::Mul => combine(qa, qb, Dim::checked_mul),
+            BinOp::Div => match (qa, qb) {
+                (Q::Free, Q::Dim(d)) => Dim::NONE.checked_div(d).map(Q::Dim),
+                _ => combine(qa, qb, Dim::checked_div),
+            },
+            BinOp::Pow => self.power(qa, &eb, qb, a, b),
+        }?;
+        Some((ir::Expr::Binary(op, Box::new(ea), Box::new(eb)), q))
+    }
+
+    fn same_dims(
+        &mut self,
+        qa: Q,
+        qb: Q,
+        a: &ast::Expr,
+        b: &ast::Expr,
+        e: &ast::Expr,
+        verb: &str,
+    ) -> Option<Q> {
+        match (qa, qb) {
+            (Q::Dim(x), Q::Dim(y)) if x != y => {
+                self.diags.push(
+                    Diagnostic::error(
+                        "BG0310",
+                        format!("quantities of different units are {verb}: {x} and {y}"),
+                    )
+                    .with_primary(e.span, "the units differ")
+                    .with_secondary(a.span, format!("this is in {x}"))
+                    .with_secondary(b.span, format!("this is in {y}"))
+                    .with_help("both sides must have one unit; check for a missing factor"),
+                );
+                None
+            }
+            (Q::Free, q) | (q, Q::Free) => Some(q),
+            (q, _) => Some(q),
+        }
+    }
+
+    fn power(&mut self, qa: Q, eb: &ir::Expr, qb: Q, a: &ast::Expr, b: &ast::Expr) -> Option<Q> {
+        if let Q::Dim(d) = qb
+            && !d.is_dimensionless()
+        {
+            self.not_dimensionless(b, d, "an exponent");
+            return None;
+        }
+        let Q::Dim(base) = qa else {
+            return Some(Q::Free);
+        };
+        if base.is_dimensionless() {
+            return Some(qa);
+        }
+        let n = if is_literal(eb) { eval(eb, &[]) } else { None };
+        let result = n.and_then(|n| {
+            if n.fract() == 0.0 && n.abs() <= 127.0 {
+                base.powi(n as i32)
+            } else if (2.0 * n).fract() == 0.0 && n.abs() <= 63.0 {
+                base.sqrt()?.powi((2.0 * n) as i32)
+            } else {
+                None
+            }
+        });
+        match result {
+            Some(d) => Some(Q::Dim(d)),
+            None => {
+                self.diags.push(
+                    Diagnostic::error(
+                        "BG0309",
+                        format!("a quantity in {base} cannot be raised to this power"),
+                    )
+                    .with_primary(b.span, "the exponent must be a constant whole number")
+                    .with_secondary(a.span, format!("this is in {base}"))
+                    .with_help(
+                        "raise only dimensionless quantities to variable or fractional powers",
+                    ),
+                );
+                None
+            }
+        }
+    }
+
+    fn not_dimensionless(&mut self, arg: &ast::Expr, d: Dim, role: &str) {
+        self.diags.push(
+            Diagnostic::error(
+                "BG0309",
+                format!("{role} must be dimensionless, but this is in {d}"),
+            )
+            .with_primary(arg.span, format!("this is in {d}"))
+            .with_help("divide by a reference quantity of the same unit to make it dimensionless"),
+        );
+    }
+
+    fn call(
+        &mut self,
+        f: &ast::Ident,
+        args: &[ast::Expr],
+        e: &ast::Expr,
+        cx: Cx,
+    ) -> Option<(ir::Expr, Q)> {
+        if let Some(var) = port_var(&f.name) {
+            if args.len() != 1 {
+                self.arity(f, 1, args.len(), e);
+                return None;
+            }
+            return self.reference(var, &args[0], e, cx);
+        }
+        if f.name == "int" {
+            self.diags.push(
+                Diagnostic::error(
+                    "BG0208",
+                    "`int` is only allowed as the whole value of a `var`",
+                )
+                .with_primary(f.span, "not allowed here")
+                .with_help("declare `var theta [rad] = int(f(x));` and use `theta`"),
+            );
+            return None;
+        }
+        let Some(func) = Func::from_name(&f.name) else {
+            let names = Func::ALL.map(Func::name);
+            let help = match closest(
+                &f.name,
+                names.iter().copied().chain(["e", "f", "p", "q", "int"]),
+            ) {
+                Some(c) => format!("did you mean `{c}`?"),
+                None => format!("the functions are {}", names.join(", ")),
+            };
+            self.diags.push(
+                Diagnostic::error("BG0208", format!("unknown function `{}`", f.name))
+                    .with_primary(f.span, "no such function")
+                    .with_help(help),
+            );
+            return None;
+        };
+        if args.len() != func.arity() {
+            self.arity(f, func.arity(), args.len(), e);
+            return None;
+        }
+        let resolved: Vec<Option<(ir::Expr, Q)>> = args.iter().map(|a| self.expr(a, cx)).collect();
+        let resolved: Vec<(ir::Expr, Q)> = resolved.into_iter().collect::<Option<_>>()?;
+        let q0 = resolved[0].1;
+        let q = match func {
+            Func::Sqrt => match q0 {
+                Q::Free => Q::Free,
+                Q::Dim(d) => match d.sqrt() {
+                    Some(r) => Q::Dim(r),
+                    None => {
+                        self.diags.push(
+                            Diagnostic::error(
+                                "BG0309",
+                                format!("the square root of a quantity in {d} has no unit"),
+                            )
+                            .with_primary(args[0].span, format!("this is in {d}"))
+                            .with_help("every exponent of the unit must be even"),
+                        );
+                        return None;
+                    }
+                },
+            },
+            Func::Abs => q0,
+            Func::Sign => match q0 {
+                Q::Free => Q::Free,
+                Q::Dim(_) => Q::Dim(Dim::NONE),
+            },
+            Func::Min | Func::Max => {
+                self.same_dims(q0, resolved[1].1, &args[0], &args[1], e, "compared")?
+            }
+            Func::Atan2 => {
+                self.same_dims(q0, resolved[1].1, &args[0], &args[1], e, "compared")?;
+                Q::Dim(Dim::NONE)
+            }
+            _ => match q0 {
+                Q::Free => Q::Free,
+                Q::Dim(d) if d.is_dimensionless() => q0,
+                Q::Dim(d) => {
+                    self.not_dimensionless(
+                        &args[0],
+                        d,
+                        &format!("the argument of `{}`", func.name()),
+                    );
+                    return None;
+                }
+            },
+        };
+        let exprs = resolved.into_iter().map(|(x, _)| x).collect();
+        Some((ir::Expr::Call(func, exprs), q))
+    }
+
+    fn arity(&mut self, f: &ast::Ident, want: usize, found: usize, e: &ast::Expr) {
+        let s = if want == 1 { "" } else { "s" };
+        self.diags.push(
+            Diagnostic::error(
+                "BG0208",
+                format!("`{}` takes {want} argument{s}, found {found}", f.name),
+            )
+            .with_primary(e.span, "wrong number of arguments")
+            .with_help(format!(
+                "call it as `{}({})`",
+                f.name,
+                if want == 1 { "x" } else { "a, b" }
+            )),
+        );
+    }
+
+    /// `e(x)`, `f(x)`, `p(x)`, `q(x)`.
+    fn reference(
+        &mut self,
+        var: PortVar,
+        arg: &ast::Expr,
+        e: &ast::Expr,
+        cx: Cx,
+    ) -> Option<(ir::Expr, Q)> {
+        let letter = var_letter(var);
+        if !matches!(cx.allow, Allow::States { .. }) {
+            self.not_allowed(e, &format!("`{letter}(..)`, a variable of the state"), cx);
+            return None;
+        }
+        let r = match &arg.kind {
+            ExprKind::Node(r) => r.clone(),
+            ExprKind::Name(n) => NodeRef {
+                path: vec![ast::Ident {
+                    name: n.clone(),
+                    span: arg.span,
+                }],
+                port: None,
+                span: arg.span,
+            },
+            ExprKind::Indexed(n, i) => NodeRef {
+                path: vec![ast::Ident {
+                    name: n.clone(),
+                    span: arg.span,
+                }],
+                port: Some((*i, arg.span)),
+                span: arg.span,
+            },
+            _ => {
+                self.diags.push(
+                    Diagnostic::error(
+                        "BG0207",
+                        format!("`{letter}(..)` takes the name of an element, junction or bond"),
+                    )
+                    .with_primary(arg.span, "not a name")
+                    .with_help(format!(
+                        "write `{letter}(x)` where `x` is declared in this model"
+                    )),
+                );
+                return None;
+            }
+        };
+        let (target, node) = self.reference_target(&r, cx.scope)?;
+        match (target, node) {
+            (Target::Bond(edge), _) => {
+                if matches!(var, PortVar::Momentum | PortVar::Displacement) {
+                    self.diags.push(
+                        Diagnostic::error("BG0207", format!("`{letter}` of a bond is not defined"))
+                            .with_primary(arg.span, "a bond has an effort and a flow only")
+                            .with_help(format!(
+                                "`{letter}(x)` takes an element: {}",
+                                if var == PortVar::Momentum {
+                                    "an inertia I"
+                                } else {
+                                    "a compliance C"
+                                }
+                            )),
+                    );
+                    return None;
+                }
+                let q = match self.bonds.get(edge.index()).and_then(|b| b.domain) {
+                    Some(d) => {
+                        let u = domain_units(d);
+                        Q::Dim(if var == PortVar::Effort {
+                            u.effort
+                        } else {
+                            u.flow
+                        })
+                    }
+                    None => Q::Free,
+                };
+                let x = if var == PortVar::Effort {
+                    ir::Expr::Effort(target)
+                } else {
+                    ir::Expr::Flow(target)
+                };
+                Some((x, q))
+            }
+            (Target::Node(n), _) => {
+                let kind = self.model.graph[n].kind;
+                let ok = match var {
+                    PortVar::Effort => {
+                        !matches!(kind, ElementKind::One) && !kind.is_two_port() && !kind.is_field()
+                    }
+                    PortVar::Flow => {
+                        !matches!(kind, ElementKind::Zero)
+                            && !kind.is_two_port()
+                            && !kind.is_field()
+                    }
+                    PortVar::Momentum => kind == ElementKind::I,
+                    PortVar::Displacement => kind == ElementKind::C,
+                };
+                if !ok {
+                    self.no_such_var(var, n, arg.span);
+                    return None;
+                }
+                let q = self.var_dim(n, 0, var);
+                Some((var_expr(var, target, n), q))
+            }
+        }
+    }
+
+    /// The node or bond an `e`/`f`/`p`/`q` argument names: `x`, `inst.x` (an element inside an instance),
+    /// `inst.port`, `field[i]` (the bond on that port), or a named bond.
+    fn reference_target(&mut self, r: &NodeRef, scope: usize) -> Option<(Target, ())> {
+        let (last, walk) = r.path.split_last()?;
+        let mut cur = scope;
+        for step in walk {
+            match self.scopes.get(cur).and_then(|s| s.get(&step.name)) {
+                Some(Entity::Instance(child)) => cur = child,
+                _ => {
+                    self.diags.push(
+                        Diagnostic::error(
+                            "BG0201",
+                            format!("no component instance `{}`", step.name),
+                        )
+                        .with_primary(step.span, "not an instance")
+                        .with_help("`a.b` names element `b` of instance `a`"),
+                    );
+                    return None;
+                }
+            }
+        }
+        if self.scopes.get(cur).is_some_and(|s| s.broken) {
+            return None;
+        }
+        let found = self.scopes.get(cur).and_then(|s| s.get(&last.name));
+        match found {
+            Some(Entity::Node(n)) => {
+                if let Some((i, span)) = r.port {
+                    let ports = self.model.graph[n].ports;
+                    let bond = if self.model.graph[n].kind.is_field() && i >= 1 && i <= ports {
+                        self.field_bonds.get(&(n, i - 1)).copied()
+                    } else {
+                        None
+                    };
+                    return match bond {
+                        Some(b) => Some((Target::Bond(b), ())),
+                        None => {
+                            self.diags.push(
+                                Diagnostic::error(
+                                    "BG0205",
+                                    format!("`{}[{i}]` is not a bonded field port", last.name),
+                                )
+                                .with_primary(span, "no such port")
+                                .with_help("fields have ports 1 to n, each with one bond"),
+                            );
+                            None
+                        }
+                    };
+                }
+                Some((Target::Node(n), ()))
+            }
+            Some(Entity::Bond(b)) => Some((Target::Bond(b), ())),
+            None if !walk.is_empty() && self.scopes[cur].ports.contains_key(&last.name) => {
+                let end = self.scopes[cur].ports[&last.name].0;
+                Some((Target::Node(end.node), ()))
+            }
+            other => {
+                let msg = match other {
+                    Some(x) => format!(
+                        "`{}` is {}, not an element, junction or bond",
+                        last.name,
+                        x.describe()
+                    ),
+                    None => format!("unknown element `{}`", last.name),
+                };
+                let help = self.scopes[cur]
+                    .suggest(&last.name, |x| {
+                        matches!(x, Entity::Node(_) | Entity::Bond(_))
+                    })
+                    .map(|c| format!("did you mean `{c}`?"))
+                    .unwrap_or_else(|| "name an element, a junction or a named bond".to_string());
+                self.diags.push(
+                    Diagnostic::error("BG0201", msg)
+                        .with_primary(r.span, "no such node")
+                        .with_help(help),
+                );
+                None
+            }
+        }
+    }
+}
+
+fn combine(a: Q, b: Q, op: impl Fn(Dim, Dim) -> Option<Dim>) -> Option<Q> {
+    Some(match (a, b) {
+        (Q::Free, Q::Free) => Q::Free,
+        (Q::Free, q) | (q, Q::Free) => q,
+        (Q::Dim(x), Q::Dim(y)) => Q::Dim(op(x, y)?),
+    })
+}
+
+pub(crate) fn port_var(name: &str) -> Option<PortVar> {
+    Some(match name {
+        "e" => PortVar::Effort,
+        "f" => PortVar::Flow,
+        "p" => PortVar::Momentum,
+        "q" => PortVar::Displacement,
+        _ => return None,
+    })
+}
+
+pub(crate) fn var_letter(v: PortVar) -> &'static str {
+    match v {
+        PortVar::Effort => "e",
+        PortVar::Flow => "f",
+        PortVar::Momentum => "p",
+        PortVar::Displacement => "q",
+    }
+}
+
+fn var_expr(var: PortVar, target: Target, node: NodeIndex) -> ir::Expr {
+    match var {
+        PortVar::Effort => ir::Expr::Effort(target),
+        PortVar::Flow => ir::Expr::Flow(target),
+        PortVar::Momentum => ir::Expr::Momentum(node),
+        PortVar::Displacement => ir::Expr::Displacement(node),
+    }
+}

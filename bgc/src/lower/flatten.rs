@@ -1,0 +1,774 @@
+//! Flattening: a model and, recursively, its component instances become one list of parameters, inputs, nodes and
+//! bonds with qualified names (`sensor.spring`, `sensor.k`).
+//!
+//! Each body is read in passes so that declarations may come in any order: first the domain, parameters (in order:
+//! a default may use earlier parameters), inputs, outputs and vars; then elements and instances; then bonds; then
+//! ports and coordinates. Component parameters become model parameters named `instance.param` whose default is the
+//! instance's override (an expression of the enclosing scope's parameters, evaluated now) or the declared default.
+
+use super::builder::{Builder, NodeInfo, ParamInfo};
+use super::consteval::eval;
+use super::exprs::{Allow, Cx, Q};
+use super::scope::{End, Entity, Scope, closest, duplicate};
+use crate::diagnostic::Diagnostic;
+use crate::ir::{self, Domain};
+use crate::syntax::ast::{
+    self, BondStmt, ElementKind, Ident, InstanceDecl, ModelDecl, ModelKind, NodeRef, Stmt,
+};
+use crate::units::{Unit, parse_unit, unit_text};
+
+/// The overrides of an instance, to be evaluated in the enclosing scope.
+pub(crate) struct Overrides<'a> {
+    pub instance: &'a InstanceDecl,
+    pub parent: usize,
+}
+
+impl<'a> Builder<'a> {
+    /// Flattens `decl` into the model under construction; returns the index of its scope.
+    pub fn instantiate(
+        &mut self,
+        decl: &'a ModelDecl,
+        prefix: String,
+        overrides: Option<Overrides<'a>>,
+    ) -> usize {
+        let instance_span = overrides.as_ref().map(|o| {
+            // The outermost instance is what the model's author sees.
+            self.scopes
+                .get(o.parent)
+                .and_then(|s| s.instance_span)
+                .unwrap_or(o.instance.span)
+        });
+        let component = match decl.kind {
+            ModelKind::Component => Some((decl.name.name.clone(), decl.name.span)),
+            ModelKind::Model => None,
+        };
+        self.scopes.push(Scope {
+            prefix,
+            component,
+            instance_span,
+            ..Default::default()
+        });
+        let sid = self.scopes.len() - 1;
+        if let Some(o) = &overrides {
+            self.check_override_names(decl, o.instance);
+        }
+        // Pass 1: domain, parameters, inputs, outputs, vars.
+        for stmt in &decl.body {
+            match stmt {
+                Stmt::Domain(d) => self.domain_stmt(sid, d),
+                Stmt::Param(p) => self.param(sid, p, overrides.as_ref()),
+                Stmt::Input(i) => {
+                    let (unit, text) = self.unit(&i.unit);
+                    let id = self.model.inputs.len();
+                    let _ = self.declare(sid, &i.name, Entity::Input(id));
+                    if !self.last_unit_ok {
+                        self.bad_units.push(Entity::Input(id));
+                    }
+                    self.model.inputs.push(ir::Input {
+                        name: self.qualified(sid, &i.name.name),
+                        unit,
+                        unit_text: text,
+                        description: i.description.clone(),
+                    });
+                    self.model.spans.inputs.push(i.span);
+                }
+                Stmt::Output(o) => {
+                    let (unit, text) = self.unit(&o.unit);
+                    let id = self.model.outputs.len();
+                    let _ = self.declare(sid, &o.name, Entity::Output(id));
+                    if !self.last_unit_ok {
+                        self.bad_units.push(Entity::Output(id));
+                    }
+                    self.model.outputs.push(ir::Output {
+                        name: self.qualified(sid, &o.name.name),
+                        unit,
+                        unit_text: text,
+                        value: ir::Expr::Const(0.0),
+                        description: o.description.clone(),
+                    });
+                    self.model.spans.outputs.push(o.span);
+                    self.pending_outputs.push((id, sid, o));
+                }
+                Stmt::Var(v) => {
+                    let (unit, text) = self.unit(&v.unit);
+                    let id = self.model.vars.len();
+                    let _ = self.declare(sid, &v.name, Entity::Var(id));
+                    if !self.last_unit_ok {
+                        self.bad_units.push(Entity::Var(id));
+                    }
+                    self.model.vars.push(ir::Var {
+                        name: self.qualified(sid, &v.name.name),
+                        unit,
+                        unit_text: text,
+                        integrand: ir::Expr::Const(0.0),
+                    });
+                    self.model.spans.vars.push(v.span);
+                    self.pending_vars.push((id, sid, v));
+                }
+                _ => {}
+            }
+        }
+        // Pass 2: elements and instances.
+        for stmt in &decl.body {
+            match stmt {
+                Stmt::Element(e) => self.element(sid, e),
+                Stmt::Instance(i) => self.instance(sid, i),
+                _ => {}
+            }
+        }
+        // Pass 3: bonds.
+        for stmt in &decl.body {
+            if let Stmt::Bond(b) = stmt {
+                self.bond_stmt(sid, b);
+            }
+        }
+        // Pass 4: ports and coordinates.
+        for stmt in &decl.body {
+            match stmt {
+                Stmt::Port(p) => {
+                    if decl.kind == ModelKind::Model {
+                        self.diags.push(
+                            Diagnostic::error("BG0313", "a model has no ports")
+                                .with_primary(p.span, "a port in a model")
+                                .with_help("ports belong to components; write `component` to make this reusable"),
+                        );
+                        continue;
+                    }
+                    let Some(end) = self.resolve_end(sid, &p.target) else {
+                        continue;
+                    };
+                    let scope = &mut self.scopes[sid];
+                    if let Some((_, first)) = scope.ports.get(&p.name.name) {
+                        let d = duplicate(&p.name.name, p.name.span, *first);
+                        self.diags.push(d);
+                    } else {
+                        scope.ports.insert(p.name.name.clone(), (end, p.name.span));
+                        scope.port_order.push(p.name.name.clone());
+                    }
+                }
+                Stmt::Coords(c) => {
+                    if decl.kind == ModelKind::Component {
+                        self.diags.push(
+                            Diagnostic::error(
+                                "BG0313",
+                                "a component cannot declare state coordinates",
+                            )
+                            .with_primary(c.span, "coordinates in a component")
+                            .with_help("declare `coords` in the model that uses the component"),
+                        );
+                    } else if let Some((_, first)) = self.pending_coords {
+                        self.diags.push(
+                            Diagnostic::error("BG0202", "state coordinates are declared twice")
+                                .with_primary(c.span, "declared again here")
+                                .with_secondary(first.span, "first declared here")
+                                .with_help("keep one `coords` list"),
+                        );
+                    } else {
+                        self.pending_coords = Some((sid, c));
+                    }
+                }
+                _ => {}
+            }
+        }
+        sid
+    }
+
+    pub fn qualified(&self, sid: usize, name: &str) -> String {
+        match self.scopes.get(sid) {
+            Some(s) => format!("{}{}", s.prefix, name),
+            None => name.to_string(),
+        }
+    }
+
+    /// Declares a name in a scope; false (with BG0202 reported) when it is already taken.
+    fn declare(&mut self, sid: usize, name: &Ident, entity: Entity) -> bool {
+        if let Some(scope) = self.scopes.get_mut(sid)
+            && let Err(d) = scope.declare(&name.name, name.span, entity)
+        {
+            self.diags.push(d);
+            return false;
+        }
+        true
+    }
+
+    /// Parses a unit, reporting an unknown symbol (BG0312); a bad unit reads as `[1]` afterwards.
+    pub fn unit(&mut self, u: &ast::UnitExpr) -> (Unit, String) {
+        let text = unit_text(u);
+        match parse_unit(u) {
+            Ok(unit) => {
+                self.last_unit_ok = true;
+                (unit, text)
+            }
+            Err(err) => {
+                let mut d = Diagnostic::error("BG0312", format!("{err} in `[{text}]`"))
+                    .with_primary(u.span, err.to_string());
+                if let crate::units::UnitError::UnknownSymbol { symbol } = &err {
+                    let known = [
+                        "m", "g", "kg", "s", "A", "K", "mol", "cd", "rad", "sr", "Hz", "N", "Pa",
+                        "J", "W", "C", "V", "F", "Ohm", "S", "Wb", "T", "H", "min", "h", "deg",
+                        "rpm", "L",
+                    ];
+                    d = d.with_help(match closest(symbol, known.into_iter()) {
+                        Some(c) => format!("did you mean `{c}`?"),
+                        None => "units are SI symbols with optional prefixes p n u µ m c d k M G (docs/language.md, Units)".to_string(),
+                    });
+                }
+                self.diags.push(d);
+                self.last_unit_ok = false;
+                (Unit::ONE, text)
+            }
+        }
+    }
+
+    fn domain_stmt(&mut self, sid: usize, d: &ast::DomainStmt) {
+        let Some(domain) = self.domain_name(&d.domain) else {
+            return;
+        };
+        let scope = &mut self.scopes[sid];
+        if let Some((_, first)) = scope.default_domain {
+            self.diags.push(
+                Diagnostic::error("BG0202", "the default domain is set twice")
+                    .with_primary(d.span, "set again here")
+                    .with_secondary(first, "first set here")
+                    .with_help(
+                        "keep one `domain` statement; give other elements their own `: DOMAIN`",
+                    ),
+            );
+        } else {
+            scope.default_domain = Some((domain, d.span));
+        }
+    }
+
+    /// A domain name, or BG0201 with a suggestion.
+    pub fn domain_name(&mut self, name: &Ident) -> Option<Domain> {
+        let found = Domain::from_name(&name.name);
+        if found.is_none() {
+            let names = Domain::ALL.map(Domain::name);
+            let help = match closest(&name.name, names.into_iter()) {
+                Some(c) => format!("did you mean `{c}`?"),
+                None => format!("the domains are {}", names.join(", ")),
+            };
+            self.diags.push(
+                Diagnostic::error("BG0201", format!("unknown domain `{}`", name.name))
+                    .with_primary(name.span, "not a domain")
+                    .with_help(help),
+            );
+        }
+        found
+    }
+
+    fn check_override_names(&mut self, decl: &ModelDecl, inst: &InstanceDecl) {
+        let params: Vec<&str> = decl
+            .body
+            .iter()
+            .filter_map(|s| match s {
+                Stmt::Param(p) => Some(p.name.name.as_str()),
+                _ => None,
+            })
+            .collect();
+        for (i, (name, _)) in inst.overrides.iter().enumerate() {
+            if let Some((first, _)) = inst.overrides[..i]
+                .iter()
+                .find(|(n, _)| n.name == name.name)
+            {
+                self.diags
+                    .push(duplicate(&name.name, name.span, first.span));
+                continue;
+            }
+            if params.contains(&name.name.as_str()) {
+                continue;
+            }
+            let help = match closest(&name.name, params.iter().copied()) {
+                Some(c) => format!("did you mean `{c}`?"),
+                None if params.is_empty() => format!("`{}` has no parameters", decl.name.name),
+                None => format!(
+                    "the parameters of `{}` are: {}",
+                    decl.name.name,
+                    params.join(", ")
+                ),
+            };
+            self.diags.push(
+                Diagnostic::error(
+                    "BG0206",
+                    format!(
+                        "component `{}` has no parameter `{}`",
+                        decl.name.name, name.name
+                    ),
+                )
+                .with_primary(name.span, "no such parameter")
+                .with_secondary(decl.name.span, "component declared here")
+                .with_help(help),
+            );
+        }
+    }
+
+    fn param(&mut self, sid: usize, p: &'a ast::ParamDecl, overrides: Option<&Overrides<'a>>) {
+        let (unit, text) = self.unit(&p.unit);
+        let unit_ok = self.last_unit_ok;
+        if !unit_ok {
+            self.bad_units.push(Entity::Param(self.model.params.len()));
+        }
+        let over = overrides.and_then(|o| {
+            o.instance
+                .overrides
+                .iter()
+                .find(|(n, _)| n.name == p.name.name)
+                .map(|(_, e)| (e, o.parent))
+        });
+        let (expr, scope) = over.unwrap_or((&p.default, sid));
+        let what = if over.is_some() {
+            "a parameter override"
+        } else {
+            "a parameter default"
+        };
+        let cx = Cx {
+            scope,
+            allow: Allow::Constant,
+            host: None,
+            what,
+        };
+        let mut value = 0.0;
+        if let Some((ir_expr, q)) = self.expr(expr, cx) {
+            match q {
+                Q::Dim(d) if unit_ok && d != unit.dim => {
+                    self.diags.push(
+                        Diagnostic::error(
+                            "BG0303",
+                            format!("the value of `{}` has unit `{d}`, but it is declared `[{text}]`", p.name.name),
+                        )
+                        .with_primary(expr.span, format!("this is in {d}"))
+                        .with_secondary(p.unit.span, "declared unit")
+                        .with_help("make the expression's unit match the declared one, or fix the declaration"),
+                    );
+                }
+                _ => {}
+            }
+            match eval(&ir_expr, &self.model.params) {
+                // A bare number is written in the declared unit; an expression of parameters is already in SI.
+                Some(v) if q == Q::Free => value = v * unit.scale,
+                Some(v) => value = v,
+                None => {}
+            }
+            if !value.is_finite() {
+                self.diags.push(
+                    Diagnostic::error(
+                        "BG0403",
+                        format!("the value of `{}` is not finite", p.name.name),
+                    )
+                    .with_primary(expr.span, format!("this evaluates to {value}"))
+                    .with_help("check for a division by zero or an overflow"),
+                );
+                value = 0.0;
+            }
+        }
+        let id = self.model.params.len();
+        // A duplicate cannot be referred to; it is not reported as unused as well.
+        let used = !self.declare(sid, &p.name, Entity::Param(id));
+        self.model.params.push(ir::Param {
+            name: self.qualified(sid, &p.name.name),
+            default: value,
+            unit,
+            unit_text: text,
+            description: p.description.clone(),
+            doc: p.doc.clone(),
+        });
+        self.model.spans.params.push(p.span);
+        self.params.push(ParamInfo {
+            used,
+            name_span: p.name.span,
+            value_span: expr.span,
+        });
+    }
+
+    fn element(&mut self, sid: usize, e: &'a ast::ElementDecl) {
+        let explicit_domain = e
+            .domain
+            .as_ref()
+            .and_then(|d| self.domain_name(d).map(|dom| (dom, d.span)));
+        let ports = match e.kind {
+            k if k.is_junction() => 0,
+            k if k.is_two_port() => 2,
+            k if k.is_field() => e.ports.map(|(n, _)| n).unwrap_or(0),
+            _ => 1,
+        };
+        let node = self.model.graph.add_node(ir::Node {
+            name: self.qualified(sid, &e.name.name),
+            kind: e.kind,
+            relation: ir::Relation::Junction,
+            ports,
+            doc: e.doc.clone(),
+        });
+        let _ = self.declare(sid, &e.name, Entity::Node(node));
+        let relation_span = match &e.body {
+            ast::ElementBody::None => None,
+            ast::ElementBody::Value(v) => Some(v.span),
+            ast::ElementBody::Laws(laws) => laws
+                .first()
+                .zip(laws.last())
+                .map(|(a, b)| a.span.to(b.span)),
+        };
+        let spans = &mut self.model.spans;
+        spans.nodes.push(e.span);
+        spans.node_names.push(e.name.span);
+        spans.node_relations.push(relation_span);
+        spans
+            .node_instances
+            .push(self.scopes.get(sid).and_then(|s| s.instance_span));
+        self.nodes.push(NodeInfo {
+            scope: sid,
+            decl: e,
+            explicit_domain,
+            domain: None,
+        });
+    }
+
+    fn instance(&mut self, sid: usize, inst: &'a InstanceDecl) {
+        if !self.try_instance(sid, inst) {
+            // Keep the name so that bonds to its ports are not reported again.
+            self.scopes.push(Scope {
+                broken: true,
+                ..Default::default()
+            });
+            let child = self.scopes.len() - 1;
+            let _ = self.declare(sid, &inst.name, Entity::Instance(child));
+        }
+    }
+
+    /// Instantiates a component; false (with BG0204 reported) when it cannot be.
+    fn try_instance(&mut self, sid: usize, inst: &'a InstanceDecl) -> bool {
+        let name = &inst.component.name;
+        let Some(&comp) = self.decls.get(name) else {
+            let mut candidates: Vec<&str> = self
+                .decls
+                .iter()
+                .filter(|(_, d)| d.kind == ModelKind::Component)
+                .map(|(n, _)| n.as_str())
+                .collect();
+            candidates.sort_unstable();
+            let help = match closest(name, candidates.iter().copied()) {
+                Some(c) => format!("did you mean `{c}`?"),
+                None => "declare the component in this file or import the file that declares it (`import \"std.bg\";` for the standard library)".to_string(),
+            };
+            self.diags.push(
+                Diagnostic::error("BG0204", format!("unknown component `{name}`"))
+                    .with_primary(inst.component.span, "no component of this name")
+                    .with_help(help),
+            );
+            return false;
+        };
+        if comp.kind == ModelKind::Model {
+            self.diags.push(
+                Diagnostic::error("BG0204", format!("`{name}` is a model, not a component"))
+                    .with_primary(inst.component.span, "instantiated here")
+                    .with_secondary(comp.name.span, "declared as a model here")
+                    .with_help("only components can be instantiated; declare it with `component`"),
+            );
+            return false;
+        }
+        if self.component_stack.iter().any(|c| c == name) {
+            self.diags.push(
+                Diagnostic::error("BG0204", format!("component `{name}` contains itself"))
+                    .with_primary(inst.span, "this instance repeats an enclosing component")
+                    .with_secondary(comp.name.span, "component declared here")
+                    .with_help("a component cannot instantiate itself, directly or through other components"),
+            );
+            return false;
+        }
+        self.component_stack.push(name.clone());
+        let prefix = format!("{}{}.", self.scopes[sid].prefix, inst.name.name);
+        let child = self.instantiate(
+            comp,
+            prefix,
+            Some(Overrides {
+                instance: inst,
+                parent: sid,
+            }),
+        );
+        self.component_stack.pop();
+        let _ = self.declare(sid, &inst.name, Entity::Instance(child));
+        true
+    }
+
+    fn bond_stmt(&mut self, sid: usize, b: &'a BondStmt) {
+        let mut created = Vec::new();
+        for pair in b.chain.windows(2) {
+            let [tails, heads] = pair else { continue };
+            for tail in tails {
+                for head in heads {
+                    let (Some(from), Some(to)) =
+                        (self.resolve_end(sid, tail), self.resolve_end(sid, head))
+                    else {
+                        continue;
+                    };
+                    if from.node == to.node {
+                        self.diags.push(
+                            Diagnostic::error("BG0203", "a bond cannot join a node to itself")
+                                .with_primary(
+                                    tail.span.to(head.span),
+                                    "both ends are the same node",
+                                )
+                                .with_help("a bond joins two different elements or junctions"),
+                        );
+                        continue;
+                    }
+                    let e = self.model.graph.add_edge(
+                        from.node,
+                        to.node,
+                        ir::Bond {
+                            name: b.label.as_ref().map(|l| self.qualified(sid, &l.name)),
+                            from_port: 0,
+                            to_port: 0,
+                            domain: Domain::Rotational,
+                            hint: None,
+                        },
+                    );
+                    self.model.spans.bonds.push(tail.span.to(head.span));
+                    self.bonds.push(super::builder::BondInfo {
+                        from,
+                        to,
+                        domain: None,
+                    });
+                    created.push((e, from, to));
+                }
+            }
+        }
+        if let [(e, from, to)] = created[..] {
+            if let Some(label) = &b.label {
+                let _ = self.declare(sid, label, Entity::Bond(e));
+            }
+            if let Some(h) = &b.hint
+                && let Some(at) = self.resolve_end(sid, &h.at)
+            {
+                let stroke_at_to = at == to;
+                if at != from && at != to {
+                    self.diags.push(
+                        Diagnostic::error(
+                            "BG0203",
+                            "the causal stroke must be at one of the bond's ends",
+                        )
+                        .with_primary(h.at.span, "not an end of this bond")
+                        .with_help("name one of the two nodes the bond joins after `stroke`"),
+                    );
+                } else {
+                    self.model.graph[e].hint = Some(ir::Hint {
+                        stroke_at_to,
+                        fixed: h.fixed,
+                    });
+                }
+            }
+        }
+    }
+
+    /// Resolves a bond end or a port target: `j1`, `leg[2]`, `inst.port`, `a.b.port`.
+    pub fn resolve_end(&mut self, sid: usize, r: &NodeRef) -> Option<End> {
+        let (last, walk) = r.path.split_last()?;
+        let mut cur = sid;
+        for step in walk {
+            match self.scopes.get(cur).and_then(|s| s.get(&step.name)) {
+                Some(Entity::Instance(child)) => cur = child,
+                other => {
+                    let msg = match other {
+                        Some(e) => format!(
+                            "`{}` is {}, not a component instance",
+                            step.name,
+                            e.describe()
+                        ),
+                        None => format!("no component instance `{}`", step.name),
+                    };
+                    let help = self.scopes[cur]
+                        .suggest(&step.name, |e| matches!(e, Entity::Instance(_)))
+                        .map(|c| format!("did you mean `{c}`?"))
+                        .unwrap_or_else(|| "`a.b` names port `b` of instance `a`".to_string());
+                    self.diags.push(
+                        Diagnostic::error("BG0203", msg)
+                            .with_primary(step.span, "not an instance")
+                            .with_help(help),
+                    );
+                    return None;
+                }
+            }
+        }
+        if self.scopes.get(cur).is_some_and(|s| s.broken) {
+            return None;
+        }
+        if !walk.is_empty() {
+            return self.instance_port(cur, walk, last, r);
+        }
+        let found = self.scopes.get(sid).and_then(|s| s.get(&last.name));
+        match found {
+            Some(Entity::Node(node)) => self.node_end(node, last, r),
+            Some(Entity::Instance(child)) => {
+                let ports = self.scopes[child].port_order.join(", ");
+                self.diags.push(
+                    Diagnostic::error(
+                        "BG0203",
+                        format!(
+                            "`{}` is a component instance; a bond goes to one of its ports",
+                            last.name
+                        ),
+                    )
+                    .with_primary(r.span, "an instance, not a node")
+                    .with_help(format!(
+                        "write `{}.PORT`; its ports are: {ports}",
+                        last.name
+                    )),
+                );
+                None
+            }
+            Some(other) => {
+                self.diags.push(
+                    Diagnostic::error(
+                        "BG0203",
+                        format!(
+                            "`{}` is {}, not an element or junction",
+                            last.name,
+                            other.describe()
+                        ),
+                    )
+                    .with_primary(r.span, "cannot be bonded")
+                    .with_help("bonds join elements, junctions and ports of instances and fields"),
+                );
+                None
+            }
+            None => {
+                let help = self.scopes[sid]
+                    .suggest(&last.name, |e| {
+                        matches!(e, Entity::Node(_) | Entity::Instance(_))
+                    })
+                    .map(|c| format!("did you mean `{c}`?"))
+                    .unwrap_or_else(|| {
+                        format!("declare it, e.g. `1 {};` for a 1-junction", last.name)
+                    });
+                self.diags.push(
+                    Diagnostic::error(
+                        "BG0203",
+                        format!("bond to `{}`, which does not exist", last.name),
+                    )
+                    .with_primary(r.span, "no element or junction of this name")
+                    .with_help(help),
+                );
+                None
+            }
+        }
+    }
+
+    fn node_end(
+        &mut self,
+        node: petgraph::graph::NodeIndex,
+        name: &Ident,
+        r: &NodeRef,
+    ) -> Option<End> {
+        let (kind, ports) = {
+            let n = &self.model.graph[node];
+            (n.kind, n.ports)
+        };
+        match (kind.is_field(), r.port) {
+            (true, Some((i, span))) => {
+                if i >= 1 && i <= ports {
+                    Some(End {
+                        node,
+                        port: Some(i - 1),
+                    })
+                } else {
+                    self.diags.push(
+                        Diagnostic::error(
+                            "BG0205",
+                            format!("field `{}` has no port {i}", name.name),
+                        )
+                        .with_primary(span, format!("out of range 1..={ports}"))
+                        .with_secondary(
+                            self.node_name_span(node),
+                            format!("declared with {ports} ports"),
+                        )
+                        .with_help(format!(
+                            "the ports of `{}` are `{0}[1]` to `{0}[{ports}]`",
+                            name.name
+                        )),
+                    );
+                    None
+                }
+            }
+            (true, None) => {
+                self.diags.push(
+                    Diagnostic::error(
+                        "BG0205",
+                        format!(
+                            "`{}` is a multiport field; a bond goes to one of its ports",
+                            name.name
+                        ),
+                    )
+                    .with_primary(r.span, "which port?")
+                    .with_help(format!("write `{}[i]` with i from 1 to {ports}", name.name)),
+                );
+                None
+            }
+            (false, Some((_, span))) => {
+                self.diags.push(
+                    Diagnostic::error(
+                        "BG0205",
+                        format!(
+                            "`{}` is a `{}`, not a multiport field",
+                            name.name,
+                            kind.keyword()
+                        ),
+                    )
+                    .with_primary(span, "only fields have numbered ports")
+                    .with_help(format!("write `{}` without an index", name.name)),
+                );
+                None
+            }
+            (false, None) => Some(End { node, port: None }),
+        }
+    }
+
+    fn instance_port(
+        &mut self,
+        child: usize,
+        walk: &[Ident],
+        port: &Ident,
+        r: &NodeRef,
+    ) -> Option<End> {
+        let scope = self.scopes.get(child)?;
+        if let Some((end, _)) = scope.ports.get(&port.name) {
+            if let Some((_, span)) = r.port {
+                self.diags.push(
+                    Diagnostic::error("BG0205", "a component port has no index")
+                        .with_primary(span, "unexpected index")
+                        .with_help("write the port without `[i]`"),
+                );
+                return None;
+            }
+            return Some(*end);
+        }
+        let inst = walk.last().map(|i| i.name.as_str()).unwrap_or("");
+        let (comp, comp_span) = scope.component.clone().unwrap_or_default();
+        let names: Vec<&str> = scope.port_order.iter().map(String::as_str).collect();
+        let help = match closest(&port.name, names.iter().copied()) {
+            Some(c) => format!("did you mean `{inst}.{c}`?"),
+            None if names.is_empty() => format!("component `{comp}` declares no ports"),
+            None => format!("the ports of `{comp}` are: {}", names.join(", ")),
+        };
+        self.diags.push(
+            Diagnostic::error(
+                "BG0205",
+                format!(
+                    "instance `{inst}` (component `{comp}`) has no port `{}`",
+                    port.name
+                ),
+            )
+            .with_primary(port.span, "no such port")
+            .with_secondary(comp_span, "component declared here")
+            .with_help(help),
+        );
+        None
+    }
+}
+
+/// Span helper for messages that name an element kind.
+pub(crate) fn kind_name(kind: ElementKind) -> &'static str {
+    match kind {
+        ElementKind::Zero => "0-junction",
+        ElementKind::One => "1-junction",
+        k => k.keyword(),
+    }
+}

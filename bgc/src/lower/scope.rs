@@ -1,0 +1,149 @@
+//! Name scopes of the lowering stage: one per model and one per component instance.
+//!
+//! A scope has one namespace for parameters, inputs, outputs, vars, elements, instances and named bonds (so that a
+//! bare name or the argument of `e(..)` has one meaning), and a separate one for the ports of a component.
+
+use crate::diagnostic::Diagnostic;
+use crate::ir::{Domain, InputId, OutputId, ParamId, VarId};
+use crate::span::Span;
+use petgraph::graph::{EdgeIndex, NodeIndex};
+use std::collections::HashMap;
+
+/// What a name in a scope stands for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Entity {
+    Param(ParamId),
+    Input(InputId),
+    Output(OutputId),
+    Var(VarId),
+    Node(NodeIndex),
+    /// A component instance: the index of its scope.
+    Instance(usize),
+    Bond(EdgeIndex),
+}
+
+impl Entity {
+    /// "a parameter", "an element", ... for messages.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Entity::Param(_) => "a parameter",
+            Entity::Input(_) => "an input",
+            Entity::Output(_) => "an output",
+            Entity::Var(_) => "an integrated flow (var)",
+            Entity::Node(_) => "an element",
+            Entity::Instance(_) => "a component instance",
+            Entity::Bond(_) => "a bond",
+        }
+    }
+}
+
+/// One end of a bond: a node and, for a multiport field, the 0-based port.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct End {
+    pub node: NodeIndex,
+    pub port: Option<u32>,
+}
+
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Scope {
+    /// `""` for the model, `"sensor."` for instance `sensor`, `"arm.sensor."` nested.
+    pub prefix: String,
+    pub names: HashMap<String, (Entity, Span)>,
+    /// Names in declaration order (for suggestions that do not depend on hashing order).
+    pub order: Vec<String>,
+    pub ports: HashMap<String, (End, Span)>,
+    pub port_order: Vec<String>,
+    pub default_domain: Option<(Domain, Span)>,
+    /// The component's name and its declaration's name span (None for a model).
+    pub component: Option<(String, Span)>,
+    /// The outermost instance declaration this scope comes from, for `SpanTable::node_instances`.
+    pub instance_span: Option<Span>,
+    /// The scope of an instance whose component could not be instantiated (already reported): references into it
+    /// are not reported again.
+    pub broken: bool,
+}
+
+impl Scope {
+    /// Declares a name, or returns the duplicate-name diagnostic (BG0202).
+    pub fn declare(&mut self, name: &str, span: Span, entity: Entity) -> Result<(), Diagnostic> {
+        if let Some((_, first)) = self.names.get(name) {
+            return Err(duplicate(name, span, *first));
+        }
+        self.names.insert(name.to_string(), (entity, span));
+        self.order.push(name.to_string());
+        Ok(())
+    }
+
+    pub fn get(&self, name: &str) -> Option<Entity> {
+        self.names.get(name).map(|(e, _)| *e)
+    }
+
+    /// The closest declared name accepted by `filter`, for "did you mean" help.
+    pub fn suggest(&self, name: &str, filter: impl Fn(Entity) -> bool) -> Option<String> {
+        let candidates = self
+            .order
+            .iter()
+            .filter(|n| self.get(n).is_some_and(&filter))
+            .map(String::as_str);
+        closest(name, candidates)
+    }
+}
+
+/// The BG0202 diagnostic for a second declaration of `name`.
+pub(crate) fn duplicate(name: &str, span: Span, first: Span) -> Diagnostic {
+    Diagnostic::error("BG0202", format!("`{name}` is declared twice"))
+        .with_primary(span, "declared again here")
+        .with_secondary(first, "first declared here")
+        .with_help(format!("rename one of the two declarations of `{name}`"))
+}
+
+/// Levenshtein distance (in characters).
+pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = Vec::with_capacity(b.len() + 1);
+        cur.push(i + 1);
+        for (j, cb) in b.iter().enumerate() {
+            let sub = prev[j] + usize::from(ca != *cb);
+            let del = prev[j + 1] + 1;
+            let ins = cur[j] + 1;
+            cur.push(sub.min(del).min(ins));
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+/// The candidate nearest to `name`, if it is near enough to be a likely typo: at most one edit for short names,
+/// a third of the length for longer ones.
+pub(crate) fn closest<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<String> {
+    let limit = (name.chars().count() / 3).max(1);
+    candidates
+        .filter(|c| *c != name)
+        .map(|c| (edit_distance(name, c), c))
+        .filter(|(d, _)| *d <= limit)
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, c)| c.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn edit_distance_counts_single_edits() {
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance("J_m", "J_n"), 1);
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(edit_distance("rotor", "rotor"), 0);
+    }
+
+    #[test]
+    fn closest_picks_a_near_name_only() {
+        let names = ["spring", "damper", "rotor"];
+        assert_eq!(closest("sprin", names.into_iter()), Some("spring".into()));
+        assert_eq!(closest("rotr", names.into_iter()), Some("rotor".into()));
+        assert_eq!(closest("xyz", names.into_iter()), None);
+    }
+}

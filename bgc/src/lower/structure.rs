@@ -1,0 +1,198 @@
+//! Structure checks: every node has the bonds its kind requires, TF/GY and field ports are numbered, and power
+//! directions make sense.
+//!
+//! - a node without any bond is unconnected (BG0306);
+//! - a 1-port (Se, Sf, MSe, MSf, C, I, R) has exactly one bond (BG0301);
+//! - a TF, GY, MTF or MGY has exactly one bond in (its port 0) and one out (its port 1) (BG0304);
+//! - a junction has at least two bonds (BG0305);
+//! - each port of a field has exactly one bond (BG0307);
+//! - a source whose bond points into it, or a C, I or R whose bond points out of it, is a warning (BG0308): the
+//!   equations are still right (the half-arrow only fixes the sign convention of power), but a source that
+//!   absorbs power or a resistor that supplies it is almost always a reversed arrow.
+
+use super::builder::Builder;
+use super::flatten::kind_name;
+use crate::diagnostic::Diagnostic;
+use crate::syntax::ast::ElementKind;
+use petgraph::Direction;
+use petgraph::graph::{EdgeIndex, NodeIndex};
+use petgraph::visit::EdgeRef;
+
+impl Builder<'_> {
+    pub fn check_structure(&mut self) {
+        let nodes: Vec<NodeIndex> = self.model.graph.node_indices().collect();
+        for n in nodes {
+            let incoming: Vec<EdgeIndex> = self
+                .model
+                .graph
+                .edges_directed(n, Direction::Incoming)
+                .map(|e| e.id())
+                .collect();
+            let outgoing: Vec<EdgeIndex> = self
+                .model
+                .graph
+                .edges_directed(n, Direction::Outgoing)
+                .map(|e| e.id())
+                .collect();
+            let kind = self.model.graph[n].kind;
+            let name = self.model.graph[n].name.clone();
+            let decl_span = self.node_name_span(n);
+            let mut all: Vec<EdgeIndex> = incoming.iter().chain(outgoing.iter()).copied().collect();
+            all.sort_unstable();
+            if all.is_empty() {
+                self.diags.push(
+                    Diagnostic::error("BG0306", format!("`{name}` is not connected"))
+                        .with_primary(decl_span, format!("this {} has no bond", kind_name(kind)))
+                        .with_help(format!("bond it (`bond j -> {name};`) or remove it")),
+                );
+                continue;
+            }
+            match kind {
+                k if k.is_junction() => {
+                    if all.len() < 2 {
+                        self.diags.push(
+                            Diagnostic::error("BG0305", format!("junction `{name}` has only one bond"))
+                                .with_primary(decl_span, "a junction joins at least two bonds")
+                                .with_secondary(self.bond_span(all[0]), "its only bond")
+                                .with_help("bond the element directly, without the junction, or add the missing bond"),
+                        );
+                    }
+                }
+                k if k.is_two_port() => {
+                    if incoming.len() != 1 || outgoing.len() != 1 {
+                        let mut d = Diagnostic::error(
+                            "BG0304",
+                            format!(
+                                "`{name}` needs one bond in and one bond out, found {} in and {} out",
+                                incoming.len(),
+                                outgoing.len()
+                            ),
+                        )
+                        .with_primary(decl_span, format!("a {} has an input and an output port", k.keyword()));
+                        for e in &all {
+                            d = d.with_secondary(self.bond_span(*e), "a bond of it");
+                        }
+                        self.diags.push(d.with_help(
+                            "the bond pointing into it is its input (port 0), the bond pointing out of it its output (port 1)",
+                        ));
+                    }
+                    for e in &incoming {
+                        self.model.graph[*e].to_port = 0;
+                    }
+                    for e in &outgoing {
+                        self.model.graph[*e].from_port = 1;
+                    }
+                }
+                k if k.is_field() => self.field_ports(n, &name, &incoming, &outgoing, decl_span),
+                _ => {
+                    if all.len() > 1 {
+                        let mut d = Diagnostic::error(
+                            "BG0301",
+                            format!("`{name}` is a 1-port but has {} bonds", all.len()),
+                        )
+                        .with_primary(self.bond_span(all[1]), "a second bond");
+                        d = d.with_secondary(self.bond_span(all[0]), "first bond");
+                        d = d.with_secondary(
+                            decl_span,
+                            format!("a `{}` has one port", kind.keyword()),
+                        );
+                        self.diags.push(d.with_help(format!(
+                            "bond `{name}` to a junction and bond the other elements to that junction"
+                        )));
+                    }
+                    self.power_direction(kind, &name, &incoming, &outgoing);
+                }
+            }
+        }
+    }
+
+    fn field_ports(
+        &mut self,
+        n: NodeIndex,
+        name: &str,
+        incoming: &[EdgeIndex],
+        outgoing: &[EdgeIndex],
+        decl_span: crate::span::Span,
+    ) {
+        let ports = self.model.graph[n].ports;
+        let mut on_port: Vec<Vec<EdgeIndex>> = vec![Vec::new(); ports as usize];
+        for (e, is_in) in incoming
+            .iter()
+            .map(|e| (*e, true))
+            .chain(outgoing.iter().map(|e| (*e, false)))
+        {
+            let Some(info) = self.bonds.get(e.index()) else {
+                continue;
+            };
+            let end = if is_in { info.to } else { info.from };
+            let Some(port) = end.port else { continue };
+            if let Some(list) = on_port.get_mut(port as usize) {
+                list.push(e);
+            }
+            let bond = &mut self.model.graph[e];
+            if is_in {
+                bond.to_port = port;
+            } else {
+                bond.from_port = port;
+            }
+        }
+        for (i, list) in on_port.iter().enumerate() {
+            match list[..] {
+                [e] => {
+                    self.field_bonds.insert((n, i as u32), e);
+                }
+                [] => self.diags.push(
+                    Diagnostic::error(
+                        "BG0307",
+                        format!("port {} of field `{name}` has no bond", i + 1),
+                    )
+                    .with_primary(decl_span, format!("`{name}[{}]` is not bonded", i + 1))
+                    .with_help(format!("bond it: `bond j -> {name}[{}];`", i + 1)),
+                ),
+                [first, second, ..] => self.diags.push(
+                    Diagnostic::error(
+                        "BG0307",
+                        format!("port {} of field `{name}` has {} bonds", i + 1, list.len()),
+                    )
+                    .with_primary(self.bond_span(second), "a second bond on this port")
+                    .with_secondary(self.bond_span(first), "first bond")
+                    .with_help(
+                        "each port of a field takes one bond; join several through a junction",
+                    ),
+                ),
+            }
+        }
+    }
+
+    fn power_direction(
+        &mut self,
+        kind: ElementKind,
+        name: &str,
+        incoming: &[EdgeIndex],
+        outgoing: &[EdgeIndex],
+    ) {
+        use ElementKind as K;
+        let (bad, expected) = match kind {
+            K::Se | K::Sf | K::MSe | K::MSf => {
+                (incoming.first(), "a source's bond points away from it")
+            }
+            K::C | K::I | K::R => (
+                outgoing.first(),
+                "a storage or dissipative element's bond points into it",
+            ),
+            _ => (None, ""),
+        };
+        let Some(&e) = bad else { return };
+        self.diags.push(
+            Diagnostic::warning(
+                "BG0308",
+                format!("the bond of `{name}` points the unusual way"),
+            )
+            .with_primary(self.bond_span(e), "power flows the other way here")
+            .with_note(format!(
+                "{expected}; reversing it changes the sign convention of the power on this bond"
+            ))
+            .with_help("turn the bond around unless the reversed sign is intended"),
+        );
+    }
+}

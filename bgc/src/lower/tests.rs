@@ -1,0 +1,683 @@
+//! Tests of the lowering stage through the parser: valid models (structure, domains, units, values) and one test
+//! per diagnostic code with its primary span.
+
+use super::*;
+use crate::diagnostic::{Severity, has_errors};
+use crate::ir::{Domain, Expr, Relation, Target};
+use crate::syntax::ast::ElementKind;
+use petgraph::visit::EdgeRef;
+
+/// Lowers `text` as file `main.bg` with extra in-memory files.
+fn lower_with(text: &str, loader: MemoryLoader) -> (Vec<ir::Model>, Vec<Diagnostic>, SourceMap) {
+    let mut sources = SourceMap::new();
+    let root = sources.add("main.bg", text);
+    let mut loader = loader;
+    let (models, diags) = lower(&mut sources, root, &mut loader);
+    (models, diags, sources)
+}
+
+fn lower_text(text: &str) -> (Vec<ir::Model>, Vec<Diagnostic>, SourceMap) {
+    lower_with(text, MemoryLoader::new())
+}
+
+fn codes(text: &str) -> Vec<&'static str> {
+    lower_text(text).1.iter().map(|d| d.code.0).collect()
+}
+
+/// The single model of `text`, which must lower without any diagnostic.
+fn clean(text: &str) -> ir::Model {
+    let (mut models, diags, sources) = lower_text(text);
+    assert!(
+        diags.is_empty(),
+        "{}",
+        crate::diagnostic::render::to_text(&sources, &diags, false)
+    );
+    assert_eq!(models.len(), 1);
+    let m = models.remove(0);
+    assert_eq!(validate(&m), Ok(()));
+    m
+}
+
+/// Asserts that `text` gives exactly one diagnostic with `code`, whose primary label covers `snippet`.
+fn expect_one(text: &str, code: &str, snippet: &str) -> Diagnostic {
+    let (_, diags, sources) = lower_text(text);
+    let matching: Vec<&Diagnostic> = diags.iter().filter(|d| d.code.0 == code).collect();
+    assert_eq!(
+        matching.len(),
+        1,
+        "expected one {code}, got:\n{}",
+        crate::diagnostic::render::to_text(&sources, &diags, false)
+    );
+    let d = matching[0].clone();
+    let span = d.primary_span().unwrap_or_default();
+    assert_eq!(sources.snippet(span), snippet, "primary span of {code}");
+    assert!(d.help.is_some(), "{code} has no help");
+    d
+}
+
+const OSCILLATOR: &str = r#"
+model oscillator {
+    domain translational;
+    param m = 2 [kg]      "moving mass";
+    param k = 800 [N/m]   "spring stiffness";
+    param d = 4 [N s/m]   "damping";
+    input F [N]           "applied force";
+    Se push = F;
+    I  mass = m;
+    C  spring = 1/k;
+    R  damper = d;
+    1  v;
+    bond push -> v -> mass, spring, damper;
+    output x [m] = q(spring);
+    output v_mass [m/s] = f(mass);
+}
+"#;
+
+#[test]
+fn oscillator_lowers_to_five_nodes_and_four_bonds() {
+    let m = clean(OSCILLATOR);
+    assert_eq!(m.graph.node_count(), 5);
+    assert_eq!(m.graph.edge_count(), 4);
+    assert!(
+        m.graph
+            .edge_weights()
+            .all(|b| b.domain == Domain::Translational)
+    );
+    let spring = m.node_by_name("spring").unwrap_or_default();
+    let k = m.param_by_name("k").unwrap_or(99);
+    assert_eq!(
+        m.graph[spring].relation,
+        Relation::Linear(Expr::Binary(
+            crate::syntax::ast::BinOp::Div,
+            Box::new(Expr::Const(1.0)),
+            Box::new(Expr::Param(k))
+        ))
+    );
+    assert_eq!(m.params[k].default, 800.0);
+    assert_eq!(m.outputs[0].value, Expr::Displacement(spring));
+    let mass = m.node_by_name("mass").unwrap_or_default();
+    assert_eq!(m.outputs[1].value, Expr::Flow(Target::Node(mass)));
+    // Every bond points away from the source and the 1-junction.
+    let v = m.node_by_name("v").unwrap_or_default();
+    assert_eq!(m.graph.edges_directed(v, Direction::Outgoing).count(), 3);
+    assert_eq!(m.spans.nodes.len(), 5);
+}
+
+/// One fixture's expectation: `// expect: CODE at "SNIPPET"` or `... at "SNIPPET" #N` (the N-th occurrence after
+/// the header comments).
+fn fixture_expectation(text: &str) -> Option<(String, String, usize)> {
+    let line = text.lines().nth(1)?.strip_prefix("// expect: ")?;
+    let (code, rest) = line.split_once(" at \"")?;
+    let (snippet, tail) = rest.rsplit_once('"')?;
+    let nth = tail
+        .trim()
+        .strip_prefix('#')
+        .map_or(Some(1), |n| n.parse().ok())?;
+    Some((code.to_string(), snippet.to_string(), nth))
+}
+
+#[test]
+fn invalid_fixtures_report_their_code_at_their_place() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/invalid");
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .map(|rd| rd.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    paths.sort();
+    let mut checked = Vec::new();
+    let mut failures = Vec::new();
+    for path in paths {
+        let file = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("")
+            .to_string();
+        if !["BG02", "BG03", "BG04"].iter().any(|p| file.starts_with(p)) {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap_or_default();
+        let Some((code, snippet, nth)) = fixture_expectation(&text) else {
+            panic!("{file}: no `// expect:` line");
+        };
+        assert!(file.starts_with(&code), "{file} expects {code}");
+        let (_, diags, sources) = lower_text(&text);
+        let rendered = crate::diagnostic::render::to_text(&sources, &diags, false);
+        let body_start = text
+            .match_indices('\n')
+            .nth(1)
+            .map(|(i, _)| i + 1)
+            .unwrap_or(0);
+        let at = text[body_start..]
+            .match_indices(snippet.as_str())
+            .nth(nth - 1)
+            .map(|(i, _)| i + body_start);
+        // Exactly the expected diagnostic, nothing else.
+        let ok = match &diags[..] {
+            [d] => {
+                let span = d.primary_span().unwrap_or_default();
+                let warning = matches!(code.as_str(), "BG0308" | "BG0402");
+                d.code.0 == code
+                    && sources.snippet(span) == snippet
+                    && Some(span.start as usize) == at
+                    && d.help.is_some()
+                    && (d.severity == Severity::Warning) == warning
+            }
+            _ => false,
+        };
+        if !ok {
+            failures.push(format!(
+                "{file}: expected {code} at {snippet:?} #{nth}:\n{rendered}"
+            ));
+        }
+        checked.push(code);
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    checked.dedup();
+    let expected = [
+        "BG0201", "BG0202", "BG0203", "BG0204", "BG0205", "BG0206", "BG0207", "BG0208", "BG0301",
+        "BG0302", "BG0303", "BG0304", "BG0305", "BG0306", "BG0307", "BG0308", "BG0309", "BG0310",
+        "BG0311", "BG0312", "BG0313", "BG0314", "BG0401", "BG0402", "BG0403",
+    ];
+    assert_eq!(checked, expected);
+}
+
+const BACK_SUPPORT: &str = include_str!("../../../models/back_support.bg");
+
+#[test]
+fn back_support_lowers_cleanly_element_for_element() {
+    let m = clean(BACK_SUPPORT);
+    assert_eq!(m.name, "back_support");
+    // Fig. 6: Se, Sf, TF, 5 I, 3 C, 6 R, 3 0-junctions and 8 1-junctions: 28 nodes in a tree of 27 bonds.
+    assert_eq!(m.graph.node_count(), 28);
+    assert_eq!(m.graph.edge_count(), 27);
+    let count = |k: ElementKind| m.graph.node_weights().filter(|n| n.kind == k).count();
+    assert_eq!(count(ElementKind::I), 5);
+    assert_eq!(count(ElementKind::C), 3);
+    assert_eq!(count(ElementKind::I) + count(ElementKind::C), 8);
+    assert_eq!(count(ElementKind::R), 6);
+    assert_eq!(count(ElementKind::TF), 1);
+    assert_eq!(count(ElementKind::Se), 1);
+    assert_eq!(count(ElementKind::Sf), 1);
+    assert_eq!(count(ElementKind::Zero), 3);
+    assert_eq!(count(ElementKind::One), 8);
+    assert!(
+        m.graph
+            .edge_weights()
+            .all(|b| b.domain == Domain::Rotational)
+    );
+    // Parameters as in the paper, with the defaults of the seeds' README, in SI units.
+    let p = |name: &str| {
+        m.param_by_name(name)
+            .map(|i| (m.params[i].default, m.params[i].unit.dim))
+    };
+    let inertia = crate::units::Dim::new(2, 1, 0, 0, 0, 0, 0);
+    let torsion = crate::units::Dim::new(2, 1, -2, 0, 0, 0, 0);
+    let damping = crate::units::Dim::new(2, 1, -1, 0, 0, 0, 0);
+    assert_eq!(p("J_m"), Some((3.06e-4, inertia)));
+    assert_eq!(p("J_g"), Some((0.40e-4, inertia)));
+    assert_eq!(p("r_g"), Some((160.0, crate::units::Dim::NONE)));
+    assert_eq!(p("k_g"), Some((2.64e4, torsion)));
+    assert_eq!(p("k_s"), Some((3.38e4, torsion)));
+    assert_eq!(p("k_eh"), Some((1125.0, torsion)));
+    assert_eq!(p("d_g"), Some((6.0, damping)));
+    assert_eq!(p("b_g"), Some((0.65, damping)));
+    assert_eq!(p("b_h"), Some((0.75, damping)));
+    assert_eq!(p("J_sint"), Some((1e-4, inertia)));
+    assert_eq!(p("J_sext"), Some((1.19e-3, inertia)));
+    assert_eq!(p("J_h"), Some((0.0491, inertia)));
+    for zero in ["b_f", "d_s", "d_eh"] {
+        assert_eq!(p(zero), Some((0.0, damping)), "{zero}");
+    }
+    assert_eq!(m.params.len(), 15);
+    // The gearbox: input bond from the motor junction on port 0, output bond to the gearbox junction on port 1.
+    let gear = m.node_by_name("gear").unwrap_or_default();
+    let j_m = m.node_by_name("j_m").unwrap_or_default();
+    let j_g = m.node_by_name("j_g").unwrap_or_default();
+    let input = m.graph.edges_directed(gear, Direction::Incoming).next();
+    let output = m.graph.edges_directed(gear, Direction::Outgoing).next();
+    assert_eq!(
+        input.map(|e| (e.source(), e.weight().to_port)),
+        Some((j_m, 0))
+    );
+    assert_eq!(
+        output.map(|e| (e.target(), e.weight().from_port)),
+        Some((j_g, 1))
+    );
+    let r_g = m.param_by_name("r_g").unwrap_or(99);
+    assert_eq!(m.graph[gear].relation, Relation::Modulus(Expr::Param(r_g)));
+    // Inputs, outputs, vars and the coordinates of Eq. (2).
+    let names = |v: Vec<&str>| v.into_iter().map(String::from).collect::<Vec<_>>();
+    assert_eq!(
+        m.inputs.iter().map(|i| i.name.clone()).collect::<Vec<_>>(),
+        names(vec!["tau_m", "omega_h"])
+    );
+    assert_eq!(
+        m.outputs.iter().map(|o| o.name.clone()).collect::<Vec<_>>(),
+        names(vec!["omega_m", "tau_s", "tau_h"])
+    );
+    assert_eq!(m.vars.len(), 4);
+    assert!(m.vars.iter().all(|v| v.unit.dim.is_dimensionless()));
+    let coords = m.coords.clone().unwrap_or_default();
+    assert_eq!(coords.len(), 7);
+    assert_eq!(coords[0], Expr::Var(0));
+    let rotor = m.node_by_name("rotor").unwrap_or_default();
+    assert_eq!(coords[1], Expr::Flow(Target::Node(rotor)));
+    assert_eq!(coords[6], Expr::Var(3));
+    let s_spring = m.node_by_name("sensor_spring").unwrap_or_default();
+    let s_damper = m.node_by_name("sensor_damper").unwrap_or_default();
+    assert_eq!(
+        m.outputs[1].value,
+        Expr::Binary(
+            crate::syntax::ast::BinOp::Add,
+            Box::new(Expr::Effort(Target::Node(s_spring))),
+            Box::new(Expr::Effort(Target::Node(s_damper)))
+        )
+    );
+}
+
+const STD_RIG: &str = r#"
+import "std.bg";
+model rig {
+    domain rotational;
+    input u [V] "supply voltage";
+    Se supply : electrical = u;
+    dc_motor motor(R_a = 2, k_t = 0.1);
+    gearbox gb(ratio = 50);
+    spring_damper_rot shaft(k = 500, d = 0.5);
+    1 load_speed;
+    I load = 0.1;
+    bond supply -> motor.v;
+    bond motor.shaft -> gb.in;
+    bond gb.out -> shaft.a;
+    bond shaft.b -> load_speed -> load;
+    output tau [N m] = e(shaft.spring) + e(shaft.damper);
+    output current [A] = f(motor.current);
+}
+"#;
+
+#[test]
+fn standard_rotational_components_instantiate_with_overrides() {
+    let m = clean(STD_RIG);
+    // dc_motor 7 nodes, gearbox 5, spring_damper_rot 4, plus supply, load_speed, load.
+    assert_eq!(m.graph.node_count(), 19);
+    assert_eq!(m.graph.edge_count(), 18);
+    let p = |name: &str| m.param_by_name(name).map(|i| m.params[i].default);
+    assert_eq!(p("motor.R_a"), Some(2.0));
+    assert_eq!(p("motor.k_t"), Some(0.1));
+    assert_eq!(p("motor.L_a"), Some(1e-3));
+    assert_eq!(p("gb.ratio"), Some(50.0));
+    assert_eq!(p("shaft.k"), Some(500.0));
+    assert_eq!(p("shaft.d"), Some(0.5));
+    // The motor joins the electrical and rotational domains through its gyrator.
+    let emf = m.node_by_name("motor.emf").unwrap_or_default();
+    let din = m
+        .graph
+        .edges_directed(emf, Direction::Incoming)
+        .map(|e| e.weight().domain)
+        .next();
+    let dout = m
+        .graph
+        .edges_directed(emf, Direction::Outgoing)
+        .map(|e| e.weight().domain)
+        .next();
+    assert_eq!(
+        (din, dout),
+        (Some(Domain::Electrical), Some(Domain::Rotational))
+    );
+    let winding = m.node_by_name("motor.winding").unwrap_or_default();
+    let wb = m.graph.edges_directed(winding, Direction::Incoming).next();
+    assert_eq!(wb.map(|e| e.weight().domain), Some(Domain::Electrical));
+    // The instance span of flattened nodes points at the instance declaration in the model.
+    let (_, _, sources) = lower_text(STD_RIG);
+    let span = m.spans.node_instances[winding.index()].unwrap_or_default();
+    assert_eq!(sources.snippet(span), "dc_motor motor(R_a = 2, k_t = 0.1);");
+}
+
+#[test]
+fn standard_translational_spring_damper_instantiates() {
+    let m = clean(
+        r#"
+import "std.bg";
+model sled {
+    domain translational;
+    input F [N];
+    Se push = F;
+    1 v1;
+    I cart = 3;
+    spring_damper_trans mount(k = 2e4);
+    1 v2;
+    I payload = 1;
+    bond push -> v1 -> cart;
+    bond v1 -> mount.a;
+    bond mount.b -> v2 -> payload;
+    output x [m] = q(mount.spring);
+}
+"#,
+    );
+    assert!(
+        m.graph
+            .edge_weights()
+            .all(|b| b.domain == Domain::Translational)
+    );
+    let k = m.param_by_name("mount.k").map(|i| m.params[i].default);
+    let d = m.param_by_name("mount.d").map(|i| m.params[i].default);
+    assert_eq!((k, d), (Some(2e4), Some(10.0)));
+    let spring = m.node_by_name("mount.spring").unwrap_or_default();
+    assert_eq!(m.outputs[0].value, Expr::Displacement(spring));
+}
+
+#[test]
+fn standard_library_has_the_documented_ports() {
+    // Every component of std.bg, instantiated alone with its ports bonded to sources or inertias.
+    let (models, diags, sources) = lower_text(
+        r#"
+import "std.bg";
+model ports {
+    domain rotational;
+    input u [V];
+    input tau [N m];
+    Se supply : electrical = u;
+    dc_motor m1;
+    I j1 = 1;
+    bond supply -> m1.v;
+    bond m1.shaft -> j1;
+    Se drive = tau;
+    gearbox g1;
+    I j2 = 1;
+    bond drive -> g1.in;
+    bond g1.out -> j2;
+}
+"#,
+    );
+    assert!(
+        diags.is_empty(),
+        "{}",
+        crate::diagnostic::render::to_text(&sources, &diags, false)
+    );
+    assert_eq!(models.len(), 1);
+}
+
+#[test]
+fn unit_mismatch_names_the_expected_unit_of_the_kind_and_domain() {
+    let d = expect_one(
+        "model m { domain rotational; param k = 800 [N/m]; input tau [N m]; Se drive = tau; C spring = 1/k; bond drive -> spring; }",
+        "BG0303",
+        "1/k",
+    );
+    assert!(
+        d.message
+            .contains("expected rad/(N m) (a compliance in the rotational domain), found m/N"),
+        "{}",
+        d.message
+    );
+    // The same stiffness in a translational model is right.
+    clean(
+        "model m { domain translational; param k = 800 [N/m]; input F [N]; Se push = F; C spring = 1/k; bond push -> spring; }",
+    );
+}
+
+#[test]
+fn duplicate_points_back_at_the_first_declaration() {
+    let text = "model m { domain rotational; input tau [N m]; Se drive = tau; I drive = 1; bond drive -> w; 1 w; }";
+    let (_, diags, sources) = lower_text(text);
+    let d = diags
+        .iter()
+        .find(|d| d.code.0 == "BG0202")
+        .cloned()
+        .unwrap_or_else(|| Diagnostic::error("none", ""));
+    let secondary: Vec<&str> = d
+        .labels
+        .iter()
+        .filter(|l| !l.primary)
+        .map(|l| sources.snippet(l.span))
+        .collect();
+    assert_eq!(secondary, vec!["drive"]);
+    let primary = d.primary_span().unwrap_or_default();
+    assert_eq!(
+        primary.start as usize,
+        text.find("I drive").unwrap_or(0) + 2
+    );
+}
+
+#[test]
+fn unknown_name_suggests_the_closest_declared_name() {
+    let d = expect_one(
+        "model m { domain rotational; param damping = 1 [N m s/rad]; input tau [N m]; Se drive = tau; R fr = damping; 1 w; bond drive -> w -> fr; output y [N m] = dampin * f(w); }",
+        "BG0201",
+        "dampin",
+    );
+    assert_eq!(d.help.as_deref(), Some("did you mean `damping`?"));
+}
+
+#[test]
+fn non_physical_values_are_errors_and_zero_resistance_is_not() {
+    // A zero stiffness makes an infinite compliance; the secondary label shows the parameter's value.
+    let d = expect_one(
+        "model m { domain rotational; param k = 0 [N m/rad]; input tau [N m]; Se drive = tau; C spring = 1/k; bond drive -> spring; }",
+        "BG0401",
+        "1/k",
+    );
+    assert!(d.message.contains("infinite compliance"), "{}", d.message);
+    assert!(
+        d.labels
+            .iter()
+            .any(|l| !l.primary && l.message == "`k` is 0")
+    );
+    expect_one(
+        "model m { domain rotational; param r = 0 [1]; input tau [N m]; Se drive = tau; TF gear = r; I load = 1; bond drive -> gear -> load; }",
+        "BG0401",
+        "r",
+    );
+    expect_one(
+        "model m { domain rotational; param b = -0.5 [N m s/rad]; input tau [N m]; Se drive = tau; R fr = b; bond drive -> fr; }",
+        "BG0401",
+        "b",
+    );
+    clean(
+        "model m { domain rotational; param b = 0 [N m s/rad]; input tau [N m]; Se drive = tau; R fr = b; bond drive -> fr; }",
+    );
+}
+
+#[test]
+fn import_cycle_and_missing_import_are_reported_at_the_import() {
+    let loader = MemoryLoader::new()
+        .with(
+            "lib/a.bg",
+            "import \"b.bg\"; component ca { domain rotational; 1 j; port p = j; }",
+        )
+        .with("lib/b.bg", "import \"a.bg\";");
+    let (_, diags, sources) = lower_with("import \"lib/a.bg\"; model m { }", loader);
+    assert_eq!(
+        diags.iter().map(|d| d.code.0).collect::<Vec<_>>(),
+        vec!["BG0107"]
+    );
+    let span = diags[0].primary_span().unwrap_or_default();
+    assert_eq!(
+        sources.get(span.file).map(|f| f.name.as_str()),
+        Some("lib/b.bg")
+    );
+    assert_eq!(sources.snippet(span), "import \"a.bg\";");
+    assert!(
+        diags[0]
+            .message
+            .contains("`lib/a.bg` -> `lib/b.bg` -> `lib/a.bg`"),
+        "{}",
+        diags[0].message
+    );
+
+    let (_, diags, sources) = lower_text("import \"nowhere.bg\";\nmodel m { }");
+    assert_eq!(
+        diags.iter().map(|d| d.code.0).collect::<Vec<_>>(),
+        vec!["BG0108"]
+    );
+    assert_eq!(
+        sources.snippet(diags[0].primary_span().unwrap_or_default()),
+        "import \"nowhere.bg\";"
+    );
+}
+
+#[test]
+fn imports_resolve_relative_to_the_importing_file_and_load_once() {
+    // main imports lib/a.bg and lib/b.bg; both import lib/common.bg (a diamond, not a cycle).
+    let loader = MemoryLoader::new()
+        .with("lib/a.bg", "import \"common.bg\";")
+        .with("lib/b.bg", "import \"./common.bg\";")
+        .with(
+            "lib/common.bg",
+            "component inertia_c { domain rotational; param J = 2 [kg m^2]; 1 w; I body = J; bond w -> body; port p = w; }",
+        );
+    let text = r#"import "lib/a.bg"; import "lib/b.bg";
+model m { domain rotational; input tau [N m]; Se drive = tau; inertia_c c1(J = 3); 1 w; I other = 1; bond drive -> w -> other; bond w -> c1.p; }"#;
+    let (models, diags, sources) = lower_with(text, loader);
+    assert!(
+        diags.is_empty(),
+        "{}",
+        crate::diagnostic::render::to_text(&sources, &diags, false)
+    );
+    assert_eq!(sources.files().count(), 4);
+    let m = &models[0];
+    assert_eq!(
+        m.param_by_name("c1.J").map(|i| m.params[i].default),
+        Some(3.0)
+    );
+}
+
+#[test]
+fn a_component_that_contains_itself_is_refused() {
+    let text = "component loop_c { domain rotational; 1 j; I x = 1; bond j -> x; loop_c inner; port p = j; }
+model m { domain rotational; input tau [N m]; Se drive = tau; loop_c c; bond drive -> c.p; }";
+    assert!(codes(text).contains(&"BG0204"));
+}
+
+#[test]
+fn domains_propagate_through_junctions_and_transformers_join_domains() {
+    // Only the source names a domain on the left; the pulley's right side is translational.
+    let m = clean(
+        r#"model m {
+    param r = 0.05 [m] "pulley radius: angular speed times r is the belt speed";
+    input tau [N m];
+    Se drive : rotational = tau;
+    1 w;
+    I wheel = 0.01;
+    TF pulley = 1/r;
+    1 v;
+    I belt : translational = 2;
+    bond drive -> w -> wheel;
+    bond w -> pulley -> v -> belt;
+}"#,
+    );
+    let dom = |name: &str| {
+        let n = m.node_by_name(name).unwrap_or_default();
+        m.graph
+            .edges_directed(n, Direction::Incoming)
+            .map(|e| e.weight().domain)
+            .next()
+    };
+    assert_eq!(dom("wheel"), Some(Domain::Rotational));
+    assert_eq!(dom("belt"), Some(Domain::Translational));
+    // The TF ratio (rad/s)/(m/s) is 1/m: a ratio given in [1] is wrong.
+    expect_one(
+        r#"model m {
+    param n = 20 [1];
+    input tau [N m];
+    Se drive : rotational = tau;
+    TF pulley = n;
+    I belt : translational = 2;
+    bond drive -> pulley -> belt;
+}"#,
+        "BG0303",
+        "n",
+    );
+}
+
+#[test]
+fn laws_and_fields_resolve_their_local_variables() {
+    let m = clean(
+        r#"model m {
+    domain rotational;
+    param b0 = 0.2 [N m];
+    param b2 = 0.01 [N m s/rad];
+    param a = 1 [kg m^2];
+    param c = 0.5 [kg m^2];
+    input tau [N m];
+    Se drive = tau;
+    Se drive2 = tau;
+    1 w;
+    R friction { e = b0*sign(f) + b2*f; }
+    IF leg(2) { mass[1,1] = a + c*cos(q[2]); mass[1,2] = c; mass[2,2] = c; }
+    bond drive -> w -> friction;
+    bond w -> leg[1];
+    bond drive2 -> leg[2];
+    output knee_torque [N m] = e(leg[2]);
+}"#,
+    );
+    let friction = m.node_by_name("friction").unwrap_or_default();
+    let Relation::Laws(laws) = &m.graph[friction].relation else {
+        panic!("friction has no laws: {:?}", m.graph[friction].relation);
+    };
+    assert_eq!(laws.len(), 1);
+    assert_eq!(laws[0].lhs, crate::ir::PortVar::Effort);
+    let leg = m.node_by_name("leg").unwrap_or_default();
+    let Relation::MassMatrix { n, entries } = &m.graph[leg].relation else {
+        panic!("leg has no mass matrix");
+    };
+    assert_eq!(*n, 2);
+    // Symmetric fill of the lower triangle.
+    assert_eq!(entries[1], entries[2]);
+    assert_eq!(entries[1], Expr::Param(m.param_by_name("c").unwrap_or(99)));
+    // e(leg[2]) is the effort on the bond of port 2.
+    let port2 = m
+        .graph
+        .edges_directed(leg, Direction::Incoming)
+        .find(|e| e.weight().to_port == 1);
+    assert_eq!(
+        m.outputs[0].value,
+        Expr::Effort(Target::Bond(port2.map(|e| e.id()).unwrap_or_default()))
+    );
+}
+
+#[test]
+fn parameter_defaults_use_earlier_parameters_and_unit_scales() {
+    let m = clean(
+        r#"model m {
+    domain rotational;
+    param J1 = 2 [kg m^2];
+    param J2 = 3 * J1 [kg m^2];
+    param c = 2 [g m^2] "a bare number is written in the declared unit";
+    param speed = 60 [rpm];
+    input tau [N m];
+    Se drive = tau;
+    1 w;
+    I a = J2 + c;
+    R fr = 1;
+    bond drive -> w -> a, fr;
+    output s [rad/s] = speed;
+}"#,
+    );
+    let v = |n: &str| {
+        m.param_by_name(n)
+            .map(|i| m.params[i].default)
+            .unwrap_or(f64::NAN)
+    };
+    assert_eq!(v("J2"), 6.0);
+    assert!((v("c") - 2e-3).abs() < 1e-15);
+    // 60 rpm = 2 pi rad/s.
+    assert!((v("speed") - 2.0 * std::f64::consts::PI).abs() < 1e-12);
+    // A later parameter is not visible to an earlier default.
+    assert!(codes("model m { param a = b [1]; param b = 1 [1]; }").contains(&"BG0201"));
+    // An output may use earlier outputs only.
+    assert!(codes(
+        "model m { domain rotational; input tau [N m]; Se drive = tau; I r = 1; bond drive -> r; output a [rad/s] = b; output b [rad/s] = f(r); }"
+    )
+    .contains(&"BG0314"));
+}
+
+#[test]
+fn lowered_models_with_errors_are_still_returned() {
+    let (models, diags, _) = lower_text("model m { domain rotational; I lonely = 1; }");
+    assert_eq!(models.len(), 1);
+    assert!(has_errors(&diags));
+    // Components are not returned as models.
+    let (models, _, _) =
+        lower_text("component c { domain rotational; 1 j; I x = 1; bond j -> x; port p = j; }");
+    assert!(models.is_empty());
+}

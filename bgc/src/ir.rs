@@ -174,7 +174,9 @@ pub enum Expr {
     /// `q(x)` of a compliance.
     Displacement(#[serde(serialize_with = "ser_node")] NodeIndex),
     /// A port variable of a multiport field inside its laws: `e[2]` of node `node` is
-    /// `FieldPort { node, var: Effort, port: 1 }` (0-based port).
+    /// `FieldPort { node, var: Effort, port: 1 }` (0-based port). Outside the laws, `q(leg[2])` (the integral of
+    /// the flow on port 2) is `FieldPort { var: Displacement, .. }`; `e(leg[2])` and `f(leg[2])` are the effort and
+    /// flow of the bond on that port (`Target::Bond`).
     FieldPort {
         #[serde(serialize_with = "ser_node")]
         node: NodeIndex,
@@ -250,7 +252,10 @@ pub struct Bond {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Param {
     pub name: String,
+    /// The default value in SI base units (a default written as a plain number in `[rpm]` is converted:
+    /// `unit.scale` times the written value).
     pub default: f64,
+    /// The declared unit; `unit.scale` converts a value in it to SI.
     pub unit: Unit,
     /// The unit as the user wrote it, for messages and generated docs.
     pub unit_text: String,
@@ -306,7 +311,8 @@ pub struct SpanTable {
     pub model: Span,
 }
 
-/// A lowered, checked model.
+/// A lowered, checked model. Parameter defaults and the constants of expressions are in SI base units; a declared
+/// unit's `scale` converts a value written in that unit to SI.
 #[derive(Clone, Debug, Serialize)]
 pub struct Model {
     pub name: String,

@@ -2,7 +2,7 @@
 //!
 //! [`decode`] checks that a file is UTF-8, [`parse`] turns its text into an [`ast::File`] plus diagnostics (it
 //! never fails: the tree holds everything that parsed) and [`format`] prints a tree back in the canonical layout.
-//! The grammar is in docs/language.md; the diagnostic codes of this stage are `BG0100`-`BG0118`.
+//! The grammar is in docs/language.md; the diagnostic codes of this stage are `BG0100`-`BG0117`.
 
 pub mod ast;
 mod decode;
@@ -15,6 +15,8 @@ mod suggest;
 
 #[cfg(test)]
 mod format_tests;
+#[cfg(test)]
+mod snapshot_tests;
 #[cfg(test)]
 mod tests;
 

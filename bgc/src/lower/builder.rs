@@ -50,10 +50,14 @@ pub(crate) struct Builder<'a> {
     pub pending_coords: Option<(usize, &'a CoordsDecl)>,
     /// Declarations whose unit could not be read: their dimension is left free to avoid follow-up errors.
     pub bad_units: Vec<super::scope::Entity>,
+    /// Nodes at the resolved end of a bond whose other end could not be resolved (already reported).
+    pub suspect_nodes: Vec<NodeIndex>,
     /// Whether the last unit read by `unit` was valid.
     pub last_unit_ok: bool,
     /// The components being instantiated, to catch a component that contains itself.
     pub component_stack: Vec<String>,
+    /// Every component instantiated while building this model.
+    pub instantiated: Vec<String>,
 }
 
 impl<'a> Builder<'a> {
@@ -84,8 +88,10 @@ impl<'a> Builder<'a> {
             pending_vars: Vec::new(),
             pending_coords: None,
             component_stack: Vec::new(),
+            instantiated: Vec::new(),
             bad_units: Vec::new(),
             last_unit_ok: true,
+            suspect_nodes: Vec::new(),
         }
     }
 

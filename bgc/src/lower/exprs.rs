@@ -402,6 +402,9 @@ impl Builder<'_> {
         let ((ea, qa), (eb, qb)) = (ra?, rb?);
         let q = match op {
             BinOp::Add | BinOp::Sub => self.same_dims(qa, qb, a, b, e, "added"),
+            // A number times a dimensionless quantity is still a number that takes its place's unit:
+            // `0.001 * sign(f(x))` may be a torque.
+            BinOp::Mul | BinOp::Div if is_free_scale(qa, qb) => Some(Q::Free),
             BinOp::Mul => combine(qa, qb, Dim::checked_mul),
             BinOp::Div => match (qa, qb) {
                 (Q::Free, Q::Dim(d)) => Dim::NONE.checked_div(d).map(Q::Dim),
@@ -649,6 +652,21 @@ impl Builder<'_> {
                 return None;
             }
         };
+        if var == PortVar::Displacement
+            && let Some((i, _)) = r.port
+            && let Some(n) = self.field_node(&r, cx.scope)
+        {
+            // `q(leg[i])`: the integral of the flow on field port i.
+            let q = self.var_dim(n, i - 1, var);
+            return Some((
+                ir::Expr::FieldPort {
+                    node: n,
+                    var,
+                    port: i - 1,
+                },
+                q,
+            ));
+        }
         let (target, node) = self.reference_target(&r, cx.scope)?;
         match (target, node) {
             (Target::Bond(edge), _) => {
@@ -706,6 +724,19 @@ impl Builder<'_> {
                 let q = self.var_dim(n, 0, var);
                 Some((var_expr(var, target, n), q))
             }
+        }
+    }
+
+    /// The field a `leg[i]` argument names, when `i` is one of its ports (otherwise `reference_target` reports).
+    fn field_node(&self, r: &NodeRef, scope: usize) -> Option<NodeIndex> {
+        let [name] = &r.path[..] else { return None };
+        let (i, _) = r.port?;
+        match self.scopes.get(scope)?.get(&name.name)? {
+            Entity::Node(n) => {
+                let node = &self.model.graph[n];
+                (node.kind.is_field() && i >= 1 && i <= node.ports).then_some(n)
+            }
+            _ => None,
         }
     }
 
@@ -789,6 +820,12 @@ impl Builder<'_> {
             }
         }
     }
+}
+
+/// One side a free number and the other free or dimensionless.
+fn is_free_scale(a: Q, b: Q) -> bool {
+    let free_or_none = |q: Q| q == Q::Free || q == Q::Dim(Dim::NONE);
+    (a == Q::Free && free_or_none(b)) || (b == Q::Free && free_or_none(a))
 }
 
 fn combine(a: Q, b: Q, op: impl Fn(Dim, Dim) -> Option<Dim>) -> Option<Q> {

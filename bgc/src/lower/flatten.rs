@@ -46,6 +46,7 @@ impl<'a> Builder<'a> {
             prefix,
             component,
             instance_span,
+            own_instance: overrides.as_ref().map(|o| o.instance.span),
             ..Default::default()
         });
         let sid = self.scopes.len() - 1;
@@ -475,6 +476,7 @@ impl<'a> Builder<'a> {
             return false;
         }
         self.component_stack.push(name.clone());
+        self.instantiated.push(name.clone());
         let prefix = format!("{}{}.", self.scopes[sid].prefix, inst.name.name);
         let child = self.instantiate(
             comp,
@@ -495,9 +497,10 @@ impl<'a> Builder<'a> {
             let [tails, heads] = pair else { continue };
             for tail in tails {
                 for head in heads {
-                    let (Some(from), Some(to)) =
-                        (self.resolve_end(sid, tail), self.resolve_end(sid, head))
-                    else {
+                    let (from, to) = (self.resolve_end(sid, tail), self.resolve_end(sid, head));
+                    let (Some(from), Some(to)) = (from, to) else {
+                        // The other end lost a bond: do not also report its bond count.
+                        self.suspect_nodes.extend(from.or(to).map(|e| e.node));
                         continue;
                     };
                     if from.node == to.node {
@@ -728,8 +731,10 @@ impl<'a> Builder<'a> {
         port: &Ident,
         r: &NodeRef,
     ) -> Option<End> {
-        let scope = self.scopes.get(child)?;
+        let scope = self.scopes.get_mut(child)?;
         if let Some((end, _)) = scope.ports.get(&port.name) {
+            let end = *end;
+            scope.connected = true;
             if let Some((_, span)) = r.port {
                 self.diags.push(
                     Diagnostic::error("BG0205", "a component port has no index")
@@ -738,7 +743,7 @@ impl<'a> Builder<'a> {
                 );
                 return None;
             }
-            return Some(*end);
+            return Some(end);
         }
         let inst = walk.last().map(|i| i.name.as_str()).unwrap_or("");
         let (comp, comp_span) = scope.component.clone().unwrap_or_default();

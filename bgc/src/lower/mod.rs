@@ -35,8 +35,9 @@ use std::path::{Path, PathBuf};
 
 pub use imports::{STD_NAME, STD_SOURCE};
 
-/// Where lowering gets the text of imported files. The CLI reads the file system; tests and build scripts may serve
-/// files from memory. `"std.bg"` never reaches the loader.
+/// Where lowering gets the text of imported files. The path is the import joined to the directory of the importing
+/// file's name in the [`SourceMap`] (so relative to wherever the root file's name is relative to). The CLI reads the
+/// file system; tests and build scripts may serve files from memory. `"std.bg"` never reaches the loader.
 pub trait SourceLoader {
     fn load(&mut self, path: &Path) -> std::io::Result<String>;
 }
@@ -71,7 +72,8 @@ impl SourceLoader for MemoryLoader {
 /// Lowers the models of file `root` (already in `sources`; imported files are added to it).
 ///
 /// Returns every `model` of the root file that could be built (components are flattened into the models that
-/// instantiate them) and all diagnostics, in the order found, without duplicates. A model is returned even when
+/// instantiate them; a component of the root file that no model uses is checked on its own) and all diagnostics, in
+/// the order found, without duplicates. A model is returned even when
 /// diagnostics about it are errors: check [`crate::diagnostic::has_errors`] before using it.
 pub fn lower(
     sources: &mut SourceMap,
@@ -82,6 +84,7 @@ pub fn lower(
     let program = Program::load(sources, root, loader, &mut diags);
     let decls = program.declarations(&mut diags);
     let mut models = Vec::new();
+    let mut instantiated: Vec<String> = Vec::new();
     for decl in program.root_models() {
         if decl.kind != ModelKind::Model {
             continue;
@@ -94,7 +97,30 @@ pub fn lower(
         b.build_signals();
         b.unused_params();
         diags.append(&mut b.diags);
+        instantiated.append(&mut b.instantiated);
         models.push(b.model);
+    }
+    // Components of the root file that no model uses are checked on their own (so that `bgc check` of a library
+    // finds its errors). What depends on how they are connected is left out: the bond counts of their port nodes
+    // and domains that only the outside could fix.
+    for decl in program.root_models() {
+        if decl.kind != ModelKind::Component || instantiated.contains(&decl.name.name) {
+            continue;
+        }
+        let mut b = Builder::new(&decls, decl);
+        let sid = b.instantiate(decl, String::new(), None);
+        let ports: Vec<_> = b.scopes[sid]
+            .ports
+            .values()
+            .map(|(end, _)| end.node)
+            .collect();
+        b.suspect_nodes.extend(ports);
+        b.check_structure();
+        b.infer_domains();
+        b.build_relations();
+        b.build_signals();
+        b.unused_params();
+        diags.extend(b.diags.into_iter().filter(|d| d.code.0 != "BG0311"));
     }
     // A component instantiated twice reports its own problems twice; keep one of each.
     let mut unique: Vec<Diagnostic> = Vec::with_capacity(diags.len());

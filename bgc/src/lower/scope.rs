@@ -61,6 +61,10 @@ pub(crate) struct Scope {
     /// The scope of an instance whose component could not be instantiated (already reported): references into it
     /// are not reported again.
     pub broken: bool,
+    /// This scope's own instance declaration (None for the model).
+    pub own_instance: Option<Span>,
+    /// Whether a bond outside the instance goes to one of its ports.
+    pub connected: bool,
 }
 
 impl Scope {

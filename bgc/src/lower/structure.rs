@@ -20,88 +20,120 @@ use petgraph::visit::EdgeRef;
 
 impl Builder<'_> {
     pub fn check_structure(&mut self) {
+        // An instance none of whose ports is bonded is reported once, not through each of its nodes.
+        let mut loose: Vec<String> = Vec::new();
+        for scope in &self.scopes {
+            if let Some(span) = scope.own_instance
+                && !scope.connected
+                && !scope.broken
+                && !loose.iter().any(|p| scope.prefix.starts_with(p.as_str()))
+            {
+                let name = scope.prefix.trim_end_matches('.').to_string();
+                self.diags.push(
+                    Diagnostic::error("BG0306", format!("instance `{name}` is not connected"))
+                        .with_primary(span, "no bond goes to any of its ports")
+                        .with_help(format!(
+                            "bond one of its ports (`bond j -> {name}.PORT;`) or remove it"
+                        )),
+                );
+                loose.push(scope.prefix.clone());
+            }
+        }
         let nodes: Vec<NodeIndex> = self.model.graph.node_indices().collect();
         for n in nodes {
-            let incoming: Vec<EdgeIndex> = self
-                .model
-                .graph
-                .edges_directed(n, Direction::Incoming)
-                .map(|e| e.id())
-                .collect();
-            let outgoing: Vec<EdgeIndex> = self
-                .model
-                .graph
-                .edges_directed(n, Direction::Outgoing)
-                .map(|e| e.id())
-                .collect();
-            let kind = self.model.graph[n].kind;
-            let name = self.model.graph[n].name.clone();
-            let decl_span = self.node_name_span(n);
-            let mut all: Vec<EdgeIndex> = incoming.iter().chain(outgoing.iter()).copied().collect();
-            all.sort_unstable();
-            if all.is_empty() {
-                self.diags.push(
-                    Diagnostic::error("BG0306", format!("`{name}` is not connected"))
-                        .with_primary(decl_span, format!("this {} has no bond", kind_name(kind)))
-                        .with_help(format!("bond it (`bond j -> {name};`) or remove it")),
-                );
-                continue;
+            // Ports are still numbered, but the counts of these nodes follow from errors already reported.
+            let quiet = loose
+                .iter()
+                .any(|p| self.model.graph[n].name.starts_with(p.as_str()))
+                || self.suspect_nodes.contains(&n);
+            let reported = self.diags.len();
+            self.check_node(n);
+            if quiet {
+                self.diags.truncate(reported);
             }
-            match kind {
-                k if k.is_junction() => {
-                    if all.len() < 2 {
-                        self.diags.push(
+        }
+    }
+
+    fn check_node(&mut self, n: NodeIndex) {
+        let incoming: Vec<EdgeIndex> = self
+            .model
+            .graph
+            .edges_directed(n, Direction::Incoming)
+            .map(|e| e.id())
+            .collect();
+        let outgoing: Vec<EdgeIndex> = self
+            .model
+            .graph
+            .edges_directed(n, Direction::Outgoing)
+            .map(|e| e.id())
+            .collect();
+        let kind = self.model.graph[n].kind;
+        let name = self.model.graph[n].name.clone();
+        let decl_span = self.node_name_span(n);
+        let mut all: Vec<EdgeIndex> = incoming.iter().chain(outgoing.iter()).copied().collect();
+        all.sort_unstable();
+        if all.is_empty() {
+            self.diags.push(
+                Diagnostic::error("BG0306", format!("`{name}` is not connected"))
+                    .with_primary(decl_span, format!("this {} has no bond", kind_name(kind)))
+                    .with_help(format!("bond it (`bond j -> {name};`) or remove it")),
+            );
+            return;
+        }
+        match kind {
+            k if k.is_junction() => {
+                if all.len() < 2 {
+                    self.diags.push(
                             Diagnostic::error("BG0305", format!("junction `{name}` has only one bond"))
                                 .with_primary(decl_span, "a junction joins at least two bonds")
                                 .with_secondary(self.bond_span(all[0]), "its only bond")
                                 .with_help("bond the element directly, without the junction, or add the missing bond"),
                         );
-                    }
                 }
-                k if k.is_two_port() => {
-                    if incoming.len() != 1 || outgoing.len() != 1 {
-                        let mut d = Diagnostic::error(
-                            "BG0304",
-                            format!(
-                                "`{name}` needs one bond in and one bond out, found {} in and {} out",
-                                incoming.len(),
-                                outgoing.len()
-                            ),
-                        )
-                        .with_primary(decl_span, format!("a {} has an input and an output port", k.keyword()));
-                        for e in &all {
-                            d = d.with_secondary(self.bond_span(*e), "a bond of it");
-                        }
-                        self.diags.push(d.with_help(
+            }
+            k if k.is_two_port() => {
+                if incoming.len() != 1 || outgoing.len() != 1 {
+                    let mut d = Diagnostic::error(
+                        "BG0304",
+                        format!(
+                            "`{name}` needs one bond in and one bond out, found {} in and {} out",
+                            incoming.len(),
+                            outgoing.len()
+                        ),
+                    )
+                    .with_primary(
+                        decl_span,
+                        format!("a {} has an input and an output port", k.keyword()),
+                    );
+                    for e in &all {
+                        d = d.with_secondary(self.bond_span(*e), "a bond of it");
+                    }
+                    self.diags.push(d.with_help(
                             "the bond pointing into it is its input (port 0), the bond pointing out of it its output (port 1)",
                         ));
-                    }
-                    for e in &incoming {
-                        self.model.graph[*e].to_port = 0;
-                    }
-                    for e in &outgoing {
-                        self.model.graph[*e].from_port = 1;
-                    }
                 }
-                k if k.is_field() => self.field_ports(n, &name, &incoming, &outgoing, decl_span),
-                _ => {
-                    if all.len() > 1 {
-                        let mut d = Diagnostic::error(
-                            "BG0301",
-                            format!("`{name}` is a 1-port but has {} bonds", all.len()),
-                        )
-                        .with_primary(self.bond_span(all[1]), "a second bond");
-                        d = d.with_secondary(self.bond_span(all[0]), "first bond");
-                        d = d.with_secondary(
-                            decl_span,
-                            format!("a `{}` has one port", kind.keyword()),
-                        );
-                        self.diags.push(d.with_help(format!(
-                            "bond `{name}` to a junction and bond the other elements to that junction"
-                        )));
-                    }
-                    self.power_direction(kind, &name, &incoming, &outgoing);
+                for e in &incoming {
+                    self.model.graph[*e].to_port = 0;
                 }
+                for e in &outgoing {
+                    self.model.graph[*e].from_port = 1;
+                }
+            }
+            k if k.is_field() => self.field_ports(n, &name, &incoming, &outgoing, decl_span),
+            _ => {
+                if all.len() > 1 {
+                    let mut d = Diagnostic::error(
+                        "BG0301",
+                        format!("`{name}` is a 1-port but has {} bonds", all.len()),
+                    )
+                    .with_primary(self.bond_span(all[1]), "a second bond");
+                    d = d.with_secondary(self.bond_span(all[0]), "first bond");
+                    d = d.with_secondary(decl_span, format!("a `{}` has one port", kind.keyword()));
+                    self.diags.push(d.with_help(format!(
+                        "bond `{name}` to a junction and bond the other elements to that junction"
+                    )));
+                }
+                self.power_direction(kind, &name, &incoming, &outgoing);
             }
         }
     }

@@ -10,8 +10,9 @@
 //! primary = NUMBER | NAME | NAME "[" INT "]" | NAME "(" args ")" | "(" expr ")"
 //! ```
 //!
-//! Binary chains are loops; only nesting (parentheses, call arguments, unary minus, exponents) recurses, and it is
-//! counted against [`MAX_DEPTH`].
+//! Binary chains are loops; nesting (parentheses, call arguments, unary minus, exponents) recurses. Both deepen the
+//! tree, and the depth of the tree is capped at [`MAX_DEPTH`] (`BG0105`), so neither the parser nor any later walk of
+//! an expression can overflow the stack.
 
 use super::ast::*;
 use super::lexer::{Tok, Token};
@@ -60,31 +61,43 @@ impl<'a> Parser<'a> {
     }
 
     fn additive(&mut self, index: bool) -> PResult<Expr> {
-        let mut lhs = self.term(index)?;
-        loop {
-            let op = match self.peek().kind {
-                Tok::Plus => BinOp::Add,
-                Tok::Minus => BinOp::Sub,
-                _ => return Ok(lhs),
-            };
-            self.bump();
-            let rhs = self.term(index)?;
-            lhs = binary(op, lhs, rhs);
-        }
+        self.chain(index, Self::term, |t| match t {
+            Tok::Plus => Some(BinOp::Add),
+            Tok::Minus => Some(BinOp::Sub),
+            _ => None,
+        })
     }
 
     fn term(&mut self, index: bool) -> PResult<Expr> {
-        let mut lhs = self.unary(index)?;
-        loop {
-            let op = match self.peek().kind {
-                Tok::Star => BinOp::Mul,
-                Tok::Slash => BinOp::Div,
-                _ => return Ok(lhs),
-            };
-            self.bump();
-            let rhs = self.unary(index)?;
-            lhs = binary(op, lhs, rhs);
-        }
+        self.chain(index, Self::unary, |t| match t {
+            Tok::Star => Some(BinOp::Mul),
+            Tok::Slash => Some(BinOp::Div),
+            _ => None,
+        })
+    }
+
+    /// A left-associative chain `x op x op x ...`. Each operator deepens the tree by one level, so each counts
+    /// against the nesting limit: a chain of thousands of terms would otherwise build a tree too deep to walk.
+    fn chain(
+        &mut self,
+        index: bool,
+        operand: fn(&mut Self, bool) -> PResult<Expr>,
+        operator: fn(Tok) -> Option<BinOp>,
+    ) -> PResult<Expr> {
+        let mut levels = 0;
+        let result = (|| {
+            let mut lhs = operand(self, index)?;
+            while let Some(op) = operator(self.peek().kind) {
+                self.enter()?;
+                levels += 1;
+                self.bump();
+                let rhs = operand(self, index)?;
+                lhs = binary(op, lhs, rhs);
+            }
+            Ok(lhs)
+        })();
+        self.depth = self.depth.saturating_sub(levels);
+        result
     }
 
     fn unary(&mut self, index: bool) -> PResult<Expr> {

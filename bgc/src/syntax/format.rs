@@ -215,12 +215,14 @@ impl Printer<'_> {
             Stmt::Domain(d) => format!("domain {};", d.domain.name),
             Stmt::Param(p) => {
                 self.docs(&p.doc);
-                let mut line = format!(
-                    "param {} = {} {}",
-                    p.name.name,
-                    expr(&p.default),
-                    unit(&p.unit)
-                );
+                // The unit follows the default, so an index at the default's top level (`(e[1])`) keeps its
+                // parentheses; without them `e[1] [1]` would read as `e` with the unit `[1]`.
+                let default = if has_bare_index(&p.default) {
+                    format!("({})", expr(&p.default))
+                } else {
+                    expr(&p.default)
+                };
+                let mut line = format!("param {} = {default} {}", p.name.name, unit(&p.unit));
                 description(&mut line, &p.description);
                 line.push(';');
                 line
@@ -352,6 +354,16 @@ fn stmt_span(s: &Stmt) -> crate::span::Span {
         Stmt::Instance(x) => x.span,
         Stmt::Bond(x) => x.span,
         Stmt::Port(x) => x.span,
+    }
+}
+
+/// An `name[i]` outside any call or parentheses.
+fn has_bare_index(e: &Expr) -> bool {
+    match &e.kind {
+        ExprKind::Indexed(..) => true,
+        ExprKind::Neg(x) => has_bare_index(x),
+        ExprKind::Binary(_, a, b) => has_bare_index(a) || has_bare_index(b),
+        _ => false,
     }
 }
 

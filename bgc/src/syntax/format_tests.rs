@@ -101,6 +101,17 @@ fn minimal_parentheses_keep_the_tree() {
 }
 
 #[test]
+fn an_index_in_a_parameter_default_keeps_its_parentheses() {
+    let out = check_round_trip(
+        "model m {\n    param a = (e[1]) * 2 + (-f[2]) [1];\n    param b = n [1];\n}\n",
+    );
+    assert_eq!(
+        out,
+        "model m {\n    param a = (e[1] * 2 + -f[2]) [1];\n    param b = n [1];\n}\n"
+    );
+}
+
+#[test]
 fn numbers_round_trip_exactly() {
     let cases = [
         ("12", "12"),
@@ -118,6 +129,9 @@ fn numbers_round_trip_exactly() {
         ("0.30000000000000004", "0.30000000000000004"),
         ("123456789012345678", "123456789012345680"),
         ("1e300", "1e300"),
+        ("12.", "12"),
+        ("1.e5", "100000"),
+        ("1E+7", "1e7"),
     ];
     for (src, want) in cases {
         let out = check_round_trip(&format!("model m {{\n    param a = {src} [1];\n}}\n"));
@@ -197,4 +211,121 @@ fn language_reference_examples_round_trip() {
 fn crlf_input_formats_to_lf() {
     let out = check_round_trip("model m {\r\n    param a = 1 [kg]; // c\r\n}\r\n");
     assert_eq!(out, "model m {\n    param a = 1 [kg]; // c\n}\n");
+}
+
+mod generated_trees {
+    //! Random expression trees printed by the formatter must parse back to themselves: this checks the minimal
+    //! parenthesisation against every combination of operators, not just the cases written out above.
+
+    use super::super::ast::*;
+    use super::super::format::expr;
+    use super::super::parse;
+    use crate::span::{FileId, Span};
+    use proptest::prelude::*;
+
+    fn e(kind: ExprKind) -> Expr {
+        Expr {
+            kind,
+            span: Span::default(),
+        }
+    }
+
+    fn ident(name: &str) -> Ident {
+        Ident {
+            name: name.to_string(),
+            span: Span::default(),
+        }
+    }
+
+    fn leaf() -> impl Strategy<Value = Expr> {
+        prop_oneof![
+            prop_oneof![
+                Just(0.0),
+                Just(1.0),
+                Just(0.1),
+                Just(3.06e-4),
+                Just(1e300),
+                Just(5e-324),
+                Just(f64::MAX),
+                0.0..1e6f64,
+                (0u32..u32::MAX).prop_map(f64::from),
+            ]
+            .prop_map(|v| e(ExprKind::Number(v))),
+            prop::sample::select(vec!["x", "k_1", "t", "pi", "mass"])
+                .prop_map(|n| e(ExprKind::Name(n.into()))),
+            (prop::sample::select(vec!["e", "f", "p", "q"]), 1u32..5)
+                .prop_map(|(n, i)| e(ExprKind::Indexed(n.into(), i))),
+            (
+                prop::sample::select(vec!["e", "f", "p", "q"]),
+                prop::collection::vec(prop::sample::select(vec!["a", "b", "leg"]), 1..3),
+                prop::option::of(1u32..4),
+            )
+                .prop_map(|(f, path, port)| {
+                    let node = NodeRef {
+                        path: path.iter().map(|p| ident(p)).collect(),
+                        port: port.map(|p| (p, Span::default())),
+                        span: Span::default(),
+                    };
+                    e(ExprKind::Call(ident(f), vec![e(ExprKind::Node(node))]))
+                }),
+        ]
+    }
+
+    fn tree() -> impl Strategy<Value = Expr> {
+        leaf().prop_recursive(6, 48, 3, |inner| {
+            prop_oneof![
+                inner.clone().prop_map(|x| e(ExprKind::Neg(Box::new(x)))),
+                (
+                    prop::sample::select(vec![
+                        BinOp::Add,
+                        BinOp::Sub,
+                        BinOp::Mul,
+                        BinOp::Div,
+                        BinOp::Pow
+                    ]),
+                    inner.clone(),
+                    inner.clone()
+                )
+                    .prop_map(|(op, a, b)| e(ExprKind::Binary(
+                        op,
+                        Box::new(a),
+                        Box::new(b)
+                    ))),
+                (
+                    prop::sample::select(vec!["sin", "atan2", "min"]),
+                    prop::collection::vec(inner, 0..3)
+                )
+                    .prop_map(|(f, args)| e(ExprKind::Call(ident(f), args))),
+            ]
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 1024, ..ProptestConfig::default() })]
+
+        #[test]
+        fn printed_trees_parse_back_to_themselves(t in tree()) {
+            let src = format!("model m {{\n    output y [1] = {};\n}}\n", expr(&t));
+            let (file, diags) = parse(FileId(0), &src);
+            prop_assert!(diags.is_empty(), "{src}\n{diags:?}");
+            let value = match file.items.first() {
+                Some(Item::Model(m)) => match m.body.first() {
+                    Some(Stmt::Output(o)) => o.value.clone(),
+                    other => return Err(TestCaseError::fail(format!("{other:?}"))),
+                },
+                other => return Err(TestCaseError::fail(format!("{other:?}"))),
+            };
+            let strip = |x: &Expr| super::meaning(&File {
+                items: vec![Item::Model(ModelDecl {
+                    kind: ModelKind::Model,
+                    doc: vec![],
+                    name: ident("m"),
+                    body: vec![Stmt::Coords(CoordsDecl { coords: vec![x.clone()], span: Span::default() })],
+                    span: Span::default(),
+                })],
+                ..File::default()
+            });
+            prop_assert_eq!(strip(&value), strip(&t), "{}", src);
+        }
+    }
 }

@@ -186,10 +186,13 @@ struct Lexer<'a> {
 
 /// Splits `text` into tokens. See the module documentation.
 pub fn lex(file: FileId, text: &str) -> Lexed {
+    let mut out = Lexed::default();
+    // About one token per six bytes in typical models; reserving avoids repeated growth of a large vector.
+    out.tokens.reserve(text.len() / 6 + 1);
     let mut lx = Lexer {
         file,
         text,
-        out: Lexed::default(),
+        out,
         junk: None,
         at_line_start: true,
     };
@@ -239,7 +242,8 @@ impl<'a> Lexer<'a> {
 
     fn run(&mut self) {
         let text = self.text;
-        let mut rest = text;
+        // A byte-order mark, which some editors write at the start of UTF-8 files, is not text.
+        let mut rest = text.strip_prefix('\u{feff}').unwrap_or(text);
         while !rest.is_empty() {
             let start = text.len() - rest.len();
             if let Ok((r, ws)) = whitespace(rest) {

@@ -270,8 +270,8 @@ impl<'a> Parser<'a> {
         }
     }
 
-    /// Expects the `;` that ends a statement. When the next token begins a new line, closes a block or ends the file,
-    /// the statement is complete and only the `;` is missing: the error points just after the statement and parsing
+    /// Expects the `;` that ends a statement. When the next token begins a new line or a statement, closes a block or
+    /// ends the file, the statement is complete and only the `;` is missing: the error points just after the statement and parsing
     /// goes on as if the `;` were there.
     pub(super) fn expect_semi(&mut self, what: &str) -> PResult<()> {
         if self.eat(Tok::Semi).is_some() {
@@ -284,7 +284,10 @@ impl<'a> Parser<'a> {
             // The unterminated string swallowed the rest of its line, `;` included; it is reported already.
             return Ok(());
         }
-        if self.starts_line(t) || matches!(t.kind, Tok::RBrace | Tok::Eof) {
+        if self.starts_line(t)
+            || self.is_statement_keyword(t)
+            || matches!(t.kind, Tok::RBrace | Tok::Eof)
+        {
             let end = self.prev_end();
             let found = self.describe(t);
             self.diags.push(
@@ -435,6 +438,10 @@ impl<'a> Parser<'a> {
             let t = self.peek();
             match t.kind {
                 Tok::Eof => break,
+                Tok::Semi => {
+                    // An empty statement has no meaning.
+                    self.bump();
+                }
                 Tok::Ident if matches!(self.tok_text(t), "model" | "component") => {
                     let docs = self.take_docs();
                     items.push(Item::Model(self.model(docs)));

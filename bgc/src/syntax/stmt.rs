@@ -371,6 +371,20 @@ impl<'a> Parser<'a> {
             ));
         }
         let name = self.expect_name("the name of the instance")?;
+        if !matches!(self.peek().kind, Tok::LParen | Tok::Semi)
+            && let Some(kw) = super::suggest::keyword_like(&component.name)
+        {
+            // `parm k = 1 [kg];` reads as an instance `k` of a component `parm`; the misspelling is the error.
+            self.diags.push(
+                Diagnostic::error(
+                    "BG0101",
+                    format!("expected a statement, found `{}`", component.name),
+                )
+                .with_primary(component.span, "not a keyword")
+                .with_help(format!("did you mean the keyword `{kw}`?")),
+            );
+            return Err(Fail);
+        }
         let mut overrides = Vec::new();
         if let Some(open) = self.eat(Tok::LParen) {
             if !self.at(Tok::RParen) {

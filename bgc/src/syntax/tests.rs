@@ -289,6 +289,22 @@ fn deep_nesting_is_an_error_not_a_crash() {
     assert_eq!(codes(&src), vec!["BG0105"]);
     let src = format!("model m {{ output y [1] = {}1; }}", "-".repeat(10_000));
     assert_eq!(codes(&src), vec!["BG0105"]);
+    let src = format!("model m {{ output y [1] = {}1; }}", "2 ^ ".repeat(10_000));
+    assert_eq!(codes(&src), vec!["BG0105"]);
+    // A long chain builds a deep tree too.
+    let src = format!("model m {{ output y [1] = {}1; }}", "x + ".repeat(10_000));
+    assert_eq!(codes(&src), vec!["BG0105"]);
+    let src = format!("model m {{ output y [1] = {}1; }}", "x * ".repeat(10_000));
+    assert_eq!(codes(&src), vec!["BG0105"]);
+    // Within the limit, all is well: 150 terms, 150 parentheses.
+    let src = format!("model m {{ output y [1] = {}1; }}", "x + ".repeat(150));
+    assert!(codes(&src).is_empty());
+    let src = format!(
+        "model m {{ output y [1] = {}1{}; }}",
+        "(".repeat(150),
+        ")".repeat(150)
+    );
+    assert!(codes(&src).is_empty());
 }
 
 /// The ```bg blocks of docs/language.md. A block without a `model`, `component` or `import` at its top level is a
@@ -332,5 +348,174 @@ fn every_example_of_the_language_reference_parses() {
     for ex in &examples {
         let (_, diags) = parse(FileId(0), ex);
         assert!(diags.is_empty(), "{ex}\n{diags:#?}");
+    }
+}
+
+#[test]
+fn megabyte_long_line() {
+    let stmt = "param p = 1 [kg]; ";
+    let n = 1_000_000 / stmt.len();
+    let mut src = String::from("model m { ");
+    for i in 0..n {
+        src.push_str(&stmt.replace("p =", &format!("p{i} =")));
+    }
+    src.push('}');
+    assert!(src.len() > 1_000_000);
+    assert_eq!(body_of(&parse_ok(&src)).len(), n);
+    // One name a megabyte long.
+    let long = "x".repeat(1 << 20);
+    let f = parse_ok(&format!("model m {{ input {long} [1]; }}"));
+    match &body_of(&f)[0] {
+        Stmt::Input(i) => assert_eq!(i.name.name.len(), 1 << 20),
+        other => panic!("{other:?}"),
+    }
+}
+
+fn body_of(f: &File) -> &[Stmt] {
+    match f.items.first() {
+        Some(Item::Model(m)) => &m.body,
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn binary_junk_is_one_diagnostic_per_run() {
+    let junk: String = (0..100_000)
+        .map(|i| char::from(b"#$%&?@`|~\x01"[i % 10]))
+        .collect();
+    let (file, diags) = parse(FileId(0), &junk);
+    assert!(file.items.is_empty());
+    assert_eq!(diags.len(), 1, "{:?}", &diags[..diags.len().min(3)]);
+    assert_eq!(diags[0].code.0, "BG0104");
+    assert_eq!(diags[0].primary_span().map(|s| s.range()), Some(0..100_000));
+    // Junk between two models is reported and the models are kept.
+    let (file, diags) = parse(FileId(0), "model a {}\n@@@ junk ###\nmodel b {}\n");
+    assert_eq!(file.items.len(), 2);
+    let c: Vec<&str> = diags.iter().map(|d| d.code.0).collect();
+    assert_eq!(c, vec!["BG0104", "BG0101", "BG0104"]);
+}
+
+#[test]
+fn crlf_line_endings() {
+    let src = "/// Doc.\r\nmodel m {\r\n    param a = 1 [kg]; // c\r\n    bond a -> b;\r\n}\r\n";
+    let f = parse_ok(src);
+    match &f.items[0] {
+        Item::Model(m) => {
+            assert_eq!(m.doc, vec!["Doc.".to_string()]);
+            assert_eq!(m.body.len(), 2);
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(f.comments[0].text, "// c");
+    // A missing `;` before a CRLF line break is found as before an LF one.
+    let (_, d) = parse(
+        FileId(0),
+        "model m {\r\n    param a = 1 [kg]\r\n    param b = 2 [kg];\r\n}\r\n",
+    );
+    assert_eq!(d.len(), 1);
+    let end_of_unit = "model m {\r\n    param a = 1 [kg]".len();
+    assert_eq!(
+        d[0].primary_span().map(|s| s.range()),
+        Some(end_of_unit..end_of_unit)
+    );
+}
+
+#[test]
+fn missing_semicolon_before_a_statement_on_the_same_line() {
+    let src = "model m { param a = 1 [kg] param b = 2 [kg]; }";
+    let (file, diags) = parse(FileId(0), src);
+    assert_eq!(diags.len(), 1);
+    let end = "model m { param a = 1 [kg]".len();
+    assert_eq!(diags[0].primary_span().map(|s| s.range()), Some(end..end));
+    assert_eq!(body_of(&file).len(), 2);
+}
+
+#[test]
+fn keyword_as_name_is_reported_and_the_statement_kept() {
+    let (file, diags) = parse(FileId(0), "model m { param bond = 1 [1]; C R = 1; }");
+    let c: Vec<&str> = diags.iter().map(|d| d.code.0).collect();
+    assert_eq!(c, vec!["BG0109", "BG0109"]);
+    assert_eq!(body_of(&file).len(), 2);
+}
+
+#[test]
+fn misspelt_keyword_gets_a_suggestion() {
+    let (_, diags) = parse(FileId(0), "model m { parm k = 1 [1]; }");
+    assert_eq!(diags.len(), 1);
+    assert_eq!(
+        diags[0].help.as_deref(),
+        Some("did you mean the keyword `param`?")
+    );
+}
+
+#[test]
+fn unclosed_paren_points_at_the_opening() {
+    let src = "model m { output y [1] = (1 + 2; }";
+    let (_, diags) = parse(FileId(0), src);
+    assert_eq!(diags.len(), 1);
+    let d = &diags[0];
+    assert_eq!(d.code.0, "BG0101");
+    assert_eq!(d.primary_span().map(|s| s.range()), Some(31..32));
+    let secondary: Vec<_> = d
+        .labels
+        .iter()
+        .filter(|l| !l.primary)
+        .map(|l| l.span.range())
+        .collect();
+    assert_eq!(secondary, vec![25..26]);
+}
+
+#[test]
+fn unclosed_law_block_stops_at_the_next_statement() {
+    let src = "model m {\n    R r { e = f;\n    param k = 1 [1];\n}\n";
+    let (file, diags) = parse(FileId(0), src);
+    let c: Vec<&str> = diags.iter().map(|d| d.code.0).collect();
+    assert_eq!(c, vec!["BG0106"]);
+    assert_eq!(body_of(&file).len(), 2);
+}
+
+#[test]
+fn spans_are_byte_ranges() {
+    let src = "model m {\n    param µk = 1 [µm];\n    output y [1] = 2 * x;\n}\n";
+    let (file, diags) = parse(FileId(0), src);
+    // `µk` is not a name (non-ASCII); `µm` is a unit.
+    assert_eq!(
+        diags.iter().map(|d| d.code.0).collect::<Vec<_>>(),
+        vec!["BG0104"]
+    );
+    let y = match &body_of(&file)[1] {
+        Stmt::Output(o) => o.clone(),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(&src[y.span.range()], "output y [1] = 2 * x;");
+    assert_eq!(&src[y.value.span.range()], "2 * x");
+    assert_eq!(&src[y.unit.span.range()], "[1]");
+}
+
+#[test]
+fn decode_points_at_the_first_bad_byte() {
+    use super::decode;
+    assert_eq!(decode(FileId(3), b"model m {}"), Ok("model m {}"));
+    // 0xC3 0x28: a two-byte sequence broken by its second byte; the error covers the first byte only.
+    let d = decode(FileId(3), b"ab\xC3\x28cd").expect_err("an error");
+    assert_eq!(d.code.0, "BG0100");
+    assert_eq!(
+        d.primary_span(),
+        Some(crate::span::Span::new(FileId(3), 2, 3))
+    );
+    // A sequence cut short by the end of the file runs to the end.
+    let d = decode(FileId(0), "é".as_bytes().get(..1).unwrap_or(&[])).expect_err("an error");
+    assert_eq!(d.primary_span().map(|s| s.range()), Some(0..1));
+    let d = decode(FileId(0), b"ab\xE2\x82").expect_err("an error");
+    assert_eq!(d.primary_span().map(|s| s.range()), Some(2..4));
+}
+
+#[test]
+fn byte_order_mark_is_ignored() {
+    let f = parse_ok("\u{feff}model m { param a = 1 [kg]; }");
+    assert_eq!(body_of(&f).len(), 1);
+    match &body_of(&f)[0] {
+        Stmt::Param(p) => assert_eq!(p.name.span.range(), 19..20),
+        other => panic!("{other:?}"),
     }
 }

@@ -127,30 +127,50 @@ pub(crate) fn gauss(a: &mut [Vec<Ex>], b: &mut [Ex]) -> Option<Vec<Ex>> {
 }
 
 /// `num / den`, with the reciprocals in the terms of `den` cleared first: `u / (1 + J_2/J_1)` becomes
-/// `J_1 u / (J_1 + J_2)`, which shows the merged inertia.
+/// `J_1 u / (J_1 + J_2)`, which shows the merged inertia. A denominator that is a product with one sum in it is
+/// handled through that sum.
 fn over_common_denominator(num: Ex, den: Ex) -> Ex {
-    let Ex::Add(terms) = &den else {
-        return div(num, den);
+    let den = sym::expand(&den);
+    let (num, terms) = match &den {
+        Ex::Add(terms) => (num, terms.clone()),
+        Ex::Mul(fs) if fs.iter().filter(|f| matches!(f, Ex::Add(_))).count() == 1 => {
+            let mut others = Vec::new();
+            let mut sum = Vec::new();
+            for f in fs {
+                match f {
+                    Ex::Add(ts) => sum = ts.clone(),
+                    other => others.push(other.clone()),
+                }
+            }
+            (div(num, mul(others)), sum)
+        }
+        _ => return div(num, den),
     };
-    let mut clear: Vec<Ex> = Vec::new();
-    for t in terms {
+    // Each base with the largest power it is divided by in any term.
+    let mut clear: Vec<(Ex, f64)> = Vec::new();
+    for t in &terms {
         let factors: Vec<&Ex> = match t {
             Ex::Mul(fs) => fs.iter().collect(),
             other => vec![other],
         };
         for f in factors {
             if let Ex::Pow(b, x) = f
-                && x.num().is_some_and(|v| v < 0.0)
-                && !clear.contains(b)
+                && let Some(v) = x.num().filter(|v| *v < 0.0)
             {
-                clear.push((**b).clone());
+                match clear.iter_mut().find(|(c, _)| c == &**b) {
+                    Some(entry) => entry.1 = entry.1.max(-v),
+                    None => clear.push(((**b).clone(), -v)),
+                }
             }
         }
     }
     if clear.is_empty() {
-        return div(num, den);
+        return div(num, sym::add(terms));
     }
-    let l = mul(clear);
+    let l = mul(clear
+        .into_iter()
+        .map(|(b, k)| sym::pow(b, Ex::Num(k)))
+        .collect());
     let den = sym::add(
         terms
             .iter()

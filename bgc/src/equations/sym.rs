@@ -343,6 +343,38 @@ pub fn eval_func(f: Func, a: &[f64]) -> Option<f64> {
     })
 }
 
+/// Products of sums multiplied out (`a (b + c)` → `a b + a c`), unless that would make more than 64 terms, in
+/// which case the expression is returned as it is.
+pub fn expand(e: &Ex) -> Ex {
+    const MAX_TERMS: usize = 64;
+    match e {
+        Ex::Add(ts) => add(ts.iter().map(expand).collect()),
+        Ex::Mul(fs) => {
+            let mut terms = vec![Ex::one()];
+            for f in fs.iter().map(expand) {
+                match f {
+                    Ex::Add(inner) => {
+                        if terms.len() * inner.len() > MAX_TERMS {
+                            return e.clone();
+                        }
+                        terms = terms
+                            .iter()
+                            .flat_map(|t| {
+                                inner.iter().map(move |i| mul(vec![t.clone(), i.clone()]))
+                            })
+                            .collect();
+                    }
+                    other => terms
+                        .iter_mut()
+                        .for_each(|t| *t = mul(vec![t.clone(), other.clone()])),
+                }
+            }
+            add(terms)
+        }
+        _ => e.clone(),
+    }
+}
+
 /// Replaces symbols: `f(s)` gives the replacement or `None` to keep `s`. The result is re-canonicalised.
 pub fn subst(e: &Ex, f: &mut dyn FnMut(Sym) -> Option<Ex>) -> Ex {
     match e {

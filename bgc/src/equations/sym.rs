@@ -531,12 +531,31 @@ pub fn eval(e: &Ex, value: &dyn Fn(Sym) -> Option<f64>) -> Result<f64, EvalError
 
 /// `e = a·s + b` with `a`, `b` free of `s`, or `None` when `e` is not affine in `s`.
 pub fn affine_in(e: &Ex, s: Sym) -> Option<(Ex, Ex)> {
+    // Functions such as sign have a zero derivative almost everywhere: the derivative test alone would take
+    // `sign(s)` for a constant. `s` must appear only under sums, products and integer powers.
+    if !algebraic_in(e, s) {
+        return None;
+    }
     let a = diff(e, s).ok()?;
     if a.contains(s) {
         return None;
     }
     let b = subst(e, &mut |t| (t == s).then(Ex::zero));
     Some((a, b))
+}
+
+/// True when `s` appears in `e` only under sums, products and integer powers.
+fn algebraic_in(e: &Ex, s: Sym) -> bool {
+    match e {
+        Ex::Num(_) | Ex::S(_) => true,
+        Ex::Add(v) | Ex::Mul(v) => v.iter().all(|t| algebraic_in(t, s)),
+        Ex::Pow(b, x) => {
+            !x.contains(s)
+                && (!b.contains(s) || x.num().is_some_and(|n| n.fract() == 0.0))
+                && algebraic_in(b, s)
+        }
+        Ex::Call(_, args) => !args.iter().any(|a| a.contains(s)),
+    }
 }
 
 #[cfg(test)]
@@ -598,5 +617,8 @@ mod tests {
         assert_eq!(a, y());
         assert_eq!(b, Ex::Num(3.0));
         assert!(affine_in(&pow(x(), Ex::Num(2.0)), Sym::Param(0)).is_none());
+        // sign(x) has a zero derivative but is not affine.
+        let coulomb = add(vec![call(Func::Sign, vec![x()]), mul(vec![y(), x()])]);
+        assert!(affine_in(&coulomb, Sym::Param(0)).is_none());
     }
 }

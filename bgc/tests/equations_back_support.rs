@@ -198,3 +198,41 @@ fn model_file_in_declared_coordinates_gives_equation_3() {
         assert_close("D", &ss.d, &d, 1e-9);
     }
 }
+
+#[test]
+fn symbolic_matrices_in_declared_coordinates() {
+    // The same A, B, C, D as expressions of the parameters, evaluated at random values; the motor row of A shows
+    // the merged inertia and the reflected gear stiffness.
+    let eqs = equations(true);
+    let ss =
+        bgc::equations::declared_state_space_symbolic(&eqs).expect("symbolic declared coordinates");
+    for seed in [4, 8] {
+        let p = random_params(seed);
+        let num = bgc::equations::evaluate_at(&eqs, &ss, &p, &[0.0; 7], &[0.0; 2], 0.0)
+            .expect("evaluate");
+        let (a, b, c, d) = paper(&p);
+        assert_close("A", &num.a, &a, 1e-9);
+        assert_close("B", &num.b, &b, 1e-9);
+        assert_close("C", &num.c, &c, 1e-9);
+        assert_close("D", &num.d, &d, 1e-9);
+    }
+    let text = |e| bgc::equations::expr_text(&eqs, e);
+    assert_eq!(text(&ss.dfdx[1][0]), "-k_g/((J_m + J_g)*r_g^2)");
+    assert_eq!(text(&ss.dfdu[1][0]), "1/(J_m + J_g)");
+    let mut printed = String::new();
+    for (name, m) in [
+        ("A", &ss.dfdx),
+        ("B", &ss.dfdu),
+        ("C", &ss.dhdx),
+        ("D", &ss.dhdu),
+    ] {
+        for (r, row) in m.iter().enumerate() {
+            for (c, e) in row.iter().enumerate() {
+                if !e.is_zero() {
+                    printed.push_str(&format!("{name}[{r}][{c}] = {}\n", text(e)));
+                }
+            }
+        }
+    }
+    insta::assert_snapshot!("back_support_declared_symbolic", printed);
+}

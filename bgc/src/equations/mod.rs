@@ -25,6 +25,7 @@
 
 mod build;
 mod coords;
+mod coords_symbolic;
 mod dense;
 mod energy;
 mod linear;
@@ -34,10 +35,11 @@ mod solve;
 pub mod sym;
 
 pub use coords::{CoordsError, declared_state_space};
+pub use coords_symbolic::declared_state_space_symbolic;
 pub use energy::{EnergyKind, EnergyTerm};
 pub use linear::{
-    Jacobians, LinearError, NumericStateSpace, StateSelection, SymbolicStateSpace, jacobians,
-    linear_state_space, linearise, numeric_state_space,
+    Jacobians, LinearError, NumericStateSpace, StateSelection, SymbolicStateSpace, evaluate_at,
+    jacobians, linear_state_space, linearise, numeric_state_space,
 };
 pub use print::{expr_latex, expr_text, to_json, to_latex, to_text};
 

@@ -183,17 +183,37 @@ fn with_span(d: Diagnostic, span: Option<&crate::span::Span>, label: &str) -> Di
 /// Returns the equations (as complete as possible) and the findings; an error diagnostic means some rate or output
 /// is missing (`None` in [`Equations::f`] or [`OutputEq::explicit`]).
 pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnostic>) {
-    let mut diags = Vec::new();
-    let params = model
-        .params
-        .iter()
-        .map(|p| (p.name.clone(), p.default))
-        .collect();
-    let inputs = model.inputs.iter().map(|i| i.name.clone()).collect();
-    let mut eqs = Equations {
+    // Substitution and the expression functions recurse along dependency chains and expression depth. They run on
+    // a thread with a large stack (reserved, not committed) so that long chains of elements end in the resolver's
+    // depth limit (a diagnostic) rather than in a stack overflow.
+    const STACK: usize = 512 << 20;
+    std::thread::scope(|scope| {
+        match std::thread::Builder::new()
+            .name("bgc-equations".into())
+            .stack_size(STACK)
+            .spawn_scoped(scope, || derive_on_this_thread(model, causality))
+        {
+            Ok(handle) => handle.join().unwrap_or_else(|_| {
+                let d = Diagnostic::error(
+                    codes::UNSUPPORTED,
+                    format!("the equations of `{}` could not be derived", model.name),
+                );
+                (empty_equations(model), vec![d])
+            }),
+            Err(_) => derive_on_this_thread(model, causality),
+        }
+    })
+}
+
+fn empty_equations(model: &Model) -> Equations {
+    Equations {
         model: model.name.clone(),
-        params,
-        inputs,
+        params: model
+            .params
+            .iter()
+            .map(|p| (p.name.clone(), p.default))
+            .collect(),
+        inputs: model.inputs.iter().map(|i| i.name.clone()).collect(),
         states: Vec::new(),
         energy_states: 0,
         rates: Vec::new(),
@@ -203,7 +223,12 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
         outputs: Vec::new(),
         coords: None,
         energy: Vec::new(),
-    };
+    }
+}
+
+fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnostic>) {
+    let mut diags = Vec::new();
+    let mut eqs = empty_equations(model);
     if !causality.consistent {
         diags.push(with_span(
             Diagnostic::error(

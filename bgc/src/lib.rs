@@ -12,5 +12,6 @@ pub mod equations;
 pub mod ir;
 pub mod lower;
 pub mod span;
+pub mod symbolic;
 pub mod syntax;
 pub mod units;

@@ -1,0 +1,67 @@
+//! A small symbolic expression engine for the equations stage and the code generators.
+//!
+//! [`Expr`] is an immutable, canonical expression over `f64` constants, [`Symbol`]s (a name and a [`SymbolKind`]),
+//! n-ary sums and products, powers and the functions of [`crate::ir::Func`]. Every constructor simplifies (see
+//! `build.rs` for the rules and the NaN caveat), so two expressions that are equal up to commutativity,
+//! associativity, like-term collection and constant folding are `==`, hash alike and print alike:
+//! `a*b + c == c + b*a`. The form is canonical, not a normal form for all identities: `2*(x + y) - 2*x` does not
+//! become `2*y` unless [`Expr::expand`] is asked for.
+//!
+//! # Simplification on construction (details in `symbolic/build.rs`)
+//! Sums and products are flattened, sorted by a total deterministic order, like terms and like factors collected
+//! (`2*x + 3*x = 5*x`, `x*x = x^2`), constants folded; `x + 0 = x`, `x*1 = x`, `x*0 = 0`, `x^0 = 1`, `x^1 = x`,
+//! `(x^a)^n = x^(a*n)` and `(x*y)^n = x^n*y^n` for integer `n`; `a - b = a + (-1)*b`, `a/b = a*b^(-1)`,
+//! `sqrt(x) = x^0.5`; a numeric coefficient times a single sum is distributed (`-(a - b) = b - a`), and a sum inside
+//! a product has its sign taken out. Calls with constant arguments are folded.
+//!
+//! NaN caveat: the rules are those of generic computer algebra. The simplified form equals the original wherever
+//! the original is finite, but may be finite where the original is NaN or infinite: `x*0 = 0`, `x - x = 0` and
+//! `x/x = 1` although `inf*0`, `inf - inf` and `0/0` are NaN; `sqrt(x)^2 = x` although the left side is NaN for
+//! `x < 0`. A NaN constant absorbs a whole sum or product. Signs of zeros are not kept (`-0` is stored as `0`).
+//!
+//! Derivatives ([`Expr::diff`]): `d|u| = sign(u) du`; `d sign(u) = 0` (exact away from `u = 0`);
+//! `d min(a, b) = (1 - s)/2 da + (1 + s)/2 db` and `d max(a, b) = (1 + s)/2 da + (1 - s)/2 db` with
+//! `s = sign(a - b)`, i.e. the derivative of the active argument and the mean of both where `a = b`.
+//!
+//! Evaluation and generated code share conventions: `sign(0) = 0`, `min`/`max` propagate NaN, `x^n` for integer
+//! constants is `powi`, `x^0.5` is `sqrt`; sums and products are computed in the order they print, so
+//! [`Expr::eval`] and the code printed by [`to_rust`] give the same bits.
+//!
+//! # Representation
+//! Nodes are shared behind `Arc` with a cached structural hash, rather than interned in an arena. Expressions here
+//! are small (element laws, state equations of a few dozen states), so hash-consing would save little memory, while
+//! `Arc` nodes need no interner threaded through every call or kept alive beside the expressions, can be built from
+//! any thread, and make `clone` a reference-count increment. The cached hash makes equality of different trees
+//! cheap to refute; the total order makes sorting, and therefore printing, deterministic.
+//!
+//! # Operations
+//! - construction: [`Expr::constant`], [`Expr::symbol`], [`Expr::sum`], [`Expr::product`], [`Expr::pow`],
+//!   [`Expr::call`], the operators `+ - * /` and unary `-` on `Expr`, `&Expr` and `f64`;
+//! - [`Expr::substitute`], [`Expr::diff`], [`Expr::jacobian`], [`Expr::eval`], [`Expr::free_symbols`],
+//!   [`Expr::expand`], [`Expr::linear_form`];
+//! - [`solve_linear`] for small linear systems;
+//! - printers [`to_text`] (also `Display`), [`to_latex`], [`to_rust`];
+//! - [`from_ir`] from the IR's expressions.
+
+mod build;
+mod diff;
+mod error;
+mod eval;
+mod expr;
+mod from_ir;
+mod linear;
+mod print;
+mod solve;
+
+#[cfg(test)]
+mod tests;
+
+pub use error::SymbolicError;
+pub use eval::{max, min, sign};
+pub use expr::{Expr, Node, Symbol, SymbolKind};
+pub use from_ir::from_ir;
+pub use linear::{LinearForm, MAX_EXPANDED_POWER, MAX_EXPANDED_TERMS};
+pub use print::latex::{latex_symbol, to_latex, to_latex_with};
+pub use print::rust::{RUST_HELPERS, RUST_MAX_FN, RUST_MIN_FN, RUST_SIGN_FN, to_rust};
+pub use print::text::{to_text, to_text_with};
+pub use solve::{LinearSolution, MAX_SOLVE_SIZE, solve_linear};

@@ -1,0 +1,413 @@
+//! Simplifying constructors: every expression is put in canonical form as it is built.
+//!
+//! Rules applied on construction:
+//! - sums: nested sums are flattened, constants folded, like terms collected (`2*x + 3*x = 5*x`), zero terms dropped
+//!   (`x + 0 = x`, `x - x = 0`);
+//! - products: nested products flattened, constants folded, like factors collected by adding exponents
+//!   (`x*x = x^2`, `x^a * x^b = x^(a+b)`, `x/x = 1`), `x*1 = x`, `x*0 = 0`, and a numeric coefficient times a single
+//!   sum is distributed (`-(a - b) = b - a`, so `-(-x) = x`);
+//! - sums inside products and under integer powers have their sign taken out, so that their first non-constant
+//!   term has a positive coefficient: `(y - x)*z = -(x - y)*z`, `(-x - 1)^2 = (x + 1)^2`. Other numeric factors are
+//!   not taken out of sums (that would need inexact divisions and print `3*(x + 0.3333333333333333)`), so
+//!   `2*(x + 1)*y` and `(2*x + 2)*y` stay different forms of the same value; [`Expr::expand`] maps both to
+//!   `2*x*y + 2*y`. Likewise, as a product is built pairwise, `(2*(x + 1))*y` is `(2*x + 2)*y`: the numeric
+//!   coefficient was distributed before `y` arrived. Build products of several factors with [`Expr::product`] when
+//!   the grouping should not matter;
+//! - powers: `x^0 = 1`, `x^1 = x`, `1^x = 1`, constant powers folded, `(x^a)^n = x^(a*n)` and
+//!   `(x*y)^n = x^n * y^n` for integer constants `n`; division is multiplication by a power `-1`;
+//! - calls: all-constant arguments are folded, `sqrt(x)` becomes `x^0.5`, `min(x, x) = max(x, x) = x`,
+//!   `abs(c*x) = |c|*abs(x)` and `sign(c*x) = sign(c)*sign(x)` for a constant `c ≠ 0`, `abs(abs(x)) = abs(x)`,
+//!   `sign(sign(x)) = sign(x)`.
+//!
+//! # Domain caveat
+//! These are the generic rules of computer algebra: the simplified form equals the original wherever the original
+//! is finite, but it may be defined where the original is not. `x*0 = 0`, `x - x = 0` and `x/x = 1` hold for finite
+//! non-zero `x` only: under IEEE arithmetic `NaN*0`, `inf - inf` and `0/0` are NaN. `x^0.5 * x^0.5 = x` holds for
+//! `x ≥ 0` (the left side is NaN for `x < 0`). Callers that need to catch such points evaluate the original
+//! expressions of the model, not only their simplified forms.
+//!
+//! A NaN constant absorbs a whole sum or product (`x + NaN = NaN`, `x * NaN = NaN`), as in IEEE arithmetic; this
+//! also keeps the result independent of the order in which NaN, zeros and infinities are combined.
+
+use super::eval::{apply_func, pow_f64};
+use super::expr::{Expr, Node, Symbol};
+use crate::ir::Func;
+use std::collections::BTreeMap;
+use std::ops;
+
+impl Expr {
+    /// A numeric constant.
+    pub fn constant(value: f64) -> Expr {
+        Expr::from_canonical(Node::Const(value))
+    }
+
+    pub fn zero() -> Expr {
+        Expr::constant(0.0)
+    }
+
+    pub fn one() -> Expr {
+        Expr::constant(1.0)
+    }
+
+    /// A bare symbol.
+    pub fn symbol(symbol: Symbol) -> Expr {
+        Expr::from_canonical(Node::Sym(symbol))
+    }
+
+    /// The canonical sum of `terms` (0 when empty).
+    pub fn sum(terms: impl IntoIterator<Item = Expr>) -> Expr {
+        let mut constant = 0.0;
+        let mut collected: BTreeMap<Expr, f64> = BTreeMap::new();
+        for term in terms {
+            collect_term(&term, &mut constant, &mut collected);
+        }
+        if constant.is_nan() || collected.values().any(|c| c.is_nan()) {
+            return Expr::constant(f64::NAN);
+        }
+        let mut out: Vec<Expr> = Vec::with_capacity(collected.len() + 1);
+        if constant != 0.0 {
+            out.push(Expr::constant(constant));
+        }
+        for (rest, coeff) in collected {
+            if coeff != 0.0 {
+                out.push(scale_rest(rest, coeff));
+            }
+        }
+        out.sort();
+        match out.len() {
+            0 => Expr::zero(),
+            1 => out.pop().unwrap_or_else(Expr::zero),
+            _ => Expr::from_canonical(Node::Add(out)),
+        }
+    }
+
+    /// The canonical product of `factors` (1 when empty).
+    pub fn product(factors: impl IntoIterator<Item = Expr>) -> Expr {
+        let mut coeff = 1.0;
+        let mut bases: BTreeMap<Expr, Vec<Expr>> = BTreeMap::new();
+        for f in factors {
+            collect_factor(&f, &mut coeff, &mut bases);
+        }
+        if coeff == 0.0 || coeff.is_nan() {
+            return Expr::constant(coeff);
+        }
+        let mut out: Vec<Expr> = Vec::with_capacity(bases.len() + 1);
+        let mut needs_another_pass = false;
+        for (base, exps) in bases {
+            let f = base.pow(&Expr::sum(exps));
+            // `pow` can yield a constant (`x^0`), a product (`(x*y)^2`) or a power of another base
+            // (`((y^1.5)^0.5)^2 = y^1.5`), which must be merged again.
+            needs_another_pass |=
+                matches!(f.node(), Node::Const(_) | Node::Mul(_)) || f.base_exp().0 != &base;
+            out.push(f);
+        }
+        if needs_another_pass {
+            out.push(Expr::constant(coeff));
+            return Expr::product(out);
+        }
+        out.sort();
+        if coeff != 1.0 {
+            if let [single] = out.as_slice()
+                && let Node::Add(terms) = single.node()
+            {
+                return Expr::sum(terms.iter().map(|t| t * coeff));
+            }
+            out.insert(0, Expr::constant(coeff));
+        }
+        match out.len() {
+            0 => Expr::constant(coeff),
+            1 => out.pop().unwrap_or_else(Expr::one),
+            _ => Expr::from_canonical(Node::Mul(out)),
+        }
+    }
+
+    /// `self ^ exponent`.
+    pub fn pow(&self, exponent: &Expr) -> Expr {
+        let int_exp = exponent.as_const().filter(|e| e.fract() == 0.0);
+        match (self.node(), exponent.as_const()) {
+            (_, Some(0.0)) => Expr::one(),
+            (_, Some(1.0)) => self.clone(),
+            (Node::Const(b), Some(e)) => Expr::constant(pow_f64(*b, e)),
+            (Node::Const(b), _) if *b == 1.0 => Expr::one(),
+            (Node::Pow(b, a), _) if int_exp.is_some() => b.pow(&(a * exponent)),
+            (Node::Mul(fs), _) if int_exp.is_some() => {
+                Expr::product(fs.iter().map(|f| f.pow(exponent)))
+            }
+            (Node::Add(_), Some(n)) if int_exp.is_some() => match split_content(self) {
+                Some((content, primitive)) => Expr::product([
+                    Expr::constant(pow_f64(content, n)),
+                    Expr::from_canonical(Node::Pow(primitive, exponent.clone())),
+                ]),
+                None => Expr::from_canonical(Node::Pow(self.clone(), exponent.clone())),
+            },
+            _ => Expr::from_canonical(Node::Pow(self.clone(), exponent.clone())),
+        }
+    }
+
+    /// `self ^ n` for an integer `n`.
+    pub fn powi(&self, n: i32) -> Expr {
+        self.pow(&Expr::constant(f64::from(n)))
+    }
+
+    /// `1 / self`.
+    pub fn recip(&self) -> Expr {
+        self.powi(-1)
+    }
+
+    /// A function call, or `None` when `args.len()` is not the function's arity.
+    pub fn call(func: Func, args: &[Expr]) -> Option<Expr> {
+        match args {
+            [x] if func.arity() == 1 => Some(call1(func, x)),
+            [a, b] if func.arity() == 2 => Some(call2(func, a, b)),
+            _ => None,
+        }
+    }
+
+    pub fn sqrt(&self) -> Expr {
+        self.pow(&Expr::constant(0.5))
+    }
+
+    pub fn atan2(y: &Expr, x: &Expr) -> Expr {
+        call2(Func::Atan2, y, x)
+    }
+
+    pub fn min(a: &Expr, b: &Expr) -> Expr {
+        call2(Func::Min, a, b)
+    }
+
+    pub fn max(a: &Expr, b: &Expr) -> Expr {
+        call2(Func::Max, a, b)
+    }
+}
+
+macro_rules! unary_funcs {
+    ($($name:ident => $func:ident),* $(,)?) => {
+        impl Expr {
+            $(
+                #[doc = concat!("`", stringify!($name), "(self)`.")]
+                pub fn $name(&self) -> Expr {
+                    call1(Func::$func, self)
+                }
+            )*
+        }
+    };
+}
+
+unary_funcs! {
+    sin => Sin, cos => Cos, tan => Tan, asin => Asin, acos => Acos, atan => Atan, exp => Exp, ln => Ln,
+    log10 => Log10, abs => Abs, sign => Sign, tanh => Tanh, sinh => Sinh, cosh => Cosh,
+}
+
+fn call1(func: Func, x: &Expr) -> Expr {
+    if let Some(v) = x.as_const() {
+        return Expr::constant(apply_func(func, &[v]));
+    }
+    let (coeff, rest) = x.coeff_and_factors();
+    match (func, x.node()) {
+        (Func::Sqrt, _) => x.sqrt(),
+        (Func::Abs | Func::Sign, Node::Call(inner, _)) if *inner == func => x.clone(),
+        (Func::Abs, Node::Mul(_)) if coeff != 1.0 => {
+            coeff.abs() * Expr::product(rest.iter().cloned()).abs()
+        }
+        (Func::Sign, Node::Mul(_)) if coeff != 1.0 => {
+            coeff.signum() * Expr::product(rest.iter().cloned()).sign()
+        }
+        _ => Expr::from_canonical(Node::Call(func, vec![x.clone()])),
+    }
+}
+
+fn call2(func: Func, a: &Expr, b: &Expr) -> Expr {
+    if let (Some(x), Some(y)) = (a.as_const(), b.as_const()) {
+        return Expr::constant(apply_func(func, &[x, y]));
+    }
+    if matches!(func, Func::Min | Func::Max) && a == b {
+        return a.clone();
+    }
+    Expr::from_canonical(Node::Call(func, vec![a.clone(), b.clone()]))
+}
+
+/// Adds `term` into a sum being collected, keyed by the term without its numeric coefficient.
+fn collect_term(term: &Expr, constant: &mut f64, collected: &mut BTreeMap<Expr, f64>) {
+    match term.node() {
+        Node::Const(c) => *constant += c,
+        Node::Add(terms) => {
+            for t in terms {
+                collect_term(t, constant, collected);
+            }
+        }
+        _ => {
+            let (coeff, rest) = term.coeff_and_factors();
+            *collected.entry(rest_of(rest)).or_insert(0.0) += coeff;
+        }
+    }
+}
+
+/// `coeff * rest` where `rest` is a canonical coefficient-free term (a non-sum, possibly a product).
+fn scale_rest(rest: Expr, coeff: f64) -> Expr {
+    if coeff == 1.0 {
+        return rest;
+    }
+    let mut factors = vec![Expr::constant(coeff)];
+    match rest.node() {
+        Node::Mul(fs) => factors.extend(fs.iter().cloned()),
+        _ => factors.push(rest),
+    }
+    Expr::from_canonical(Node::Mul(factors))
+}
+
+fn collect_factor(f: &Expr, coeff: &mut f64, bases: &mut BTreeMap<Expr, Vec<Expr>>) {
+    match f.node() {
+        Node::Const(c) => *coeff *= c,
+        Node::Mul(fs) => {
+            for x in fs {
+                collect_factor(x, coeff, bases);
+            }
+        }
+        Node::Pow(b, e) => bases.entry(b.clone()).or_default().push(e.clone()),
+        Node::Add(_) => match split_content(f) {
+            Some((content, primitive)) => {
+                *coeff *= content;
+                bases.entry(primitive).or_default().push(Expr::one());
+            }
+            None => bases.entry(f.clone()).or_default().push(Expr::one()),
+        },
+        _ => bases.entry(f.clone()).or_default().push(Expr::one()),
+    }
+}
+
+/// A sum whose first non-constant term has a negative coefficient, as `(-1, -sum)`: `-2*x + 4` → `(-1, 2*x - 4)`.
+/// `None` for other sums.
+fn split_content(sum: &Expr) -> Option<(f64, Expr)> {
+    let Node::Add(terms) = sum.node() else {
+        return None;
+    };
+    let leading = terms
+        .iter()
+        .find(|t| t.as_const().is_none())?
+        .coeff_and_factors()
+        .0;
+    if leading >= 0.0 || leading.is_nan() {
+        return None;
+    }
+    let negated = Expr::sum(terms.iter().map(|t| match t.as_const() {
+        Some(c) => Expr::constant(-c),
+        None => {
+            let (c, rest) = t.coeff_and_factors();
+            scale_rest(rest_of(rest), -c)
+        }
+    }));
+    Some((-1.0, negated))
+}
+
+/// The coefficient-free term made of `factors`.
+fn rest_of(factors: &[Expr]) -> Expr {
+    match factors {
+        [single] => single.clone(),
+        _ => Expr::from_canonical(Node::Mul(factors.to_vec())),
+    }
+}
+
+impl From<f64> for Expr {
+    fn from(v: f64) -> Expr {
+        Expr::constant(v)
+    }
+}
+
+impl From<Symbol> for Expr {
+    fn from(s: Symbol) -> Expr {
+        Expr::symbol(s)
+    }
+}
+
+impl From<&Symbol> for Expr {
+    fn from(s: &Symbol) -> Expr {
+        Expr::symbol(s.clone())
+    }
+}
+
+fn sub2(a: &Expr, b: &Expr) -> Expr {
+    Expr::sum([a.clone(), -b])
+}
+
+fn div2(a: &Expr, b: &Expr) -> Expr {
+    Expr::product([a.clone(), b.recip()])
+}
+
+/// Implements a binary operator for every combination of `Expr`, `&Expr` and `f64` operands.
+macro_rules! binary_op {
+    ($trait:ident, $method:ident, $f:expr) => {
+        impl ops::$trait<&Expr> for &Expr {
+            type Output = Expr;
+            fn $method(self, rhs: &Expr) -> Expr {
+                $f(self, rhs)
+            }
+        }
+        impl ops::$trait<Expr> for Expr {
+            type Output = Expr;
+            fn $method(self, rhs: Expr) -> Expr {
+                $f(&self, &rhs)
+            }
+        }
+        impl ops::$trait<&Expr> for Expr {
+            type Output = Expr;
+            fn $method(self, rhs: &Expr) -> Expr {
+                $f(&self, rhs)
+            }
+        }
+        impl ops::$trait<Expr> for &Expr {
+            type Output = Expr;
+            fn $method(self, rhs: Expr) -> Expr {
+                $f(self, &rhs)
+            }
+        }
+        impl ops::$trait<f64> for &Expr {
+            type Output = Expr;
+            fn $method(self, rhs: f64) -> Expr {
+                $f(self, &Expr::constant(rhs))
+            }
+        }
+        impl ops::$trait<f64> for Expr {
+            type Output = Expr;
+            fn $method(self, rhs: f64) -> Expr {
+                $f(&self, &Expr::constant(rhs))
+            }
+        }
+        impl ops::$trait<Expr> for f64 {
+            type Output = Expr;
+            fn $method(self, rhs: Expr) -> Expr {
+                $f(&Expr::constant(self), &rhs)
+            }
+        }
+        impl ops::$trait<&Expr> for f64 {
+            type Output = Expr;
+            fn $method(self, rhs: &Expr) -> Expr {
+                $f(&Expr::constant(self), rhs)
+            }
+        }
+    };
+}
+
+binary_op!(Add, add, |a: &Expr, b: &Expr| Expr::sum([
+    a.clone(),
+    b.clone()
+]));
+binary_op!(Sub, sub, sub2);
+binary_op!(Mul, mul, |a: &Expr, b: &Expr| Expr::product([
+    a.clone(),
+    b.clone()
+]));
+binary_op!(Div, div, div2);
+
+impl ops::Neg for &Expr {
+    type Output = Expr;
+    fn neg(self) -> Expr {
+        Expr::product([Expr::constant(-1.0), self.clone()])
+    }
+}
+
+impl ops::Neg for Expr {
+    type Output = Expr;
+    fn neg(self) -> Expr {
+        -&self
+    }
+}

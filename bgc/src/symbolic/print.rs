@@ -1,0 +1,87 @@
+//! Printers: plain text, LaTeX and Rust source.
+//!
+//! All three walk the canonical form in its sorted order, so the same expression always prints the same text. They
+//! share the layout decisions made here: a sum prints its constant term last and its negative terms as `- term`; a
+//! product prints its numeric coefficient first, then the factors with non-negative exponents, then `/` and the
+//! factors with negative exponents (made positive); `x^0.5` prints as a square root.
+//!
+//! Each printer takes a closure mapping a symbol to its printed name, so the caller decides whether `J_m` prints as
+//! `J_m`, `p.J_m` or `x[0]`.
+
+pub mod latex;
+pub mod rust;
+pub mod text;
+
+use super::expr::{Expr, Node};
+
+/// Binding strength of what a printer produced, weakest first: callers parenthesise a part whose strength is below
+/// what its position needs.
+pub(super) const SUM: u8 = 1;
+pub(super) const PRODUCT: u8 = 2;
+pub(super) const UNARY: u8 = 3;
+pub(super) const POWER: u8 = 4;
+pub(super) const ATOM: u8 = 5;
+
+/// `-e` when `e` prints with a leading minus (a negative constant or a product with a negative coefficient).
+pub(super) fn negated(e: &Expr) -> Option<Expr> {
+    match e.node() {
+        Node::Const(c) if *c < 0.0 => Some(Expr::constant(-c)),
+        Node::Mul(_) if e.coeff_and_factors().0 < 0.0 => Some(-e),
+        _ => None,
+    }
+}
+
+/// The terms of a sum in print order: sorted, the constant last, then the first term that prints without a minus
+/// moved to the front (`1 - x`, not `-x + 1`).
+pub(super) fn sum_print_order(terms: &[Expr]) -> Vec<&Expr> {
+    let (consts, others): (Vec<&Expr>, Vec<&Expr>) =
+        terms.iter().partition(|t| t.as_const().is_some());
+    let mut order: Vec<&Expr> = others.into_iter().chain(consts).collect();
+    if let Some(i) = order.iter().position(|t| negated(t).is_none()) {
+        let first_positive = order.remove(i);
+        order.insert(0, first_positive);
+    }
+    order
+}
+
+/// A product laid out as `coeff * num / den`, the exponents of `den` made positive.
+pub(super) struct Fraction {
+    pub coeff: f64,
+    pub num: Vec<Expr>,
+    pub den: Vec<Expr>,
+}
+
+/// `b^(-e)` when `f = b^e` has a visibly negative exponent (a negative constant or a negative coefficient).
+pub(super) fn reciprocal(f: &Expr) -> Option<Expr> {
+    f.negative_power().map(|(b, e)| b.pow(&-e))
+}
+
+/// Splits a product (or a single power) into coefficient, numerator and denominator.
+pub(super) fn split_fraction(e: &Expr) -> Fraction {
+    let (coeff, factors) = match e.node() {
+        Node::Mul(_) => e.coeff_and_factors(),
+        _ => (1.0, std::slice::from_ref(e)),
+    };
+    let mut num = Vec::new();
+    let mut den = Vec::new();
+    for f in factors {
+        match reciprocal(f) {
+            Some(r) => den.push(r),
+            None => num.push(f.clone()),
+        }
+    }
+    Fraction { coeff, num, den }
+}
+
+/// Shortest text that parses back to exactly `c`: integers without a decimal point, others as Rust's `{:?}`.
+pub(super) fn number_text(c: f64) -> String {
+    if c.is_nan() {
+        "NaN".to_string()
+    } else if c.is_infinite() {
+        if c > 0.0 { "inf" } else { "-inf" }.to_string()
+    } else if c.fract() == 0.0 && c.abs() < 1e15 {
+        format!("{c:.0}")
+    } else {
+        format!("{c:?}")
+    }
+}

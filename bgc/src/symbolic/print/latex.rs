@@ -1,0 +1,247 @@
+//! LaTeX printer: `\frac{}{}`, `x^{2}`, `\sqrt{}`, `\sin\left(...\right)`, `\left|x\right|`.
+//!
+//! Symbol names are typeset by [`latex_symbol`]: the part before the first `_` is the main symbol (a Greek letter
+//! name becomes the letter, one character stays as is, a longer name is upright `\mathrm{}`), the rest is the
+//! subscript (a Greek name becomes the letter, other text is kept with `_` escaped): `J_m` → `J_{m}`,
+//! `theta_sint` → `\theta_{sint}`, `omega` → `\omega`, `x_theta` → `x_{\theta}`, `Kt` → `\mathrm{Kt}`.
+
+use super::super::expr::{Expr, Node, Symbol};
+use super::{
+    ATOM, PRODUCT, SUM, UNARY, negated, number_text, reciprocal, split_fraction, sum_print_order,
+};
+use crate::ir::Func;
+
+const GREEK: [&str; 40] = [
+    "alpha",
+    "beta",
+    "gamma",
+    "delta",
+    "epsilon",
+    "varepsilon",
+    "zeta",
+    "eta",
+    "theta",
+    "vartheta",
+    "iota",
+    "kappa",
+    "lambda",
+    "mu",
+    "nu",
+    "xi",
+    "pi",
+    "varpi",
+    "rho",
+    "varrho",
+    "sigma",
+    "varsigma",
+    "tau",
+    "upsilon",
+    "phi",
+    "varphi",
+    "chi",
+    "psi",
+    "omega",
+    "Gamma",
+    "Delta",
+    "Theta",
+    "Lambda",
+    "Xi",
+    "Pi",
+    "Sigma",
+    "Upsilon",
+    "Phi",
+    "Psi",
+    "Omega",
+];
+
+fn is_greek(s: &str) -> bool {
+    GREEK.contains(&s)
+}
+
+/// The LaTeX form of a symbol name (see the module docs).
+pub fn latex_symbol(name: &str) -> String {
+    let (head, sub) = match name.split_once('_') {
+        Some((h, s)) if !h.is_empty() && !s.is_empty() => (h, Some(s)),
+        _ => (name, None),
+    };
+    let head = if is_greek(head) {
+        format!("\\{head}")
+    } else if head.chars().count() == 1 {
+        head.to_string()
+    } else {
+        format!("\\mathrm{{{}}}", escape(head))
+    };
+    match sub {
+        None => head,
+        Some(s) if is_greek(s) => format!("{head}_{{\\{s}}}"),
+        Some(s) => format!("{head}_{{{}}}", escape(s)),
+    }
+}
+
+/// Escapes the characters that are special in LaTeX math.
+fn escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '_' | '#' | '$' | '%' | '&' | '{' | '}' => {
+                out.push('\\');
+                out.push(c);
+            }
+            _ => out.push(c),
+        }
+    }
+    out
+}
+
+/// `e` in LaTeX, symbols by [`latex_symbol`].
+pub fn to_latex(e: &Expr) -> String {
+    to_latex_with(e, &|s: &Symbol| latex_symbol(s.name()))
+}
+
+/// `e` in LaTeX, each symbol printed as `names` says.
+pub fn to_latex_with(e: &Expr, names: &dyn Fn(&Symbol) -> String) -> String {
+    LatexPrinter { names }.print(e).0
+}
+
+/// A constant: `1.5 \cdot 10^{-7}` for exponent notation.
+fn latex_number(c: f64) -> String {
+    if c.is_nan() {
+        return "\\mathrm{NaN}".to_string();
+    }
+    if c.is_infinite() {
+        return if c > 0.0 { "\\infty" } else { "-\\infty" }.to_string();
+    }
+    let text = number_text(c);
+    match text.split_once('e') {
+        Some((mantissa, exp)) => format!("{mantissa} \\cdot 10^{{{exp}}}"),
+        None => text,
+    }
+}
+
+struct LatexPrinter<'a> {
+    names: &'a dyn Fn(&Symbol) -> String,
+}
+
+impl LatexPrinter<'_> {
+    fn print(&self, e: &Expr) -> (String, u8) {
+        match e.node() {
+            Node::Const(c) => (latex_number(*c), if *c < 0.0 { UNARY } else { ATOM }),
+            Node::Sym(s) => ((self.names)(s), ATOM),
+            Node::Add(terms) => (self.sum(terms), SUM),
+            Node::Mul(_) => match negated(e) {
+                Some(pos) => (format!("-{}", self.product(&pos)), PRODUCT),
+                None => (self.product(e), PRODUCT),
+            },
+            Node::Pow(b, x) => match reciprocal(e) {
+                Some(_) => (self.product(e), PRODUCT),
+                None => self.power(b, x),
+            },
+            Node::Call(f, args) => (self.call(*f, args), ATOM),
+        }
+    }
+
+    fn wrapped(&self, e: &Expr, need: u8) -> String {
+        let (s, p) = self.print(e);
+        if p < need {
+            format!("\\left({s}\\right)")
+        } else {
+            s
+        }
+    }
+
+    fn sum(&self, terms: &[Expr]) -> String {
+        let mut out = String::new();
+        for (i, t) in sum_print_order(terms).into_iter().enumerate() {
+            match (i, negated(t)) {
+                (0, _) => out.push_str(&self.print(t).0),
+                (_, Some(pos)) => {
+                    out.push_str(" - ");
+                    out.push_str(&self.wrapped(&pos, PRODUCT));
+                }
+                (_, None) => {
+                    out.push_str(" + ");
+                    out.push_str(&self.print(t).0);
+                }
+            }
+        }
+        out
+    }
+
+    /// Factors side by side, with `\cdot` where a factor starts with a digit (so `2 \cdot 3^{x}`, not `2 3^{x}`).
+    fn juxtapose(&self, parts: Vec<String>) -> String {
+        let mut out = String::new();
+        for (i, p) in parts.into_iter().enumerate() {
+            if i > 0 {
+                let digit = p.chars().next().is_some_and(|c| c.is_ascii_digit());
+                out.push_str(if digit { " \\cdot " } else { " " });
+            }
+            out.push_str(&p);
+        }
+        out
+    }
+
+    fn factors(&self, coeff: Option<f64>, fs: &[Expr]) -> String {
+        let alone = fs.len() + usize::from(coeff.is_some()) == 1;
+        let mut parts: Vec<String> = coeff.map(latex_number).into_iter().collect();
+        // A lone sum needs no parentheses inside a `\frac`.
+        parts.extend(fs.iter().map(|f| {
+            if alone {
+                self.print(f).0
+            } else {
+                self.wrapped(f, UNARY)
+            }
+        }));
+        if parts.is_empty() {
+            "1".to_string()
+        } else {
+            self.juxtapose(parts)
+        }
+    }
+
+    fn product(&self, e: &Expr) -> String {
+        let fr = split_fraction(e);
+        let coeff = (fr.coeff != 1.0).then_some(fr.coeff);
+        if fr.den.is_empty() {
+            return self.factors(coeff, &fr.num);
+        }
+        format!(
+            "\\frac{{{}}}{{{}}}",
+            self.factors(coeff, &fr.num),
+            self.factors(None, &fr.den)
+        )
+    }
+
+    fn power(&self, base: &Expr, exp: &Expr) -> (String, u8) {
+        if exp.as_const() == Some(0.5) {
+            return (format!("\\sqrt{{{}}}", self.print(base).0), ATOM);
+        }
+        let b = self.wrapped(base, ATOM);
+        (format!("{b}^{{{}}}", self.print(exp).0), super::POWER)
+    }
+
+    fn call(&self, f: Func, args: &[Expr]) -> String {
+        let args: Vec<String> = args.iter().map(|a| self.print(a).0).collect();
+        let inner = args.join(", ");
+        let name = match f {
+            Func::Abs => return format!("\\left|{inner}\\right|"),
+            Func::Sqrt => return format!("\\sqrt{{{inner}}}"),
+            Func::Sin => "\\sin",
+            Func::Cos => "\\cos",
+            Func::Tan => "\\tan",
+            Func::Asin => "\\arcsin",
+            Func::Acos => "\\arccos",
+            Func::Atan => "\\arctan",
+            Func::Atan2 => "\\operatorname{atan2}",
+            Func::Exp => "\\exp",
+            Func::Ln => "\\ln",
+            Func::Log10 => "\\log_{10}",
+            Func::Sign => "\\operatorname{sign}",
+            Func::Min => "\\min",
+            Func::Max => "\\max",
+            Func::Tanh => "\\tanh",
+            Func::Sinh => "\\sinh",
+            Func::Cosh => "\\cosh",
+        };
+        format!("{name}\\left({inner}\\right)")
+    }
+}

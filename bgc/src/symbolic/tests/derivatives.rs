@@ -1,0 +1,132 @@
+//! Derivatives of every function against central finite differences at random points.
+
+use super::super::{Expr, Symbol};
+use super::{Rng, c, p, s};
+use crate::ir::Func;
+
+/// Central difference of `e` in `x` at `x0` with `others` bound for the remaining symbols.
+fn central_difference(e: &Expr, x: &Symbol, x0: f64, others: &[(Symbol, f64)]) -> f64 {
+    let h = 1e-5 * x0.abs().max(1.0);
+    let at = |v: f64| {
+        e.eval(|sym: &Symbol| {
+            if sym == x {
+                Some(v)
+            } else {
+                others.iter().find(|(o, _)| o == sym).map(|(_, val)| *val)
+            }
+        })
+        .unwrap_or(f64::NAN)
+    };
+    (at(x0 + h) - at(x0 - h)) / (2.0 * h)
+}
+
+/// Checks `d e/dx` against finite differences at `n` points of `[lo, hi]`.
+fn check_derivative(e: &Expr, lo: f64, hi: f64, rng: &mut Rng) {
+    let x = Symbol::state("x");
+    let y = (Symbol::param("y"), 0.7);
+    let d = e.diff(&x);
+    for _ in 0..20 {
+        let x0 = rng.uniform(lo, hi);
+        let exact = d
+            .eval(|sym: &Symbol| if sym == &x { Some(x0) } else { Some(y.1) })
+            .unwrap_or(f64::NAN);
+        let fd = central_difference(e, &x, x0, std::slice::from_ref(&y));
+        let tol = 1e-6 * exact.abs().max(1.0);
+        assert!(
+            (exact - fd).abs() <= tol,
+            "d/dx {e} = {d} at x = {x0}: {exact} vs finite difference {fd}"
+        );
+    }
+}
+
+#[test]
+fn every_function_differentiates_like_its_finite_difference() {
+    let mut rng = Rng(7);
+    let x = s("x");
+    // The argument is itself a function of x, so the chain rule is exercised too.
+    let u = 0.3 * &x + 0.1;
+    let cases: Vec<(Func, f64, f64)> = vec![
+        (Func::Sin, -3.0, 3.0),
+        (Func::Cos, -3.0, 3.0),
+        (Func::Tan, -3.0, 3.0),
+        (Func::Asin, -3.0, 2.5),
+        (Func::Acos, -3.0, 2.5),
+        (Func::Atan, -3.0, 3.0),
+        (Func::Exp, -3.0, 3.0),
+        (Func::Ln, 0.5, 3.0),
+        (Func::Log10, 0.5, 3.0),
+        (Func::Sqrt, 0.5, 3.0),
+        (Func::Abs, -3.0, -0.5),
+        (Func::Abs, 0.5, 3.0),
+        (Func::Sign, 0.5, 3.0),
+        (Func::Tanh, -3.0, 3.0),
+        (Func::Sinh, -3.0, 3.0),
+        (Func::Cosh, -3.0, 3.0),
+    ];
+    for (func, lo, hi) in cases {
+        let e = Expr::call(func, std::slice::from_ref(&u)).unwrap_or_else(Expr::zero);
+        check_derivative(&e, lo, hi, &mut rng);
+    }
+}
+
+#[test]
+fn two_argument_functions_differentiate_like_their_finite_differences() {
+    let mut rng = Rng(11);
+    let (x, y) = (s("x"), p("y"));
+    let a = x.powi(2) + 1.0;
+    // atan2 in all quadrants.
+    check_derivative(&Expr::atan2(&a, &(&x * &y)), -3.0, 3.0, &mut rng);
+    check_derivative(&Expr::atan2(&(&x - 0.2), &c(-1.0)), -3.0, 3.0, &mut rng);
+    // min/max on each side of the crossing x² + 1 = 2x + 1 (x = 0 and x = 2).
+    for (lo, hi) in [(-3.0, -0.1), (0.1, 1.9), (2.1, 4.0)] {
+        check_derivative(&Expr::min(&a, &(2.0 * &x + 1.0)), lo, hi, &mut rng);
+        check_derivative(&Expr::max(&a, &(2.0 * &x + 1.0)), lo, hi, &mut rng);
+    }
+}
+
+#[test]
+fn powers_differentiate_in_base_and_exponent() {
+    let mut rng = Rng(3);
+    let (x, y) = (s("x"), p("y"));
+    check_derivative(&x.powi(3), -2.0, 2.0, &mut rng);
+    check_derivative(&x.powi(-2), 0.5, 2.0, &mut rng);
+    check_derivative(&x.pow(&c(1.7)), 0.5, 2.0, &mut rng);
+    check_derivative(&x.pow(&y), 0.5, 2.0, &mut rng);
+    check_derivative(&y.pow(&x), -2.0, 2.0, &mut rng);
+    check_derivative(&x.pow(&x), 0.5, 2.0, &mut rng);
+    check_derivative(&((&x + 1.0) / (x.powi(2) + 2.0)), -2.0, 2.0, &mut rng);
+}
+
+#[test]
+fn hand_derivatives() {
+    let (x, k) = (Symbol::state("x"), p("k"));
+    let xe = Expr::symbol(x.clone());
+    assert_eq!((&k * xe.powi(2)).diff(&x), 2.0 * &k * &xe);
+    assert_eq!(xe.sin().diff(&x), xe.cos());
+    assert_eq!(xe.abs().diff(&x), xe.sign());
+    assert!(xe.sign().diff(&x).is_zero());
+    assert!(k.diff(&x).is_zero());
+    // d/dx min(x, k) = (1 - sign(x - k))/2: 1 below k, 0 above, 1/2 at the crossing.
+    let dmin = Expr::min(&xe, &k).diff(&x);
+    let at = |xv: f64| dmin.eval(|s: &Symbol| Some(if s == &x { xv } else { 1.0 }));
+    assert_eq!(at(0.0), Ok(1.0));
+    assert_eq!(at(2.0), Ok(0.0));
+    assert_eq!(at(1.0), Ok(0.5));
+}
+
+#[test]
+fn jacobian_of_a_pendulum() {
+    // ẋ1 = x2, ẋ2 = -g/l sin(x1) - b x2: J = [[0, 1], [-g/l cos(x1), -b]].
+    let (x1, x2) = (Symbol::state("x1"), Symbol::state("x2"));
+    let (g, l, b) = (p("g"), p("l"), p("b"));
+    let f = [
+        Expr::symbol(x2.clone()),
+        -(&g / &l) * Expr::symbol(x1.clone()).sin() - &b * Expr::symbol(x2.clone()),
+    ];
+    let j = Expr::jacobian(&f, &[x1.clone(), x2.clone()]);
+    let expected = vec![
+        vec![c(0.0), c(1.0)],
+        vec![-(&g / &l) * Expr::symbol(x1).cos(), -b],
+    ];
+    assert_eq!(j, expected);
+}

@@ -1,0 +1,223 @@
+//! Printer snapshots for text, LaTeX and Rust, and the exact forms the code generators rely on.
+
+use super::super::{Expr, Symbol, SymbolKind, latex_symbol, to_latex, to_rust, to_text};
+use super::{c, p, s};
+
+/// A gallery of expressions covering every printing rule.
+fn gallery() -> Vec<Expr> {
+    let (x, y, k, m, b) = (s("x"), s("y"), p("k"), p("m"), p("b"));
+    let jm = p("J_m");
+    let theta = s("theta_sint");
+    let tau = Expr::symbol(Symbol::input("tau"));
+    let t = Expr::symbol(Symbol::time());
+    vec![
+        c(2.0),
+        c(-0.1),
+        c(1e-7),
+        c(6.02214076e23),
+        c(f64::INFINITY),
+        &x + 1.0,
+        &x - 1.0,
+        1.0 - &x,
+        -&x,
+        -(&k * &x) / &m - &b * &y / &m + &tau,
+        x.powi(2),
+        x.powi(-1),
+        x.powi(-2) * &k,
+        &k / (&m * &jm),
+        x.sqrt(),
+        x.pow(&c(-0.5)),
+        x.pow(&c(1.5)),
+        x.pow(&y),
+        x.pow(&-&y),
+        (&x + &y).powi(2),
+        (&x + &y).recip(),
+        (&x + &y).pow(&(&k + 1.0)),
+        &k * (&x + &y),
+        c(2.0).pow(&x),
+        3.0 * c(2.0).pow(&x),
+        x.powi(2).sqrt(),
+        (&jm * &theta).sin(),
+        theta.cos().powi(2),
+        Expr::atan2(&y, &x),
+        Expr::min(&x, &k) + Expr::max(&y, &k),
+        x.abs() * x.sign(),
+        (&x * &y).sqrt(),
+        x.exp() + x.ln() + x.log10() + x.tan() + x.asin() + x.acos() + x.atan(),
+        x.tanh() - x.sinh() * x.cosh(),
+        (-(&x) + 2.0).abs(),
+        t.sin() * &tau,
+        0.5 * &k * x.powi(2) + 0.5 * &m * y.powi(2),
+    ]
+}
+
+fn table(print: impl Fn(&Expr) -> String) -> String {
+    gallery()
+        .iter()
+        .map(|e| format!("{}\n", print(e)))
+        .collect()
+}
+
+/// Rust names: parameters from `p`, states from `x[i]`, others bare.
+fn rust_name(sym: &Symbol) -> String {
+    match sym.kind() {
+        SymbolKind::Param => format!("p.{}", sym.name()),
+        SymbolKind::State => format!("x[{}]", if sym.name() == "x" { 0 } else { 1 }),
+        _ => sym.name().to_string(),
+    }
+}
+
+#[test]
+fn text_snapshot() {
+    insta::assert_snapshot!(table(to_text));
+}
+
+#[test]
+fn latex_snapshot() {
+    insta::assert_snapshot!(table(to_latex));
+}
+
+#[test]
+fn rust_snapshot() {
+    insta::assert_snapshot!(table(|e| to_rust(e, &rust_name)));
+}
+
+#[test]
+fn printing_is_deterministic_across_construction_orders() {
+    let (a, b, cc) = (p("a"), p("b"), s("c"));
+    let one = &a * &b + &cc;
+    let other = &cc + &b * &a;
+    assert_eq!(to_text(&one), to_text(&other));
+    assert_eq!(to_latex(&one), to_latex(&other));
+    assert_eq!(to_rust(&one, &rust_name), to_rust(&other, &rust_name));
+}
+
+#[test]
+fn latex_symbol_names() {
+    assert_eq!(latex_symbol("J_m"), "J_{m}");
+    assert_eq!(latex_symbol("theta_sint"), "\\theta_{sint}");
+    assert_eq!(latex_symbol("omega"), "\\omega");
+    assert_eq!(latex_symbol("x_theta"), "x_{\\theta}");
+    assert_eq!(latex_symbol("p_rotor_x"), "p_{rotor\\_x}");
+    assert_eq!(latex_symbol("Kt"), "\\mathrm{Kt}");
+    assert_eq!(latex_symbol("x"), "x");
+    assert_eq!(latex_symbol("_x"), "\\mathrm{\\_x}");
+}
+
+#[test]
+fn rust_forms_the_code_generators_rely_on() {
+    let x = s("x");
+    assert_eq!(to_rust(&x.powi(2), &rust_name), "x[0].powi(2)");
+    assert_eq!(to_rust(&x.sqrt(), &rust_name), "x[0].sqrt()");
+    assert_eq!(
+        to_rust(&Expr::atan2(&p("a"), &x), &rust_name),
+        "f64::atan2(p.a, x[0])"
+    );
+    assert_eq!(to_rust(&x.sign(), &rust_name), "bgc_sign(x[0])");
+    assert_eq!(to_rust(&c(0.1), &rust_name), "0.1");
+    assert_eq!(to_rust(&c(2.0).pow(&x), &rust_name), "2.0_f64.powf(x[0])");
+    assert_eq!(to_rust(&c(1e-7).pow(&x), &rust_name), "1e-7_f64.powf(x[0])");
+    assert_eq!(
+        to_rust(&c(-2.0).pow(&x), &rust_name),
+        "(-2.0_f64).powf(x[0])"
+    );
+    assert_eq!(
+        to_rust(&c(f64::NAN).pow(&x), &rust_name),
+        "f64::NAN.powf(x[0])"
+    );
+    // Rust accepts these literal forms and reads back the same values.
+    assert_eq!((-2.0_f64).powf(3.0), -8.0);
+    assert_eq!(1e-7_f64.sqrt(), 1e-7f64.sqrt());
+}
+
+#[test]
+fn numbers_round_trip_through_text() {
+    for v in [
+        0.1,
+        1.0 / 3.0,
+        2.0,
+        -7.0,
+        1e-7,
+        6.02214076e23,
+        123456.789,
+        1e15,
+        f64::MIN_POSITIVE,
+        f64::MAX,
+    ] {
+        let printed = to_text(&c(v));
+        assert_eq!(printed.parse::<f64>(), Ok(v), "{printed}");
+        let rust = to_rust(&c(v), &rust_name);
+        assert_eq!(rust.parse::<f64>(), Ok(v), "{rust}");
+    }
+}
+
+/// The Rust printer's output for [`end_to_end_expr`], pasted here so the compiler checks it and the test below can
+/// run it: printing is compared to this text, and its value to the evaluator's.
+mod generated {
+    include!("../print/rust_helpers.rs");
+
+    pub struct Params {
+        pub k: f64,
+        pub m: f64,
+    }
+
+    pub fn value(x: &[f64; 2], p: &Params) -> f64 {
+        2.0_f64.powf(x[1]) - p.k * x[0] / p.m
+            + x[0].exp().cos().powi(3) / (x[1].abs().powf(1.5) * (x[0] + x[1]))
+            + f64::atan2(x[1], x[0]) * (x[0].powi(2) + 1.0).sqrt()
+            + bgc_sign(x[1]) * bgc_min(x[0], p.k)
+            - bgc_max(x[1], 0.0)
+    }
+
+    pub fn helpers(v: f64) -> [f64; 3] {
+        [bgc_sign(v), bgc_min(v, 0.0), bgc_max(0.0, v)]
+    }
+}
+
+const END_TO_END_RUST: &str = "2.0_f64.powf(x[1]) - p.k * x[0] / p.m + x[0].exp().cos().powi(3) / (x[1].abs().powf(1.5) \
+    * (x[0] + x[1])) + f64::atan2(x[1], x[0]) * (x[0].powi(2) + 1.0).sqrt() + bgc_sign(x[1]) * bgc_min(x[0], p.k) \
+    - bgc_max(x[1], 0.0)";
+
+fn end_to_end_expr() -> Expr {
+    let (x, y, k, m) = (s("x"), s("y"), p("k"), p("m"));
+    -(&k * &x) / &m + y.sign() * Expr::min(&x, &k) - Expr::max(&y, &c(0.0))
+        + c(2.0).pow(&y)
+        + Expr::atan2(&y, &x) * (x.powi(2) + 1.0).sqrt()
+        + (&x + &y).recip() * x.exp().cos().powi(3) / y.abs().pow(&c(1.5))
+}
+
+#[test]
+fn printed_rust_compiles_and_computes_what_eval_computes() {
+    let e = end_to_end_expr();
+    assert_eq!(to_rust(&e, &rust_name), END_TO_END_RUST);
+    let params = generated::Params { k: 1.5, m: 0.8 };
+    let mut rng = super::Rng(21);
+    for _ in 0..50 {
+        let x = [rng.uniform(-2.0, 2.0), rng.uniform(-2.0, 2.0)];
+        let env = |sym: &Symbol| match sym.name() {
+            "x" => Some(x[0]),
+            "y" => Some(x[1]),
+            "k" => Some(params.k),
+            "m" => Some(params.m),
+            _ => None,
+        };
+        let (compiled, evaluated) = (
+            generated::value(&x, &params),
+            e.eval(env).unwrap_or(f64::NAN),
+        );
+        // Same formulas in the same order: the same bits.
+        assert_eq!(
+            compiled.to_bits(),
+            evaluated.to_bits(),
+            "{compiled} vs {evaluated} at {x:?}"
+        );
+    }
+}
+
+#[test]
+fn rust_helpers_follow_bgc_conventions() {
+    assert_eq!(generated::helpers(0.0), [0.0, 0.0, 0.0]);
+    assert_eq!(generated::helpers(-3.0), [-1.0, -3.0, 0.0]);
+    assert_eq!(generated::helpers(2.0), [1.0, 0.0, 2.0]);
+    assert!(generated::helpers(f64::NAN).iter().all(|v| v.is_nan()));
+}

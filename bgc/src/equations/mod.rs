@@ -1,14 +1,33 @@
 //! The equations stage: from a causal bond graph to state equations `ẋ = f(x, u, p, t)` and outputs
 //! `y = h(x, u, p, t)`.
 //!
-//! Steps ([`derive`]):
+//! Steps ([`derive()`]):
 //! 1. States are the energy variables of the storages in integral causality (`p_rotor`, `q_hd_spring`), then the
 //!    integrated flows (`var`s, named as declared); their rates are `ṗ = e`, `q̇ = f`, `θ̇ = integrand`.
-//! 2. Every node writes the causal equation of each bond variable it computes ([`build`]).
+//! 2. Every node writes the causal equation of each bond variable it computes (`build.rs`).
 //! 3. The rates and outputs are expressed in states, inputs, parameters and `t` by substitution in dependency order
-//!    ([`resolve`]); algebraic loops are torn and solved when affine, storages in derivative causality contribute
-//!    `ẋ` terms, solved for by a symbolic linear solve ([`solve`]).
+//!    (`resolve.rs`); algebraic loops are torn and solved when affine, storages in derivative causality contribute
+//!    `ẋ` terms, solved for by a symbolic linear solve (`solve.rs`).
 //! 4. Readable forms keep intermediates (one per bond variable that is computed and not a mere copy of another).
+//!
+//! # Calling it
+//! ```text
+//! let (causality, _) = bgc::causality::analyse(&model);
+//! let (eqs, diags) = bgc::equations::derive(&model, &causality);      // check has_errors(&diags)
+//! bgc::equations::to_text(&eqs) / to_latex(&eqs) / to_json(&eqs)      // `bgc equations`
+//! let p = eqs.default_params();
+//! numeric_state_space(&eqs, StateSelection::Energy, &p)               // `bgc statespace` (energy states)
+//! declared_state_space(&eqs, &p)                                      // ... in the model's `coords`
+//! declared_state_space_symbolic(&eqs)                                 // ... as expressions of the parameters
+//! linear_state_space(&eqs, StateSelection::Energy)                    // symbolic A, B, C, D
+//! jacobians(&eqs, sel) / linearise(&eqs, sel, &p, &x0, &u0, t0)       // nonlinear models
+//! eqs.f[i], eqs.outputs[k].explicit + to_symbolic(&eqs, e)            // `bgc simulate`, code generation
+//! ```
+//! The states are `eqs.states` (energy states first, `eqs.energy_states` of them, then one per `var`); symbols
+//! in expressions are named by [`Equations::sym_name`].
+//!
+//! The expressions are those of [`sym`], a small canonical engine of this stage; [`to_symbolic`] converts them to
+//! the shared engine [`crate::symbolic`] for its printers.
 //!
 //! Diagnostics of this stage:
 //!
@@ -23,6 +42,7 @@
 //! | BG0606 | declared coordinates that are not a linear, invertible function of the states |
 //! | BG0607 | the stored energy of a law that cannot be integrated symbolically (warning) |
 
+mod bridge;
 mod build;
 mod coords;
 mod coords_symbolic;
@@ -34,6 +54,7 @@ mod resolve;
 mod solve;
 pub mod sym;
 
+pub use bridge::{symbol, to_symbolic};
 pub use coords::{CoordsError, declared_state_space};
 pub use coords_symbolic::declared_state_space_symbolic;
 pub use energy::{EnergyKind, EnergyTerm};

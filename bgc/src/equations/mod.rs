@@ -153,6 +153,9 @@ pub struct Equations {
     pub coords: Option<Vec<(String, Ex)>>,
     /// Stored energy, dissipated and supplied power of each element.
     pub energy: Vec<EnergyTerm>,
+    /// The intermediates at which algebraic loops were solved exactly: the readable intermediates around them are
+    /// implicit (they refer to each other), the explicit rates and outputs are not.
+    pub loops: Vec<String>,
 }
 
 impl Equations {
@@ -244,6 +247,7 @@ fn empty_equations(model: &Model) -> Equations {
         outputs: Vec::new(),
         coords: None,
         energy: Vec::new(),
+        loops: Vec::new(),
     }
 }
 
@@ -428,6 +432,11 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
     eqs.rates = readable.rates;
     eqs.intermediates = readable.intermediates;
     eqs.var_names = readable.names;
+    eqs.loops = resolver
+        .torn()
+        .into_iter()
+        .map(|v| eqs.sym_name(Sym::Var(v)))
+        .collect();
     eqs.states = built.states;
     (eqs, diags)
 }

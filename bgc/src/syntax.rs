@@ -2,7 +2,15 @@
 //!
 //! [`decode`] checks that a file is UTF-8, [`parse`] turns its text into an [`ast::File`] plus diagnostics (it
 //! never fails: the tree holds everything that parsed) and [`format`] prints a tree back in the canonical layout.
-//! The grammar is in docs/language.md; the diagnostic codes of this stage are `BG0100`-`BG0117`.
+//! [`format_source`] parses and formats, refusing text with syntax errors; [`format_expr`], [`format_unit`],
+//! [`format_node`] and [`format_number`] print pieces of a tree (for messages of later stages).
+//!
+//! The grammar is in docs/language.md ("Lexical structure"). Diagnostic codes of this stage: `BG0100` invalid UTF-8,
+//! `BG0101` unexpected token, `BG0102` unterminated string, `BG0103` bad number, `BG0104` invalid character, `BG0105`
+//! nesting too deep, `BG0106` unclosed `{`, `BG0109` keyword as a name, `BG0110` misplaced fan-out, bond name or hint,
+//! `BG0111` unmatched closing bracket, `BG0112` unknown string escape, `BG0113` causal stroke not at an end of its bond,
+//! `BG0114` (warning) doc comment documenting nothing, `BG0115` bad port count or index, `BG0116` malformed unit,
+//! `BG0117` port count on a non-field or missing on a field.
 
 pub mod ast;
 mod decode;
@@ -21,7 +29,10 @@ mod snapshot_tests;
 mod tests;
 
 pub use decode::decode;
-pub use format::{format, format_source};
+pub use format::{
+    expr as format_expr, format, format_source, node as format_node, number as format_number,
+    unit as format_unit,
+};
 pub use parser::{KEYWORDS, MAX_DEPTH};
 
 use crate::diagnostic::Diagnostic;

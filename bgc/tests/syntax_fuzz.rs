@@ -181,3 +181,36 @@ fn every_truncation_of_every_seed_is_handled() {
         }
     }
 }
+
+/// A comment inserted at any space or line break of a valid file keeps it valid, survives formatting (the formatter
+/// may move it to the end of its statement's line, never drop it) and the formatted file is stable.
+#[test]
+fn a_comment_anywhere_is_kept_and_formatting_is_stable() {
+    for s in seeds() {
+        for (i, c) in s.char_indices() {
+            if c != ' ' && c != '\n' {
+                continue;
+            }
+            for comment in [" // note\n", "\n// note\n", " /// doc\n"] {
+                let mut text = s.clone();
+                text.insert_str(i, comment);
+                if let Err(e) = check_bytes(text.as_bytes()) {
+                    panic!("comment {comment:?} at {i}: {e}");
+                }
+                let (tree, diags) = parse(FileId(0), &text);
+                if !bgc::diagnostic::has_errors(&diags) {
+                    let out = format(&tree);
+                    let want = s.matches("note").count() + 1;
+                    let ordinary = comment.contains("note");
+                    if ordinary {
+                        assert_eq!(
+                            out.matches("note").count(),
+                            want,
+                            "comment lost:\n{text}\n---\n{out}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}

@@ -299,35 +299,42 @@ impl Engine {
         }
     }
 
-    /// The causal path that led to `bond`'s assignment: `(deciding node, bond)` from the origin to `bond`.
-    pub fn path_to(&self, bond: u32) -> Vec<(u32, u32)> {
+    /// The bonds in the order of their final assignment: a bond's `via` always comes before it.
+    pub fn order(&self) -> &[u32] {
+        &self.trail
+    }
+
+    /// The node that decided `bond` when its reason is not propagation (the origin of a causal path).
+    pub fn origin_node(&self, bond: u32) -> u32 {
+        match self.reason[bond as usize] {
+            Reason::Source(n)
+            | Reason::Storage(n)
+            | Reason::Fallback(n)
+            | Reason::Law(n)
+            | Reason::Arbitrary(n)
+            | Reason::Propagated { node: n, .. } => n,
+            Reason::FixedHint | Reason::PreferredHint | Reason::Unassigned => {
+                let (from, to) = self.ends[bond as usize];
+                if self.effort_from[bond as usize] == Some(true) {
+                    from
+                } else {
+                    to
+                }
+            }
+        }
+    }
+
+    /// The last `limit` steps of the causal path that led to `bond`'s assignment, as `(deciding node, bond)` in
+    /// causal order, ending with `bond`; it starts at the origin when the path is no longer than `limit`.
+    pub fn path_to(&self, bond: u32, limit: usize) -> Vec<(u32, u32)> {
         let mut steps = Vec::new();
         let mut b = bond;
-        // Each step goes to a bond assigned earlier, so the walk ends; the bound guards the invariant.
-        for _ in 0..=self.ends.len() {
+        // Each step goes to a bond assigned earlier, so the walk ends; the bound also keeps it short.
+        for _ in 0..limit.min(self.ends.len() + 1) {
+            steps.push((self.origin_node(b), b));
             match self.reason[b as usize] {
-                Reason::Propagated { node, via } => {
-                    steps.push((node, b));
-                    b = via;
-                }
-                Reason::Source(n)
-                | Reason::Storage(n)
-                | Reason::Fallback(n)
-                | Reason::Law(n)
-                | Reason::Arbitrary(n) => {
-                    steps.push((n, b));
-                    break;
-                }
-                Reason::FixedHint | Reason::PreferredHint | Reason::Unassigned => {
-                    let (from, to) = self.ends[b as usize];
-                    let setter = if self.effort_from[b as usize] == Some(true) {
-                        from
-                    } else {
-                        to
-                    };
-                    steps.push((setter, b));
-                    break;
-                }
+                Reason::Propagated { via, .. } => b = via,
+                _ => break,
             }
         }
         steps.reverse();

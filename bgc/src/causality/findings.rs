@@ -1,129 +1,17 @@
 //! From an assignment to the public result and its diagnostics (codes in the module docs of [`super`]).
 
-use super::engine::{Conflict, Engine, Reason, Role};
+use super::conflicts::{conflict, violated_hint};
+use super::context::Ctx;
+use super::engine::{Conflict, Reason};
 use super::scap::{Assignment, storage_ports};
 use super::{
     ArbitraryChoice, Causality, End, HintOutcome, StorageCausality, StorageForm, StorageKind,
 };
 use crate::diagnostic::Diagnostic;
 use crate::ir::Model;
-use crate::span::Span;
 use crate::syntax::ast::ElementKind;
 use petgraph::graph::{EdgeIndex, NodeIndex};
 use std::collections::BTreeSet;
-
-/// Longest causal path shown in full; longer ones keep their two ends.
-const PATH_SHOWN: usize = 12;
-
-struct Ctx<'a> {
-    model: &'a Model,
-    engine: &'a Engine,
-}
-
-impl Ctx<'_> {
-    fn node(&self, n: u32) -> NodeIndex {
-        NodeIndex::new(n as usize)
-    }
-
-    fn name(&self, n: u32) -> &str {
-        self.model
-            .graph
-            .node_weight(self.node(n))
-            .map_or("?", |w| w.name.as_str())
-    }
-
-    fn kind(&self, n: u32) -> Option<ElementKind> {
-        self.model.graph.node_weight(self.node(n)).map(|w| w.kind)
-    }
-
-    fn node_span(&self, n: u32) -> Span {
-        self.model
-            .spans
-            .nodes
-            .get(n as usize)
-            .copied()
-            .unwrap_or(self.model.spans.model)
-    }
-
-    fn bond_span(&self, b: u32) -> Span {
-        self.model
-            .spans
-            .bonds
-            .get(b as usize)
-            .copied()
-            .unwrap_or(self.model.spans.model)
-    }
-
-    fn bond_name(&self, b: u32) -> String {
-        self.model.bond_name(EdgeIndex::new(b as usize))
-    }
-
-    /// `inertia `J_m``, `1-junction `j``, ...
-    fn describe(&self, n: u32) -> String {
-        let what = match self.kind(n) {
-            Some(ElementKind::Se) => "effort source",
-            Some(ElementKind::MSe) => "modulated effort source",
-            Some(ElementKind::Sf) => "flow source",
-            Some(ElementKind::MSf) => "modulated flow source",
-            Some(ElementKind::C) => "compliance",
-            Some(ElementKind::I) => "inertia",
-            Some(ElementKind::R) => "resistor",
-            Some(ElementKind::TF) => "transformer",
-            Some(ElementKind::MTF) => "modulated transformer",
-            Some(ElementKind::GY) => "gyrator",
-            Some(ElementKind::MGY) => "modulated gyrator",
-            Some(ElementKind::Zero) => "0-junction",
-            Some(ElementKind::One) => "1-junction",
-            Some(ElementKind::CF) => "C-field",
-            Some(ElementKind::RF) => "R-field",
-            Some(ElementKind::IF) => "I-field",
-            None => "element",
-        };
-        format!("{what} `{}`", self.name(n))
-    }
-
-    /// Secondary labels along a causal path, element by element.
-    fn path_labels(&self, mut d: Diagnostic, steps: &[(u32, u32)]) -> Diagnostic {
-        let shown: Vec<(usize, &(u32, u32))> = if steps.len() > PATH_SHOWN {
-            let tail = PATH_SHOWN / 2;
-            let mut v: Vec<_> = steps.iter().enumerate().take(PATH_SHOWN - tail).collect();
-            v.extend(steps.iter().enumerate().skip(steps.len() - tail));
-            d = d.with_note(format!(
-                "the causal path has {} steps; {} in its middle are not shown",
-                steps.len(),
-                steps.len() - PATH_SHOWN
-            ));
-            v
-        } else {
-            steps.iter().enumerate().collect()
-        };
-        for (i, &(n, b)) in shown {
-            let var = if self.engine.node_sets(n, b) == Some(true) {
-                "effort"
-            } else {
-                "flow"
-            };
-            d = d.with_secondary(
-                self.node_span(n),
-                format!(
-                    "({}) `{}` sets the {var} on bond `{}`",
-                    i + 1,
-                    self.name(n),
-                    self.bond_name(b)
-                ),
-            );
-        }
-        d
-    }
-
-    /// The origin of the causal path of a bond, with its reason.
-    fn origin(&self, bond: u32) -> (u32, Reason) {
-        let steps = self.engine.path_to(bond);
-        let first = steps.first().map_or(bond, |&(_, b)| b);
-        let node = steps.first().map_or(0, |&(n, _)| n);
-        (node, self.engine.reason[first as usize])
-    }
-}
 
 /// Turns the assignment into the result and the diagnostics.
 pub fn conclude(
@@ -131,10 +19,7 @@ pub fn conclude(
     a: Assignment,
     loops: Vec<Vec<NodeIndex>>,
 ) -> (Causality, Vec<Diagnostic>) {
-    let cx = Ctx {
-        model,
-        engine: &a.engine,
-    };
+    let cx = Ctx::new(model, &a.engine, &a.fallbacks);
     let mut diags = Vec::new();
     let mut hints_in_conflict = BTreeSet::new();
 
@@ -163,7 +48,7 @@ pub fn conclude(
         if h.fixed && !h.honoured {
             diags.push(violated_hint(&cx, b));
         } else if !hints_in_conflict.contains(&b) {
-            diags.push(hint_note(&cx, b, h, &a));
+            diags.push(hint_note(&cx, b, h));
         }
     }
 
@@ -180,7 +65,7 @@ pub fn conclude(
             StorageForm::Derivative
         };
         if form == StorageForm::Derivative {
-            diags.push(derivative(&cx, n, b, kind, &a));
+            diags.push(derivative(&cx, n, b, kind));
         }
         storage.push(StorageCausality {
             node: NodeIndex::new(n as usize),
@@ -243,176 +128,8 @@ pub fn conclude(
     )
 }
 
-/// BG0501, BG0502, BG0503 or BG0541 for a violated constraint.
-fn conflict(cx: &Ctx, c: Conflict, hints_in_conflict: &mut BTreeSet<u32>) -> Diagnostic {
-    let e = cx.engine;
-    let role = e.roles.get(c.node as usize).copied().unwrap_or(Role::Free);
-    if matches!(role, Role::EffortSource | Role::FlowSource) {
-        return forced_source(cx, c, role, hints_in_conflict);
-    }
-    // The bonds whose causality meets at the node.
-    let bonds: Vec<u32> = match role {
-        Role::Zero | Role::One => {
-            let strong_sets = role == Role::One;
-            let strong: Vec<u32> = e
-                .incident(c.node)
-                .iter()
-                .copied()
-                .filter(|&b| e.node_sets(c.node, b) == Some(strong_sets))
-                .collect();
-            if strong.len() > 1 {
-                strong
-            } else {
-                e.incident(c.node).to_vec()
-            }
-        }
-        _ => e.incident(c.node).to_vec(),
-    };
-    let origins: Vec<(u32, Reason)> = bonds.iter().map(|&b| cx.origin(b)).collect();
-    let mut sources: Vec<u32> = Vec::new();
-    for &(n, r) in &origins {
-        if matches!(r, Reason::Source(_)) && !sources.contains(&n) {
-            sources.push(n);
-        }
-    }
-    let hint_bonds: Vec<u32> = bonds
-        .iter()
-        .map(|&b| e.path_to(b).first().map_or(b, |&(_, first)| first))
-        .filter(|&first| e.reason[first as usize] == Reason::FixedHint)
-        .collect();
-    let what = match role {
-        Role::Zero => "effort",
-        Role::One => "flow",
-        _ => "causality",
-    };
-    let mut d = if let Some(&hb) = hint_bonds.first() {
-        hints_in_conflict.extend(hint_bonds.iter().copied());
-        Diagnostic::error(
-            "BG0541",
-            format!(
-                "the fixed causality hint on bond `{}` cannot be met: it over-determines {}",
-                cx.bond_name(hb),
-                cx.describe(c.node)
-            ),
-        )
-        .with_primary(cx.bond_span(hb), "fixed hint")
-        .with_secondary(cx.node_span(c.node), "over-determined here")
-        .with_help("remove the hint or change it to a preference (`stroke` instead of `stroke!`)")
-    } else if sources.len() >= 2 {
-        Diagnostic::error(
-            "BG0501",
-            format!(
-                "{} and {} both impose the {what} of {}",
-                cx.describe(sources[0]),
-                cx.describe(sources[1]),
-                cx.describe(c.node)
-            ),
-        )
-        .with_primary(cx.node_span(c.node), format!("{what} imposed twice"))
-        .with_help(
-            "remove one of the sources, or put a storage or resistive element between them so that each \
-             imposes its variable on its own element",
-        )
-    } else {
-        let detail = match role {
-            Role::Zero | Role::One
-                if bonds.len() > 1 && e.incident(c.node).len() != bonds.len() =>
-            {
-                format!("more than one bond imposes its {what}")
-            }
-            Role::Zero | Role::One => format!("no bond imposes its {what}"),
-            Role::Transformer => "both ports impose their effort, or neither".to_string(),
-            _ => "both ports impose the same variable".to_string(),
-        };
-        Diagnostic::error(
-            "BG0502",
-            format!("{} is over-determined: {detail}", cx.describe(c.node)),
-        )
-        .with_primary(cx.node_span(c.node), "over-determined")
-        .with_help(
-            "the elements around it impose incompatible variables: remove one of them, or add a storage \
-             element (a compliance on a 0-junction, an inertia on a 1-junction) to absorb the difference",
-        )
-    };
-    for &b in bonds.iter().take(3) {
-        d = cx.path_labels(d, &e.path_to(b));
-    }
-    d
-}
-
-/// A source whose bond the rest of the graph assigns against it.
-fn forced_source(cx: &Ctx, c: Conflict, role: Role, hints: &mut BTreeSet<u32>) -> Diagnostic {
-    let e = cx.engine;
-    let steps = e.path_to(c.bond);
-    let (origin, reason) = cx.origin(c.bond);
-    let mine = if role == Role::EffortSource {
-        "effort"
-    } else {
-        "flow"
-    };
-    let (from, to) = e.ends[c.bond as usize];
-    let neighbour = if from == c.node { to } else { from };
-    let shared = matches!(
-        (role, e.roles.get(neighbour as usize)),
-        (Role::EffortSource, Some(Role::Zero)) | (Role::FlowSource, Some(Role::One))
-    );
-    let mut d = if matches!(reason, Reason::Source(_)) && shared {
-        Diagnostic::error(
-            "BG0501",
-            format!(
-                "{} and {} both impose the {mine} of {}",
-                cx.describe(origin),
-                cx.describe(c.node),
-                cx.describe(neighbour)
-            ),
-        )
-        .with_primary(cx.node_span(neighbour), format!("{mine} imposed twice"))
-        .with_secondary(cx.node_span(c.node), format!("also imposes the {mine}"))
-        .with_help(
-            "remove one of the sources, or put a storage or resistive element between them so that each \
-             imposes its variable on its own element",
-        )
-    } else {
-        if let (Reason::FixedHint, Some(&(_, first))) = (reason, steps.first()) {
-            hints.insert(first);
-        }
-        Diagnostic::error(
-            "BG0503",
-            format!(
-                "{} is forced into the wrong causality: {} imposes the {mine} on its bond",
-                cx.describe(c.node),
-                cx.describe(origin)
-            ),
-        )
-        .with_primary(cx.node_span(c.node), format!("must set the {mine}"))
-        .with_help(format!(
-            "a source sets its {mine} whatever the rest of the graph does: remove the element that also \
-             imposes it, or add a storage or resistive element between them"
-        ))
-    };
-    d = cx.path_labels(d, &steps);
-    d
-}
-
-/// BG0541 for a fixed hint the final causality does not meet.
-fn violated_hint(cx: &Ctx, b: u32) -> Diagnostic {
-    let steps = cx.engine.path_to(b);
-    let (origin, _) = cx.origin(b);
-    let d = Diagnostic::error(
-        "BG0541",
-        format!(
-            "the fixed causality hint on bond `{}` cannot be met: {} decides the other way",
-            cx.bond_name(b),
-            cx.describe(origin)
-        ),
-    )
-    .with_primary(cx.bond_span(b), "fixed hint violated")
-    .with_help("remove the hint, change it to a preference (`stroke`), or move the stroke to the other end");
-    cx.path_labels(d, &steps)
-}
-
 /// BG0540 for a hint that was honoured or overruled.
-fn hint_note(cx: &Ctx, b: u32, h: &HintOutcome, a: &Assignment) -> Diagnostic {
+fn hint_note(cx: &Ctx, b: u32, h: &HintOutcome) -> Diagnostic {
     let kind = if h.fixed { "fixed" } else { "preferred" };
     if h.honoured {
         return Diagnostic::note_diag(
@@ -433,7 +150,7 @@ fn hint_note(cx: &Ctx, b: u32, h: &HintOutcome, a: &Assignment) -> Diagnostic {
         ),
     )
     .with_primary(cx.bond_span(b), "overruled");
-    if let Some(&(_, c)) = a.fallbacks.iter().find(|(fb, _)| *fb == b) {
+    if let Some(c) = cx.fallbacks.get(&b) {
         d = d.with_note(format!(
             "the hinted causality would over-determine {}",
             cx.describe(c.node)
@@ -441,34 +158,33 @@ fn hint_note(cx: &Ctx, b: u32, h: &HintOutcome, a: &Assignment) -> Diagnostic {
     } else {
         let (origin, _) = cx.origin(b);
         d = d.with_note(format!("{} decides the other way", cx.describe(origin)));
-        d = cx.path_labels(d, &cx.engine.path_to(b));
+        d = cx.path_labels(d, b);
     }
     d.with_help("make it fixed (`stroke!`) to turn it into a requirement, or remove it")
 }
 
 /// BG0510 for a storage port in derivative causality.
-fn derivative(cx: &Ctx, n: u32, b: u32, kind: StorageKind, a: &Assignment) -> Diagnostic {
-    let e = cx.engine;
+fn derivative(cx: &Ctx, n: u32, b: u32, kind: StorageKind) -> Diagnostic {
     let (what, var) = match kind {
         StorageKind::I => ("inertia", "flow"),
         StorageKind::C => ("compliance", "effort"),
     };
     let name = cx.name(n);
-    let steps = e.path_to(b);
     let (origin, reason) = cx.origin(b);
-    let through: Vec<String> = steps
-        .iter()
+    let through: Vec<String> = cx
+        .path_nodes(b)
+        .into_iter()
         .skip(1)
-        .map(|&(m, _)| m)
         .filter(|&m| m != n && m != origin)
         .map(|m| cx.describe(m))
         .collect();
-    let across = if through.is_empty() {
-        String::new()
-    } else {
-        format!(" across {}", through.join(", "))
+    let shortened = cx.path(b).1 > cx.path(b).0.len();
+    let across = match (through.is_empty(), shortened) {
+        (true, _) => String::new(),
+        (false, false) => format!(" across {}", through.join(", ")),
+        (false, true) => format!(" across ..., {}", through.join(", ")),
     };
-    let fallback = a.fallbacks.iter().find(|(fb, _)| *fb == b).map(|&(_, c)| c);
+    let fallback = cx.fallbacks.get(&b).copied();
     let (imposer, help) = match (fallback, reason, cx.kind(origin)) {
         (Some(c), _, _) => (
             format!(
@@ -479,6 +195,19 @@ fn derivative(cx: &Ctx, n: u32, b: u32, kind: StorageKind, a: &Assignment) -> Di
              causality"
                 .to_string(),
         ),
+        (None, Reason::FixedHint | Reason::PreferredHint, _) => {
+            let first = cx.first[b as usize];
+            (
+                format!(
+                    "its {var} is imposed by the causality hint on bond `{}`{across}",
+                    cx.bond_name(first)
+                ),
+                format!(
+                    "this is what the hint asks for; remove or move the hint to let `{name}` take integral \
+                     causality"
+                ),
+            )
+        }
         (None, Reason::Storage(_), _) => (
             format!("its {var} is imposed by {}{across}", cx.describe(origin)),
             match kind {
@@ -499,13 +228,18 @@ fn derivative(cx: &Ctx, n: u32, b: u32, kind: StorageKind, a: &Assignment) -> Di
             format!(
                 "the source prescribes `{name}`'s {var}, so `{name}` adds no state and the source must be \
                  differentiable; if that is not intended, add a {} between `{}` and `{name}`, or drive it \
-                 with the dual source",
+                 with {} instead",
                 if kind == StorageKind::I {
                     "compliance"
                 } else {
                     "resistance or an inertia"
                 },
-                cx.name(origin)
+                cx.name(origin),
+                if kind == StorageKind::I {
+                    "an effort source"
+                } else {
+                    "a flow source"
+                },
             ),
         ),
         _ => (
@@ -522,7 +256,7 @@ fn derivative(cx: &Ctx, n: u32, b: u32, kind: StorageKind, a: &Assignment) -> Di
         "the model stays usable: `{name}` contributes no independent state"
     ))
     .with_help(help);
-    cx.path_labels(d, &steps)
+    cx.path_labels(d, b)
 }
 
 /// BG0520 for an algebraic loop.
@@ -613,5 +347,5 @@ fn inverted_law(cx: &Ctx, n: u32, b: u32, prefers_sets: bool) -> Diagnostic {
     .with_primary(cx.node_span(n), "law used the other way round")
     .with_note(format!("{} decides its causality", cx.describe(origin)))
     .with_help("write the law in the other form if it has a closed-form inverse");
-    cx.path_labels(d, &cx.engine.path_to(b))
+    cx.path_labels(d, b)
 }

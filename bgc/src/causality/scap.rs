@@ -2,8 +2,10 @@
 //!
 //! Decisions are taken in this order, each followed by full propagation before the next:
 //! 1. sources (their causality is fixed), then fixed hints (`stroke!`): hard constraints; a violation is a conflict;
-//! 2. preferred hints (`stroke`): the user's choice beats the default preferences below;
-//! 3. storage ports (C, I, and every port of CF and IF) in declaration order: integral causality preferred;
+//! 2. preferred hints (`stroke`) on the bonds of storage ports: the user's choice of which storage keeps its state
+//!    (which of two rigidly coupled inertias goes derivative) beats the default below;
+//! 3. storage ports (C, I, and every port of CF and IF) in declaration order: integral causality preferred; then
+//!    the other preferred hints, where storage left a choice;
 //! 4. resistors with a nonlinear law: the causality of the law's form (`e = g(f)` resistance, `f = g(e)`
 //!    conductance);
 //! 5. whatever is left (linear resistors, then junction-to-junction bonds in loops): an arbitrary choice.
@@ -132,20 +134,20 @@ pub fn assign(model: &Model) -> Assignment {
             Some(_) => {}
         }
     }
-    // 2. Preferred hints.
-    for h in a.hints.clone().iter().filter(|h| !h.fixed) {
-        let from = a.engine.ends[h.bond as usize].0;
-        decide(
-            &mut a,
-            h.bond,
-            from,
-            h.wants_effort_from,
-            Reason::PreferredHint,
-        );
+    // 2. Preferred hints on storage bonds: the user's choice of which storage keeps its state.
+    let storage = storage_ports(model, &a.engine);
+    let on_storage = |b: u32| storage.iter().any(|&(_, _, sb, _)| sb == b);
+    let preferred: Vec<HintRecord> = a.hints.iter().filter(|h| !h.fixed).copied().collect();
+    for h in preferred.iter().filter(|h| on_storage(h.bond)) {
+        prefer_hint(&mut a, h);
     }
     // 3. Storage.
-    for (n, _port, b, sets) in storage_ports(model, &a.engine) {
+    for &(n, _port, b, sets) in &storage {
         decide(&mut a, b, n, sets, Reason::Storage(n));
+    }
+    // 3b. The other preferred hints, where storage left a choice.
+    for h in preferred.iter().filter(|h| !on_storage(h.bond)) {
+        prefer_hint(&mut a, h);
     }
     // 4. Resistor laws.
     for (n, port, b, sets) in law_preferences(model, &a.engine) {
@@ -173,6 +175,11 @@ pub fn assign(model: &Model) -> Assignment {
         }
     }
     a
+}
+
+fn prefer_hint(a: &mut Assignment, h: &HintRecord) {
+    let from = a.engine.ends[h.bond as usize].0;
+    decide(a, h.bond, from, h.wants_effort_from, Reason::PreferredHint);
 }
 
 /// Takes a tentative decision: `node` sets the effort on `bond` when `sets`, else the other way round.

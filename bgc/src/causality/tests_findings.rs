@@ -392,3 +392,93 @@ fn fixed_hint_against_a_source_over_determines_a_junction() {
     assert_eq!(e.primary_span(), Some(m.spans.bonds[hinted.index()]));
     assert!(d.iter().all(|x| x.code.0 != "BG0540"));
 }
+
+#[test]
+fn preferred_hint_on_a_resistor_takes_the_place_of_an_arbitrary_choice() {
+    // The divider of `resistor_divider_has_an_algebraic_loop` with a hint putting r1 in conductance: r1 is no
+    // longer an arbitrary choice, but the 0-junction still needs one of R2, R3 to set its effort.
+    let mut b = Builder::new("divider_hint");
+    let se = b.node(K::Se, "u");
+    let s = b.node(K::One, "series");
+    let r1 = b.node(K::R, "R1");
+    let p = b.node(K::Zero, "mid");
+    let r2 = b.node(K::R, "R2");
+    let r3 = b.node(K::R, "R3");
+    b.bond(se, s);
+    b.bond_hint(s, r1, true, false);
+    b.chain(&[s, p, r2]);
+    b.bond(p, r3);
+    let (m, _) = b.finish();
+    let (ca, d) = analyse(&m);
+    assert!(ca.hints[0].honoured);
+    assert_eq!(ca.arbitrary.len(), 1);
+    assert_eq!(ca.arbitrary[0].node, r2);
+    assert_eq!(only(&d, "BG0530").primary_span(), Some(span_of(&m, "R2")));
+    assert_eq!(ca.loops.len(), 1);
+}
+
+#[test]
+fn preferred_hint_does_not_push_storage_into_derivative_causality() {
+    // Series Se-R-C: a hint asking the resistor to set the effort would leave the capacitor's effort to the
+    // junction (derivative). Storage is decided before hints on other bonds, so the hint is overruled instead.
+    let mut b = Builder::new("rc_hint");
+    let se = b.node(K::Se, "u");
+    let j = b.node(K::One, "loop");
+    let r = b.node(K::R, "R");
+    let c = b.node(K::C, "C");
+    b.bond(se, j);
+    b.bond_hint(j, r, false, false);
+    b.bond(j, c);
+    let (m, _) = b.finish();
+    let (ca, d) = analyse(&m);
+    assert_eq!(ca.independent_states(), 1);
+    assert!(!ca.hints[0].honoured);
+    let note = only(&d, "BG0540");
+    assert!(note.message.contains("overruled"));
+    assert!(
+        note.notes
+            .iter()
+            .any(|n| n.contains("compliance `C` decides the other way")),
+        "{note:#?}"
+    );
+}
+
+#[test]
+fn long_causal_paths_are_shortened() {
+    // A rigid chain Se -> 1 -> I -> TF -> 1 -> I -> TF ...: the first inertia is integral, every later one is
+    // imposed through all the transformers before it. Each warning shows the origin and the last steps only, so the
+    // findings stay linear in size.
+    let stages = 300;
+    let mut b = Builder::new("rigid_chain");
+    let se = b.node(K::Se, "tau");
+    let mut prev = se;
+    for k in 0..stages {
+        let j = b.node(K::One, &format!("j{k}"));
+        let i = b.node(K::I, &format!("J{k}"));
+        b.chain(&[prev, j, i]);
+        let tf = b.node(K::TF, &format!("g{k}"));
+        b.bond(j, tf);
+        prev = tf;
+    }
+    let end = b.node(K::One, "end");
+    let r = b.node(K::R, "load");
+    b.chain(&[prev, end, r]);
+    let (m, _) = b.finish();
+    let (c, d) = analyse(&m);
+    assert_eq!(c.independent_states(), 1);
+    assert_eq!(d.len(), stages - 1);
+    let last = d.last().unwrap();
+    assert!(
+        last.message.contains("`J299`") && last.message.contains("inertia `J0`"),
+        "{}",
+        last.message
+    );
+    assert!(last.labels.len() <= 14, "{}", last.labels.len());
+    assert!(
+        last.notes
+            .iter()
+            .any(|n| n.contains("in its middle are not shown"))
+    );
+    // The origin is still the first secondary label.
+    assert_eq!(last.labels[1].span, span_of(&m, "J0"));
+}

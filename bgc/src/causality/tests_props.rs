@@ -22,7 +22,7 @@ const KINDS: [K; 13] = [
     K::One,
 ];
 
-fn build(kinds: &[usize], edges: &[(usize, usize, u8)]) -> Model {
+fn build(kinds: &[usize], edges: &[(usize, usize, u8)], self_loops: bool) -> Model {
     let mut b = Builder::new("random");
     let nodes: Vec<_> = kinds
         .iter()
@@ -32,7 +32,7 @@ fn build(kinds: &[usize], edges: &[(usize, usize, u8)]) -> Model {
     for &(a, c, h) in edges {
         let (a, c) = (nodes[a % nodes.len()], nodes[c % nodes.len()]);
         // A bond from a node to itself breaks the IR's invariants (lowering rejects it).
-        if a == c {
+        if a == c && !self_loops {
             continue;
         }
         match h % 4 {
@@ -87,7 +87,7 @@ proptest! {
     #[test]
     fn random_graphs(kinds in prop::collection::vec(0usize..13, 1..14),
                      edges in prop::collection::vec((0usize..14, 0usize..14, 0u8..=255), 0..24)) {
-        let m = build(&kinds, &edges);
+        let m = build(&kinds, &edges, false);
         let (c, d) = analyse(&m);
         prop_assert_eq!(c.effort_set_by.len(), m.graph.edge_count());
         prop_assert_eq!(c.consistent, !crate::diagnostic::has_errors(&d));
@@ -103,5 +103,22 @@ proptest! {
         let _ = to_json(&m, &c, serde_json::Value::Null);
         let _ = crate::draw::svg(&m, Some(&c));
         let _ = crate::draw::dot(&m, Some(&c));
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+    /// Graphs that break the IR's invariants (bonds from a node to itself, wrong bond counts) still give a
+    /// complete result and no panic.
+    #[test]
+    fn malformed_graphs_do_not_panic(kinds in prop::collection::vec(0usize..13, 1..8),
+                                     edges in prop::collection::vec((0usize..8, 0usize..8, 0u8..=255), 0..16)) {
+        let m = build(&kinds, &edges, true);
+        let (c, _) = analyse(&m);
+        prop_assert_eq!(c.effort_set_by.len(), m.graph.edge_count());
+        let _ = to_text(&m, &c);
+        let _ = crate::draw::svg(&m, Some(&c));
+        let _ = crate::draw::dot(&m, None);
     }
 }

@@ -86,8 +86,9 @@ pub fn expr_text(model: &Model, e: &Expr, outer: u8) -> String {
             format!("{v}({})[{}]", node_name(model, *node), port + 1)
         }
         Expr::Neg(inner) => {
+            // `-a*b` reads the same either way; only a power or a right operand needs the parentheses.
             let s = format!("-{}", expr_text(model, inner, 3));
-            if outer > 1 { format!("({s})") } else { s }
+            if outer > 2 { format!("({s})") } else { s }
         }
         Expr::Binary(op, a, b) => {
             let p = binding(*op);

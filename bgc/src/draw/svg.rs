@@ -91,7 +91,8 @@ fn node(out: &mut String, model: &Model, i: usize, p: &Placed, mark: Highlight) 
 /// Renders the layout as SVG.
 pub fn render(model: &Model, lay: &Layout, causality: Option<&Causality>, marks: &Marks) -> String {
     let height = lay.height + LEGEND_H + LINE_H;
-    let width = lay.width.max(440.0);
+    // Wide enough for the legend's longest line.
+    let width = lay.width.max(MARGIN * 2.0 + 44.0 + 64.0 * 6.7);
     let mut out = String::new();
     let _ = writeln!(
         out,

@@ -5,52 +5,36 @@ use crate::causality::test_model::Builder;
 use crate::ir::Model;
 use crate::syntax::ast::ElementKind as K;
 
-/// The back-support exoskeleton of Fig. 6 (Shojaei Barjuei et al., Designs 2020), built by hand.
+/// The back-support exoskeleton of Fig. 6 (Shojaei Barjuei et al., Designs 2020), from `models/back_support.bg`.
 pub fn back_support() -> Model {
-    let mut b = Builder::new("back_support");
-    let tau = b.node(K::Se, "tau_m");
-    let jm = b.node(K::One, "j_m");
-    let rotor = b.node(K::I, "J_m");
-    let gin = b.node(K::I, "J_g");
-    let bf = b.node(K::R, "b_f");
-    let gear = b.node(K::TF, "r_g");
-    let jg = b.node(K::One, "j_g");
-    let bg = b.node(K::R, "b_g");
-    let z1 = b.node(K::Zero, "z_g");
-    let rel1 = b.node(K::One, "j_kg");
-    let kg = b.node(K::C, "k_g");
-    let dg = b.node(K::R, "d_g");
-    let js = b.node(K::One, "j_sint");
-    let sint = b.node(K::I, "J_sint");
-    let z2 = b.node(K::Zero, "z_s");
-    let rel2 = b.node(K::One, "j_ks");
-    let ks = b.node(K::C, "k_s");
-    let ds = b.node(K::R, "d_s");
-    let je = b.node(K::One, "j_sext");
-    let sext = b.node(K::I, "J_sext");
-    let z3 = b.node(K::Zero, "z_h");
-    let rel3 = b.node(K::One, "j_keh");
-    let keh = b.node(K::C, "k_eh");
-    let deh = b.node(K::R, "d_eh");
-    let jh = b.node(K::One, "j_h");
-    let trunk = b.node(K::I, "J_h");
-    let bh = b.node(K::R, "b_h");
-    let sf = b.node(K::Sf, "omega_h");
-    b.chain(&[tau, jm, rotor]);
-    b.bond(jm, gin);
-    b.bond(jm, bf);
-    b.chain(&[jm, gear, jg, bg]);
-    b.chain(&[jg, z1, rel1, kg]);
-    b.bond(rel1, dg);
-    b.chain(&[z1, js, sint]);
-    b.chain(&[js, z2, rel2, ks]);
-    b.bond(rel2, ds);
-    b.chain(&[z2, je, sext]);
-    b.chain(&[je, z3, rel3, keh]);
-    b.bond(rel3, deh);
-    b.chain(&[z3, jh, trunk]);
-    b.bond(jh, bh);
-    b.bond(sf, jh);
+    let text = include_str!("../../../models/back_support.bg");
+    let mut sources = crate::span::SourceMap::new();
+    let root = sources.add("back_support.bg", text);
+    let (mut models, diags) =
+        crate::lower::lower(&mut sources, root, &mut crate::lower::MemoryLoader::new());
+    assert!(!crate::diagnostic::has_errors(&diags), "{diags:?}");
+    models.remove(0)
+}
+
+/// A small hand-built graph with a field, a gyrator and a long bond that skips a layer.
+fn assorted() -> Model {
+    let mut b = Builder::new("assorted");
+    let se = b.node(K::Se, "u");
+    let j1 = b.node(K::One, "a");
+    let gy = b.node(K::GY, "emf");
+    let j2 = b.node(K::One, "b");
+    let c = b.node(K::C, "spring");
+    let z = b.node(K::Zero, "c");
+    let mass = crate::ir::Relation::MassMatrix {
+        n: 2,
+        entries: vec![crate::ir::Expr::Const(1.0); 4],
+    };
+    let leg = b.add(K::IF, "leg", mass, 2);
+    b.chain(&[se, j1, gy, j2, z]);
+    b.bond(j1, z);
+    b.bond(z, c);
+    b.bond_full(j2, None, leg, Some(0), None);
+    b.bond_full(z, None, leg, Some(1), None);
     b.finish().0
 }
 
@@ -139,6 +123,17 @@ fn back_support_layout_is_readable() {
 }
 
 #[test]
+fn assorted_layout_is_readable() {
+    let m = assorted();
+    let lay = layout(&m);
+    check_geometry(&m, &lay);
+    let (c, _) = crate::causality::analyse(&m);
+    let s = super::svg(&m, Some(&c));
+    // Field ports are numbered at the field's ends.
+    assert!(s.contains(">1</text>") && s.contains(">2</text>"));
+}
+
+#[test]
 fn svg_marks_derivative_storage_and_strokes() {
     let m = back_support();
     let (c, _) = crate::causality::analyse(&m);
@@ -155,8 +150,65 @@ fn svg_marks_derivative_storage_and_strokes() {
         s.matches(r#"stroke-width="2"/>"#).count(),
         m.graph.edge_count() + 1
     );
-    assert!(s.contains(">I:J_m<") || s.contains(">I:1<"));
+    assert!(s.contains(">I:J_m<") && s.contains(">C:1/k_g<") && s.contains(">TF:r_g<"));
+    assert!(s.contains(">rotor<") && s.contains(">Sf:omega_h<"));
     let d = super::dot(&m, Some(&c));
     assert_eq!(d.matches(" -> ").count(), m.graph.edge_count());
     assert!(d.contains("tee"));
+}
+
+#[test]
+fn loop_members_are_highlighted() {
+    // Se -> 1 -> R1; 1 -> 0 -> R2, R3: one algebraic loop through all but the source.
+    let mut b = Builder::new("divider");
+    let se = b.node(K::Se, "u");
+    let s1 = b.node(K::One, "series");
+    let r1 = b.node(K::R, "R1");
+    let p = b.node(K::Zero, "mid");
+    let r2 = b.node(K::R, "R2");
+    let r3 = b.node(K::R, "R3");
+    b.chain(&[se, s1, r1]);
+    b.chain(&[s1, p, r2]);
+    b.bond(p, r3);
+    let m = b.finish().0;
+    let (c, _) = crate::causality::analyse(&m);
+    let s = super::svg(&m, Some(&c));
+    let loop_nodes = c.loops[0]
+        .iter()
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
+    // Each loop member's box has the loop colour, plus the legend's swatch.
+    assert_eq!(
+        s.matches(r##"fill="#f1e8fa" stroke="#6a3d9a""##).count(),
+        loop_nodes + 1
+    );
+    check_geometry(&m, &layout(&m));
+}
+
+#[test]
+fn dot_strokes_follow_the_causality() {
+    // Se -> 1 -> I, C: the source sets the effort (stroke at the junction's end, the head); the junction sets the
+    // inertia's effort (stroke at the inertia, the head); the compliance sets its own (stroke at the junction, the
+    // tail).
+    let mut b = Builder::new("osc");
+    let se = b.node(K::Se, "push");
+    let j = b.node(K::One, "v");
+    let i = b.node(K::I, "mass");
+    let c = b.node(K::C, "spring");
+    b.chain(&[se, j, i]);
+    b.bond(j, c);
+    let m = b.finish().0;
+    let (ca, d) = crate::causality::analyse(&m);
+    assert!(d.is_empty());
+    let dot = super::dot(&m, Some(&ca));
+    assert!(dot.contains("n0 -> n1 [arrowhead=teelvee];"), "{dot}");
+    assert!(dot.contains("n1 -> n2 [arrowhead=teelvee];"), "{dot}");
+    assert!(
+        dot.contains("n1 -> n3 [arrowhead=lvee, dir=both, arrowtail=tee];"),
+        "{dot}"
+    );
+    assert!(dot.contains(r#"n0 [label="Se:1\npush""#), "{dot}");
+    // Without a causality there are no strokes.
+    let plain = super::dot(&m, None);
+    assert!(!plain.contains("tee"));
 }

@@ -33,6 +33,8 @@ pub(crate) struct ParamInfo {
     pub name_span: Span,
     /// The expression that gave its value (the default, or the instance's override).
     pub value_span: Span,
+    /// Its declared unit.
+    pub unit_span: Span,
 }
 
 pub(crate) struct Builder<'a> {
@@ -51,7 +53,7 @@ pub(crate) struct Builder<'a> {
     /// Declarations whose unit could not be read: their dimension is left free to avoid follow-up errors.
     pub bad_units: Vec<super::scope::Entity>,
     /// Nodes at the resolved end of a bond whose other end could not be resolved (already reported).
-    pub suspect_nodes: Vec<NodeIndex>,
+    pub suspect_nodes: std::collections::HashSet<NodeIndex>,
     /// Whether the last unit read by `unit` was valid.
     pub last_unit_ok: bool,
     /// The components being instantiated, to catch a component that contains itself.
@@ -91,7 +93,7 @@ impl<'a> Builder<'a> {
             instantiated: Vec::new(),
             bad_units: Vec::new(),
             last_unit_ok: true,
-            suspect_nodes: Vec::new(),
+            suspect_nodes: std::collections::HashSet::new(),
         }
     }
 

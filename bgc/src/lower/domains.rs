@@ -4,7 +4,8 @@
 //! a TF, GY or field keeps its bonds in separate groups (they may join two domains). A group takes the domain
 //! written on any of its elements (`I rotor : rotational`); two different written domains are a mismatch (BG0302).
 //! A group with no written domain takes the default (`domain NAME;`) of the scopes its junctions and 1-ports come
-//! from; two different defaults are also a mismatch, and no domain at all is BG0311.
+//! from, or failing those the default of the scopes of its TFs, GYs and fields; two different defaults are also a
+//! mismatch, and no domain at all is BG0311.
 
 use super::builder::Builder;
 use crate::diagnostic::Diagnostic;
@@ -59,17 +60,16 @@ impl Builder<'_> {
         }
         let mut explicit: Vec<Vec<Constraint>> = vec![Vec::new(); nb];
         let mut defaults: Vec<Vec<Constraint>> = vec![Vec::new(); nb];
+        let mut weak: Vec<Vec<Constraint>> = vec![Vec::new(); nb];
         for n in self.model.graph.node_indices() {
             let Some(info) = self.node_info(n) else {
                 continue;
             };
             let kind = info.decl.kind;
             let written = info.explicit_domain;
-            let default = if kind.is_two_port() || kind.is_field() {
-                None
-            } else {
-                self.scopes.get(info.scope).and_then(|s| s.default_domain)
-            };
+            let default = self.scopes.get(info.scope).and_then(|s| s.default_domain);
+            // A TF, GY or field may join domains: its scope's default only decides when nothing else does.
+            let weak_default = kind.is_two_port() || kind.is_field();
             let edges: Vec<EdgeIndex> = self
                 .model
                 .graph
@@ -92,7 +92,12 @@ impl Builder<'_> {
                     });
                 }
                 if let Some((domain, span)) = default {
-                    defaults[g].push(Constraint {
+                    let list = if weak_default {
+                        &mut weak[g]
+                    } else {
+                        &mut defaults[g]
+                    };
+                    list.push(Constraint {
                         domain,
                         span,
                         node: n,
@@ -109,9 +114,12 @@ impl Builder<'_> {
                 continue;
             }
             reported[g] = true;
-            let chosen = match (explicit[g].first(), defaults[g].first()) {
+            let chosen = match (explicit[g].first(), defaults[g].first().or(weak[g].first())) {
                 (Some(&first), _) => self.agree(&explicit[g], first, "declared"),
-                (None, Some(&first)) => self.agree(&defaults[g], first, "default"),
+                (None, Some(&first)) if !defaults[g].is_empty() => {
+                    self.agree(&defaults[g], first, "default")
+                }
+                (None, Some(&first)) => self.agree(&weak[g], first, "default"),
                 (None, None) => {
                     let span = self.bond_span(EdgeIndex::new(e));
                     self.diags.push(

@@ -10,7 +10,6 @@
 use super::builder::Builder;
 use super::consteval::{eval, params_of};
 use super::exprs::{Allow, Cx, Q, port_var, var_letter};
-use super::scope::Entity;
 use crate::diagnostic::Diagnostic;
 use crate::ir::{self, Domain, Law, PortVar, Relation};
 use crate::span::Span;
@@ -82,13 +81,10 @@ impl Builder<'_> {
                     } else {
                         (u.flow, u.flow_text, "a flow")
                     };
-                    self.expect_unit(
-                        q,
-                        want,
-                        v.span,
-                        &format!("{text} ({what} in the {} domain)", d.name()),
-                        &name,
-                    );
+                    let expected = format!("{text} ({what} in the {} domain)", d.name());
+                    if self.expect_unit(q, want, v.span, &expected, &name) {
+                        self.explain_units(&expr);
+                    }
                 }
                 Some(Relation::Source(expr))
             }
@@ -108,13 +104,10 @@ impl Builder<'_> {
                         K::I => "an inertia",
                         _ => "a resistance",
                     };
-                    self.expect_unit(
-                        q,
-                        want,
-                        v.span,
-                        &format!("{text} ({what} in the {} domain)", d.name()),
-                        &name,
-                    );
+                    let expected = format!("{text} ({what} in the {} domain)", d.name());
+                    if self.expect_unit(q, want, v.span, &expected, &name) {
+                        self.explain_units(&expr);
+                    }
                 }
                 self.check_value(kind, &name, &expr, v.span);
                 Some(Relation::Linear(expr))
@@ -146,7 +139,9 @@ impl Builder<'_> {
                     };
                     if let Some(want) = num.checked_div(uo.flow) {
                         let text = format!("{want} ({what}, {} to {})", din.name(), dout.name());
-                        self.expect_unit(q, want, v.span, &text, &name);
+                        if self.expect_unit(q, want, v.span, &text, &name) {
+                            self.explain_units(&expr);
+                        }
                     }
                 }
                 if matches!(kind, K::TF | K::GY) {
@@ -198,9 +193,9 @@ impl Builder<'_> {
     }
 
     /// BG0303 when a value's dimension is not the one its place needs.
-    pub fn expect_unit(&mut self, q: Q, want: Dim, span: Span, expected: &str, name: &str) {
+    pub fn expect_unit(&mut self, q: Q, want: Dim, span: Span, expected: &str, name: &str) -> bool {
         if q.fits(want) {
-            return;
+            return false;
         }
         self.diags.push(
             Diagnostic::error(
@@ -213,6 +208,33 @@ impl Builder<'_> {
             .with_primary(span, format!("this is in {}", q.dim()))
             .with_help(format!("the value must be in {expected}")),
         );
+        true
+    }
+
+    /// Adds to the last diagnostic a secondary label at the declared unit of each parameter `expr` uses.
+    fn explain_units(&mut self, expr: &ir::Expr) {
+        let mut used = Vec::new();
+        params_of(expr, &mut used);
+        let labels: Vec<(Span, String)> = used
+            .into_iter()
+            .filter_map(|id| {
+                let p = self.model.params.get(id)?;
+                let info = self.params.get(id)?;
+                Some((
+                    info.unit_span,
+                    format!("`{}` is declared in {}", p.name, p.unit_text),
+                ))
+            })
+            .collect();
+        if let Some(d) = self.diags.last_mut() {
+            for (span, msg) in labels {
+                d.labels.push(crate::diagnostic::Label {
+                    span,
+                    message: msg,
+                    primary: false,
+                });
+            }
+        }
     }
 
     /// BG0401: the value with the parameters at their defaults must be physical.
@@ -492,113 +514,6 @@ impl Builder<'_> {
             }
         }
         Some(Relation::Laws(out))
-    }
-
-    /// Outputs, integrated flows and declared coordinates.
-    pub fn build_signals(&mut self) {
-        for (id, scope, decl) in std::mem::take(&mut self.pending_outputs) {
-            let cx = Cx {
-                scope,
-                allow: Allow::States {
-                    outputs_before: Some(id),
-                },
-                host: None,
-                what: "an output",
-            };
-            let Some((expr, q)) = self.expr(&decl.value, cx) else {
-                continue;
-            };
-            let declared = self.model.outputs[id].unit.dim;
-            let unit_ok = !self.bad_units.contains(&Entity::Output(id));
-            if unit_ok && !q.fits(declared) {
-                let text = self.model.outputs[id].unit_text.clone();
-                self.diags.push(
-                    Diagnostic::error(
-                        "BG0303",
-                        format!(
-                            "output `{}` is declared [{text}] but its value is in {}",
-                            decl.name.name,
-                            q.dim()
-                        ),
-                    )
-                    .with_primary(decl.value.span, format!("this is in {}", q.dim()))
-                    .with_secondary(decl.unit.span, "declared unit")
-                    .with_help("fix the declared unit or the expression"),
-                );
-            }
-            self.model.outputs[id].value = expr;
-        }
-        for (id, scope, decl) in std::mem::take(&mut self.pending_vars) {
-            let cx = Cx {
-                scope,
-                allow: Allow::States {
-                    outputs_before: None,
-                },
-                host: None,
-                what: "an integrated flow",
-            };
-            let Some((expr, q)) = self.expr(&decl.integrand, cx) else {
-                continue;
-            };
-            let declared = self.model.vars[id].unit.dim;
-            let second = Dim::new(0, 0, 1, 0, 0, 0, 0);
-            let integral = match q {
-                Q::Free => Q::Free,
-                Q::Dim(d) => d.checked_mul(second).map(Q::Dim).unwrap_or(Q::Free),
-            };
-            let unit_ok = !self.bad_units.contains(&Entity::Var(id));
-            if unit_ok && !integral.fits(declared) {
-                let text = self.model.vars[id].unit_text.clone();
-                self.diags.push(
-                    Diagnostic::error(
-                        "BG0303",
-                        format!(
-                            "`{}` is declared [{text}] but the integral of its flow is in {}",
-                            decl.name.name,
-                            integral.dim()
-                        ),
-                    )
-                    .with_primary(
-                        decl.integrand.span,
-                        format!("this is in {}, its integral in {}", q.dim(), integral.dim()),
-                    )
-                    .with_secondary(decl.unit.span, "declared unit")
-                    .with_help("the unit of `int(x)` is the unit of `x` times seconds"),
-                );
-            }
-            self.model.vars[id].integrand = expr;
-        }
-        if let Some((scope, decl)) = self.pending_coords.take() {
-            let cx = Cx {
-                scope,
-                allow: Allow::States {
-                    outputs_before: None,
-                },
-                host: None,
-                what: "a state coordinate",
-            };
-            let mut coords = Vec::new();
-            for c in &decl.coords {
-                if let Some((expr, _)) = self.expr(c, cx) {
-                    coords.push(expr);
-                    self.model.spans.coords.push(c.span);
-                }
-            }
-            self.model.coords = Some(coords);
-        }
-    }
-
-    /// BG0402 for every parameter nothing uses.
-    pub fn unused_params(&mut self) {
-        for (p, info) in self.model.params.iter().zip(&self.params) {
-            if !info.used {
-                self.diags.push(
-                    Diagnostic::warning("BG0402", format!("parameter `{}` is never used", p.name))
-                        .with_primary(info.name_span, "declared here")
-                        .with_help("remove it, or use it in an element, law or output"),
-                );
-            }
-        }
     }
 }
 

@@ -10,6 +10,7 @@
 //! counts, TF/GY and field port numbers), domain inference, element relations with unit and value checks,
 //! outputs/vars/coordinates, unused parameters.
 
+mod bonds;
 mod builder;
 mod consteval;
 mod domains;
@@ -17,9 +18,13 @@ mod elements;
 mod exprs;
 mod flatten;
 mod imports;
+mod references;
 mod scope;
+mod signals;
 mod structure;
 
+#[cfg(test)]
+mod fixture_tests;
 #[cfg(test)]
 mod tests;
 
@@ -123,12 +128,11 @@ pub fn lower(
         diags.extend(b.diags.into_iter().filter(|d| d.code.0 != "BG0311"));
     }
     // A component instantiated twice reports its own problems twice; keep one of each.
-    let mut unique: Vec<Diagnostic> = Vec::with_capacity(diags.len());
-    for d in diags {
-        if !unique.contains(&d) {
-            unique.push(d);
-        }
-    }
+    let mut seen = std::collections::HashSet::new();
+    let unique: Vec<Diagnostic> = diags
+        .into_iter()
+        .filter(|d| seen.insert((d.code, d.message.clone(), d.primary_span())))
+        .collect();
     (models, unique)
 }
 

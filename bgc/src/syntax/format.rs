@@ -23,6 +23,7 @@ pub fn format(file: &File) -> String {
         indent: 0,
         last_end: 0,
         block_start: true,
+        pending: Vec::new(),
     };
     p.file(file);
     p.out
@@ -47,6 +48,9 @@ struct Printer<'f> {
     last_end: u32,
     /// Nothing has been printed yet in the current block (no blank line goes there).
     block_start: bool,
+    /// Comments moved out of a statement that did not fit at the end of its line; they go on their own lines
+    /// before whatever comes next, exactly where a reformatting finds them.
+    pending: Vec<&'f Comment>,
 }
 
 impl Printer<'_> {
@@ -72,8 +76,15 @@ impl Printer<'_> {
         self.last_end = self.last_end.max(end);
     }
 
-    /// Prints, on their own lines, the comments that start before `before`.
+    /// Prints, on their own lines, the pending comments and the comments that start before `before`.
     fn leading(&mut self, before: u32) {
+        for c in std::mem::take(&mut self.pending) {
+            self.begin_unit(c.span.start);
+            self.pad();
+            self.out.push_str(&c.text);
+            self.out.push('\n');
+            self.end_unit(c.span.end);
+        }
         while let Some(c) = self.comments.get(self.next_comment) {
             if c.span.start >= before {
                 break;
@@ -87,11 +98,13 @@ impl Printer<'_> {
         }
     }
 
-    /// Ends the line of a construct spanning to `end`, whose next sibling starts at `next`: comments inside the construct
-    /// and one comment trailing it on its line go at the end of the line, further ones on the lines after it.
+    /// Ends the line of a construct spanning to `end`, whose next sibling starts at `next`: of the comments inside the
+    /// construct and the one trailing it on its line, the first goes at the end of the line and the others become
+    /// pending (printed on their own lines before the next thing).
     fn finish_line(&mut self, end: u32, next: u32) {
+        let comments = self.comments;
         let mut moved = Vec::new();
-        while let Some(c) = self.comments.get(self.next_comment) {
+        while let Some(c) = comments.get(self.next_comment) {
             if c.span.start < end {
                 moved.push(c);
                 self.next_comment += 1;
@@ -99,7 +112,7 @@ impl Printer<'_> {
                 break;
             }
         }
-        if let Some(c) = self.comments.get(self.next_comment)
+        if let Some(c) = comments.get(self.next_comment)
             && !c.own_line
             && c.span.start < next
         {
@@ -113,12 +126,7 @@ impl Printer<'_> {
         }
         self.out.push('\n');
         self.end_unit(end);
-        for c in iter {
-            self.pad();
-            self.out.push_str(&c.text);
-            self.out.push('\n');
-            self.end_unit(c.span.end);
-        }
+        self.pending.extend(iter);
     }
 
     fn docs(&mut self, doc: &[String]) {

@@ -336,7 +336,7 @@ impl<'a> Lexer<'a> {
         let (tail, rest) = r.split_at(glued);
         let end = start + n.len() + tail.len();
         let span = self.span(start, end);
-        let literal = &self.text[start..end];
+        let literal = self.text.get(start..end).unwrap_or(n);
         let exponent_without_digits = n.ends_with(['e', 'E', '+', '-']);
         if !tail.is_empty() || exponent_without_digits {
             let (msg, help) = if tail.starts_with('.') || n.matches('.').count() > 1 {

@@ -13,9 +13,11 @@
 //! `BG0117` port count on a non-field or missing on a field.
 
 pub mod ast;
+mod bond;
 mod decode;
 mod expr;
 mod format;
+mod items;
 mod lexer;
 mod parser;
 mod stmt;

@@ -77,6 +77,33 @@ pub enum Stmt {
     Port(PortDecl),
 }
 
+impl Stmt {
+    /// From the statement's first token (after its doc comments) to its `;` or closing `}`.
+    pub fn span(&self) -> Span {
+        match self {
+            Stmt::Domain(x) => x.span,
+            Stmt::Param(x) => x.span,
+            Stmt::Input(x) => x.span,
+            Stmt::Output(x) => x.span,
+            Stmt::Var(x) => x.span,
+            Stmt::Coords(x) => x.span,
+            Stmt::Element(x) => x.span,
+            Stmt::Instance(x) => x.span,
+            Stmt::Bond(x) => x.span,
+            Stmt::Port(x) => x.span,
+        }
+    }
+}
+
+impl Item {
+    pub fn span(&self) -> Span {
+        match self {
+            Item::Import(x) => x.span,
+            Item::Model(x) => x.span,
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct DomainStmt {
     pub domain: Ident,

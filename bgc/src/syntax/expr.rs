@@ -242,6 +242,13 @@ impl<'a> Parser<'a> {
     /// `NAME(.NAME)*([INT])?`
     pub(super) fn node_ref(&mut self) -> PResult<NodeRef> {
         let start = self.peek().start;
+        if !self.at(Tok::Ident) {
+            return Err(self.expected(
+                "a node",
+                "a node is an element or a junction (`j1`), a component instance's port (`shaft.a`) or a field's \
+                 port (`leg[2]`)",
+            ));
+        }
         let mut path =
             vec![self.expect_name("a node (an element, a junction, `inst.port` or `field[i]`)")?];
         while self.eat(Tok::Dot).is_some() {
@@ -259,7 +266,8 @@ impl<'a> Parser<'a> {
         })
     }
 
-    /// A closing bracket matching `open`; when missing, the error shows where the bracket was opened.
+    /// A closing bracket matching `open`; when missing, the error shows where the bracket was opened. When the
+    /// next token is on a later line, the bracket is missing at the end of the line, and the error points there.
     pub(super) fn close(&mut self, kind: Tok, open: Token, what: &str) -> PResult<Token> {
         if let Some(t) = self.eat(kind) {
             return Ok(t);
@@ -267,12 +275,18 @@ impl<'a> Parser<'a> {
         let t = self.peek();
         let found = self.describe(t);
         let want = kind.describe();
+        let at = if self.starts_line(t) {
+            let end = self.prev_end();
+            self.span(end, end)
+        } else {
+            self.tok_span(t)
+        };
         self.diags.push(
             Diagnostic::error(
                 "BG0101",
                 format!("expected {want} to close {what}, found {found}"),
             )
-            .with_primary(self.tok_span(t), format!("expected {want}"))
+            .with_primary(at, format!("expected {want}"))
             .with_secondary(self.tok_span(open), "opened here")
             .with_help(format!("add the missing {want}")),
         );
@@ -351,8 +365,9 @@ impl<'a> Parser<'a> {
         })
     }
 
+    /// Unit symbols with their powers, on one line: a name on the next line begins the next statement, not a unit.
     fn unit_factors(&mut self, out: &mut Vec<(String, i32)>) -> PResult<()> {
-        while self.at(Tok::Ident) {
+        while self.at(Tok::Ident) && (out.is_empty() || !self.starts_line(self.peek())) {
             let t = self.bump();
             let symbol = self.tok_text(t).to_string();
             let mut power = 1;

@@ -145,10 +145,7 @@ impl Printer<'_> {
     fn file(&mut self, file: &File) {
         let mut prev_was_model = false;
         for (i, item) in file.items.iter().enumerate() {
-            let span = match item {
-                Item::Import(im) => im.span,
-                Item::Model(m) => m.span,
-            };
+            let span = item.span();
             let is_model = matches!(item, Item::Model(_));
             if i > 0 && (is_model || prev_was_model) && !self.out.ends_with("\n\n") {
                 // Models and components are always set apart by a blank line.
@@ -160,10 +157,7 @@ impl Printer<'_> {
             let next = file
                 .items
                 .get(i + 1)
-                .map(|it| match it {
-                    Item::Import(im) => im.span.start,
-                    Item::Model(m) => m.span.start,
-                })
+                .map(|it| it.span().start)
                 .unwrap_or(u32::MAX);
             match item {
                 Item::Import(im) => {
@@ -202,11 +196,7 @@ impl Printer<'_> {
         self.indent += 1;
         self.block_start = true;
         for (i, s) in m.body.iter().enumerate() {
-            let next_stmt = m
-                .body
-                .get(i + 1)
-                .map(|s| stmt_span(s).start)
-                .unwrap_or(close);
+            let next_stmt = m.body.get(i + 1).map(|s| s.span().start).unwrap_or(close);
             self.statement(s, next_stmt);
         }
         self.leading(close);
@@ -216,7 +206,7 @@ impl Printer<'_> {
     }
 
     fn statement(&mut self, s: &Stmt, next: u32) {
-        let span = stmt_span(s);
+        let span = s.span();
         self.leading(span.start);
         self.begin_unit(span.start);
         let line = match s {
@@ -347,21 +337,6 @@ impl Printer<'_> {
                 self.finish_line(e.span.end, next);
             }
         }
-    }
-}
-
-fn stmt_span(s: &Stmt) -> crate::span::Span {
-    match s {
-        Stmt::Domain(x) => x.span,
-        Stmt::Param(x) => x.span,
-        Stmt::Input(x) => x.span,
-        Stmt::Output(x) => x.span,
-        Stmt::Var(x) => x.span,
-        Stmt::Coords(x) => x.span,
-        Stmt::Element(x) => x.span,
-        Stmt::Instance(x) => x.span,
-        Stmt::Bond(x) => x.span,
-        Stmt::Port(x) => x.span,
     }
 }
 

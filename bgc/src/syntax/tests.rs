@@ -519,3 +519,21 @@ fn byte_order_mark_is_ignored() {
         other => panic!("{other:?}"),
     }
 }
+
+#[test]
+fn unclosed_unit_bracket_at_a_line_end() {
+    let src = "model m {\n    param k = 800 [N/m\n    C s = 1 / k;\n}\n";
+    let (file, diags) = parse(FileId(0), src);
+    assert_eq!(diags.len(), 1, "{diags:#?}");
+    let end = "model m {\n    param k = 800 [N/m".len();
+    assert_eq!(diags[0].primary_span().map(|s| s.range()), Some(end..end));
+    // The next statement is read, not swallowed as unit symbols.
+    assert!(matches!(body_of(&file), [Stmt::Element(_)]));
+}
+
+#[test]
+fn a_bad_model_name_is_one_error_and_the_body_is_read() {
+    let (file, diags) = parse(FileId(0), "model 3 { param a = 1 [1]; }");
+    assert_eq!(diags.len(), 1, "{diags:#?}");
+    assert_eq!(body_of(&file).len(), 1);
+}

@@ -141,6 +141,21 @@ impl<'a, M: Parametric, const NP: usize> ParametricDualModel<'a, M, NP> {
         Ok(w)
     }
 
+    /// `run(model, out)` with the model's parameters set to `w`; all `NaN` when the model refuses `w` (the
+    /// refusal is kept for [`DualModel::take_error`]).
+    fn at_parameters<const N: usize>(
+        &mut self,
+        w: &SVector<f64, NP>,
+        run: impl FnOnce(&M, &mut SVector<f64, N>),
+    ) -> SVector<f64, N> {
+        if !self.set(w) {
+            return SVector::repeat(f64::NAN);
+        }
+        let mut out = SVector::zeros();
+        run(self.model, &mut out);
+        out
+    }
+
     fn set(&mut self, w: &SVector<f64, NP>) -> bool {
         for (j, &index) in self.indices.iter().enumerate() {
             if let Err(e) = self.model.set_param(index, w[j]) {
@@ -163,12 +178,7 @@ where
         u: &SVector<f64, NU>,
         w: &SVector<f64, NP>,
     ) -> SVector<f64, NX> {
-        if !self.set(w) {
-            return SVector::repeat(f64::NAN);
-        }
-        let mut next = SVector::zeros();
-        self.model.step(x, u, &mut next);
-        next
+        self.at_parameters(w, |model, out| model.step(x, u, out))
     }
 
     fn observe(
@@ -177,12 +187,7 @@ where
         u: &SVector<f64, NU>,
         w: &SVector<f64, NP>,
     ) -> SVector<f64, NY> {
-        if !self.set(w) {
-            return SVector::repeat(f64::NAN);
-        }
-        let mut y = SVector::zeros();
-        self.model.outputs(x, u, &mut y);
-        y
+        self.at_parameters(w, |model, out| model.outputs(x, u, out))
     }
 
     fn commit(&mut self, w: &SVector<f64, NP>) -> Result<(), EstimationError> {

@@ -8,6 +8,8 @@
 //! - [`sigma`]: Merwe scaled sigma points and weights (paper 000, Eqs. 13, 20);
 //! - [`ukf`], [`ukf_augmented`], [`srukf`]: the UKF with additive noise, with non-additive (augmented) noise,
 //!   and in square-root form (paper 000, Eqs. 6–22);
+//! - `unscented` (private): the input checks, sigma-point evaluation, predicted and innovation moments and Kalman
+//!   correction those filters share;
 //! - [`dual_ukf`]: joint state and parameter estimation with RLS forgetting (paper 000, Eqs. 23–27);
 //! - [`health`]: filter health statistics of paper 000, Table 7;
 //! - [`fault`]: the error and outcome types and the fault contract all filters share.
@@ -27,6 +29,7 @@ pub mod sigma;
 pub mod srukf;
 pub mod ukf;
 pub mod ukf_augmented;
+mod unscented;
 
 pub use fault::{CovarianceRepair, EstimationError, FaultPolicy, RejectReason, UpdateOutcome};
 pub use kalman::{GainMode, KalmanFilter, LinearDiscreteModel, SteadyStateGain};

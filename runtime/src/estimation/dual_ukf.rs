@@ -37,16 +37,16 @@
 //! error changes nothing, also on a [`Parametric`] model (whose parameters are set to `ŵ` only when the step
 //! succeeds).
 
-use super::dense::first_non_finite;
 use super::fault::{
-    CovarianceRepair, EstimationError, FaultPolicy, RejectReason, UpdateOutcome, check_finite,
-    check_positive_definite, repair_covariance,
+    CovarianceRepair, EstimationError, FaultPolicy, UpdateOutcome, check_estimate,
+    repair_covariance,
 };
-use super::sigma::{
-    MeanFn, SigmaPoints, cross_covariance, first_bad_column, subtract, unscented_transform,
-    weighted_mean,
+use super::sigma::{MeanFn, SigmaPoints, subtract, weighted_mean};
+use super::ukf::UnscentedKalmanFilter;
+use super::unscented::{
+    SpaceFns, check_input, evaluate_points, innovation_moments, kalman_correct,
+    rejected_measurement,
 };
-use super::ukf::{UnscentedKalmanFilter, kalman_correct};
 use crate::model::{DiscreteModel, ParamError, Parametric};
 use nalgebra::{SMatrix, SVector};
 
@@ -141,6 +141,21 @@ impl<'a, M: Parametric, const NP: usize> ParametricDualModel<'a, M, NP> {
         Ok(w)
     }
 
+    /// `run(model, out)` with the model's parameters set to `w`; all `NaN` when the model refuses `w` (the
+    /// refusal is kept for [`DualModel::take_error`]).
+    fn at_parameters<const N: usize>(
+        &mut self,
+        w: &SVector<f64, NP>,
+        run: impl FnOnce(&M, &mut SVector<f64, N>),
+    ) -> SVector<f64, N> {
+        if !self.set(w) {
+            return SVector::repeat(f64::NAN);
+        }
+        let mut out = SVector::zeros();
+        run(self.model, &mut out);
+        out
+    }
+
     fn set(&mut self, w: &SVector<f64, NP>) -> bool {
         for (j, &index) in self.indices.iter().enumerate() {
             if let Err(e) = self.model.set_param(index, w[j]) {
@@ -163,12 +178,7 @@ where
         u: &SVector<f64, NU>,
         w: &SVector<f64, NP>,
     ) -> SVector<f64, NX> {
-        if !self.set(w) {
-            return SVector::repeat(f64::NAN);
-        }
-        let mut next = SVector::zeros();
-        self.model.step(x, u, &mut next);
-        next
+        self.at_parameters(w, |model, out| model.step(x, u, out))
     }
 
     fn observe(
@@ -177,12 +187,7 @@ where
         u: &SVector<f64, NU>,
         w: &SVector<f64, NP>,
     ) -> SVector<f64, NY> {
-        if !self.set(w) {
-            return SVector::repeat(f64::NAN);
-        }
-        let mut y = SVector::zeros();
-        self.model.outputs(x, u, &mut y);
-        y
+        self.at_parameters(w, |model, out| model.outputs(x, u, out))
     }
 
     fn commit(&mut self, w: &SVector<f64, NP>) -> Result<(), EstimationError> {
@@ -273,8 +278,7 @@ impl<
         pw0: SMatrix<f64, NP, NP>,
         forgetting: f64,
     ) -> Result<Self, EstimationError> {
-        check_finite("w0", &w0)?;
-        check_positive_definite("Pw0", &pw0)?;
+        check_estimate(("w0", "Pw0"), &w0, &pw0)?;
         if !(forgetting > 0.0 && forgetting <= 1.0) {
             return Err(EstimationError::InvalidSetting {
                 name: "lambda_RLS",
@@ -358,18 +362,13 @@ impl<
         u: &SVector<f64, NU>,
         y: &SVector<f64, NY>,
     ) -> Result<DualOutcome, EstimationError> {
-        if let Some(index) = first_non_finite(u) {
-            return Err(EstimationError::NonFiniteInput { index });
-        }
+        check_input(u)?;
         let mut st = self.state.clone();
         let x_prev = *st.state();
         let w_prior = self.w;
         let state_prediction_repair = st.predict(u, |x, u| model.propagate(x, u, &w_prior))?;
 
-        if let Some(index) = first_non_finite(y) {
-            let rejected = UpdateOutcome::Rejected {
-                reason: RejectReason::NonFiniteMeasurement { index },
-            };
+        if let Some(rejected) = rejected_measurement(y) {
             model.commit(&self.w)?;
             self.state = st;
             return Ok(DualOutcome {
@@ -387,32 +386,29 @@ impl<
         let mut pw = self.pw / self.forgetting;
         repair_covariance(&mut pw, self.param_policy.eigen_floor, FILTER)?;
         let wpts = self.param_points.generate(&w, &pw)?;
-        let mut ds = SMatrix::<f64, NY, NSP>::zeros();
-        for i in 0..NSP {
+        let ds = evaluate_points("model at a parameter sigma point", |i| {
             let wi: SVector<f64, NP> = wpts.column(i).into_owned();
             let xi = model.propagate(&x_prev, u, &wi);
-            ds.set_column(i, &model.observe(&xi, u, &wi));
-        }
-        if let Some(sigma_point) = first_bad_column(&ds) {
-            return Err(EstimationError::NonFiniteModelOutput {
-                function: "model at a parameter sigma point",
-                sigma_point,
-            });
-        }
+            model.observe(&xi, u, &wi)
+        })?;
         let y_residual = st.measurement_residual();
-        let wc = self.param_points.covariance_weights();
-        let (d_hat, mut sd) = unscented_transform(
-            &ds,
-            self.param_points.mean_weights(),
-            wc,
-            self.param_measurement_mean,
-            y_residual,
-        );
-        sd += match self.param_noise {
+        let d_fns = SpaceFns {
+            mean: self.param_measurement_mean,
+            residual: y_residual,
+        };
+        let observation_noise = match self.param_noise {
             ParameterObservationNoise::MeasurementNoise => *st.measurement_noise(),
             ParameterObservationNoise::StateInnovation => *st.innovation_covariance(),
         };
-        let pwd = cross_covariance(&wpts, &w, &ds, &d_hat, wc, subtract::<NP>, y_residual);
+        let (d_hat, sd, pwd) = innovation_moments(
+            &wpts,
+            &w,
+            subtract::<NP>,
+            &ds,
+            &d_fns,
+            Some(&observation_noise),
+            &self.param_points,
+        );
         let e = y_residual(y, &d_hat);
         let (parameters, _) =
             kalman_correct(&mut w, &mut pw, &e, &sd, &pwd, &self.param_policy, FILTER)?;

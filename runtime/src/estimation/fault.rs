@@ -19,7 +19,7 @@
 
 use super::dense::{all_finite, cholesky_lower, symmetric_eigen, symmetrise};
 use crate::model::ParamError;
-use nalgebra::SMatrix;
+use nalgebra::{SMatrix, SVector};
 
 /// Why a filter could not be built or could not take a step.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -252,6 +252,25 @@ pub(crate) fn check_positive_semidefinite<const N: usize>(
         });
     }
     Ok(())
+}
+
+/// Checks the noise covariances `Q` and `R` (positive semi-definite) of an additive-noise filter.
+pub(crate) fn check_additive_noise<const NX: usize, const NY: usize>(
+    q: &SMatrix<f64, NX, NX>,
+    r: &SMatrix<f64, NY, NY>,
+) -> Result<(), EstimationError> {
+    check_positive_semidefinite("Q", q)?;
+    check_positive_semidefinite("R", r)
+}
+
+/// Checks an estimate `(x, P)`: `x` finite, `P` positive definite; `names` are those of `x` and `P` in errors.
+pub(crate) fn check_estimate<const NX: usize>(
+    names: (&'static str, &'static str),
+    x: &SVector<f64, NX>,
+    p: &SMatrix<f64, NX, NX>,
+) -> Result<(), EstimationError> {
+    check_finite(names.0, x)?;
+    check_positive_definite(names.1, p)
 }
 
 fn is_symmetric<const N: usize>(m: &SMatrix<f64, N, N>) -> bool {

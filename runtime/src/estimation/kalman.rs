@@ -30,8 +30,9 @@
 
 use super::dense::{cholesky_lower, cholesky_solve, first_non_finite, symmetrise};
 use super::fault::{
-    CovarianceRepair, EstimationError, FaultPolicy, UpdateOutcome, check_finite,
-    check_positive_definite, check_positive_semidefinite, repair_covariance,
+    CovarianceRepair, EstimationError, FaultPolicy, UpdateOutcome, check_additive_noise,
+    check_estimate, check_finite, check_positive_definite, check_positive_semidefinite,
+    repair_covariance,
 };
 use crate::statespace::StateSpace;
 use nalgebra::{DMatrix, SMatrix, SVector};
@@ -108,10 +109,8 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         p0: SMatrix<f64, NX, NX>,
     ) -> Result<Self, EstimationError> {
         model.validate()?;
-        check_positive_semidefinite("Q", &q)?;
-        check_positive_semidefinite("R", &r)?;
-        check_finite("x0", &x0)?;
-        check_positive_definite("P0", &p0)?;
+        check_additive_noise(&q, &r)?;
+        check_estimate(("x0", "P0"), &x0, &p0)?;
         Ok(KalmanFilter {
             model,
             q,
@@ -155,8 +154,7 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         x: SVector<f64, NX>,
         p: SMatrix<f64, NX, NX>,
     ) -> Result<(), EstimationError> {
-        check_finite("x", &x)?;
-        check_positive_definite("P", &p)?;
+        check_estimate(("x", "P"), &x, &p)?;
         self.x = x;
         self.p = p;
         Ok(())

@@ -22,11 +22,13 @@ use super::dense::{
     solve_lower, solve_upper_transposed,
 };
 use super::fault::{
-    CovarianceRepair, EstimationError, FaultPolicy, RejectReason, UpdateOutcome, check_finite,
-    check_positive_definite, check_positive_semidefinite, repair_covariance,
+    CovarianceRepair, EstimationError, FaultPolicy, UpdateOutcome, check_additive_noise,
+    check_estimate, repair_covariance,
 };
-use super::sigma::{
-    MeanFn, ResidualFn, SigmaPoints, cross_covariance, first_bad_column, subtract, weighted_mean,
+use super::sigma::{MeanFn, ResidualFn, SigmaPoints, cross_covariance};
+use super::unscented::{
+    SpaceFns, check_input, check_state_mean, evaluate_points, model_measurement, model_process,
+    rejected_measurement,
 };
 use crate::model::DiscreteModel;
 use nalgebra::{SMatrix, SVector};
@@ -41,10 +43,8 @@ pub struct SquareRootUkf<const NX: usize, const NU: usize, const NY: usize, cons
     s: SMatrix<f64, NX, NX>,
     sqrt_q: SMatrix<f64, NX, NX>,
     sqrt_r: SMatrix<f64, NY, NY>,
-    x_mean: MeanFn<NX, NS>,
-    x_residual: ResidualFn<NX>,
-    y_mean: MeanFn<NY, NS>,
-    y_residual: ResidualFn<NY>,
+    x_fns: SpaceFns<NX, NS>,
+    y_fns: SpaceFns<NY, NS>,
     policy: FaultPolicy,
     innovation: SVector<f64, NY>,
     sqrt_innovation_cov: SMatrix<f64, NY, NY>,
@@ -61,10 +61,8 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         x0: SVector<f64, NX>,
         p0: SMatrix<f64, NX, NX>,
     ) -> Result<Self, EstimationError> {
-        check_positive_semidefinite("Q", &q)?;
-        check_positive_semidefinite("R", &r)?;
-        check_finite("x0", &x0)?;
-        check_positive_definite("P0", &p0)?;
+        check_additive_noise(&q, &r)?;
+        check_estimate(("x0", "P0"), &x0, &p0)?;
         let not_pd = |name| EstimationError::NotPositiveDefinite {
             name,
             kind: "definite",
@@ -75,10 +73,8 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
             s: cholesky_lower(&p0).ok_or(not_pd("P0"))?,
             sqrt_q: cholesky_psd(&q).ok_or(not_pd("Q"))?,
             sqrt_r: cholesky_psd(&r).ok_or(not_pd("R"))?,
-            x_mean: weighted_mean::<NX, NS>,
-            x_residual: subtract::<NX>,
-            y_mean: weighted_mean::<NY, NS>,
-            y_residual: subtract::<NY>,
+            x_fns: SpaceFns::default(),
+            y_fns: SpaceFns::default(),
             policy: FaultPolicy::default(),
             innovation: SVector::zeros(),
             sqrt_innovation_cov: SMatrix::zeros(),
@@ -87,8 +83,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
 
     /// Replaces the state mean and residual functions.
     pub fn with_state_functions(mut self, mean: MeanFn<NX, NS>, residual: ResidualFn<NX>) -> Self {
-        self.x_mean = mean;
-        self.x_residual = residual;
+        self.x_fns = SpaceFns { mean, residual };
         self
     }
 
@@ -98,8 +93,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         mean: MeanFn<NY, NS>,
         residual: ResidualFn<NY>,
     ) -> Self {
-        self.y_mean = mean;
-        self.y_residual = residual;
+        self.y_fns = SpaceFns { mean, residual };
         self
     }
 
@@ -119,28 +113,12 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
     where
         F: FnMut(&SVector<f64, NX>, &SVector<f64, NU>) -> SVector<f64, NX>,
     {
-        if let Some(index) = first_non_finite(u) {
-            return Err(EstimationError::NonFiniteInput { index });
-        }
+        check_input(u)?;
         let chi = self.points.generate_from_factor(&self.x, &self.s);
-        let mut prop = SMatrix::<f64, NX, NS>::zeros();
-        for i in 0..NS {
-            prop.set_column(i, &f(&chi.column(i).into_owned(), u));
-        }
-        if let Some(sigma_point) = first_bad_column(&prop) {
-            return Err(EstimationError::NonFiniteModelOutput {
-                function: "process function",
-                sigma_point,
-            });
-        }
-        let x = (self.x_mean)(&prop, self.points.mean_weights());
-        if first_non_finite(&x).is_some() {
-            return Err(EstimationError::NonFiniteModelOutput {
-                function: "state mean function",
-                sigma_point: 0,
-            });
-        }
-        let (s, repair) = self.factor_of_spread(&prop, &x, &self.sqrt_q, self.x_residual)?;
+        let prop = evaluate_points("process function", |i| f(&chi.column(i).into_owned(), u))?;
+        let x = (self.x_fns.mean)(&prop, self.points.mean_weights());
+        check_state_mean(&x)?;
+        let (s, repair) = self.factor_of_spread(&prop, &x, &self.sqrt_q, self.x_fns.residual)?;
         self.x = x;
         self.s = s;
         Ok(repair)
@@ -156,29 +134,18 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
     where
         H: FnMut(&SVector<f64, NX>, &SVector<f64, NU>) -> SVector<f64, NY>,
     {
-        if let Some(index) = first_non_finite(y) {
-            return Ok(UpdateOutcome::Rejected {
-                reason: RejectReason::NonFiniteMeasurement { index },
-            });
+        if let Some(rejected) = rejected_measurement(y) {
+            return Ok(rejected);
         }
-        if let Some(index) = first_non_finite(u) {
-            return Err(EstimationError::NonFiniteInput { index });
-        }
+        check_input(u)?;
         let chi = self.points.generate_from_factor(&self.x, &self.s);
-        let mut ys = SMatrix::<f64, NY, NS>::zeros();
-        for i in 0..NS {
-            ys.set_column(i, &h(&chi.column(i).into_owned(), u));
-        }
-        if let Some(sigma_point) = first_bad_column(&ys) {
-            return Err(EstimationError::NonFiniteModelOutput {
-                function: "measurement function",
-                sigma_point,
-            });
-        }
-        let y_hat = (self.y_mean)(&ys, self.points.mean_weights());
+        let ys = evaluate_points("measurement function", |i| {
+            h(&chi.column(i).into_owned(), u)
+        })?;
+        let y_hat = (self.y_fns.mean)(&ys, self.points.mean_weights());
         let singular = EstimationError::SingularInnovation { filter: FILTER };
         let (sy, _) = self
-            .factor_of_spread(&ys, &y_hat, &self.sqrt_r, self.y_residual)
+            .factor_of_spread(&ys, &y_hat, &self.sqrt_r, self.y_fns.residual)
             .map_err(|_| singular.clone())?;
         if (0..NY).any(|i| sy[(i, i)] <= 0.0) {
             return Err(singular);
@@ -189,10 +156,10 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
             &ys,
             &y_hat,
             self.points.covariance_weights(),
-            self.x_residual,
-            self.y_residual,
+            self.x_fns.residual,
+            self.y_fns.residual,
         );
-        let e = (self.y_residual)(y, &y_hat);
+        let e = (self.y_fns.residual)(y, &y_hat);
         let whitened = solve_lower(&sy, &e).ok_or(singular.clone())?;
         let nis = whitened.norm_squared();
         self.innovation = e;
@@ -238,11 +205,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         model: &M,
         u: &SVector<f64, NU>,
     ) -> Result<Option<CovarianceRepair>, EstimationError> {
-        self.predict(u, |x, u| {
-            let mut next = SVector::zeros();
-            model.step(x, u, &mut next);
-            next
-        })
+        self.predict(u, model_process(model))
     }
 
     /// [`Self::update`] with a [`DiscreteModel`]'s `outputs` as the measurement function.
@@ -252,11 +215,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         y: &SVector<f64, NY>,
         u: &SVector<f64, NU>,
     ) -> Result<UpdateOutcome, EstimationError> {
-        self.update(y, u, |x, u| {
-            let mut out = SVector::zeros();
-            model.outputs(x, u, &mut out);
-            out
-        })
+        self.update(y, u, model_measurement(model))
     }
 
     /// The lower factor of `Σ W⁽ᶜ⁾ rᵢ rᵢᵀ + noise noiseᵀ` for residuals `rᵢ = residual(pointsᵢ, mean)`.

@@ -23,14 +23,15 @@
 //! Every step works on copies and commits at the end: a step that returns an error leaves the filter
 //! unchanged. Steps do not allocate.
 
-use super::dense::{cholesky_lower, cholesky_solve, first_non_finite, symmetrise};
+use super::dense::symmetrise;
 use super::fault::{
-    CovarianceRepair, EstimationError, FaultPolicy, RejectReason, UpdateOutcome, check_finite,
-    check_positive_definite, check_positive_semidefinite, repair_covariance,
+    CovarianceRepair, EstimationError, FaultPolicy, UpdateOutcome, check_additive_noise,
+    check_estimate,
 };
-use super::sigma::{
-    MeanFn, ResidualFn, SigmaPoints, cross_covariance, first_bad_column, subtract,
-    unscented_transform, weighted_mean,
+use super::sigma::{MeanFn, ResidualFn, SigmaPoints};
+use super::unscented::{
+    SpaceFns, check_input, evaluate_points, innovation_moments, kalman_correct, model_measurement,
+    model_process, predicted_moments, rejected_measurement,
 };
 use crate::model::DiscreteModel;
 use nalgebra::{SMatrix, SVector};
@@ -46,10 +47,8 @@ pub struct UnscentedKalmanFilter<const NX: usize, const NU: usize, const NY: usi
     p: SMatrix<f64, NX, NX>,
     q: SMatrix<f64, NX, NX>,
     r: SMatrix<f64, NY, NY>,
-    x_mean: MeanFn<NX, NS>,
-    x_residual: ResidualFn<NX>,
-    y_mean: MeanFn<NY, NS>,
-    y_residual: ResidualFn<NY>,
+    x_fns: SpaceFns<NX, NS>,
+    y_fns: SpaceFns<NY, NS>,
     policy: FaultPolicy,
     innovation: SVector<f64, NY>,
     innovation_cov: SMatrix<f64, NY, NY>,
@@ -69,20 +68,16 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         x0: SVector<f64, NX>,
         p0: SMatrix<f64, NX, NX>,
     ) -> Result<Self, EstimationError> {
-        check_positive_semidefinite("Q", &q)?;
-        check_positive_semidefinite("R", &r)?;
-        check_finite("x0", &x0)?;
-        check_positive_definite("P0", &p0)?;
+        check_additive_noise(&q, &r)?;
+        check_estimate(("x0", "P0"), &x0, &p0)?;
         Ok(UnscentedKalmanFilter {
             points,
             x: x0,
             p: p0,
             q,
             r,
-            x_mean: weighted_mean::<NX, NS>,
-            x_residual: subtract::<NX>,
-            y_mean: weighted_mean::<NY, NS>,
-            y_residual: subtract::<NY>,
+            x_fns: SpaceFns::default(),
+            y_fns: SpaceFns::default(),
             policy: FaultPolicy::default(),
             innovation: SVector::zeros(),
             innovation_cov: r,
@@ -92,8 +87,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
 
     /// Replaces the state mean and residual functions (for angle states).
     pub fn with_state_functions(mut self, mean: MeanFn<NX, NS>, residual: ResidualFn<NX>) -> Self {
-        self.x_mean = mean;
-        self.x_residual = residual;
+        self.x_fns = SpaceFns { mean, residual };
         self
     }
 
@@ -103,8 +97,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         mean: MeanFn<NY, NS>,
         residual: ResidualFn<NY>,
     ) -> Self {
-        self.y_mean = mean;
-        self.y_residual = residual;
+        self.y_fns = SpaceFns { mean, residual };
         self
     }
 
@@ -121,8 +114,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         q: SMatrix<f64, NX, NX>,
         r: SMatrix<f64, NY, NY>,
     ) -> Result<(), EstimationError> {
-        check_positive_semidefinite("Q", &q)?;
-        check_positive_semidefinite("R", &r)?;
+        check_additive_noise(&q, &r)?;
         self.q = q;
         self.r = r;
         Ok(())
@@ -134,8 +126,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         x: SVector<f64, NX>,
         p: SMatrix<f64, NX, NX>,
     ) -> Result<(), EstimationError> {
-        check_finite("x", &x)?;
-        check_positive_definite("P", &p)?;
+        check_estimate(("x", "P"), &x, &p)?;
         self.x = x;
         self.p = p;
         Ok(())
@@ -150,35 +141,17 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
     where
         F: FnMut(&SVector<f64, NX>, &SVector<f64, NU>) -> SVector<f64, NX>,
     {
-        if let Some(index) = first_non_finite(u) {
-            return Err(EstimationError::NonFiniteInput { index });
-        }
+        check_input(u)?;
         let chi = self.points.generate(&self.x, &self.p)?;
-        let mut prop = SMatrix::<f64, NX, NS>::zeros();
-        for i in 0..NS {
-            prop.set_column(i, &f(&chi.column(i).into_owned(), u));
-        }
-        if let Some(sigma_point) = first_bad_column(&prop) {
-            return Err(EstimationError::NonFiniteModelOutput {
-                function: "process function",
-                sigma_point,
-            });
-        }
-        let (x, mut p) = unscented_transform(
+        let prop = evaluate_points("process function", |i| f(&chi.column(i).into_owned(), u))?;
+        let (x, p, repair) = predicted_moments(
             &prop,
-            self.points.mean_weights(),
-            self.points.covariance_weights(),
-            self.x_mean,
-            self.x_residual,
-        );
-        p += self.q;
-        let repair = repair_covariance(&mut p, self.policy.eigen_floor, FILTER)?;
-        if first_non_finite(&x).is_some() {
-            return Err(EstimationError::NonFiniteModelOutput {
-                function: "state mean function",
-                sigma_point: 0,
-            });
-        }
+            &self.points,
+            &self.x_fns,
+            Some(&self.q),
+            &self.policy,
+            FILTER,
+        )?;
         self.x = x;
         self.p = p;
         Ok(repair)
@@ -194,45 +167,25 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
     where
         H: FnMut(&SVector<f64, NX>, &SVector<f64, NU>) -> SVector<f64, NY>,
     {
-        if let Some(index) = first_non_finite(y) {
-            return Ok(UpdateOutcome::Rejected {
-                reason: RejectReason::NonFiniteMeasurement { index },
-            });
+        if let Some(rejected) = rejected_measurement(y) {
+            return Ok(rejected);
         }
-        if let Some(index) = first_non_finite(u) {
-            return Err(EstimationError::NonFiniteInput { index });
-        }
+        check_input(u)?;
         let chi = self.points.generate(&self.x, &self.p)?;
-        let mut ys = SMatrix::<f64, NY, NS>::zeros();
-        for i in 0..NS {
-            ys.set_column(i, &h(&chi.column(i).into_owned(), u));
-        }
-        if let Some(sigma_point) = first_bad_column(&ys) {
-            return Err(EstimationError::NonFiniteModelOutput {
-                function: "measurement function",
-                sigma_point,
-            });
-        }
-        let wc = self.points.covariance_weights();
-        let (y_hat, mut s) = unscented_transform(
-            &ys,
-            self.points.mean_weights(),
-            wc,
-            self.y_mean,
-            self.y_residual,
-        );
-        s += self.r;
-        symmetrise(&mut s);
-        let pxy = cross_covariance(
+        let ys = evaluate_points("measurement function", |i| {
+            h(&chi.column(i).into_owned(), u)
+        })?;
+        let (y_hat, mut s, pxy) = innovation_moments(
             &chi,
             &self.x,
+            self.x_fns.residual,
             &ys,
-            &y_hat,
-            wc,
-            self.x_residual,
-            self.y_residual,
+            &self.y_fns,
+            Some(&self.r),
+            &self.points,
         );
-        let e = (self.y_residual)(y, &y_hat);
+        symmetrise(&mut s);
+        let e = (self.y_fns.residual)(y, &y_hat);
         let outcome = kalman_correct(&mut self.x, &mut self.p, &e, &s, &pxy, &self.policy, FILTER)?;
         self.innovation = e;
         self.innovation_cov = s;
@@ -248,11 +201,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         model: &M,
         u: &SVector<f64, NU>,
     ) -> Result<Option<CovarianceRepair>, EstimationError> {
-        self.predict(u, |x, u| {
-            let mut next = SVector::zeros();
-            model.step(x, u, &mut next);
-            next
-        })
+        self.predict(u, model_process(model))
     }
 
     /// [`Self::update`] with a [`DiscreteModel`]'s `outputs` as the measurement function.
@@ -262,11 +211,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         y: &SVector<f64, NY>,
         u: &SVector<f64, NU>,
     ) -> Result<UpdateOutcome, EstimationError> {
-        self.update(y, u, |x, u| {
-            let mut out = SVector::zeros();
-            model.outputs(x, u, &mut out);
-            out
-        })
+        self.update(y, u, model_measurement(model))
     }
 
     /// The state estimate.
@@ -306,43 +251,11 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
 
     /// The measurement residual function.
     pub(crate) fn measurement_residual(&self) -> ResidualFn<NY> {
-        self.y_residual
+        self.y_fns.residual
     }
 
     /// The sigma-point weights in use.
     pub fn sigma_points(&self) -> &SigmaPoints<NX, NS> {
         &self.points
     }
-}
-
-/// The Kalman correction shared by the unscented filters: NIS and gate, `K = P_xy S⁻¹`, `x += K e`,
-/// `P −= K S Kᵀ`, repair. `x` and `p` change only when the measurement is accepted and no error occurs.
-pub(crate) fn kalman_correct<const N: usize, const M: usize>(
-    x: &mut SVector<f64, N>,
-    p: &mut SMatrix<f64, N, N>,
-    e: &SVector<f64, M>,
-    s: &SMatrix<f64, M, M>,
-    pxy: &SMatrix<f64, N, M>,
-    policy: &FaultPolicy,
-    filter: &'static str,
-) -> Result<(UpdateOutcome, Option<SMatrix<f64, N, M>>), EstimationError> {
-    let singular = EstimationError::SingularInnovation { filter };
-    let ls = cholesky_lower(s).ok_or(singular.clone())?;
-    let nis = e.dot(&cholesky_solve(&ls, e).ok_or(singular.clone())?);
-    if let Some(reason) = policy.gate(nis) {
-        return Ok((UpdateOutcome::Rejected { reason }, None));
-    }
-    // K = P_xy S⁻¹  ⇔  Kᵀ = S⁻¹ P_xyᵀ.
-    let k = cholesky_solve(&ls, &pxy.transpose())
-        .ok_or(singular)?
-        .transpose();
-    let new_x = *x + k * e;
-    let mut new_p = *p - k * s * k.transpose();
-    let repair = repair_covariance(&mut new_p, policy.eigen_floor, filter)?;
-    if first_non_finite(&new_x).is_some() {
-        return Err(EstimationError::NonFiniteCovariance { filter });
-    }
-    *x = new_x;
-    *p = new_p;
-    Ok((UpdateOutcome::Accepted { nis, repair }, Some(k)))
 }

@@ -15,16 +15,16 @@
 //! `NA` and `NS` are const parameters because stable Rust cannot compute them; wrong values are compile
 //! errors.
 
-use super::dense::{first_non_finite, symmetrise};
+use super::dense::symmetrise;
 use super::fault::{
-    CovarianceRepair, EstimationError, FaultPolicy, RejectReason, UpdateOutcome, check_finite,
-    check_positive_definite, repair_covariance,
+    CovarianceRepair, EstimationError, FaultPolicy, UpdateOutcome, check_estimate,
+    check_positive_definite,
 };
-use super::sigma::{
-    MeanFn, ResidualFn, SigmaPoints, cross_covariance, first_bad_column, subtract,
-    unscented_transform, weighted_mean,
+use super::sigma::{MeanFn, ResidualFn, SigmaPoints};
+use super::unscented::{
+    SpaceFns, check_input, evaluate_points, innovation_moments, kalman_correct, predicted_moments,
+    rejected_measurement,
 };
-use super::ukf::kalman_correct;
 use nalgebra::{SMatrix, SVector};
 
 const FILTER: &str = "augmented UKF";
@@ -50,10 +50,8 @@ pub struct AugmentedUkf<
     /// Measurement-noise parts of the last predict's points.
     meas_noise: SMatrix<f64, NN, NS>,
     fresh: bool,
-    x_mean: MeanFn<NX, NS>,
-    x_residual: ResidualFn<NX>,
-    y_mean: MeanFn<NY, NS>,
-    y_residual: ResidualFn<NY>,
+    x_fns: SpaceFns<NX, NS>,
+    y_fns: SpaceFns<NY, NS>,
     policy: FaultPolicy,
     innovation: SVector<f64, NY>,
     innovation_cov: SMatrix<f64, NY, NY>,
@@ -84,8 +82,7 @@ impl<
         let () = Self::SIZE_CHECK;
         check_positive_definite("Q", &q)?;
         check_positive_definite("R", &r)?;
-        check_finite("x0", &x0)?;
-        check_positive_definite("P0", &p0)?;
+        check_estimate(("x0", "P0"), &x0, &p0)?;
         Ok(AugmentedUkf {
             points,
             x: x0,
@@ -95,10 +92,8 @@ impl<
             propagated: SMatrix::zeros(),
             meas_noise: SMatrix::zeros(),
             fresh: false,
-            x_mean: weighted_mean::<NX, NS>,
-            x_residual: subtract::<NX>,
-            y_mean: weighted_mean::<NY, NS>,
-            y_residual: subtract::<NY>,
+            x_fns: SpaceFns::default(),
+            y_fns: SpaceFns::default(),
             policy: FaultPolicy::default(),
             innovation: SVector::zeros(),
             innovation_cov: SMatrix::zeros(),
@@ -107,8 +102,7 @@ impl<
 
     /// Replaces the state mean and residual functions.
     pub fn with_state_functions(mut self, mean: MeanFn<NX, NS>, residual: ResidualFn<NX>) -> Self {
-        self.x_mean = mean;
-        self.x_residual = residual;
+        self.x_fns = SpaceFns { mean, residual };
         self
     }
 
@@ -118,8 +112,7 @@ impl<
         mean: MeanFn<NY, NS>,
         residual: ResidualFn<NY>,
     ) -> Self {
-        self.y_mean = mean;
-        self.y_residual = residual;
+        self.y_fns = SpaceFns { mean, residual };
         self
     }
 
@@ -150,39 +143,17 @@ impl<
     where
         F: FnMut(&SVector<f64, NX>, &SVector<f64, NU>, &SVector<f64, NV>) -> SVector<f64, NX>,
     {
-        if let Some(index) = first_non_finite(u) {
-            return Err(EstimationError::NonFiniteInput { index });
-        }
+        check_input(u)?;
         let chi = self.augmented_points()?;
-        let mut prop = SMatrix::<f64, NX, NS>::zeros();
-        let mut noise = SMatrix::<f64, NN, NS>::zeros();
-        for i in 0..NS {
+        let prop = evaluate_points("process function", |i| {
             let c = chi.column(i);
             let xs: SVector<f64, NX> = c.fixed_rows::<NX>(0).into_owned();
             let vs: SVector<f64, NV> = c.fixed_rows::<NV>(NX).into_owned();
-            prop.set_column(i, &f(&xs, u, &vs));
-            noise.set_column(i, &c.fixed_rows::<NN>(NX + NV));
-        }
-        if let Some(sigma_point) = first_bad_column(&prop) {
-            return Err(EstimationError::NonFiniteModelOutput {
-                function: "process function",
-                sigma_point,
-            });
-        }
-        let (x, mut p) = unscented_transform(
-            &prop,
-            self.points.mean_weights(),
-            self.points.covariance_weights(),
-            self.x_mean,
-            self.x_residual,
-        );
-        let repair = repair_covariance(&mut p, self.policy.eigen_floor, FILTER)?;
-        if first_non_finite(&x).is_some() {
-            return Err(EstimationError::NonFiniteModelOutput {
-                function: "state mean function",
-                sigma_point: 0,
-            });
-        }
+            f(&xs, u, &vs)
+        })?;
+        let noise: SMatrix<f64, NN, NS> = chi.fixed_rows::<NN>(NX + NV).into_owned();
+        let (x, p, repair) =
+            predicted_moments(&prop, &self.points, &self.x_fns, None, &self.policy, FILTER)?;
         self.x = x;
         self.p = p;
         self.propagated = prop;
@@ -201,15 +172,11 @@ impl<
     where
         H: FnMut(&SVector<f64, NX>, &SVector<f64, NU>, &SVector<f64, NN>) -> SVector<f64, NY>,
     {
-        if let Some(index) = first_non_finite(y) {
+        if let Some(rejected) = rejected_measurement(y) {
             self.fresh = false;
-            return Ok(UpdateOutcome::Rejected {
-                reason: RejectReason::NonFiniteMeasurement { index },
-            });
+            return Ok(rejected);
         }
-        if let Some(index) = first_non_finite(u) {
-            return Err(EstimationError::NonFiniteInput { index });
-        }
+        check_input(u)?;
         let (xs, ns) = if self.fresh {
             (self.propagated, self.meas_noise)
         } else {
@@ -219,37 +186,22 @@ impl<
                 chi.fixed_rows::<NN>(NX + NV).into_owned(),
             )
         };
-        let mut ys = SMatrix::<f64, NY, NS>::zeros();
-        for i in 0..NS {
+        let ys = evaluate_points("measurement function", |i| {
             let xi: SVector<f64, NX> = xs.column(i).into_owned();
             let ni: SVector<f64, NN> = ns.column(i).into_owned();
-            ys.set_column(i, &h(&xi, u, &ni));
-        }
-        if let Some(sigma_point) = first_bad_column(&ys) {
-            return Err(EstimationError::NonFiniteModelOutput {
-                function: "measurement function",
-                sigma_point,
-            });
-        }
-        let wc = self.points.covariance_weights();
-        let (y_hat, mut s) = unscented_transform(
-            &ys,
-            self.points.mean_weights(),
-            wc,
-            self.y_mean,
-            self.y_residual,
-        );
-        symmetrise(&mut s);
-        let pxy = cross_covariance(
+            h(&xi, u, &ni)
+        })?;
+        let (y_hat, mut s, pxy) = innovation_moments(
             &xs,
             &self.x,
+            self.x_fns.residual,
             &ys,
-            &y_hat,
-            wc,
-            self.x_residual,
-            self.y_residual,
+            &self.y_fns,
+            None,
+            &self.points,
         );
-        let e = (self.y_residual)(y, &y_hat);
+        symmetrise(&mut s);
+        let e = (self.y_fns.residual)(y, &y_hat);
         let (outcome, _) =
             kalman_correct(&mut self.x, &mut self.p, &e, &s, &pxy, &self.policy, FILTER)?;
         self.innovation = e;

@@ -10,14 +10,15 @@
 //! least-squares solution of `[W₁₂; W₂₂ + I] X = −[W₁₁ + I; W₂₁]`; then Newton–Kleinman refinement in correction
 //! form: `(Ã − GX)ᵀ Δ + Δ (Ã − GX) + Res(X) = 0`, `X ← X + Δ`, until the residual stops decreasing. The final
 //! relative residual `‖Res(X)‖ / (‖ÃᵀX‖ + ‖XÃ‖ + ‖XGX‖ + ‖Q̃‖)` (Frobenius norms, original coordinates) must
-//! be below [`RICCATI_TOLERANCE`] and `A − BK` must be stable, else an error is returned.
+//! be below [`super::riccati::RICCATI_TOLERANCE`] and `A − BK` must be stable, else an error is returned.
 
 use nalgebra::DMatrix;
 
 use super::lyapunov::{lyap, symmetrize};
 use super::pbh::Domain;
-use super::riccati::{Problem, RICCATI_TOLERANCE, Riccati, RiccatiError, Scaled, finite_solution};
-use super::schur::eigenvalues;
+use super::riccati::{
+    Problem, Riccati, RiccatiError, Scaled, finite_solution, stabilising_solution,
+};
 use super::sign::hamiltonian_sign;
 
 /// Newton–Kleinman steps at most.
@@ -101,25 +102,9 @@ pub fn care_with_cross(
     finite_solution(&x, sign_iterations + steps)?;
     let g = p.g();
     let rel_orig = relative(&residual(&p.a, &g, &p.q, &x), &p.a, &g, &p.q, &x);
-    if rel_orig.is_nan() || rel_orig > RICCATI_TOLERANCE {
-        return Err(p.diagnose(Domain::Continuous, rel_orig, sign_iterations + steps));
-    }
+    p.check_residual(Domain::Continuous, rel_orig, sign_iterations + steps)?;
     let k = &p.r_inv * (p.b.transpose() * &x + &p.n_t);
-    let closed_loop_eigenvalues = eigenvalues(&(a - b * &k))?;
-    // A stabilising X puts the closed loop clearly inside; only rounding-level margins are tolerated here.
-    if let Some(&eigenvalue) = closed_loop_eigenvalues
-        .iter()
-        .find(|l| !Domain::Continuous.is_stable(**l, 0.0))
-    {
-        return Err(RiccatiError::ClosedLoopUnstable { eigenvalue });
-    }
-    Ok(Riccati {
-        x,
-        k,
-        closed_loop_eigenvalues,
-        relative_residual: rel_orig,
-        refinement_steps: steps,
-    })
+    stabilising_solution(Domain::Continuous, a, b, x, k, rel_orig, steps)
 }
 
 /// `AᵀX + XA − XGX + Q`.

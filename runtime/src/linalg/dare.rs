@@ -13,15 +13,16 @@
 //!
 //! where `Hₖ → X` quadratically; then Hewer's (Newton's) refinement in correction form
 //! `(Ã − BK)ᵀ Δ (Ã − BK) − Δ + Res(X) = 0`, `X ← X + Δ`, while the residual decreases. The relative residual
-//! `‖Res(X)‖ / (‖ÃᵀXÃ‖ + ‖X‖ + ‖ÃᵀXB(R + BᵀXB)⁻¹BᵀXÃ‖ + ‖Q̃‖)` must be below [`RICCATI_TOLERANCE`] and
+//! `‖Res(X)‖ / (‖ÃᵀXÃ‖ + ‖X‖ + ‖ÃᵀXB(R + BᵀXB)⁻¹BᵀXÃ‖ + ‖Q̃‖)` must be below [`super::riccati::RICCATI_TOLERANCE`] and
 //! `A − BK` stable, else an error is returned.
 
 use nalgebra::DMatrix;
 
 use super::lyapunov::{dlyap, symmetrize};
 use super::pbh::Domain;
-use super::riccati::{Problem, RICCATI_TOLERANCE, Riccati, RiccatiError, Scaled, finite_solution};
-use super::schur::eigenvalues;
+use super::riccati::{
+    Problem, Riccati, RiccatiError, Scaled, finite_solution, stabilising_solution,
+};
 
 /// Doubling steps at most (each squares the convergence factor).
 const MAX_DOUBLING_STEPS: usize = 100;
@@ -109,29 +110,14 @@ pub fn dare_with_cross(
     let Some(orig) = Evaluation::new(&p.a, &p.b, &p.q, &p.r, &x) else {
         return Err(RiccatiError::Singular { what: "R + BᵀXB" });
     };
-    if orig.relative.is_nan() || orig.relative > RICCATI_TOLERANCE {
-        return Err(p.diagnose(Domain::Discrete, orig.relative, doubling + steps));
-    }
+    p.check_residual(Domain::Discrete, orig.relative, doubling + steps)?;
     // K for the original (cross-weighted) problem: (R + BᵀXB)⁻¹(BᵀXA + Nᵀ).
     let btx = p.b.transpose() * &x;
     let k = (&p.r + &btx * &p.b)
         .lu()
         .solve(&(&btx * a + &p.n_t))
         .ok_or(RiccatiError::Singular { what: "R + BᵀXB" })?;
-    let closed_loop_eigenvalues = eigenvalues(&(a - b * &k))?;
-    if let Some(&eigenvalue) = closed_loop_eigenvalues
-        .iter()
-        .find(|l| !Domain::Discrete.is_stable(**l, 0.0))
-    {
-        return Err(RiccatiError::ClosedLoopUnstable { eigenvalue });
-    }
-    Ok(Riccati {
-        x,
-        k,
-        closed_loop_eigenvalues,
-        relative_residual: orig.relative,
-        refinement_steps: steps,
-    })
+    stabilising_solution(Domain::Discrete, a, b, x, k, orig.relative, steps)
 }
 
 /// The DARE residual at `X` with the gain `K = (R + BᵀXB)⁻¹BᵀXA` of the problem without cross term.

@@ -17,7 +17,7 @@ use super::balance::power_of_two;
 use super::check::{self, MatrixError};
 use super::lyapunov::LyapunovError;
 use super::pbh::{self, Domain, PbhError};
-use super::schur::SchurError;
+use super::schur::{SchurError, eigenvalues};
 
 /// The largest state dimension the Riccati solvers accept. The cost is dominated by `O(n⁴)` parts: the PBH
 /// checks (one SVD of an `(n + m) x n` complex matrix per eigenvalue) and the Lyapunov solves of the Newton
@@ -226,6 +226,20 @@ impl Problem {
         (self.n <= DIRECTION_MAX_ORDER).then_some(v)
     }
 
+    /// Refuses a solution whose relative residual in the original coordinates is NaN or above
+    /// [`RICCATI_TOLERANCE`], with the diagnosis of [`Self::diagnose`].
+    pub fn check_residual(
+        &self,
+        domain: Domain,
+        relative_residual: f64,
+        iterations: usize,
+    ) -> Result<(), RiccatiError> {
+        if relative_residual.is_nan() || relative_residual > RICCATI_TOLERANCE {
+            return Err(self.diagnose(domain, relative_residual, iterations));
+        }
+        Ok(())
+    }
+
     /// After a failed solve: names the least controllable or least observable mode on or near the stability
     /// boundary (within `10⁴` times the margin of the precondition check, as a defective eigenvalue is only
     /// computed to about `√ε`) when it is nearly rank deficient (PBH margin below `1e-6`), else reports
@@ -369,6 +383,33 @@ fn hamiltonian_scales(a: &DMatrix<f64>, g: &DMatrix<f64>, q: &DMatrix<f64>) -> D
         }
     }
     d
+}
+
+/// The solution `x` with gain `k` as a [`Riccati`], once every eigenvalue of `A − BK` is stable in `domain`.
+pub(crate) fn stabilising_solution(
+    domain: Domain,
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    x: DMatrix<f64>,
+    k: DMatrix<f64>,
+    relative_residual: f64,
+    refinement_steps: usize,
+) -> Result<Riccati, RiccatiError> {
+    let closed_loop_eigenvalues = eigenvalues(&(a - b * &k))?;
+    // A stabilising X puts the closed loop clearly inside; only rounding-level margins are tolerated here.
+    if let Some(&eigenvalue) = closed_loop_eigenvalues
+        .iter()
+        .find(|l| !domain.is_stable(**l, 0.0))
+    {
+        return Err(RiccatiError::ClosedLoopUnstable { eigenvalue });
+    }
+    Ok(Riccati {
+        x,
+        k,
+        closed_loop_eigenvalues,
+        relative_residual,
+        refinement_steps,
+    })
 }
 
 /// Refuses a solution with non-finite entries.

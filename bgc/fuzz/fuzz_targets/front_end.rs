@@ -1,4 +1,4 @@
-//! Any bytes through decode → parse → lower → causality: nothing may panic, hang or overflow the stack, and every
+//! Any bytes through decode → parse → lower → causality → equations: nothing may panic, hang or overflow the stack, and every
 //! error must be located inside the text.
 #![no_main]
 
@@ -29,7 +29,13 @@ fuzz_target!(|data: &[u8]| {
             }
         }
     }
+    if bgc::diagnostic::has_errors(&diags) {
+        return;
+    }
     for m in &models {
-        let _ = bgc::causality::analyse(m);
+        let (causality, causal_diags) = bgc::causality::analyse(m);
+        if !bgc::diagnostic::has_errors(&causal_diags) {
+            let _ = bgc::equations::derive(m, &causality);
+        }
     }
 });

@@ -108,3 +108,45 @@ fn back_support_declared_entries_by_hand() {
     assert!(rel(a[(3, 0)], p.k_g / (p.r_g * p.J_sint)), "{}", a[(3, 0)]);
     assert!(rel(a[(3, 2)], -(p.k_g + p.k_s) / p.J_sint), "{}", a[(3, 2)]);
 }
+
+#[path = "support/eq3.rs"]
+mod eq3;
+
+/// The generated `state_space_declared` is the hand-written Eq. (3) (see `support/eq3.rs`), entry for entry.
+#[test]
+fn back_support_declared_is_the_papers_eq3() {
+    use bgc_models::back_support as m;
+    let p = m::Params::default();
+    let hand = eq3::Eq3::new(&eq3::Eq3Params {
+        j_m: p.J_m,
+        j_g: p.J_g,
+        b_f: p.b_f,
+        r_g: p.r_g,
+        b_g: p.b_g,
+        k_g: p.k_g,
+        d_g: p.d_g,
+        j_sint: p.J_sint,
+        k_s: p.k_s,
+        d_s: p.d_s,
+        j_sext: p.J_sext,
+        k_eh: p.k_eh,
+        d_eh: p.d_eh,
+    });
+    let (a, b, _, _) = m::state_space_declared(&p);
+    for r in 0..7 {
+        for c in 0..7 {
+            let (g, w) = (a[(r, c)], hand.a[(r, c)]);
+            assert!(
+                (g - w).abs() <= 1e-12 * w.abs().max(1.0),
+                "A[{r}][{c}]: generated {g}, by hand {w}"
+            );
+        }
+        for c in 0..2 {
+            let (g, w) = (b[(r, c)], hand.b[(r, c)]);
+            assert!(
+                (g - w).abs() <= 1e-12 * w.abs().max(1.0),
+                "B[{r}][{c}]: generated {g}, by hand {w}"
+            );
+        }
+    }
+}

@@ -150,3 +150,67 @@ fn back_support_declared_is_the_papers_eq3() {
         }
     }
 }
+
+/// The generated rhs (energy states and angles) moves the declared coordinates as the hand-written Eq. (3) does, on
+/// states where each spring's deflection matches the angles (the invariant the angles and deflections share).
+#[test]
+fn back_support_rhs_follows_eq3() {
+    use bgc_models::back_support as m;
+    let p = m::Params::default();
+    let hand = eq3::Eq3::new(&eq3::Eq3Params {
+        j_m: p.J_m,
+        j_g: p.J_g,
+        b_f: p.b_f,
+        r_g: p.r_g,
+        b_g: p.b_g,
+        k_g: p.k_g,
+        d_g: p.d_g,
+        j_sint: p.J_sint,
+        k_s: p.k_s,
+        d_s: p.d_s,
+        j_sext: p.J_sext,
+        k_eh: p.k_eh,
+        d_eh: p.d_eh,
+    });
+    let mut rng = support::Rng::new(3);
+    for _ in 0..100 {
+        let z = nalgebra::SVector::<f64, 7>::from_fn(|_, _| rng.uniform(-1.0, 1.0));
+        let u = m::Inputs::new(rng.uniform(-5.0, 5.0), rng.uniform(-1.0, 1.0));
+        let (th_m, w_m, th_si, w_si, th_se, w_se, th_h) =
+            (z[0], z[1], z[2], z[3], z[4], z[5], z[6]);
+        // States: p_rotor, q_gear_spring, p_sensor_in, q_sensor_spring, p_sensor_out, q_coupling_spring, angles.
+        let x = m::State::from_column_slice(&[
+            p.J_m * w_m,
+            th_m / p.r_g - th_si,
+            p.J_sint * w_si,
+            th_si - th_se,
+            p.J_sext * w_se,
+            th_se - th_h,
+            th_m,
+            th_si,
+            th_se,
+            th_h,
+        ]);
+        let dx = m::rhs(&p, 0.0, &x, &u);
+        let generated = [
+            dx[6],
+            dx[0] / p.J_m,
+            dx[7],
+            dx[2] / p.J_sint,
+            dx[8],
+            dx[4] / p.J_sext,
+            dx[9],
+        ];
+        let mut want = nalgebra::SVector::<f64, 7>::zeros();
+        hand.rhs(&z, &u, &mut want);
+        for i in 0..7 {
+            let scale = (hand.a.abs() * z.abs() + hand.b.abs() * u.abs())[i];
+            assert!(
+                (generated[i] - want[i]).abs() <= 1e-12 * scale.max(1.0),
+                "ż[{i}]: generated {}, Eq. (3) {}",
+                generated[i],
+                want[i]
+            );
+        }
+    }
+}

@@ -5,7 +5,7 @@
 //! A block uses the readable form of the equations stage (one `let` per named bond variable, then the rates) when
 //! every intermediate it needs is defined before use and is not a derivative; otherwise (an algebraic loop, a
 //! storage in derivative causality behind an output) it falls back to the explicit `f(x, u, p, t)`, which the
-//! stage always provides for a complete model. Both are the same function; the tests check the generated code
+//! stage always provides for a complete model, and also when it would need more than [`MAX_LETS`] intermediates. Both are the same function; the tests check the generated code
 //! against the stage's own evaluation of `f`.
 
 use super::adapter::{AdaptError, to_symbolic};
@@ -166,13 +166,20 @@ fn state_space(
     })
 }
 
+/// The most `let`s a generated function gets. rustc's stack grows with the number of nested `let` scopes of one
+/// function, and a few thousand overflow its default stack (a 1000-state chain has 3000 intermediates), so larger
+/// models compute the explicit `f(x, u, p, t)` directly.
+pub(crate) const MAX_LETS: usize = 256;
+
 /// The readable block for `roots` (in intermediates), or the explicit expressions when the readable form cannot be
 /// computed in order.
 fn block(eqs: &Equations, roots: &[Ex], explicit: &[Expr]) -> Block {
-    readable_block(eqs, roots).unwrap_or_else(|| Block {
-        lets: Vec::new(),
-        results: explicit.to_vec(),
-    })
+    readable_block(eqs, roots)
+        .filter(|b| b.lets.len() <= MAX_LETS)
+        .unwrap_or_else(|| Block {
+            lets: Vec::new(),
+            results: explicit.to_vec(),
+        })
 }
 
 fn intermediates_of(e: &Expr) -> impl Iterator<Item = Symbol> {

@@ -18,7 +18,7 @@
 //! }
 //! ```
 //!
-//! ```ignore
+//! ```text
 //! // src/lib.rs: the module of `back_support.bg` is `$OUT_DIR/back_support.rs`.
 //! pub mod back_support {
 //!     include!(concat!(env!("OUT_DIR"), "/back_support.rs"));

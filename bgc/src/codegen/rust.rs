@@ -171,10 +171,16 @@ impl<'a> Writer<'a> {
 
     fn name_array(&mut self, konst: &str, size: &str, what: &str, names: &[String]) {
         let list: Vec<String> = names.iter().map(|n| string_literal(n)).collect();
+        let one_line = list.join(", ");
+        // As rustfmt lays it out: on one line when it fits in 100 columns, else one name per line.
+        let body = if one_line.len() + konst.len() + size.len() + 22 <= 100 {
+            one_line
+        } else {
+            format!("\n    {},\n", list.join(",\n    "))
+        };
         let _ = writeln!(
             self.out,
-            "\n/// The names of the {what}, in vector order.\npub const {konst}: [&str; {size}] = [{}];",
-            list.join(", ")
+            "\n/// The names of the {what}, in vector order.\npub const {konst}: [&str; {size}] = [{body}];"
         );
     }
 
@@ -285,8 +291,8 @@ pub type OutJacU = SMatrix<f64, N_OUTPUTS, N_INPUTS>;
         let values: Vec<String> = self.fields.iter().map(|f| format!("self.{f}")).collect();
         let _ = writeln!(
             self.out,
-            "        let values: [f64; N_PARAMS] = [{}];\n        for (name, value) in PARAM_NAMES.into_iter().zip(values) {{\n            if !value.is_finite() {{\n                return Err(ParamError::NonPhysical {{ name, value, reason: \"not a finite number\" }});\n            }}\n        }}",
-            values.join(", ")
+            "        let values: [f64; N_PARAMS] = [\n            {},\n        ];\n        for (name, value) in PARAM_NAMES.into_iter().zip(values) {{\n            if !value.is_finite() {{\n                return Err(ParamError::NonPhysical {{\n                    name,\n                    value,\n                    reason: \"not a finite number\",\n                }});\n            }}\n        }}",
+            values.join(",\n            ")
         );
         let field_of: HashMap<String, String> = model
             .params
@@ -352,7 +358,7 @@ pub type OutJacU = SMatrix<f64, N_OUTPUTS, N_INPUTS>;
             };
             let _ = writeln!(
                 self.out,
-                "        // {}: {}\n        let v = {code};\n        if {cond} {{\n            return Err(ParamError::NonPhysical {{ name: {}, value: self.{first_field}, reason: {} }});\n        }}",
+                "        // {}: {}\n        let v = {code};\n        if {cond} {{\n            return Err(ParamError::NonPhysical {{\n                name: {},\n                value: self.{first_field},\n                reason: {},\n            }});\n        }}",
                 comment(&node.name),
                 comment(&to_text(&value)),
                 string_literal(first.name()),

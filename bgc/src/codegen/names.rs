@@ -11,7 +11,7 @@ use std::collections::HashSet;
 /// The identifiers the generated functions use for themselves.
 pub const RESERVED: &[&str] = &[
     "p", "t", "x", "u", "dx", "y", "jac", "v", "a", "b", "c", "d", "params", "index", "value",
-    "out", "bgc_sign", "bgc_min", "bgc_max",
+    "out", "terms", "bgc_sign", "bgc_min", "bgc_max",
 ];
 
 const KEYWORDS: &[&str] = &[

@@ -376,12 +376,20 @@ pub type OutJacU = SMatrix<f64, N_OUTPUTS, N_INPUTS>;
         }
         for (i, s) in self.plan.states.clone().iter().enumerate() {
             if used.contains(s) {
-                let _ = writeln!(self.out, "    let {} = x[{i}];", self.names[s]);
+                let _ = writeln!(
+                    self.out,
+                    "    let {} = x[{i}];",
+                    self.names.get(s).cloned().unwrap_or_default()
+                );
             }
         }
         for (i, s) in self.plan.inputs.clone().iter().enumerate() {
             if used.contains(s) {
-                let _ = writeln!(self.out, "    let {} = u[{i}];", self.names[s]);
+                let _ = writeln!(
+                    self.out,
+                    "    let {} = u[{i}];",
+                    self.names.get(s).cloned().unwrap_or_default()
+                );
             }
         }
     }

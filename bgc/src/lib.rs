@@ -5,7 +5,9 @@
 //! IR of [`ir`], and later stages analyse causality and derive equations. No stage prints or touches files; the CLI
 //! (`src/main.rs`) and the build-script API do.
 
+pub mod build;
 pub mod causality;
+pub mod codegen;
 pub mod diagnostic;
 pub mod draw;
 pub mod equations;

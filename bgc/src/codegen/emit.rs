@@ -1,0 +1,227 @@
+//! What the generated functions compute, as symbolic-engine expressions: the explicit rates and outputs, the
+//! readable blocks (intermediates, then rates or outputs) that the function bodies print, the Jacobians, the state
+//! spaces and the energy terms.
+//!
+//! A block uses the readable form of the equations stage (one `let` per named bond variable, then the rates) when
+//! every intermediate it needs is defined before use and is not a derivative; otherwise (an algebraic loop, a
+//! storage in derivative causality behind an output) it falls back to the explicit `f(x, u, p, t)`, which the
+//! stage always provides for a complete model, and also when it would need more than [`MAX_LETS`] intermediates. Both are the same function; the tests check the generated code
+//! against the stage's own evaluation of `f`.
+
+use super::adapter::{AdaptError, to_symbolic};
+use crate::equations::sym::Ex;
+use crate::equations::{
+    EnergyKind, Equations, StateSelection, declared_state_space_symbolic, linear_state_space,
+};
+use crate::symbolic::{Expr, Symbol, SymbolKind};
+use std::collections::{BTreeSet, HashMap};
+
+/// Let-bindings then results.
+#[derive(Clone, Debug)]
+pub(crate) struct Block {
+    pub lets: Vec<(Symbol, Expr)>,
+    pub results: Vec<Expr>,
+}
+
+/// A state space with symbolic entries (free of states, inputs and time).
+#[derive(Clone, Debug)]
+pub(crate) struct StateSpace {
+    pub states: Vec<String>,
+    pub a: Vec<Vec<Expr>>,
+    pub b: Vec<Vec<Expr>>,
+    pub c: Vec<Vec<Expr>>,
+    pub d: Vec<Vec<Expr>>,
+}
+
+/// The `(element, value)` terms of one kind of energy, or the elements without a closed form.
+pub(crate) type EnergyTerms = Result<Vec<(String, Expr)>, Vec<String>>;
+
+/// Everything the generator prints for one model.
+#[derive(Clone, Debug)]
+pub(crate) struct Plan {
+    pub states: Vec<Symbol>,
+    pub inputs: Vec<Symbol>,
+    pub rhs: Block,
+    pub outputs: Block,
+    pub dfdx: Vec<Vec<Expr>>,
+    pub dfdu: Vec<Vec<Expr>>,
+    pub dhdx: Vec<Vec<Expr>>,
+    pub dhdu: Vec<Vec<Expr>>,
+    /// `A, B, C, D` in the energy states, or why there is none.
+    pub energy_ss: Result<StateSpace, String>,
+    /// `A, B, C, D` in the declared coordinates (`None`: the model declares none), or why there is none.
+    pub declared_ss: Option<Result<StateSpace, String>>,
+    /// Stored energy, dissipated and supplied power: the terms `(element, value)`, or the elements without a closed
+    /// form.
+    pub energy: Vec<(EnergyKind, EnergyTerms)>,
+}
+
+/// Checks that the equations are complete and convertible (what [`plan`] needs).
+pub(crate) fn check(eqs: &Equations) -> Result<(), String> {
+    plan(eqs).map(|_| ())
+}
+
+fn convert_all(eqs: &Equations, es: &[Ex]) -> Result<Vec<Expr>, AdaptError> {
+    es.iter().map(|e| to_symbolic(eqs, e)).collect()
+}
+
+fn convert_matrix(eqs: &Equations, m: &[Vec<Ex>]) -> Result<Vec<Vec<Expr>>, AdaptError> {
+    m.iter().map(|row| convert_all(eqs, row)).collect()
+}
+
+/// The plan of a complete model.
+pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
+    let mut f_ex = Vec::with_capacity(eqs.f.len());
+    for (i, f) in eqs.f.iter().enumerate() {
+        let name = eqs.states.get(i).map(|s| s.name.as_str()).unwrap_or("?");
+        f_ex.push(
+            f.clone()
+                .ok_or_else(|| format!("the rate of `{name}` was not derived"))?,
+        );
+    }
+    let mut h_ex = Vec::with_capacity(eqs.outputs.len());
+    for o in &eqs.outputs {
+        h_ex.push(
+            o.explicit
+                .clone()
+                .ok_or_else(|| format!("output `{}` was not derived", o.name))?,
+        );
+    }
+    let f = convert_all(eqs, &f_ex).map_err(|e| e.to_string())?;
+    let h = convert_all(eqs, &h_ex).map_err(|e| e.to_string())?;
+    let states: Vec<Symbol> = eqs
+        .states
+        .iter()
+        .map(|s| Symbol::state(s.name.as_str()))
+        .collect();
+    let inputs: Vec<Symbol> = eqs
+        .inputs
+        .iter()
+        .map(|i| Symbol::input(i.as_str()))
+        .collect();
+    let rhs = block(eqs, &eqs.rates, &f);
+    let readable_outputs: Vec<Ex> = eqs.outputs.iter().map(|o| o.value.clone()).collect();
+    let outputs = block(eqs, &readable_outputs, &h);
+    let energy_ss = linear_state_space(eqs, StateSelection::Energy)
+        .map_err(|e| e.to_string())
+        .and_then(|j| state_space(eqs, j.states, &j.dfdx, &j.dfdu, &j.dhdx, &j.dhdu));
+    let declared_ss = eqs.coords.as_ref().map(|_| {
+        declared_state_space_symbolic(eqs)
+            .map_err(|e| e.to_string())
+            .and_then(|j| state_space(eqs, j.states, &j.dfdx, &j.dfdu, &j.dhdx, &j.dhdu))
+    });
+    let mut energy = Vec::new();
+    for kind in [
+        EnergyKind::Stored,
+        EnergyKind::Dissipated,
+        EnergyKind::Supplied,
+    ] {
+        let mut terms = Vec::new();
+        let mut missing = Vec::new();
+        for t in eqs.energy.iter().filter(|t| t.kind == kind) {
+            match t.value.as_ref().map(|v| to_symbolic(eqs, v)) {
+                Some(Ok(v)) => terms.push((t.element.clone(), v)),
+                _ => missing.push(t.element.clone()),
+            }
+        }
+        energy.push((
+            kind,
+            if missing.is_empty() {
+                Ok(terms)
+            } else {
+                Err(missing)
+            },
+        ));
+    }
+    Ok(Plan {
+        dfdx: Expr::jacobian(&f, &states),
+        dfdu: Expr::jacobian(&f, &inputs),
+        dhdx: Expr::jacobian(&h, &states),
+        dhdu: Expr::jacobian(&h, &inputs),
+        states,
+        inputs,
+        rhs,
+        outputs,
+        energy_ss,
+        declared_ss,
+        energy,
+    })
+}
+
+fn state_space(
+    eqs: &Equations,
+    states: Vec<String>,
+    a: &[Vec<Ex>],
+    b: &[Vec<Ex>],
+    c: &[Vec<Ex>],
+    d: &[Vec<Ex>],
+) -> Result<StateSpace, String> {
+    let m = |x: &[Vec<Ex>]| convert_matrix(eqs, x).map_err(|e| e.to_string());
+    Ok(StateSpace {
+        states,
+        a: m(a)?,
+        b: m(b)?,
+        c: m(c)?,
+        d: m(d)?,
+    })
+}
+
+/// The most `let`s a generated function gets. rustc's stack grows with the number of nested `let` scopes of one
+/// function, and a few thousand overflow its default stack (a 1000-state chain has 3000 intermediates), so larger
+/// models compute the explicit `f(x, u, p, t)` directly.
+pub(crate) const MAX_LETS: usize = 256;
+
+/// The readable block for `roots` (in intermediates), or the explicit expressions when the readable form cannot be
+/// computed in order.
+fn block(eqs: &Equations, roots: &[Ex], explicit: &[Expr]) -> Block {
+    readable_block(eqs, roots)
+        .filter(|b| b.lets.len() <= MAX_LETS)
+        .unwrap_or_else(|| Block {
+            lets: Vec::new(),
+            results: explicit.to_vec(),
+        })
+}
+
+fn intermediates_of(e: &Expr) -> impl Iterator<Item = Symbol> {
+    e.free_symbols()
+        .into_iter()
+        .filter(|s| s.kind() == SymbolKind::Intermediate)
+}
+
+fn readable_block(eqs: &Equations, roots: &[Ex]) -> Option<Block> {
+    let results = convert_all(eqs, roots).ok()?;
+    let position: HashMap<&str, usize> = eqs
+        .intermediates
+        .iter()
+        .enumerate()
+        .map(|(k, i)| (i.name.as_str(), k))
+        .collect();
+    // The intermediates needed, transitively.
+    let mut needed: BTreeSet<usize> = BTreeSet::new();
+    let mut converted: HashMap<usize, Expr> = HashMap::new();
+    let mut stack: Vec<Symbol> = results.iter().flat_map(intermediates_of).collect();
+    while let Some(s) = stack.pop() {
+        let k = *position.get(s.name())?;
+        if !needed.insert(k) {
+            continue;
+        }
+        let def = eqs.intermediates.get(k)?;
+        if def.derivative {
+            return None;
+        }
+        let value = to_symbolic(eqs, &def.value).ok()?;
+        stack.extend(intermediates_of(&value));
+        converted.insert(k, value);
+    }
+    // In list order, each defined before use.
+    let mut lets = Vec::with_capacity(needed.len());
+    for &k in &needed {
+        let value = converted.remove(&k)?;
+        if intermediates_of(&value).any(|s| position.get(s.name()).is_none_or(|&j| j >= k)) {
+            return None;
+        }
+        let name = eqs.intermediates.get(k)?.name.as_str();
+        lets.push((Symbol::intermediate(name), value));
+    }
+    Some(Block { lets, results })
+}

@@ -1,0 +1,162 @@
+//! Code generation: Rust model modules from `.bg` files.
+//!
+//! [`compile`] runs the pipeline on a file (lowering with its imports, causality, equations) and refuses it when
+//! any stage reports an error; [`rust::generate`] turns the result into the source of a Rust module. The module
+//! is plain Rust over `nalgebra` fixed-size types that implements `bgc_runtime::model::ContinuousModel` and
+//! `Parametric`; its functions allocate nothing and never panic. [`crate::build`] wraps both for build scripts.
+//!
+//! Diagnostics of this stage:
+//!
+//! | code | finding |
+//! |---|---|
+//! | BG0700 | the file declares no `model` (components alone generate nothing) |
+//! | BG0701 | equations that cannot be generated (incomplete, or an expression with no value in code) |
+
+mod adapter;
+mod emit;
+mod names;
+pub mod rust;
+
+pub use adapter::{AdaptError, to_symbolic};
+
+use crate::diagnostic::{Diagnostic, has_errors};
+use crate::equations::Equations;
+use crate::ir;
+use crate::lower::SourceLoader;
+use crate::span::{FileId, SourceMap};
+
+/// The diagnostic codes of this stage.
+pub mod codes {
+    pub const NO_MODEL: &str = "BG0700";
+    pub const NOT_GENERATABLE: &str = "BG0701";
+}
+
+/// One model with its derived equations.
+#[derive(Clone, Debug)]
+pub struct CompiledModel {
+    pub model: ir::Model,
+    pub equations: Equations,
+}
+
+/// The models of one file, ready for generation.
+#[derive(Clone, Debug)]
+pub struct CompiledFile {
+    pub models: Vec<CompiledModel>,
+    /// Warnings of all stages (errors make [`compile`] fail instead).
+    pub warnings: Vec<Diagnostic>,
+    /// [`input_hash`] of every file the compilation read.
+    pub hash: u64,
+}
+
+/// Runs lowering, causality and equations on the models of file `root` (already in `sources`; imports are added).
+///
+/// Returns every diagnostic when any is an error, so that nothing is generated from a model with a known problem.
+pub fn compile(
+    sources: &mut SourceMap,
+    root: FileId,
+    loader: &mut dyn SourceLoader,
+) -> Result<CompiledFile, Vec<Diagnostic>> {
+    let (models, mut diags) = crate::lower::lower(sources, root, loader);
+    if has_errors(&diags) {
+        return Err(diags);
+    }
+    if models.is_empty() {
+        let name = sources.get(root).map(|f| f.name.as_str()).unwrap_or("?");
+        diags.push(
+            Diagnostic::error(
+                codes::NO_MODEL,
+                format!("`{name}` declares no model: there is nothing to generate"),
+            )
+            .with_help("declare a `model` that instantiates the components"),
+        );
+        return Err(diags);
+    }
+    let mut compiled = Vec::with_capacity(models.len());
+    for model in models {
+        let (causality, cdiags) = crate::causality::analyse(&model);
+        diags.extend(cdiags);
+        if has_errors(&diags) {
+            return Err(diags);
+        }
+        let (equations, ediags) = crate::equations::derive(&model, &causality);
+        diags.extend(ediags);
+        if has_errors(&diags) {
+            return Err(diags);
+        }
+        if let Err(why) = emit::check(&equations) {
+            let d = Diagnostic::error(
+                codes::NOT_GENERATABLE,
+                format!("cannot generate code for `{}`: {why}", model.name),
+            );
+            diags.push(d.with_primary(model.spans.model, "this model"));
+            return Err(diags);
+        }
+        compiled.push(CompiledModel { model, equations });
+    }
+    Ok(CompiledFile {
+        models: compiled,
+        warnings: diags,
+        hash: input_hash(sources),
+    })
+}
+
+/// FNV-1a (64 bit) of every file of `sources`: each file's name, a zero byte, its text, a zero byte, in load order.
+/// Stable across platforms and Rust versions (unlike `std`'s hashers), so generated headers are reproducible.
+pub fn input_hash(sources: &SourceMap) -> u64 {
+    let mut h = Fnv1a::new();
+    for (_, f) in sources.files() {
+        h.write(f.name.as_bytes());
+        h.write(&[0]);
+        h.write(f.text.as_bytes());
+        h.write(&[0]);
+    }
+    h.finish()
+}
+
+/// The 64-bit FNV-1a hash.
+#[derive(Clone, Copy, Debug)]
+pub struct Fnv1a(u64);
+
+impl Fnv1a {
+    const OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+    const PRIME: u64 = 0x0000_0100_0000_01b3;
+
+    pub fn new() -> Fnv1a {
+        Fnv1a(Self::OFFSET)
+    }
+
+    pub fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 ^= u64::from(b);
+            self.0 = self.0.wrapping_mul(Self::PRIME);
+        }
+    }
+
+    pub fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+impl Default for Fnv1a {
+    fn default() -> Self {
+        Fnv1a::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fnv1a_reference_values() {
+        // Reference values of the FNV specification (http://www.isthe.com/chongo/tech/comp/fnv/):
+        // FNV-1a 64 of "" and of "a".
+        assert_eq!(Fnv1a::new().finish(), 0xcbf29ce484222325);
+        let mut h = Fnv1a::new();
+        h.write(b"a");
+        assert_eq!(h.finish(), 0xaf63dc4c8601ec8c);
+        let mut h = Fnv1a::new();
+        h.write(b"foobar");
+        assert_eq!(h.finish(), 0x85944171f73967e8);
+    }
+}

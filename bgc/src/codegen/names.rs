@@ -1,0 +1,98 @@
+//! Rust identifiers for the names of a model.
+//!
+//! Names in a `.bg` file are identifiers, possibly qualified (`sensor.spring`); in Rust they must be valid, must
+//! not be keywords, and must not collide with each other or with the names the generated functions use for their
+//! own arguments (`p`, `t`, `x`, `u`, ...). [`Namer`] turns each name into a unique identifier: characters other
+//! than letters, digits and `_` become `_`, a leading digit gets a `_` prefix, a keyword or a reserved name gets a
+//! `_` suffix, and a name already taken gets `_2`, `_3`, ... appended.
+
+use std::collections::HashSet;
+
+/// The identifiers the generated functions use for themselves.
+pub const RESERVED: &[&str] = &[
+    "p", "t", "x", "u", "dx", "y", "jac", "v", "a", "b", "c", "d", "params", "index", "value",
+    "out", "terms", "bgc_sign", "bgc_min", "bgc_max",
+];
+
+const KEYWORDS: &[&str] = &[
+    "as", "async", "await", "break", "const", "continue", "crate", "dyn", "else", "enum", "extern",
+    "false", "fn", "for", "gen", "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut",
+    "pub", "ref", "return", "self", "Self", "static", "struct", "super", "trait", "true", "type",
+    "unsafe", "use", "where", "while", "abstract", "become", "box", "do", "final", "macro",
+    "override", "priv", "typeof", "unsized", "virtual", "yield", "try", "union", "_",
+];
+
+/// `name` with every character that cannot be in an identifier replaced.
+pub fn sanitize(name: &str) -> String {
+    let mut s: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if s.is_empty() || s.starts_with(|c: char| c.is_ascii_digit()) {
+        s.insert(0, '_');
+    }
+    s
+}
+
+/// Hands out unique identifiers.
+#[derive(Clone, Debug, Default)]
+pub struct Namer {
+    taken: HashSet<String>,
+}
+
+impl Namer {
+    /// A namer with the generated code's own names already taken.
+    pub fn with_reserved() -> Namer {
+        Namer {
+            taken: RESERVED.iter().map(|s| s.to_string()).collect(),
+        }
+    }
+
+    /// A unique identifier for `name`.
+    pub fn ident(&mut self, name: &str) -> String {
+        let mut base = sanitize(name);
+        if KEYWORDS.contains(&base.as_str()) {
+            base.push('_');
+        }
+        let mut candidate = base.clone();
+        let mut k = 2;
+        while self.taken.contains(&candidate) {
+            candidate = format!("{base}_{k}");
+            k += 1;
+        }
+        self.taken.insert(candidate.clone());
+        candidate
+    }
+}
+
+/// `s` as the contents of a Rust string literal.
+pub fn string_literal(s: &str) -> String {
+    format!("{s:?}")
+}
+
+/// `s` made safe for a `///` or `//` comment line (no line breaks).
+pub fn comment(s: &str) -> String {
+    s.replace(['\n', '\r'], " ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn identifiers_are_valid_and_unique() {
+        let mut n = Namer::with_reserved();
+        assert_eq!(n.ident("J_m"), "J_m");
+        assert_eq!(n.ident("sensor.spring"), "sensor_spring");
+        assert_eq!(n.ident("sensor_spring"), "sensor_spring_2");
+        assert_eq!(n.ident("type"), "type_");
+        assert_eq!(n.ident("p"), "p_2");
+        assert_eq!(n.ident("2x"), "_2x");
+    }
+}

@@ -1,0 +1,59 @@
+//! The generated back-support rhs against a hand-written nalgebra implementation of the paper's Eq. (3)
+//! (`ẋ = A x + B u` with `A`, `B` formed once; see `tests/support/eq3.rs`). The generated rhs works in the energy
+//! states plus the four angles (10 states) and computes the bond-graph equations directly.
+
+use bgc_models::back_support as m;
+use criterion::{Criterion, criterion_group, criterion_main};
+use nalgebra::SVector;
+use std::hint::black_box;
+
+#[path = "../tests/support/eq3.rs"]
+mod eq3;
+
+fn rhs(c: &mut Criterion) {
+    let p = m::Params::default();
+    let x = m::State::from_fn(|i, _| 1e-3 * (i as f64 + 1.0));
+    let u = m::Inputs::new(0.5, 0.1);
+    let mut dx = m::State::zeros();
+    let mut group = c.benchmark_group("back_support_rhs");
+    group.bench_function("generated", |b| {
+        b.iter(|| {
+            m::rhs_into(black_box(&p), 0.0, black_box(&x), black_box(&u), &mut dx);
+            black_box(&dx);
+        })
+    });
+    let hand = eq3::Eq3::new(&eq3::Eq3Params {
+        j_m: p.J_m,
+        j_g: p.J_g,
+        b_f: p.b_f,
+        r_g: p.r_g,
+        b_g: p.b_g,
+        k_g: p.k_g,
+        d_g: p.d_g,
+        j_sint: p.J_sint,
+        k_s: p.k_s,
+        d_s: p.d_s,
+        j_sext: p.J_sext,
+        k_eh: p.k_eh,
+        d_eh: p.d_eh,
+    });
+    let x7 = SVector::<f64, 7>::from_fn(|i, _| 1e-3 * (i as f64 + 1.0));
+    let mut dx7 = SVector::<f64, 7>::zeros();
+    group.bench_function("hand_written_eq3", |b| {
+        b.iter(|| {
+            black_box(&hand).rhs(black_box(&x7), black_box(&u), &mut dx7);
+            black_box(&dx7);
+        })
+    });
+    let mut jac = m::JacX::zeros();
+    group.bench_function("generated_jac_x", |b| {
+        b.iter(|| {
+            m::jac_x_into(black_box(&p), 0.0, black_box(&x), black_box(&u), &mut jac);
+            black_box(&jac);
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, rhs);
+criterion_main!(benches);

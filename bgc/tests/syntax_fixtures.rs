@@ -81,7 +81,7 @@ fn every_invalid_fixture_gives_its_code_at_the_expected_place() {
         .filter(|p| {
             p.file_name()
                 .and_then(|n| n.to_str())
-                .is_some_and(|n| n.starts_with("BG01"))
+                .is_some_and(is_syntax_fixture)
         })
         .collect();
     assert!(files.len() >= 20, "only {} invalid fixtures", files.len());
@@ -148,4 +148,9 @@ fn every_valid_fixture_parses_cleanly_and_is_canonical() {
             path.display()
         );
     }
+}
+
+/// The syntax stage's fixtures: BG01xx, except the import codes BG0107 and BG0108 that lowering reports.
+fn is_syntax_fixture(name: &str) -> bool {
+    name.starts_with("BG01") && !name.starts_with("BG0107") && !name.starts_with("BG0108")
 }

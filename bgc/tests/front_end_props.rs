@@ -226,3 +226,27 @@ fn formatting_is_idempotent_and_keeps_meaning_on_every_file() {
     }
     assert!(count >= 60, "only {count} files formatted");
 }
+
+/// The shipped models are kept in the canonical layout, so `bgc fmt --check models/*.bg` stays clean.
+#[test]
+fn shipped_models_are_in_canonical_layout() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
+    let mut count = 0;
+    for e in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
+        let path = e.path();
+        if path.extension().is_none_or(|x| x != "bg") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap_or_default();
+        let formatted = bgc::syntax::format_source(FileId(0), &text)
+            .unwrap_or_else(|d| panic!("{}: {d:?}", path.display()));
+        assert_eq!(
+            formatted,
+            text,
+            "{} is not in the canonical layout",
+            path.display()
+        );
+        count += 1;
+    }
+    assert!(count >= 3, "only {count} models");
+}

@@ -8,6 +8,7 @@
 pub mod causality;
 pub mod diagnostic;
 pub mod draw;
+pub mod equations;
 pub mod ir;
 pub mod lower;
 pub mod span;

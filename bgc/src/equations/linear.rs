@@ -1,0 +1,360 @@
+//! Linear state space and Jacobians.
+//!
+//! For `ẋ = f(x, u, p, t)`, `y = h(x, u, p, t)`: `A = ∂f/∂x`, `B = ∂f/∂u`, `C = ∂h/∂x`, `D = ∂h/∂u` as symbolic
+//! expressions of the parameters (and, for a nonlinear model, of the operating point). A model is linear when
+//! every entry is free of states, inputs and time and `f(0, 0) = 0`, `h(0, 0) = 0`; then [`linear_state_space`]
+//! gives `A, B, C, D` exactly. For any model, [`linearise`] evaluates the Jacobians at an operating point.
+
+use super::Equations;
+use super::sym::{self, Ex, Sym};
+
+/// Which states make up the state vector.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StateSelection {
+    /// The energy variables of the storages in integral causality only (the minimal state of the bond graph).
+    Energy,
+    /// The energy states followed by every integrated flow (`var`).
+    All,
+}
+
+/// Why a state space could not be formed.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum LinearError {
+    #[error("the equations are incomplete: {what} could not be derived")]
+    Incomplete { what: String },
+    #[error(
+        "{what} depends on the integrated flow `{state}`, which the energy state vector leaves out"
+    )]
+    NeedsIntegratedState { what: String, state: String },
+    #[error("{what} is not linear: {entry} depends on `{symbol}`")]
+    NotLinear {
+        what: String,
+        entry: String,
+        symbol: String,
+    },
+    #[error(
+        "{what} has a constant part (an affine model): linearise it at an operating point instead"
+    )]
+    Affine { what: String },
+    #[error("cannot differentiate {what}: it uses `{func}`")]
+    NotDifferentiable { what: String, func: &'static str },
+    #[error("cannot evaluate {what}: `{symbol}` has no value")]
+    Unbound { what: String, symbol: String },
+    #[error("{what} evaluates to a non-finite number")]
+    NonFinite { what: String },
+    #[error("expected {expected} {what} values, got {got}")]
+    Dimension {
+        what: &'static str,
+        expected: usize,
+        got: usize,
+    },
+}
+
+/// Symbolic Jacobians of `f` and `h`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Jacobians {
+    pub states: Vec<String>,
+    pub inputs: Vec<String>,
+    pub outputs: Vec<String>,
+    /// `∂f/∂x`, `n × n`.
+    pub dfdx: Vec<Vec<Ex>>,
+    /// `∂f/∂u`, `n × m`.
+    pub dfdu: Vec<Vec<Ex>>,
+    /// `∂h/∂x`, `p × n`.
+    pub dhdx: Vec<Vec<Ex>>,
+    /// `∂h/∂u`, `p × m`.
+    pub dhdu: Vec<Vec<Ex>>,
+}
+
+/// `A, B, C, D` of a linear model as expressions of the parameters.
+pub type SymbolicStateSpace = Jacobians;
+
+/// A numeric state space `ẋ = A x + B u`, `y = C x + D u`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NumericStateSpace {
+    pub states: Vec<String>,
+    pub inputs: Vec<String>,
+    pub outputs: Vec<String>,
+    pub a: Vec<Vec<f64>>,
+    pub b: Vec<Vec<f64>>,
+    pub c: Vec<Vec<f64>>,
+    pub d: Vec<Vec<f64>>,
+}
+
+impl Equations {
+    /// The default parameter values, in parameter order.
+    pub fn default_params(&self) -> Vec<f64> {
+        self.params.iter().map(|p| p.1).collect()
+    }
+
+    /// The number of states of a selection.
+    pub fn state_count(&self, selection: StateSelection) -> usize {
+        match selection {
+            StateSelection::Energy => self.energy_states,
+            StateSelection::All => self.states.len(),
+        }
+    }
+}
+
+/// The selected rates and all outputs, explicit, checked for use of left-out states.
+fn selected(eqs: &Equations, selection: StateSelection) -> Result<(Vec<Ex>, Vec<Ex>), LinearError> {
+    let n = eqs.state_count(selection);
+    let mut f = Vec::with_capacity(n);
+    for i in 0..n {
+        let name = eqs
+            .states
+            .get(i)
+            .map(|s| s.name.clone())
+            .unwrap_or_default();
+        let e = eqs
+            .f
+            .get(i)
+            .cloned()
+            .flatten()
+            .ok_or_else(|| LinearError::Incomplete {
+                what: format!("the rate of `{name}`"),
+            })?;
+        f.push(e);
+    }
+    let mut h = Vec::with_capacity(eqs.outputs.len());
+    for o in &eqs.outputs {
+        h.push(o.explicit.clone().ok_or_else(|| LinearError::Incomplete {
+            what: format!("output `{}`", o.name),
+        })?);
+    }
+    let what_f = |i: usize| {
+        format!(
+            "the rate of `{}`",
+            eqs.states.get(i).map(|s| s.name.as_str()).unwrap_or("?")
+        )
+    };
+    let what_h = |k: usize| {
+        format!(
+            "output `{}`",
+            eqs.outputs.get(k).map(|o| o.name.as_str()).unwrap_or("?")
+        )
+    };
+    let check = |e: &Ex, what: String| -> Result<(), LinearError> {
+        for j in n..eqs.states.len() {
+            if e.contains(Sym::State(j)) {
+                return Err(LinearError::NeedsIntegratedState {
+                    what,
+                    state: eqs.sym_name(Sym::State(j)),
+                });
+            }
+        }
+        Ok(())
+    };
+    for (i, e) in f.iter().enumerate() {
+        check(e, what_f(i))?;
+    }
+    for (k, e) in h.iter().enumerate() {
+        check(e, what_h(k))?;
+    }
+    Ok((f, h))
+}
+
+fn jacobian(
+    rows: &[Ex],
+    vars: &[Sym],
+    what: &dyn Fn(usize) -> String,
+) -> Result<Vec<Vec<Ex>>, LinearError> {
+    rows.iter()
+        .enumerate()
+        .map(|(i, r)| {
+            vars.iter()
+                .map(|&v| {
+                    sym::diff(r, v).map_err(|sym::NotDifferentiable(f)| {
+                        LinearError::NotDifferentiable {
+                            what: what(i),
+                            func: f.name(),
+                        }
+                    })
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The symbolic Jacobians `∂f/∂x, ∂f/∂u, ∂h/∂x, ∂h/∂u` of the selected state vector.
+pub fn jacobians(eqs: &Equations, selection: StateSelection) -> Result<Jacobians, LinearError> {
+    let (f, h) = selected(eqs, selection)?;
+    let n = f.len();
+    let xs: Vec<Sym> = (0..n).map(Sym::State).collect();
+    let us: Vec<Sym> = (0..eqs.inputs.len()).map(Sym::Input).collect();
+    let wf = |i: usize| format!("the rate of `{}`", eqs.sym_name(Sym::State(i)));
+    let wh = |k: usize| {
+        format!(
+            "output `{}`",
+            eqs.outputs.get(k).map(|o| o.name.as_str()).unwrap_or("?")
+        )
+    };
+    Ok(Jacobians {
+        states: (0..n).map(|i| eqs.sym_name(Sym::State(i))).collect(),
+        inputs: eqs.inputs.clone(),
+        outputs: eqs.outputs.iter().map(|o| o.name.clone()).collect(),
+        dfdx: jacobian(&f, &xs, &wf)?,
+        dfdu: jacobian(&f, &us, &wf)?,
+        dhdx: jacobian(&h, &xs, &wh)?,
+        dhdu: jacobian(&h, &us, &wh)?,
+    })
+}
+
+/// `A, B, C, D` of a linear model, as expressions of the parameters; an error names the first nonlinear or affine
+/// entry.
+pub fn linear_state_space(
+    eqs: &Equations,
+    selection: StateSelection,
+) -> Result<SymbolicStateSpace, LinearError> {
+    let j = jacobians(eqs, selection)?;
+    let variable = |s: Sym| matches!(s, Sym::State(_) | Sym::Input(_) | Sym::Time);
+    let check = |m: &[Vec<Ex>], name: &str, what: &str| -> Result<(), LinearError> {
+        for (r, row) in m.iter().enumerate() {
+            for (c, e) in row.iter().enumerate() {
+                let mut found = None;
+                e.for_each_sym(&mut |s| {
+                    if found.is_none() && variable(s) {
+                        found = Some(s);
+                    }
+                });
+                if let Some(s) = found {
+                    return Err(LinearError::NotLinear {
+                        what: what.to_string(),
+                        entry: format!("{name}[{r}][{c}]"),
+                        symbol: eqs.sym_name(s),
+                    });
+                }
+            }
+        }
+        Ok(())
+    };
+    check(&j.dfdx, "A", "f")?;
+    check(&j.dfdu, "B", "f")?;
+    check(&j.dhdx, "C", "h")?;
+    check(&j.dhdu, "D", "h")?;
+    // Linear, not affine: f(0, 0) = 0 and h(0, 0) = 0.
+    let (f, h) = selected(eqs, selection)?;
+    let at_zero = |e: &Ex| sym::subst(e, &mut |s| variable(s).then(Ex::zero));
+    for (i, e) in f.iter().enumerate() {
+        if !at_zero(e).is_zero() {
+            return Err(LinearError::Affine {
+                what: format!("the rate of `{}`", eqs.sym_name(Sym::State(i))),
+            });
+        }
+    }
+    for (k, e) in h.iter().enumerate() {
+        if !at_zero(e).is_zero() {
+            return Err(LinearError::Affine {
+                what: format!("output `{}`", j.outputs.get(k).cloned().unwrap_or_default()),
+            });
+        }
+    }
+    Ok(j)
+}
+
+fn check_len(what: &'static str, expected: usize, got: usize) -> Result<(), LinearError> {
+    if expected == got {
+        Ok(())
+    } else {
+        Err(LinearError::Dimension {
+            what,
+            expected,
+            got,
+        })
+    }
+}
+
+fn evaluate(
+    eqs: &Equations,
+    m: &[Vec<Ex>],
+    name: &str,
+    value: &dyn Fn(Sym) -> Option<f64>,
+) -> Result<Vec<Vec<f64>>, LinearError> {
+    m.iter()
+        .enumerate()
+        .map(|(r, row)| {
+            row.iter()
+                .enumerate()
+                .map(|(c, e)| {
+                    let what = format!("{name}[{r}][{c}]");
+                    let v = sym::eval(e, value).map_err(|err| match err {
+                        sym::EvalError::Unbound(s) => LinearError::Unbound {
+                            what: what.clone(),
+                            symbol: eqs.sym_name(s),
+                        },
+                        sym::EvalError::Arity(f) => LinearError::NotDifferentiable {
+                            what: what.clone(),
+                            func: f.name(),
+                        },
+                    })?;
+                    if v.is_finite() {
+                        Ok(v)
+                    } else {
+                        Err(LinearError::NonFinite { what })
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Evaluates a symbolic state space (or Jacobians) at parameter values, operating point `x0`, `u0` and time `t0`.
+pub fn evaluate_at(
+    eqs: &Equations,
+    j: &Jacobians,
+    params: &[f64],
+    x0: &[f64],
+    u0: &[f64],
+    t0: f64,
+) -> Result<NumericStateSpace, LinearError> {
+    check_len("parameter", eqs.params.len(), params.len())?;
+    check_len("state", j.states.len(), x0.len())?;
+    check_len("input", eqs.inputs.len(), u0.len())?;
+    let value = |s: Sym| match s {
+        Sym::Param(i) => params.get(i).copied(),
+        Sym::State(i) => x0.get(i).copied(),
+        Sym::Input(i) => u0.get(i).copied(),
+        Sym::Time => Some(t0),
+        _ => None,
+    };
+    Ok(NumericStateSpace {
+        states: j.states.clone(),
+        inputs: j.inputs.clone(),
+        outputs: j.outputs.clone(),
+        a: evaluate(eqs, &j.dfdx, "A", &value)?,
+        b: evaluate(eqs, &j.dfdu, "B", &value)?,
+        c: evaluate(eqs, &j.dhdx, "C", &value)?,
+        d: evaluate(eqs, &j.dhdu, "D", &value)?,
+    })
+}
+
+/// The numeric `A, B, C, D` of a linear model at parameter values (in [`Equations::params`] order).
+pub fn numeric_state_space(
+    eqs: &Equations,
+    selection: StateSelection,
+    params: &[f64],
+) -> Result<NumericStateSpace, LinearError> {
+    let ss = linear_state_space(eqs, selection)?;
+    let n = ss.states.len();
+    evaluate_at(
+        eqs,
+        &ss,
+        params,
+        &vec![0.0; n],
+        &vec![0.0; eqs.inputs.len()],
+        0.0,
+    )
+}
+
+/// The linearisation of any model at the operating point `(x0, u0, t0)`: the Jacobians evaluated there.
+pub fn linearise(
+    eqs: &Equations,
+    selection: StateSelection,
+    params: &[f64],
+    x0: &[f64],
+    u0: &[f64],
+    t0: f64,
+) -> Result<NumericStateSpace, LinearError> {
+    let j = jacobians(eqs, selection)?;
+    evaluate_at(eqs, &j, params, x0, u0, t0)
+}

@@ -1,0 +1,537 @@
+//! The equations stage: from a causal bond graph to state equations `ẋ = f(x, u, p, t)` and outputs
+//! `y = h(x, u, p, t)`.
+//!
+//! Steps ([`derive`]):
+//! 1. States are the energy variables of the storages in integral causality (`p_rotor`, `q_hd_spring`), then the
+//!    integrated flows (`var`s, named as declared); their rates are `ṗ = e`, `q̇ = f`, `θ̇ = integrand`.
+//! 2. Every node writes the causal equation of each bond variable it computes ([`build`]).
+//! 3. The rates and outputs are expressed in states, inputs, parameters and `t` by substitution in dependency order
+//!    ([`resolve`]); algebraic loops are torn and solved when affine, storages in derivative causality contribute
+//!    `ẋ` terms, solved for by a symbolic linear solve ([`solve`]).
+//! 4. Readable forms keep intermediates (one per bond variable that is computed and not a mere copy of another).
+//!
+//! Diagnostics of this stage:
+//!
+//! | code | finding |
+//! |---|---|
+//! | BG0600 | the causality has conflicts: no equations |
+//! | BG0601 | a nonlinear law must be inverted for its causality and is not affine in the unknown |
+//! | BG0602 | an output needs the time derivative of an input |
+//! | BG0603 | a nonlinear (or singular) algebraic loop |
+//! | BG0604 | derivative causality that cannot be resolved (nonlinear in the rates, singular, or a state rate needing the derivative of an input) |
+//! | BG0605 | a construct the equations stage does not support (multiport fields, ambiguous references) |
+//! | BG0606 | declared coordinates that are not a linear, invertible function of the states |
+//! | BG0607 | the stored energy of a law that cannot be integrated symbolically (warning) |
+
+mod build;
+mod coords;
+mod coords_symbolic;
+mod dense;
+mod energy;
+mod linear;
+mod print;
+mod resolve;
+mod solve;
+pub mod sym;
+
+pub use coords::{CoordsError, declared_state_space};
+pub use coords_symbolic::declared_state_space_symbolic;
+pub use energy::{EnergyKind, EnergyTerm};
+pub use linear::{
+    Jacobians, LinearError, NumericStateSpace, StateSelection, SymbolicStateSpace, evaluate_at,
+    jacobians, linear_state_space, linearise, numeric_state_space,
+};
+pub use print::{expr_latex, expr_text, to_json, to_latex, to_text};
+
+use crate::causality::Causality;
+use crate::diagnostic::Diagnostic;
+use crate::ir::{Expr, Model, VarId};
+use petgraph::graph::NodeIndex;
+use resolve::{ResolveError, Resolver};
+use sym::{Ex, Sym};
+
+/// The diagnostic codes of this stage.
+pub mod codes {
+    pub const CAUSALITY_CONFLICT: &str = "BG0600";
+    pub const NOT_INVERTIBLE: &str = "BG0601";
+    pub const INPUT_DERIVATIVE: &str = "BG0602";
+    pub const ALGEBRAIC_LOOP: &str = "BG0603";
+    pub const DERIVATIVE_CAUSALITY: &str = "BG0604";
+    pub const UNSUPPORTED: &str = "BG0605";
+    pub const COORDS: &str = "BG0606";
+    pub const ENERGY: &str = "BG0607";
+}
+
+/// What a state is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StateKind {
+    /// The momentum `p` of an inertia.
+    Momentum,
+    /// The displacement `q` of a compliance.
+    Displacement,
+    /// A declared integrated flow (`var`).
+    Integrated,
+}
+
+/// One state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateSpec {
+    /// `p_<element>`, `q_<element>` or the `var`'s name.
+    pub name: String,
+    pub kind: StateKind,
+    /// The storage element (energy states).
+    pub node: Option<NodeIndex>,
+    /// The integrated flow (integrated states).
+    pub var: Option<VarId>,
+}
+
+/// A named intermediate variable in the readable equations.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Intermediate {
+    /// Named after its element, junction or bond: `e_hd_spring`, `f_j_sint`, `e_gear_in`.
+    pub name: String,
+    /// The right-hand side, in states, inputs, parameters, `t` and earlier intermediates ([`Sym::Var`]).
+    pub value: Ex,
+    /// True when the intermediate is `d/dt(value)` (the output of a storage in derivative causality).
+    pub derivative: bool,
+}
+
+/// One output.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OutputEq {
+    pub name: String,
+    /// In states, inputs, parameters, `t` and intermediates.
+    pub value: Ex,
+    /// In states, inputs, parameters and `t` only: `h(x, u, p, t)`. `None` when it could not be derived (a
+    /// diagnostic says why).
+    pub explicit: Option<Ex>,
+}
+
+/// The state equations of a model.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Equations {
+    pub model: String,
+    /// Parameter names and default values (indexed by [`Sym::Param`]).
+    pub params: Vec<(String, f64)>,
+    /// Input names (indexed by [`Sym::Input`]).
+    pub inputs: Vec<String>,
+    /// Energy states first, then one integrated state per `var`.
+    pub states: Vec<StateSpec>,
+    /// The number of energy states (the first entries of `states`).
+    pub energy_states: usize,
+    /// Readable rates: `ẋ_i = rates[i]` in states, inputs, parameters, `t` and intermediates.
+    pub rates: Vec<Ex>,
+    /// Explicit rates `f(x, u, p, t)`; `None` for a rate that could not be derived (a diagnostic says why).
+    pub f: Vec<Option<Ex>>,
+    /// Intermediates in dependency order.
+    pub intermediates: Vec<Intermediate>,
+    /// Names of the bond variables as intermediates (indexed by [`Sym::Var`]).
+    pub var_names: Vec<String>,
+    pub outputs: Vec<OutputEq>,
+    /// Declared coordinates, explicit in the states (linear, checked), with their names.
+    pub coords: Option<Vec<(String, Ex)>>,
+    /// Stored energy, dissipated and supplied power of each element.
+    pub energy: Vec<EnergyTerm>,
+}
+
+impl Equations {
+    /// The printable name of a symbol.
+    pub fn sym_name(&self, s: Sym) -> String {
+        match s {
+            Sym::Param(i) => self
+                .params
+                .get(i)
+                .map(|p| p.0.clone())
+                .unwrap_or_else(|| format!("param{i}")),
+            Sym::Input(i) => self
+                .inputs
+                .get(i)
+                .cloned()
+                .unwrap_or_else(|| format!("input{i}")),
+            Sym::InputDot(i) => format!("d{}_dt", self.sym_name(Sym::Input(i))),
+            Sym::State(i) => self
+                .states
+                .get(i)
+                .map(|s| s.name.clone())
+                .unwrap_or_else(|| format!("x{i}")),
+            Sym::StateDot(i) => format!("d{}_dt", self.sym_name(Sym::State(i))),
+            Sym::Var(i) => self
+                .var_names
+                .get(i)
+                .cloned()
+                .unwrap_or_else(|| format!("v{i}")),
+            Sym::Tear(i) => format!("loop_{}", self.sym_name(Sym::Var(i))),
+            Sym::Time => "t".to_string(),
+        }
+    }
+
+    /// True when every explicit rate and output was derived.
+    pub fn complete(&self) -> bool {
+        self.f.iter().all(Option::is_some) && self.outputs.iter().all(|o| o.explicit.is_some())
+    }
+}
+
+fn with_span(d: Diagnostic, span: Option<&crate::span::Span>, label: &str) -> Diagnostic {
+    match span {
+        Some(s) => d.with_primary(*s, label),
+        None => d,
+    }
+}
+
+/// Derives the state equations of `model` with the causality `causality`.
+///
+/// Returns the equations (as complete as possible) and the findings; an error diagnostic means some rate or output
+/// is missing (`None` in [`Equations::f`] or [`OutputEq::explicit`]).
+pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnostic>) {
+    let mut diags = Vec::new();
+    let params = model
+        .params
+        .iter()
+        .map(|p| (p.name.clone(), p.default))
+        .collect();
+    let inputs = model.inputs.iter().map(|i| i.name.clone()).collect();
+    let mut eqs = Equations {
+        model: model.name.clone(),
+        params,
+        inputs,
+        states: Vec::new(),
+        energy_states: 0,
+        rates: Vec::new(),
+        f: Vec::new(),
+        intermediates: Vec::new(),
+        var_names: Vec::new(),
+        outputs: Vec::new(),
+        coords: None,
+        energy: Vec::new(),
+    };
+    if !causality.consistent {
+        diags.push(with_span(
+            Diagnostic::error(
+                codes::CAUSALITY_CONFLICT,
+                format!(
+                    "no equations for `{}`: its causality has conflicts",
+                    model.name
+                ),
+            ),
+            Some(&model.spans.model),
+            "this model",
+        ));
+        return (eqs, diags);
+    }
+    let (mut ctx, states) = build::context(model, causality);
+    let built = build::build(model, causality, &mut ctx, states, &mut diags);
+    eqs.energy_states = built
+        .states
+        .iter()
+        .filter(|s| s.kind != StateKind::Integrated)
+        .count();
+    let nstates = built.states.len();
+    let mut resolver = Resolver::new(&built, nstates, model.inputs.len());
+
+    // Explicit rates, with ẋ of derivative-causality storages still symbolic.
+    let mut implicit = Vec::with_capacity(nstates);
+    let mut rate_ok = vec![true; nstates];
+    for (i, rate) in built.rates.iter().enumerate() {
+        match resolver.expr(rate) {
+            Ok(e) => implicit.push(e),
+            Err(e) => {
+                diags.push(resolve_diag(
+                    model,
+                    &built,
+                    &e,
+                    &format!("the rate of state `{}`", built.states[i].name),
+                ));
+                rate_ok[i] = false;
+                implicit.push(Ex::zero());
+            }
+        }
+    }
+    for (i, e) in implicit.iter().enumerate() {
+        if rate_ok[i] && e.any_sym(&|s| matches!(s, Sym::InputDot(_))) {
+            rate_ok[i] = false;
+            let d = Diagnostic::error(
+                codes::DERIVATIVE_CAUSALITY,
+                format!("the rate of state `{}` needs the time derivative of an input", built.states[i].name),
+            )
+            .with_help("a storage in derivative causality is driven by a source through this state's equation; give the source a state (add a compliance or a resistance) or move the storage");
+            diags.push(with_span(
+                d,
+                state_span(model, &built.states[i]),
+                "this storage",
+            ));
+        }
+    }
+    let solved = match solve::solve_rates(&implicit) {
+        Ok(x) => x,
+        Err(e) => {
+            let msg = match e {
+                solve::SolveError::Nonlinear(i) => format!(
+                    "the storages in derivative causality enter the rate of `{}` nonlinearly in the state rates",
+                    built.states.get(i).map(|s| s.name.as_str()).unwrap_or("?")
+                ),
+                solve::SolveError::Singular => {
+                    "the storages in derivative causality make the rate equations singular".into()
+                }
+                solve::SolveError::NotDifferentiable(_) => {
+                    "a law under derivative causality cannot be differentiated".into()
+                }
+            };
+            let mut d = Diagnostic::error(codes::DERIVATIVE_CAUSALITY, msg);
+            if let Some(s) = causality
+                .derivative()
+                .next()
+                .and_then(|s| model.spans.nodes.get(s.node.index()))
+            {
+                d = d.with_primary(*s, "a storage in derivative causality");
+            }
+            diags.push(d);
+            rate_ok.iter_mut().for_each(|ok| *ok = false);
+            implicit.clone()
+        }
+    };
+    let rate_of = |e: &Ex| {
+        sym::subst(e, &mut |s| match s {
+            Sym::StateDot(j) => solved.get(j).cloned(),
+            _ => None,
+        })
+    };
+    eqs.f = solved
+        .iter()
+        .zip(&rate_ok)
+        .map(|(e, ok)| ok.then(|| e.clone()))
+        .collect();
+    let all_rates_ok = rate_ok.iter().all(|&ok| ok);
+
+    // Outputs.
+    for (k, out) in model.outputs.iter().enumerate() {
+        let value = match ctx.convert(&out.value) {
+            Ok(v) => v,
+            Err(build::ConvertError::Unsupported(what)) => {
+                let d = Diagnostic::error(
+                    codes::UNSUPPORTED,
+                    format!("cannot derive output `{}`: {what}", out.name),
+                );
+                diags.push(with_span(d, model.spans.outputs.get(k), "this output"));
+                eqs.outputs.push(OutputEq {
+                    name: out.name.clone(),
+                    value: Ex::zero(),
+                    explicit: None,
+                });
+                continue;
+            }
+        };
+        let explicit = match resolver.expr(&value) {
+            Ok(e) if e.any_sym(&|s| matches!(s, Sym::InputDot(_))) => {
+                let names: Vec<String> = (0..model.inputs.len())
+                    .filter(|&j| e.contains(Sym::InputDot(j)))
+                    .map(|j| model.inputs[j].name.clone())
+                    .collect();
+                let d = Diagnostic::error(
+                    codes::INPUT_DERIVATIVE,
+                    format!("output `{}` needs the time derivative of input `{}`", out.name, names.join("`, `")),
+                )
+                .with_note("a storage in derivative causality behind a source makes its effort or flow the derivative of the source's value")
+                .with_help("measure a variable that does not depend on that storage, or give the input's derivative as an input");
+                diags.push(with_span(d, model.spans.outputs.get(k), "this output"));
+                None
+            }
+            Ok(e) if e.any_sym(&|s| matches!(s, Sym::StateDot(_))) && !all_rates_ok => None,
+            Ok(e) => Some(rate_of(&e)),
+            Err(e) => {
+                diags.push(resolve_diag(
+                    model,
+                    &built,
+                    &e,
+                    &format!("output `{}`", out.name),
+                ));
+                None
+            }
+        };
+        eqs.outputs.push(OutputEq {
+            name: out.name.clone(),
+            value,
+            explicit,
+        });
+    }
+
+    // Declared coordinates.
+    if let Some(list) = &model.coords {
+        eqs.coords = coords::derive_coords(
+            model,
+            &ctx,
+            &mut resolver,
+            list,
+            &rate_of,
+            &built.states,
+            &mut diags,
+        );
+    }
+
+    eqs.energy = energy::terms(model, &ctx, &mut resolver, &rate_of, &mut diags);
+
+    // Readable forms.
+    let output_values: Vec<Ex> = eqs.outputs.iter().map(|o| o.value.clone()).collect();
+    let readable = print::readable(
+        &built,
+        &resolver_rates(&built, &solved, &implicit),
+        &output_values,
+    );
+    for o in &mut eqs.outputs {
+        o.value = readable.alias(&o.value);
+    }
+    eqs.rates = readable.rates;
+    eqs.intermediates = readable.intermediates;
+    eqs.var_names = readable.names;
+    eqs.states = built.states;
+    (eqs, diags)
+}
+
+/// The rates to show: the readable rate when it needs no solve, the solved explicit rate for rates coupled through
+/// derivative causality.
+fn resolver_rates(built: &build::Built, solved: &[Ex], implicit: &[Ex]) -> Vec<Ex> {
+    // The coupled rates in intermediates: inline the intermediates that lead to a derivative-causality output,
+    // drop those outputs (their ẋ terms are on the left-hand side), and solve the same block.
+    let mut leads = vec![None::<bool>; built.defs.len()];
+    fn lead(built: &build::Built, v: usize, memo: &mut [Option<bool>], depth: usize) -> bool {
+        if let Some(known) = memo.get(v).copied().flatten() {
+            return known;
+        }
+        let result = match built.defs.get(v).and_then(Option::as_ref) {
+            Some(build::Def::Rate(_)) => true,
+            Some(build::Def::Plain(e)) if depth < 10_000 => {
+                let mut vars = Vec::new();
+                e.for_each_sym(&mut |s| {
+                    if let Sym::Var(w) = s {
+                        vars.push(w)
+                    }
+                });
+                if let Some(slot) = memo.get_mut(v) {
+                    // A loop back to `v` does not lead anywhere new.
+                    *slot = Some(false);
+                }
+                vars.into_iter().any(|w| lead(built, w, memo, depth + 1))
+            }
+            _ => false,
+        };
+        if let Some(slot) = memo.get_mut(v) {
+            *slot = Some(result);
+        }
+        result
+    }
+    fn inline(built: &build::Built, e: &Ex, memo: &mut [Option<bool>], depth: usize) -> Ex {
+        sym::subst(e, &mut |s| match s {
+            Sym::Var(v) if depth < 10_000 && lead(built, v, memo, 0) => {
+                match built.defs.get(v).and_then(Option::as_ref) {
+                    Some(build::Def::Plain(d)) => Some(inline(built, d, memo, depth + 1)),
+                    _ => Some(Ex::zero()),
+                }
+            }
+            _ => None,
+        })
+    }
+    let f0: Vec<Ex> = built
+        .rates
+        .iter()
+        .map(|r| inline(built, r, &mut leads, 0))
+        .collect();
+    let readable = solve::solve_rates_with(implicit, Some(&f0)).unwrap_or_else(|_| solved.to_vec());
+    built
+        .rates
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let coupled = implicit.iter().any(|e| e.contains(Sym::StateDot(i)));
+            if coupled {
+                readable.get(i).cloned().unwrap_or_else(|| r.clone())
+            } else {
+                r.clone()
+            }
+        })
+        .collect()
+}
+
+fn state_span<'m>(model: &'m Model, s: &StateSpec) -> Option<&'m crate::span::Span> {
+    match (s.node, s.var) {
+        (Some(n), _) => model.spans.nodes.get(n.index()),
+        (_, Some(v)) => model.spans.vars.get(v),
+        _ => None,
+    }
+}
+
+/// The diagnostic of a resolution failure while deriving `what`.
+fn resolve_diag(model: &Model, built: &build::Built, e: &ResolveError, what: &str) -> Diagnostic {
+    let var_name = |v: usize| {
+        built
+            .names
+            .get(v)
+            .cloned()
+            .unwrap_or_else(|| format!("v{v}"))
+    };
+    let definer_span = |v: usize| {
+        built
+            .definer
+            .get(v)
+            .copied()
+            .flatten()
+            .and_then(|n| model.spans.nodes.get(n.index()))
+    };
+    match e {
+        ResolveError::Undefined(v) => Diagnostic::error(
+            codes::UNSUPPORTED,
+            format!("cannot derive {what}: nothing computes `{}`", var_name(*v)),
+        ),
+        ResolveError::NonlinearLoop(v) | ResolveError::SingularLoop(v) => {
+            let kind = if matches!(e, ResolveError::NonlinearLoop(_)) {
+                "a nonlinear algebraic loop"
+            } else {
+                "a singular algebraic loop (its loop gain is one)"
+            };
+            let d = Diagnostic::error(codes::ALGEBRAIC_LOOP, format!("cannot derive {what}: {kind} through `{}`", var_name(*v)))
+                .with_note("linear algebraic loops are solved exactly; nonlinear ones need an iterative solver, which bgc does not generate yet")
+                .with_help("break the loop with a small storage element, or write the resistor law in the causal form the loop needs");
+            with_span(d, definer_span(*v), "the loop passes here")
+        }
+        ResolveError::HigherOrder(v) => with_span(
+            Diagnostic::error(
+                codes::DERIVATIVE_CAUSALITY,
+                format!(
+                    "cannot derive {what}: `{}` is the derivative of a variable that itself holds a derivative or an algebraic loop",
+                    var_name(*v)
+                ),
+            ),
+            definer_span(*v),
+            "this storage is in derivative causality",
+        ),
+        ResolveError::NotDifferentiable(v, f) => with_span(
+            Diagnostic::error(
+                codes::DERIVATIVE_CAUSALITY,
+                format!(
+                    "cannot derive {what}: `{}` is in derivative causality and its law uses `{}`, which has no derivative",
+                    var_name(*v),
+                    f.name()
+                ),
+            ),
+            definer_span(*v),
+            "this storage",
+        ),
+        ResolveError::TooDeep => Diagnostic::error(
+            codes::UNSUPPORTED,
+            format!("cannot derive {what}: its chain of dependencies is too long"),
+        ),
+    }
+}
+
+/// The name of a declared coordinate: a `var`'s name, `f_x`, `p_x`, `q_x`, or `z<k>`.
+pub(crate) fn coord_name(model: &Model, e: &Expr, k: usize) -> String {
+    use crate::ir::Target;
+    let node = |n: NodeIndex| model.graph.node_weight(n).map(|w| build::sanitize(&w.name));
+    let name = match e {
+        Expr::Var(v) => model.vars.get(*v).map(|v| build::sanitize(&v.name)),
+        Expr::Flow(Target::Node(n)) => node(*n).map(|s| format!("f_{s}")),
+        Expr::Effort(Target::Node(n)) => node(*n).map(|s| format!("e_{s}")),
+        Expr::Momentum(n) => node(*n).map(|s| format!("p_{s}")),
+        Expr::Displacement(n) => node(*n).map(|s| format!("q_{s}")),
+        _ => None,
+    };
+    name.unwrap_or_else(|| format!("z{k}"))
+}

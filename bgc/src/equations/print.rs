@@ -1,0 +1,467 @@
+//! Readable equations and their printers: text, LaTeX and JSON.
+//!
+//! The readable form keeps one intermediate per bond variable that the rates and outputs need, except copies (a
+//! junction's common effort or flow on its other bonds), which are replaced by the variable they copy. Intermediates
+//! are listed in dependency order (depth-first from the rates, then the outputs), so each is defined before use
+//! unless an algebraic loop joins them. Output is deterministic: same model, same text.
+
+use super::build::{Built, Def};
+use super::sym::{self, Ex, Sym};
+use super::{Equations, Intermediate, StateKind};
+use crate::ir::Func;
+use serde_json::{Value, json};
+use std::collections::HashMap;
+
+pub(crate) struct Readable {
+    pub rates: Vec<Ex>,
+    pub intermediates: Vec<Intermediate>,
+    /// Per bond variable: the printed name of its representative.
+    pub names: Vec<String>,
+    rep: Vec<usize>,
+}
+
+impl Readable {
+    /// Replaces copies by the variable they copy.
+    pub fn alias(&self, e: &Ex) -> Ex {
+        sym::subst(e, &mut |s| match s {
+            Sym::Var(v) => self.rep.get(v).map(|&r| Ex::S(Sym::Var(r))),
+            _ => None,
+        })
+    }
+}
+
+pub(crate) fn readable(built: &Built, rates: &[Ex], outputs: &[Ex]) -> Readable {
+    let n = built.defs.len();
+    let mut rep: Vec<usize> = (0..n).collect();
+    for (v, slot) in rep.iter_mut().enumerate() {
+        let mut cur = v;
+        // A chain of copies is at most as long as the number of variables.
+        for _ in 0..n {
+            match built.defs.get(cur).and_then(Option::as_ref) {
+                Some(Def::Plain(Ex::S(Sym::Var(w)))) if *w != cur => cur = *w,
+                _ => break,
+            }
+        }
+        *slot = cur;
+    }
+    let mut r = Readable {
+        rates: Vec::new(),
+        intermediates: Vec::new(),
+        names: Vec::new(),
+        rep,
+    };
+    r.rates = rates.iter().map(|e| r.alias(e)).collect();
+    let defs: Vec<Option<(Ex, bool)>> = built
+        .defs
+        .iter()
+        .map(|d| match d {
+            Some(Def::Plain(e)) => Some((r.alias(e), false)),
+            Some(Def::Rate(e)) => Some((r.alias(e), true)),
+            None => None,
+        })
+        .collect();
+    // Depth-first post-order from the roots, on an explicit stack.
+    let mut seen = vec![false; n];
+    let mut order = Vec::new();
+    let roots: Vec<Ex> = r
+        .rates
+        .iter()
+        .cloned()
+        .chain(outputs.iter().map(|o| r.alias(o)))
+        .collect();
+    for root in &roots {
+        for v in vars_of(root) {
+            if seen[v] {
+                continue;
+            }
+            seen[v] = true;
+            let mut stack = vec![(
+                v,
+                vars_of(defs[v].as_ref().map(|d| &d.0).unwrap_or(&Ex::zero())),
+                0usize,
+            )];
+            while let Some((node, deps, i)) = stack.last_mut() {
+                if let Some(&w) = deps.get(*i) {
+                    *i += 1;
+                    if !seen[w] {
+                        seen[w] = true;
+                        let d = vars_of(defs[w].as_ref().map(|d| &d.0).unwrap_or(&Ex::zero()));
+                        stack.push((w, d, 0));
+                    }
+                } else {
+                    order.push(*node);
+                    stack.pop();
+                }
+            }
+        }
+    }
+    // Unique names: a second variable with a taken name gets a numeric suffix.
+    let mut names: Vec<String> = built.names.clone();
+    let mut taken: HashMap<String, usize> = HashMap::new();
+    for &v in &order {
+        let base = names[v].clone();
+        let count = taken.entry(base.clone()).or_insert(0);
+        *count += 1;
+        if *count > 1 {
+            names[v] = format!("{base}_{count}");
+        }
+    }
+    r.names = (0..n).map(|v| names[r.rep[v]].clone()).collect();
+    for &v in &order {
+        if let Some((value, derivative)) = &defs[v] {
+            r.intermediates.push(Intermediate {
+                name: r.names[v].clone(),
+                value: value.clone(),
+                derivative: *derivative,
+            });
+        }
+    }
+    r
+}
+
+/// The bond variables of an expression, in first-use order.
+fn vars_of(e: &Ex) -> Vec<usize> {
+    let mut out = Vec::new();
+    e.for_each_sym(&mut |s| {
+        if let Sym::Var(v) = s
+            && !out.contains(&v)
+        {
+            out.push(v);
+        }
+    });
+    out
+}
+
+/// The output style of [`expr`].
+#[derive(Clone, Copy, PartialEq)]
+enum Style {
+    Text,
+    Latex,
+}
+
+/// Binding strength of what an expression prints as.
+fn precedence(e: &Ex) -> u8 {
+    match e {
+        Ex::Add(_) => 1,
+        Ex::Num(v) if *v < 0.0 => 1,
+        Ex::Mul(fs) if matches!(fs.first(), Some(Ex::Num(c)) if *c < 0.0) => 1,
+        Ex::Mul(_) => 2,
+        Ex::Pow(_, x) if x.num().is_some_and(|v| v < 0.0) => 2,
+        Ex::Pow(..) => 3,
+        _ => 4,
+    }
+}
+
+fn number(v: f64, style: Style) -> String {
+    let s = format!("{v}");
+    if style == Style::Latex
+        && s.len() > 8
+        && let Some((m, e)) = format!("{v:e}").split_once('e')
+    {
+        return format!("{m} \\cdot 10^{{{e}}}");
+    }
+    s
+}
+
+const GREEK: [&str; 24] = [
+    "alpha", "beta", "gamma", "delta", "epsilon", "zeta", "eta", "theta", "iota", "kappa",
+    "lambda", "mu", "nu", "xi", "pi", "rho", "sigma", "tau", "upsilon", "phi", "chi", "psi",
+    "omega", "Omega",
+];
+
+/// A name in LaTeX: `J_sint` → `J_{sint}`, `tau_m` → `\tau_{m}`, `e_hd_spring` → `e_{hd\_spring}`.
+fn latex_name(name: &str) -> String {
+    let (base, sub) = match name.split_once('_') {
+        Some((b, s)) if !b.is_empty() && !s.is_empty() => (b, Some(s)),
+        _ => (name, None),
+    };
+    let base = if GREEK.contains(&base) {
+        format!("\\{base}")
+    } else if base.chars().count() > 1 {
+        format!("\\mathrm{{{}}}", base.replace('_', "\\_"))
+    } else {
+        base.to_string()
+    };
+    match sub {
+        Some(s) => format!("{base}_{{{}}}", s.replace('_', "\\_")),
+        None => base,
+    }
+}
+
+fn name_of(eqs: &Equations, s: Sym, style: Style) -> String {
+    match (style, s) {
+        (Style::Latex, Sym::StateDot(i)) => {
+            format!("\\dot{{{}}}", name_of(eqs, Sym::State(i), style))
+        }
+        (Style::Latex, Sym::InputDot(i)) => {
+            format!("\\dot{{{}}}", name_of(eqs, Sym::Input(i), style))
+        }
+        (Style::Latex, _) => latex_name(&eqs.sym_name(s)),
+        (Style::Text, _) => eqs.sym_name(s),
+    }
+}
+
+fn wrap(s: String, style: Style) -> String {
+    match style {
+        Style::Text => format!("({s})"),
+        Style::Latex => format!("\\left({s}\\right)"),
+    }
+}
+
+/// Prints `e`, in parentheses when it binds less tightly than `min`.
+fn expr_at(eqs: &Equations, e: &Ex, style: Style, min: u8) -> String {
+    let s = expr(eqs, e, style);
+    if precedence(e) < min {
+        wrap(s, style)
+    } else {
+        s
+    }
+}
+
+fn expr(eqs: &Equations, e: &Ex, style: Style) -> String {
+    match e {
+        Ex::Num(v) => number(*v, style),
+        Ex::S(s) => name_of(eqs, *s, style),
+        Ex::Add(ts) => {
+            let mut out = String::new();
+            for (i, t) in ts.iter().enumerate() {
+                let (negative, body) = match t {
+                    Ex::Num(v) if *v < 0.0 => (true, Ex::Num(-v)),
+                    Ex::Mul(fs) if matches!(fs.first(), Some(Ex::Num(c)) if *c < 0.0) => {
+                        (true, sym::neg(t.clone()))
+                    }
+                    _ => (false, t.clone()),
+                };
+                let body = expr_at(eqs, &body, style, 2);
+                match (i, negative) {
+                    (0, false) => out.push_str(&body),
+                    (0, true) => out.push_str(&format!("-{body}")),
+                    (_, false) => out.push_str(&format!(" + {body}")),
+                    (_, true) => out.push_str(&format!(" - {body}")),
+                }
+            }
+            out
+        }
+        Ex::Mul(fs) => {
+            let mut coef = 1.0;
+            let mut num = Vec::new();
+            let mut den = Vec::new();
+            for f in fs {
+                match f {
+                    Ex::Num(v) => coef *= v,
+                    Ex::Pow(b, x) if x.num().is_some_and(|v| v < 0.0) => {
+                        den.push(sym::pow((**b).clone(), Ex::Num(-x.num().unwrap_or(-1.0))))
+                    }
+                    other => num.push(other.clone()),
+                }
+            }
+            let sign = if coef < 0.0 { "-" } else { "" };
+            let coef = coef.abs();
+            let join = |list: &[Ex], min: u8| -> String {
+                let sep = if style == Style::Text { "*" } else { " " };
+                list.iter()
+                    .map(|f| expr_at(eqs, f, style, min))
+                    .collect::<Vec<_>>()
+                    .join(sep)
+            };
+            let mut numerator = join(&num, 3);
+            if coef != 1.0 || num.is_empty() {
+                let c = number(coef, style);
+                numerator = if num.is_empty() {
+                    c
+                } else if style == Style::Text {
+                    format!("{c}*{numerator}")
+                } else {
+                    format!("{c} {numerator}")
+                };
+            }
+            if den.is_empty() {
+                return format!("{sign}{numerator}");
+            }
+            match style {
+                Style::Latex => {
+                    let d = if den.len() == 1 {
+                        expr(eqs, &den[0], style)
+                    } else {
+                        den.iter()
+                            .map(|f| expr_at(eqs, f, style, 3))
+                            .collect::<Vec<_>>()
+                            .join(" ")
+                    };
+                    format!("{sign}\\frac{{{numerator}}}{{{d}}}")
+                }
+                Style::Text => {
+                    let d = if den.len() == 1 {
+                        expr_at(eqs, &den[0], style, 4)
+                    } else {
+                        wrap(join(&den, 3), style)
+                    };
+                    format!("{sign}{numerator}/{d}")
+                }
+            }
+        }
+        Ex::Pow(b, x) => {
+            if let Some(v) = x.num() {
+                if v < 0.0 {
+                    let positive = sym::pow((**b).clone(), Ex::Num(-v));
+                    return match style {
+                        Style::Text => format!("1/{}", expr_at(eqs, &positive, style, 4)),
+                        Style::Latex => format!("\\frac{{1}}{{{}}}", expr(eqs, &positive, style)),
+                    };
+                }
+                if v == 0.5 {
+                    return call(eqs, Func::Sqrt, std::slice::from_ref(b), style);
+                }
+            }
+            let base = expr_at(eqs, b, style, 4);
+            match style {
+                Style::Text => format!("{base}^{}", expr_at(eqs, x, style, 4)),
+                Style::Latex => format!("{base}^{{{}}}", expr(eqs, x, style)),
+            }
+        }
+        Ex::Call(f, args) => call(eqs, *f, args, style),
+    }
+}
+
+fn call(eqs: &Equations, f: Func, args: &[Ex], style: Style) -> String {
+    let list = args
+        .iter()
+        .map(|a| expr(eqs, a, style))
+        .collect::<Vec<_>>()
+        .join(", ");
+    match style {
+        Style::Text => format!("{}({list})", f.name()),
+        Style::Latex => match f {
+            Func::Sqrt => format!("\\sqrt{{{list}}}"),
+            Func::Abs => format!("\\left|{list}\\right|"),
+            Func::Sin
+            | Func::Cos
+            | Func::Tan
+            | Func::Exp
+            | Func::Ln
+            | Func::Tanh
+            | Func::Sinh
+            | Func::Cosh => {
+                format!("\\{}\\left({list}\\right)", f.name())
+            }
+            _ => format!("\\operatorname{{{}}}\\left({list}\\right)", f.name()),
+        },
+    }
+}
+
+/// An expression as text, with the symbol names of `eqs`.
+pub fn expr_text(eqs: &Equations, e: &Ex) -> String {
+    expr(eqs, e, Style::Text)
+}
+
+/// An expression in LaTeX.
+pub fn expr_latex(eqs: &Equations, e: &Ex) -> String {
+    expr(eqs, e, Style::Latex)
+}
+
+/// The equations as text: one equation per line, grouped into states, intermediates and outputs.
+pub fn to_text(eqs: &Equations) -> String {
+    let mut out = format!("model {}\n", eqs.model);
+    out.push_str("states:\n");
+    for (s, r) in eqs.states.iter().zip(&eqs.rates) {
+        out.push_str(&format!("  d/dt {} = {}\n", s.name, expr_text(eqs, r)));
+    }
+    out.push_str("intermediates:\n");
+    for i in &eqs.intermediates {
+        let v = expr_text(eqs, &i.value);
+        if i.derivative {
+            out.push_str(&format!("  {} = d/dt({v})\n", i.name));
+        } else {
+            out.push_str(&format!("  {} = {v}\n", i.name));
+        }
+    }
+    out.push_str("outputs:\n");
+    for o in &eqs.outputs {
+        out.push_str(&format!("  {} = {}\n", o.name, expr_text(eqs, &o.value)));
+    }
+    out
+}
+
+/// The equations in LaTeX: one `aligned` environment per group.
+pub fn to_latex(eqs: &Equations) -> String {
+    let mut out = String::new();
+    let mut group = |title: &str, lines: Vec<(String, String)>| {
+        out.push_str(&format!("% {title}\n\\begin{{aligned}}\n"));
+        for (l, r) in lines {
+            out.push_str(&format!("  {l} &= {r} \\\\\n"));
+        }
+        out.push_str("\\end{aligned}\n");
+    };
+    group(
+        "states",
+        eqs.states
+            .iter()
+            .zip(&eqs.rates)
+            .map(|(s, r)| {
+                (
+                    format!("\\dot{{{}}}", latex_name(&s.name)),
+                    expr_latex(eqs, r),
+                )
+            })
+            .collect(),
+    );
+    group(
+        "intermediates",
+        eqs.intermediates
+            .iter()
+            .map(|i| {
+                let v = expr_latex(eqs, &i.value);
+                let v = if i.derivative {
+                    format!("\\frac{{d}}{{dt}}\\left({v}\\right)")
+                } else {
+                    v
+                };
+                (latex_name(&i.name), v)
+            })
+            .collect(),
+    );
+    group(
+        "outputs",
+        eqs.outputs
+            .iter()
+            .map(|o| (latex_name(&o.name), expr_latex(eqs, &o.value)))
+            .collect(),
+    );
+    out
+}
+
+/// The equations as JSON: readable and explicit forms of every rate and output, as text.
+pub fn to_json(eqs: &Equations) -> Value {
+    let text = |e: &Option<Ex>| e.as_ref().map(|e| expr_text(eqs, e));
+    json!({
+        "model": eqs.model,
+        "params": eqs.params.iter().map(|(n, v)| json!({"name": n, "default": v})).collect::<Vec<_>>(),
+        "inputs": eqs.inputs,
+        "states": eqs.states.iter().enumerate().map(|(i, s)| json!({
+            "name": s.name,
+            "kind": match s.kind {
+                StateKind::Momentum => "momentum",
+                StateKind::Displacement => "displacement",
+                StateKind::Integrated => "integrated",
+            },
+            "rate": eqs.rates.get(i).map(|r| expr_text(eqs, r)),
+            "explicit": text(eqs.f.get(i).unwrap_or(&None)),
+        })).collect::<Vec<_>>(),
+        "intermediates": eqs.intermediates.iter().map(|i| json!({
+            "name": i.name,
+            "value": expr_text(eqs, &i.value),
+            "derivative": i.derivative,
+        })).collect::<Vec<_>>(),
+        "outputs": eqs.outputs.iter().map(|o| json!({
+            "name": o.name,
+            "value": expr_text(eqs, &o.value),
+            "explicit": text(&o.explicit),
+        })).collect::<Vec<_>>(),
+        "coords": eqs.coords.as_ref().map(|c| c.iter().map(|(n, e)| json!({"name": n, "value": expr_text(eqs, e)})).collect::<Vec<_>>()),
+        "energy": eqs.energy.iter().map(|t| json!({
+            "element": t.element,
+            "kind": t.kind.name(),
+            "value": text(&t.value),
+        })).collect::<Vec<_>>(),
+    })
+}

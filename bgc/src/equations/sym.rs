@@ -1,0 +1,624 @@
+//! A small symbolic expression type for the equations stage.
+//!
+//! Expressions are built through constructors that keep them in a light canonical form, so that equal expressions
+//! compare equal often enough for cancellation (`x - x = 0`, `J * J^-1 = 1`) and printing is deterministic:
+//! - sums are flat, numbers are folded, like terms (same non-numeric part) are collected, terms are sorted;
+//! - products are flat, numbers are folded, equal bases are collected by adding exponents, factors are sorted;
+//! - `a - b` is `a + (-1)·b`, `a / b` is `a · b^-1`; a numeric power of a product is distributed.
+//!
+//! Nothing here knows about bond graphs: leaves are [`Sym`] symbols that the stage names.
+
+use crate::ir::Func;
+use std::collections::BTreeMap;
+
+/// A leaf symbol.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Sym {
+    /// A model parameter.
+    Param(usize),
+    /// A model input.
+    Input(usize),
+    /// The time derivative of an input (only appears transiently; an equation that keeps one is refused).
+    InputDot(usize),
+    /// A state (index into the equations' state list).
+    State(usize),
+    /// The time derivative of a state (an unknown while derivative causality is resolved).
+    StateDot(usize),
+    /// An intermediate bond variable (index into the equations' variable table).
+    Var(usize),
+    /// A tear variable of an algebraic loop (the variable index it stands for).
+    Tear(usize),
+    /// Time.
+    Time,
+}
+
+/// A symbolic expression.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Ex {
+    Num(f64),
+    S(Sym),
+    Add(Vec<Ex>),
+    Mul(Vec<Ex>),
+    Pow(Box<Ex>, Box<Ex>),
+    Call(Func, Vec<Ex>),
+}
+
+impl Ex {
+    pub fn zero() -> Ex {
+        Ex::Num(0.0)
+    }
+
+    pub fn one() -> Ex {
+        Ex::Num(1.0)
+    }
+
+    pub fn sym(s: Sym) -> Ex {
+        Ex::S(s)
+    }
+
+    pub fn num(&self) -> Option<f64> {
+        match self {
+            Ex::Num(v) => Some(*v),
+            _ => None,
+        }
+    }
+
+    pub fn is_zero(&self) -> bool {
+        self.num() == Some(0.0)
+    }
+
+    /// A structural key: equal keys mean equal expressions. Used for sorting and collecting.
+    pub fn key(&self) -> String {
+        let mut s = String::new();
+        self.write_key(&mut s);
+        s
+    }
+
+    fn write_key(&self, s: &mut String) {
+        match self {
+            // Numbers sort first; their bit pattern makes the key exact.
+            Ex::Num(v) => s.push_str(&format!("#{v:e}")),
+            Ex::S(sym) => s.push_str(&format!("{sym:?}")),
+            Ex::Add(ts) => {
+                s.push_str("+(");
+                for t in ts {
+                    t.write_key(s);
+                    s.push(',');
+                }
+                s.push(')');
+            }
+            Ex::Mul(fs) => {
+                s.push_str("*(");
+                for f in fs {
+                    f.write_key(s);
+                    s.push(',');
+                }
+                s.push(')');
+            }
+            Ex::Pow(b, e) => {
+                s.push_str("^(");
+                b.write_key(s);
+                s.push(',');
+                e.write_key(s);
+                s.push(')');
+            }
+            Ex::Call(f, args) => {
+                s.push_str(f.name());
+                s.push('(');
+                for a in args {
+                    a.write_key(s);
+                    s.push(',');
+                }
+                s.push(')');
+            }
+        }
+    }
+
+    /// Visits every symbol.
+    pub fn for_each_sym(&self, f: &mut dyn FnMut(Sym)) {
+        match self {
+            Ex::Num(_) => {}
+            Ex::S(s) => f(*s),
+            Ex::Add(v) | Ex::Mul(v) | Ex::Call(_, v) => v.iter().for_each(|e| e.for_each_sym(f)),
+            Ex::Pow(b, e) => {
+                b.for_each_sym(f);
+                e.for_each_sym(f);
+            }
+        }
+    }
+
+    /// True when some symbol satisfies `pred`.
+    pub fn any_sym(&self, pred: &dyn Fn(Sym) -> bool) -> bool {
+        let mut found = false;
+        self.for_each_sym(&mut |s| found |= pred(s));
+        found
+    }
+
+    pub fn contains(&self, s: Sym) -> bool {
+        self.any_sym(&|t| t == s)
+    }
+}
+
+/// `a + b + ...` in canonical form.
+pub fn add(terms: Vec<Ex>) -> Ex {
+    let mut constant = 0.0;
+    // Non-numeric part key -> (coefficient, part).
+    let mut groups: BTreeMap<String, (f64, Ex)> = BTreeMap::new();
+    let mut stack = terms;
+    while let Some(t) = stack.pop() {
+        match t {
+            Ex::Num(v) => constant += v,
+            Ex::Add(inner) => stack.extend(inner),
+            other => {
+                let (c, rest) = split_coefficient(other);
+                let entry = groups.entry(rest.key()).or_insert((0.0, rest));
+                entry.0 += c;
+            }
+        }
+    }
+    let mut out: Vec<Ex> = Vec::new();
+    if constant != 0.0 {
+        out.push(Ex::Num(constant));
+    }
+    for (_, (c, rest)) in groups {
+        if c != 0.0 {
+            out.push(scale(c, rest));
+        }
+    }
+    match out.len() {
+        0 => Ex::zero(),
+        1 => out.pop().unwrap_or(Ex::zero()),
+        _ => Ex::Add(out),
+    }
+}
+
+/// Splits `c · rest` with `c` numeric.
+fn split_coefficient(e: Ex) -> (f64, Ex) {
+    match e {
+        Ex::Mul(fs) => {
+            let mut c = 1.0;
+            let mut rest = Vec::new();
+            for f in fs {
+                match f {
+                    Ex::Num(v) => c *= v,
+                    other => rest.push(other),
+                }
+            }
+            let rest = match rest.len() {
+                1 => rest.pop().unwrap_or(Ex::one()),
+                _ => Ex::Mul(rest),
+            };
+            (c, rest)
+        }
+        other => (1.0, other),
+    }
+}
+
+fn scale(c: f64, rest: Ex) -> Ex {
+    if c == 1.0 {
+        rest
+    } else {
+        mul(vec![Ex::Num(c), rest])
+    }
+}
+
+/// `a · b · ...` in canonical form.
+pub fn mul(factors: Vec<Ex>) -> Ex {
+    let mut constant = 1.0;
+    // Base key -> (base, exponent terms).
+    let mut groups: BTreeMap<String, (Ex, Vec<Ex>)> = BTreeMap::new();
+    let mut stack = factors;
+    while let Some(f) = stack.pop() {
+        match f {
+            Ex::Num(v) => constant *= v,
+            Ex::Mul(inner) => stack.extend(inner),
+            Ex::Pow(b, e) => {
+                let entry = groups.entry(b.key()).or_insert((*b, Vec::new()));
+                entry.1.push(*e);
+            }
+            other => {
+                let entry = groups.entry(other.key()).or_insert((other, Vec::new()));
+                entry.1.push(Ex::one());
+            }
+        }
+    }
+    if constant == 0.0 {
+        return Ex::zero();
+    }
+    let mut out: Vec<Ex> = Vec::new();
+    for (_, (base, exps)) in groups {
+        match pow(base, add(exps)) {
+            Ex::Num(v) => constant *= v,
+            Ex::Mul(inner) => {
+                // A power that distributed over a product: fold it in again (its factors are already canonical).
+                for f in inner {
+                    match f {
+                        Ex::Num(v) => constant *= v,
+                        other => out.push(other),
+                    }
+                }
+            }
+            other => out.push(other),
+        }
+    }
+    if constant == 0.0 {
+        return Ex::zero();
+    }
+    out.sort_by_key(Ex::key);
+    if constant != 1.0 {
+        out.insert(0, Ex::Num(constant));
+    }
+    match out.len() {
+        0 => Ex::one(),
+        1 => out.pop().unwrap_or(Ex::one()),
+        _ => Ex::Mul(out),
+    }
+}
+
+/// `base ^ exponent`.
+pub fn pow(base: Ex, exponent: Ex) -> Ex {
+    match (&base, exponent.num()) {
+        (_, Some(0.0)) => Ex::one(),
+        (_, Some(1.0)) => base,
+        (Ex::Num(b), Some(e)) => {
+            let v = b.powf(e);
+            if v.is_finite() {
+                Ex::Num(v)
+            } else {
+                Ex::Pow(Box::new(base), Box::new(exponent))
+            }
+        }
+        (Ex::Num(b), None) if *b == 1.0 => Ex::one(),
+        (Ex::Pow(b, e1), Some(e)) => match e1.num() {
+            // (b^n)^m = b^(nm) for integer m (always valid) or when b^n is known positive for even n... keep to
+            // integer m.
+            Some(n) if e.fract() == 0.0 => pow((**b).clone(), Ex::Num(n * e)),
+            _ => Ex::Pow(Box::new(base), Box::new(exponent)),
+        },
+        (Ex::Mul(fs), Some(e)) if e.fract() == 0.0 => {
+            mul(fs.iter().map(|f| pow(f.clone(), Ex::Num(e))).collect())
+        }
+        _ => Ex::Pow(Box::new(base), Box::new(exponent)),
+    }
+}
+
+pub fn neg(a: Ex) -> Ex {
+    mul(vec![Ex::Num(-1.0), a])
+}
+
+pub fn sub(a: Ex, b: Ex) -> Ex {
+    add(vec![a, neg(b)])
+}
+
+pub fn div(a: Ex, b: Ex) -> Ex {
+    mul(vec![a, pow(b, Ex::Num(-1.0))])
+}
+
+pub fn recip(a: Ex) -> Ex {
+    pow(a, Ex::Num(-1.0))
+}
+
+/// A function call, folded when its arguments are numbers.
+pub fn call(f: Func, args: Vec<Ex>) -> Ex {
+    let nums: Option<Vec<f64>> = args.iter().map(Ex::num).collect();
+    if let Some(v) = nums.and_then(|n| eval_func(f, &n))
+        && v.is_finite()
+    {
+        return Ex::Num(v);
+    }
+    Ex::Call(f, args)
+}
+
+/// Evaluates a function on numbers (`None` on an arity mismatch).
+pub fn eval_func(f: Func, a: &[f64]) -> Option<f64> {
+    let x = *a.first()?;
+    let y = a.get(1).copied();
+    Some(match f {
+        Func::Sin => x.sin(),
+        Func::Cos => x.cos(),
+        Func::Tan => x.tan(),
+        Func::Asin => x.asin(),
+        Func::Acos => x.acos(),
+        Func::Atan => x.atan(),
+        Func::Atan2 => x.atan2(y?),
+        Func::Exp => x.exp(),
+        Func::Ln => x.ln(),
+        Func::Log10 => x.log10(),
+        Func::Sqrt => x.sqrt(),
+        Func::Abs => x.abs(),
+        Func::Sign => {
+            if x > 0.0 {
+                1.0
+            } else if x < 0.0 {
+                -1.0
+            } else {
+                0.0
+            }
+        }
+        Func::Min => x.min(y?),
+        Func::Max => x.max(y?),
+        Func::Tanh => x.tanh(),
+        Func::Sinh => x.sinh(),
+        Func::Cosh => x.cosh(),
+    })
+}
+
+/// Products of sums multiplied out (`a (b + c)` → `a b + a c`), unless that would make more than 64 terms, in
+/// which case the expression is returned as it is.
+pub fn expand(e: &Ex) -> Ex {
+    const MAX_TERMS: usize = 64;
+    match e {
+        Ex::Add(ts) => add(ts.iter().map(expand).collect()),
+        Ex::Mul(fs) => {
+            let mut terms = vec![Ex::one()];
+            for f in fs.iter().map(expand) {
+                match f {
+                    Ex::Add(inner) => {
+                        if terms.len() * inner.len() > MAX_TERMS {
+                            return e.clone();
+                        }
+                        terms = terms
+                            .iter()
+                            .flat_map(|t| {
+                                inner.iter().map(move |i| mul(vec![t.clone(), i.clone()]))
+                            })
+                            .collect();
+                    }
+                    other => terms
+                        .iter_mut()
+                        .for_each(|t| *t = mul(vec![t.clone(), other.clone()])),
+                }
+            }
+            add(terms)
+        }
+        _ => e.clone(),
+    }
+}
+
+/// Replaces symbols: `f(s)` gives the replacement or `None` to keep `s`. The result is re-canonicalised.
+pub fn subst(e: &Ex, f: &mut dyn FnMut(Sym) -> Option<Ex>) -> Ex {
+    match e {
+        Ex::Num(_) => e.clone(),
+        Ex::S(s) => f(*s).unwrap_or_else(|| e.clone()),
+        Ex::Add(ts) => add(ts.iter().map(|t| subst(t, f)).collect()),
+        Ex::Mul(fs) => mul(fs.iter().map(|t| subst(t, f)).collect()),
+        Ex::Pow(b, x) => pow(subst(b, f), subst(x, f)),
+        Ex::Call(func, args) => call(*func, args.iter().map(|a| subst(a, f)).collect()),
+    }
+}
+
+/// Why an expression could not be differentiated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NotDifferentiable(pub Func);
+
+/// `∂e/∂s`.
+pub fn diff(e: &Ex, s: Sym) -> Result<Ex, NotDifferentiable> {
+    if !e.contains(s) {
+        return Ok(Ex::zero());
+    }
+    Ok(match e {
+        Ex::Num(_) => Ex::zero(),
+        Ex::S(t) => {
+            if *t == s {
+                Ex::one()
+            } else {
+                Ex::zero()
+            }
+        }
+        Ex::Add(ts) => add(ts.iter().map(|t| diff(t, s)).collect::<Result<_, _>>()?),
+        Ex::Mul(fs) => {
+            let mut terms = Vec::new();
+            for (i, fi) in fs.iter().enumerate() {
+                let d = diff(fi, s)?;
+                if d.is_zero() {
+                    continue;
+                }
+                let mut prod: Vec<Ex> = fs
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, _)| *j != i)
+                    .map(|(_, f)| f.clone())
+                    .collect();
+                prod.push(d);
+                terms.push(mul(prod));
+            }
+            add(terms)
+        }
+        Ex::Pow(b, x) => {
+            let db = diff(b, s)?;
+            if !x.contains(s) {
+                // n b^(n-1) b'
+                mul(vec![
+                    (**x).clone(),
+                    pow((**b).clone(), sub((**x).clone(), Ex::one())),
+                    db,
+                ])
+            } else {
+                // b^x (x' ln b + x b'/b)
+                let dx = diff(x, s)?;
+                mul(vec![
+                    e.clone(),
+                    add(vec![
+                        mul(vec![dx, call(Func::Ln, vec![(**b).clone()])]),
+                        mul(vec![(**x).clone(), db, recip((**b).clone())]),
+                    ]),
+                ])
+            }
+        }
+        Ex::Call(f, args) => {
+            let a = args.first().cloned().unwrap_or(Ex::zero());
+            let da = diff(&a, s)?;
+            let outer = match f {
+                Func::Sin => call(Func::Cos, vec![a]),
+                Func::Cos => neg(call(Func::Sin, vec![a])),
+                Func::Tan => pow(call(Func::Cos, vec![a]), Ex::Num(-2.0)),
+                Func::Asin => pow(sub(Ex::one(), pow(a, Ex::Num(2.0))), Ex::Num(-0.5)),
+                Func::Acos => neg(pow(sub(Ex::one(), pow(a, Ex::Num(2.0))), Ex::Num(-0.5))),
+                Func::Atan => recip(add(vec![Ex::one(), pow(a, Ex::Num(2.0))])),
+                Func::Exp => call(Func::Exp, vec![a]),
+                Func::Ln => recip(a),
+                Func::Log10 => recip(mul(vec![Ex::Num(std::f64::consts::LN_10), a])),
+                Func::Sqrt => mul(vec![Ex::Num(0.5), pow(a, Ex::Num(-0.5))]),
+                Func::Abs => call(Func::Sign, vec![a]),
+                // The derivative of sign is zero almost everywhere.
+                Func::Sign => Ex::zero(),
+                Func::Tanh => sub(Ex::one(), pow(call(Func::Tanh, vec![a]), Ex::Num(2.0))),
+                Func::Sinh => call(Func::Cosh, vec![a]),
+                Func::Cosh => call(Func::Sinh, vec![a]),
+                Func::Atan2 => {
+                    // atan2(y, x): (x y' - y x') / (x^2 + y^2)
+                    let y = a;
+                    let x = args.get(1).cloned().unwrap_or(Ex::one());
+                    let dx = diff(&x, s)?;
+                    return Ok(div(
+                        sub(mul(vec![x.clone(), da]), mul(vec![y.clone(), dx])),
+                        add(vec![pow(x, Ex::Num(2.0)), pow(y, Ex::Num(2.0))]),
+                    ));
+                }
+                Func::Min | Func::Max => return Err(NotDifferentiable(*f)),
+            };
+            mul(vec![outer, da])
+        }
+    })
+}
+
+/// Why an expression could not be evaluated.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EvalError {
+    /// A symbol without a value.
+    Unbound(Sym),
+    /// A function call with the wrong number of arguments.
+    Arity(Func),
+}
+
+/// Evaluates with values of the symbols from `value`.
+pub fn eval(e: &Ex, value: &dyn Fn(Sym) -> Option<f64>) -> Result<f64, EvalError> {
+    Ok(match e {
+        Ex::Num(v) => *v,
+        Ex::S(s) => value(*s).ok_or(EvalError::Unbound(*s))?,
+        Ex::Add(ts) => {
+            let mut acc = 0.0;
+            for t in ts {
+                acc += eval(t, value)?;
+            }
+            acc
+        }
+        Ex::Mul(fs) => {
+            let mut acc = 1.0;
+            for f in fs {
+                acc *= eval(f, value)?;
+            }
+            acc
+        }
+        Ex::Pow(b, x) => {
+            let b = eval(b, value)?;
+            let x = eval(x, value)?;
+            if x.fract() == 0.0 && x.abs() < 64.0 {
+                b.powi(x as i32)
+            } else {
+                b.powf(x)
+            }
+        }
+        Ex::Call(f, args) => {
+            let vals = args
+                .iter()
+                .map(|a| eval(a, value))
+                .collect::<Result<Vec<_>, _>>()?;
+            eval_func(*f, &vals).ok_or(EvalError::Arity(*f))?
+        }
+    })
+}
+
+/// `e = a·s + b` with `a`, `b` free of `s`, or `None` when `e` is not affine in `s`.
+pub fn affine_in(e: &Ex, s: Sym) -> Option<(Ex, Ex)> {
+    // Functions such as sign have a zero derivative almost everywhere: the derivative test alone would take
+    // `sign(s)` for a constant. `s` must appear only under sums, products and integer powers.
+    if !algebraic_in(e, s) {
+        return None;
+    }
+    let a = diff(e, s).ok()?;
+    if a.contains(s) {
+        return None;
+    }
+    let b = subst(e, &mut |t| (t == s).then(Ex::zero));
+    Some((a, b))
+}
+
+/// True when `s` appears in `e` only under sums, products and integer powers.
+fn algebraic_in(e: &Ex, s: Sym) -> bool {
+    match e {
+        Ex::Num(_) | Ex::S(_) => true,
+        Ex::Add(v) | Ex::Mul(v) => v.iter().all(|t| algebraic_in(t, s)),
+        Ex::Pow(b, x) => {
+            !x.contains(s)
+                && (!b.contains(s) || x.num().is_some_and(|n| n.fract() == 0.0))
+                && algebraic_in(b, s)
+        }
+        Ex::Call(_, args) => !args.iter().any(|a| a.contains(s)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn x() -> Ex {
+        Ex::S(Sym::Param(0))
+    }
+    fn y() -> Ex {
+        Ex::S(Sym::Param(1))
+    }
+
+    #[test]
+    fn cancellation_and_collection() {
+        assert_eq!(sub(x(), x()), Ex::zero());
+        assert_eq!(div(x(), x()), Ex::one());
+        assert_eq!(add(vec![x(), x()]), mul(vec![Ex::Num(2.0), x()]));
+        assert_eq!(mul(vec![x(), x()]), pow(x(), Ex::Num(2.0)));
+        // Order does not matter.
+        assert_eq!(add(vec![x(), y()]), add(vec![y(), x()]));
+        assert_eq!(mul(vec![x(), y()]), mul(vec![y(), x()]));
+        // (x y)^-1 x = y^-1
+        assert_eq!(mul(vec![recip(mul(vec![x(), y()])), x()]), recip(y()));
+    }
+
+    #[test]
+    fn derivatives_match_finite_differences() {
+        // e = x^3 sin(x y) + exp(x)/y
+        let e = add(vec![
+            mul(vec![
+                pow(x(), Ex::Num(3.0)),
+                call(Func::Sin, vec![mul(vec![x(), y()])]),
+            ]),
+            div(call(Func::Exp, vec![x()]), y()),
+        ]);
+        let d = diff(&e, Sym::Param(0)).unwrap_or(Ex::zero());
+        let at = |xv: f64| {
+            move |s: Sym| match s {
+                Sym::Param(0) => Some(xv),
+                Sym::Param(1) => Some(0.7),
+                _ => None,
+            }
+        };
+        let h = 1e-6;
+        let fd = (eval(&e, &at(1.3 + h)).unwrap_or(0.0) - eval(&e, &at(1.3 - h)).unwrap_or(0.0))
+            / (2.0 * h);
+        let exact = eval(&d, &at(1.3)).unwrap_or(f64::NAN);
+        assert!(
+            (fd - exact).abs() < 1e-6 * exact.abs().max(1.0),
+            "{fd} vs {exact}"
+        );
+    }
+
+    #[test]
+    fn affine_split() {
+        let e = add(vec![mul(vec![x(), y()]), Ex::Num(3.0)]);
+        let (a, b) = affine_in(&e, Sym::Param(0)).unwrap_or((Ex::zero(), Ex::zero()));
+        assert_eq!(a, y());
+        assert_eq!(b, Ex::Num(3.0));
+        assert!(affine_in(&pow(x(), Ex::Num(2.0)), Sym::Param(0)).is_none());
+        // sign(x) has a zero derivative but is not affine.
+        let coulomb = add(vec![call(Func::Sign, vec![x()]), mul(vec![y(), x()])]);
+        assert!(affine_in(&coulomb, Sym::Param(0)).is_none());
+    }
+}

@@ -174,6 +174,8 @@ fn a_linear_algebraic_loop_is_solved_exactly() {
     );
     let (eqs, diags) = derive(&model, &causality);
     assert!(diags.is_empty(), "{diags:?}");
+    assert!(!eqs.loops.is_empty());
+    assert!(to_text(&eqs).contains("algebraic loop, solved exactly"));
     // Node voltage v: (u - v)/R1 = v/R2 + (v - q/C)/R3, so v = (u/R1 + q/(C R3))/G with G = 1/R1 + 1/R2 + 1/R3;
     // q̇ = (v - q/C)/R3.
     let mut rng = Rng(21);

@@ -78,6 +78,27 @@ fn hardening_spring_jacobians_and_linearisation() {
         }
     };
     assert_eq!(sym::eval(entry, &at(0.1)), Ok(-(800.0 + 3.0 * 5e4 * 0.01)));
+    // The same rate through the shared expression engine evaluates to the same number.
+    for (i, f) in eqs.f.iter().enumerate() {
+        let f = f.as_ref().expect("rate");
+        let shared = bgc::equations::to_symbolic(&eqs, f).expect("convertible");
+        let env = |s: &bgc::symbolic::Symbol| match s.name() {
+            "m" => Some(2.0),
+            "k" => Some(800.0),
+            "k3" => Some(5e4),
+            "d" => Some(4.0),
+            "F" => Some(1.5),
+            "q_spring" => Some(0.1),
+            "p_mass" => Some(0.4),
+            _ => None,
+        };
+        let ours = sym::eval(f, &|s| env(&bgc::equations::symbol(&eqs, s))).expect("eval");
+        let theirs = shared.eval(env).expect("eval");
+        assert!(
+            (ours - theirs).abs() <= 1e-12 * ours.abs().max(1.0),
+            "rate {i}: {ours} vs {theirs}"
+        );
+    }
     let mut x0 = vec![0.0; 2];
     x0[q_index] = 0.1;
     x0[p_index] = 0.4;

@@ -24,6 +24,8 @@
 //! A causally complete model (no conflict, no derivative causality, no loop, no arbitrary choice, no hint) gets no
 //! diagnostics at all.
 
+mod conflicts;
+mod context;
 mod engine;
 mod findings;
 mod loops;

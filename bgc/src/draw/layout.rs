@@ -3,12 +3,15 @@
 //! The "backbone" (junctions, two-ports, fields, and 1-ports not hanging on a junction) is laid out left to right
 //! in layers: the power direction of the bonds gives a longest-path layering (after reversing the back edges of a
 //! depth-first search so that it is acyclic), bonds spanning several layers get dummy points, and the order within
-//! each layer is improved by barycentric sweeps. Each 1-port attached to a junction (its satellites) is placed
-//! above or below that junction, alternately, so that storage, resistors and sources sit next to the junction
+//! each layer is improved by barycentric sweeps. Heights follow the neighbours' mean, with the node on the longest
+//! chain of each layer kept in place, so that the main chain of junctions is drawn on one straight line. Each
+//! 1-port attached to a junction (its satellites) is placed beside it (a source, on a free side) or above or below
+//! it, alternately, so that storage, resistors and sources sit next to the junction
 //! they belong to, as drawn in textbooks. Every backbone node owns a cell as wide as its satellites: bonds between
 //! layers leave a cell horizontally, so they never run through another element.
 
 use super::label::{NodeLabel, node_label};
+use super::layers::{acyclic, longest_path_layers, order_layers};
 use crate::ir::Model;
 use crate::syntax::ast::ElementKind;
 use petgraph::graph::NodeIndex;
@@ -74,7 +77,7 @@ struct Extent {
 
 /// A layer slot: a backbone node or a dummy point of a long bond.
 #[derive(Clone, Copy, PartialEq)]
-enum Slot {
+pub enum Slot {
     Node(usize),
     Dummy(usize),
 }
@@ -257,11 +260,50 @@ pub fn layout(model: &Model) -> Layout {
         x += l + r + COL_GAP;
     }
 
+    // The longest chain through each slot: in each layer the slot on the longest chain is the anchor that keeps
+    // the height it wants, so that the main chain of junctions is drawn straight and branches go around it.
+    let total_slots = n + dummy_layer.len();
+    let mut down = vec![0usize; total_slots];
+    let mut up = vec![0usize; total_slots];
+    for layer_slots in slots.iter().rev() {
+        for &s in layer_slots {
+            down[key(s)] = succs[key(s)]
+                .iter()
+                .map(|&t| down[key(t)] + 1)
+                .max()
+                .unwrap_or(0);
+        }
+    }
+    for layer_slots in &slots {
+        for &s in layer_slots {
+            up[key(s)] = preds[key(s)]
+                .iter()
+                .map(|&t| up[key(t)] + 1)
+                .max()
+                .unwrap_or(0);
+        }
+    }
+    let anchor: Vec<Option<usize>> = slots
+        .iter()
+        .map(|layer_slots| {
+            (0..layer_slots.len()).max_by_key(|&k| {
+                let s = layer_slots[k];
+                // Ties go to the node with more bonds (the one with more hanging on it), then to the first.
+                let degree = match s {
+                    Slot::Node(v) => g.neighbors_undirected(NodeIndex::new(v)).count(),
+                    Slot::Dummy(_) => 0,
+                };
+                (up[key(s)] + down[key(s)], degree, std::cmp::Reverse(k))
+            })
+        })
+        .collect();
+
     // Vertical positions: towards the neighbours' mean, left to right then right to left, without overlap.
     let mut y_node = vec![0.0f64; n];
     let mut y_dummy = vec![0.0f64; dummy_layer.len()];
+    // The last pass goes left to right, so that the power flow's main chain ends up straight.
     for pass in 0..4 {
-        let forward = pass % 2 == 0;
+        let forward = pass % 2 == 1;
         let order: Vec<usize> = if forward {
             (0..layers_count).collect()
         } else {
@@ -294,7 +336,7 @@ pub fn layout(model: &Model) -> Layout {
                 };
                 wanted.push(want);
             }
-            // Place in order, pushing down to avoid overlap, then centre the block on what was wanted.
+            // Place in order, pushing down to avoid overlap, then shift the block so the anchor is where it wants.
             let mut placed = Vec::new();
             for (k, &s) in slots[l].iter().enumerate() {
                 let ext = cell(s, &nodes);
@@ -302,12 +344,9 @@ pub fn layout(model: &Model) -> Layout {
                 prev_bottom = y + ext.d;
                 placed.push(y);
             }
-            let shift = if placed.is_empty() {
-                0.0
-            } else {
-                let want_mean = wanted.iter().sum::<f64>() / wanted.len() as f64;
-                let got_mean = placed.iter().sum::<f64>() / placed.len() as f64;
-                want_mean - got_mean
+            let shift = match anchor[l] {
+                Some(k) => wanted[k] - placed[k],
+                None => 0.0,
             };
             for (k, &s) in slots[l].iter().enumerate() {
                 let y = placed[k] + shift;
@@ -448,127 +487,4 @@ fn clip(p: &Placed, toward: (f64, f64)) -> (f64, f64) {
     };
     let t = tx.min(ty).min(1.0);
     (p.x + dx * t, p.y + dy * t)
-}
-
-/// The edges of the backbone with the back edges of an iterative depth-first search reversed.
-fn acyclic(backbone: &[usize], out: &[Vec<usize>], n: usize) -> Vec<(usize, usize)> {
-    // 0 = unvisited, 1 = on the stack, 2 = done.
-    let mut state = vec![0u8; n];
-    let mut edges = Vec::new();
-    // Start from nodes without incoming backbone edges, so that sources come first.
-    let mut indeg = vec![0usize; n];
-    for &v in backbone {
-        for &w in &out[v] {
-            indeg[w] += 1;
-        }
-    }
-    let mut roots: Vec<usize> = backbone
-        .iter()
-        .copied()
-        .filter(|&v| indeg[v] == 0)
-        .collect();
-    roots.extend(backbone.iter().copied().filter(|&v| indeg[v] != 0));
-    for root in roots {
-        if state[root] != 0 {
-            continue;
-        }
-        let mut stack: Vec<(usize, usize)> = vec![(root, 0)];
-        state[root] = 1;
-        while let Some(&mut (v, ref mut k)) = stack.last_mut() {
-            if let Some(&w) = out[v].get(*k) {
-                *k += 1;
-                match state[w] {
-                    0 => {
-                        edges.push((v, w));
-                        state[w] = 1;
-                        stack.push((w, 0));
-                    }
-                    1 => edges.push((w, v)),
-                    _ => edges.push((v, w)),
-                }
-            } else {
-                state[v] = 2;
-                stack.pop();
-            }
-        }
-    }
-    edges
-}
-
-/// Longest-path layers of an acyclic edge list (Kahn's order).
-fn longest_path_layers(backbone: &[usize], dag: &[(usize, usize)], n: usize) -> Vec<usize> {
-    let mut out: Vec<Vec<usize>> = vec![Vec::new(); n];
-    let mut indeg = vec![0usize; n];
-    for &(a, b) in dag {
-        out[a].push(b);
-        indeg[b] += 1;
-    }
-    let mut layer = vec![0usize; n];
-    let mut ready: Vec<usize> = backbone
-        .iter()
-        .copied()
-        .filter(|&v| indeg[v] == 0)
-        .collect();
-    while let Some(v) = ready.pop() {
-        for &w in &out[v] {
-            layer[w] = layer[w].max(layer[v] + 1);
-            indeg[w] -= 1;
-            if indeg[w] == 0 {
-                ready.push(w);
-            }
-        }
-    }
-    layer
-}
-
-/// Orders each layer by barycentric sweeps over the links between adjacent layers.
-fn order_layers(slots: &mut [Vec<Slot>], links: &[(Slot, Slot)], n: usize, dummies: usize) {
-    let key = |s: Slot| match s {
-        Slot::Node(v) => v,
-        Slot::Dummy(d) => n + d,
-    };
-    let mut pos = vec![0.0f64; n + dummies];
-    let refresh = |slots: &[Vec<Slot>], pos: &mut Vec<f64>| {
-        for layer in slots {
-            for (i, &s) in layer.iter().enumerate() {
-                pos[key(s)] = i as f64;
-            }
-        }
-    };
-    refresh(slots, &mut pos);
-    let mut up: Vec<Vec<usize>> = vec![Vec::new(); n + dummies];
-    let mut down: Vec<Vec<usize>> = vec![Vec::new(); n + dummies];
-    for &(a, b) in links {
-        down[key(a)].push(key(b));
-        up[key(b)].push(key(a));
-    }
-    for sweep in 0..8 {
-        let forward = sweep % 2 == 0;
-        let range: Vec<usize> = if forward {
-            (1..slots.len()).collect()
-        } else {
-            (0..slots.len().saturating_sub(1)).rev().collect()
-        };
-        for l in range {
-            let nb = if forward { &up } else { &down };
-            let mut keyed: Vec<(f64, usize, Slot)> = slots[l]
-                .iter()
-                .enumerate()
-                .map(|(i, &s)| {
-                    let ns = &nb[key(s)];
-                    let bary = if ns.is_empty() {
-                        pos[key(s)]
-                    } else {
-                        ns.iter().map(|&k| pos[k]).sum::<f64>() / ns.len() as f64
-                    };
-                    (bary, i, s)
-                })
-                .collect();
-            keyed.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            slots[l] = keyed.into_iter().map(|(_, _, s)| s).collect();
-            for (i, &s) in slots[l].iter().enumerate() {
-                pos[key(s)] = i as f64;
-            }
-        }
-    }
 }

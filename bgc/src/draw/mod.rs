@@ -8,6 +8,7 @@
 
 mod dot;
 mod label;
+mod layers;
 mod layout;
 mod svg;
 

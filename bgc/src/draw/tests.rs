@@ -184,3 +184,31 @@ fn loop_members_are_highlighted() {
     );
     check_geometry(&m, &layout(&m));
 }
+
+#[test]
+fn dot_strokes_follow_the_causality() {
+    // Se -> 1 -> I, C: the source sets the effort (stroke at the junction's end, the head); the junction sets the
+    // inertia's effort (stroke at the inertia, the head); the compliance sets its own (stroke at the junction, the
+    // tail).
+    let mut b = Builder::new("osc");
+    let se = b.node(K::Se, "push");
+    let j = b.node(K::One, "v");
+    let i = b.node(K::I, "mass");
+    let c = b.node(K::C, "spring");
+    b.chain(&[se, j, i]);
+    b.bond(j, c);
+    let m = b.finish().0;
+    let (ca, d) = crate::causality::analyse(&m);
+    assert!(d.is_empty());
+    let dot = super::dot(&m, Some(&ca));
+    assert!(dot.contains("n0 -> n1 [arrowhead=teelvee];"), "{dot}");
+    assert!(dot.contains("n1 -> n2 [arrowhead=teelvee];"), "{dot}");
+    assert!(
+        dot.contains("n1 -> n3 [arrowhead=lvee, dir=both, arrowtail=tee];"),
+        "{dot}"
+    );
+    assert!(dot.contains(r#"n0 [label="Se:1\npush""#), "{dot}");
+    // Without a causality there are no strokes.
+    let plain = super::dot(&m, None);
+    assert!(!plain.contains("tee"));
+}

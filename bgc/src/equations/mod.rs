@@ -1,14 +1,33 @@
 //! The equations stage: from a causal bond graph to state equations `ẋ = f(x, u, p, t)` and outputs
 //! `y = h(x, u, p, t)`.
 //!
-//! Steps ([`derive`]):
+//! Steps ([`derive()`]):
 //! 1. States are the energy variables of the storages in integral causality (`p_rotor`, `q_hd_spring`), then the
 //!    integrated flows (`var`s, named as declared); their rates are `ṗ = e`, `q̇ = f`, `θ̇ = integrand`.
-//! 2. Every node writes the causal equation of each bond variable it computes ([`build`]).
+//! 2. Every node writes the causal equation of each bond variable it computes (`build.rs`).
 //! 3. The rates and outputs are expressed in states, inputs, parameters and `t` by substitution in dependency order
-//!    ([`resolve`]); algebraic loops are torn and solved when affine, storages in derivative causality contribute
-//!    `ẋ` terms, solved for by a symbolic linear solve ([`solve`]).
+//!    (`resolve.rs`); algebraic loops are torn and solved when affine, storages in derivative causality contribute
+//!    `ẋ` terms, solved for by a symbolic linear solve (`solve.rs`).
 //! 4. Readable forms keep intermediates (one per bond variable that is computed and not a mere copy of another).
+//!
+//! # Calling it
+//! ```text
+//! let (causality, _) = bgc::causality::analyse(&model);
+//! let (eqs, diags) = bgc::equations::derive(&model, &causality);      // check has_errors(&diags)
+//! bgc::equations::to_text(&eqs) / to_latex(&eqs) / to_json(&eqs)      // `bgc equations`
+//! let p = eqs.default_params();
+//! numeric_state_space(&eqs, StateSelection::Energy, &p)               // `bgc statespace` (energy states)
+//! declared_state_space(&eqs, &p)                                      // ... in the model's `coords`
+//! declared_state_space_symbolic(&eqs)                                 // ... as expressions of the parameters
+//! linear_state_space(&eqs, StateSelection::Energy)                    // symbolic A, B, C, D
+//! jacobians(&eqs, sel) / linearise(&eqs, sel, &p, &x0, &u0, t0)       // nonlinear models
+//! eqs.f[i], eqs.outputs[k].explicit + to_symbolic(&eqs, e)            // `bgc simulate`, code generation
+//! ```
+//! The states are `eqs.states` (energy states first, `eqs.energy_states` of them, then one per `var`); symbols
+//! in expressions are named by [`Equations::sym_name`].
+//!
+//! The expressions are those of [`sym`], a small canonical engine of this stage; [`to_symbolic`] converts them to
+//! the shared engine [`crate::symbolic`] for its printers.
 //!
 //! Diagnostics of this stage:
 //!
@@ -23,6 +42,7 @@
 //! | BG0606 | declared coordinates that are not a linear, invertible function of the states |
 //! | BG0607 | the stored energy of a law that cannot be integrated symbolically (warning) |
 
+mod bridge;
 mod build;
 mod coords;
 mod coords_symbolic;
@@ -34,6 +54,7 @@ mod resolve;
 mod solve;
 pub mod sym;
 
+pub use bridge::{symbol, to_symbolic};
 pub use coords::{CoordsError, declared_state_space};
 pub use coords_symbolic::declared_state_space_symbolic;
 pub use energy::{EnergyKind, EnergyTerm};
@@ -132,6 +153,9 @@ pub struct Equations {
     pub coords: Option<Vec<(String, Ex)>>,
     /// Stored energy, dissipated and supplied power of each element.
     pub energy: Vec<EnergyTerm>,
+    /// The intermediates at which algebraic loops were solved exactly: the readable intermediates around them are
+    /// implicit (they refer to each other), the explicit rates and outputs are not.
+    pub loops: Vec<String>,
 }
 
 impl Equations {
@@ -183,17 +207,37 @@ fn with_span(d: Diagnostic, span: Option<&crate::span::Span>, label: &str) -> Di
 /// Returns the equations (as complete as possible) and the findings; an error diagnostic means some rate or output
 /// is missing (`None` in [`Equations::f`] or [`OutputEq::explicit`]).
 pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnostic>) {
-    let mut diags = Vec::new();
-    let params = model
-        .params
-        .iter()
-        .map(|p| (p.name.clone(), p.default))
-        .collect();
-    let inputs = model.inputs.iter().map(|i| i.name.clone()).collect();
-    let mut eqs = Equations {
+    // Substitution and the expression functions recurse along dependency chains and expression depth. They run on
+    // a thread with a large stack (reserved, not committed) so that long chains of elements end in the resolver's
+    // depth limit (a diagnostic) rather than in a stack overflow.
+    const STACK: usize = 512 << 20;
+    std::thread::scope(|scope| {
+        match std::thread::Builder::new()
+            .name("bgc-equations".into())
+            .stack_size(STACK)
+            .spawn_scoped(scope, || derive_on_this_thread(model, causality))
+        {
+            Ok(handle) => handle.join().unwrap_or_else(|_| {
+                let d = Diagnostic::error(
+                    codes::UNSUPPORTED,
+                    format!("the equations of `{}` could not be derived", model.name),
+                );
+                (empty_equations(model), vec![d])
+            }),
+            Err(_) => derive_on_this_thread(model, causality),
+        }
+    })
+}
+
+fn empty_equations(model: &Model) -> Equations {
+    Equations {
         model: model.name.clone(),
-        params,
-        inputs,
+        params: model
+            .params
+            .iter()
+            .map(|p| (p.name.clone(), p.default))
+            .collect(),
+        inputs: model.inputs.iter().map(|i| i.name.clone()).collect(),
         states: Vec::new(),
         energy_states: 0,
         rates: Vec::new(),
@@ -203,7 +247,13 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
         outputs: Vec::new(),
         coords: None,
         energy: Vec::new(),
-    };
+        loops: Vec::new(),
+    }
+}
+
+fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnostic>) {
+    let mut diags = Vec::new();
+    let mut eqs = empty_equations(model);
     if !causality.consistent {
         diags.push(with_span(
             Diagnostic::error(
@@ -382,6 +432,11 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
     eqs.rates = readable.rates;
     eqs.intermediates = readable.intermediates;
     eqs.var_names = readable.names;
+    eqs.loops = resolver
+        .torn()
+        .into_iter()
+        .map(|v| eqs.sym_name(Sym::Var(v)))
+        .collect();
     eqs.states = built.states;
     (eqs, diags)
 }

@@ -375,6 +375,12 @@ pub fn to_text(eqs: &Equations) -> String {
             out.push_str(&format!("  {} = {v}\n", i.name));
         }
     }
+    if !eqs.loops.is_empty() {
+        out.push_str(&format!(
+            "  (algebraic loop, solved exactly for: {})\n",
+            eqs.loops.join(", ")
+        ));
+    }
     out.push_str("outputs:\n");
     for o in &eqs.outputs {
         out.push_str(&format!("  {} = {}\n", o.name, expr_text(eqs, &o.value)));
@@ -458,6 +464,7 @@ pub fn to_json(eqs: &Equations) -> Value {
             "explicit": text(&o.explicit),
         })).collect::<Vec<_>>(),
         "coords": eqs.coords.as_ref().map(|c| c.iter().map(|(n, e)| json!({"name": n, "value": expr_text(eqs, e)})).collect::<Vec<_>>()),
+        "loops": eqs.loops,
         "energy": eqs.energy.iter().map(|t| json!({
             "element": t.element,
             "kind": t.kind.name(),

@@ -65,6 +65,13 @@ impl<'a> Resolver<'a> {
         }
     }
 
+    /// The bond variables at which algebraic loops were torn (and solved).
+    pub fn torn(&self) -> Vec<usize> {
+        (0..self.torn.len())
+            .filter(|&v| self.torn[v] && self.mark[v] == Mark::Done)
+            .collect()
+    }
+
     /// The value of bond variable `v`.
     pub fn var(&mut self, v: usize) -> Result<Ex, ResolveError> {
         match self.mark.get(v).copied() {

@@ -804,3 +804,96 @@ fn a_bond_between_two_two_ports_takes_the_default_domain() {
             .all(|b| b.domain == Domain::Rotational)
     );
 }
+
+#[test]
+fn library_and_model_files_are_in_canonical_layout() {
+    for (name, text) in [("std.bg", STD_SOURCE), ("back_support.bg", BACK_SUPPORT)] {
+        let (tree, diags) = crate::syntax::parse(FileId(0), text);
+        assert!(diags.is_empty(), "{name}: {diags:?}");
+        assert_eq!(
+            crate::syntax::format(&tree),
+            text,
+            "{name} is not formatted"
+        );
+    }
+}
+
+mod random_models {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Statements over a small pool of names, so that random picks collide, repeat and reference each other.
+    const FRAGMENTS: &[&str] = &[
+        "domain rotational;",
+        "domain electrical;",
+        "param k = 1e3 [N m/rad];",
+        "param k = 0 [N/m];",
+        "param J = 2 [kg m^2];",
+        "param J = -1 [kg];",
+        "param r = k * J [1];",
+        "input u [N m];",
+        "input u [V];",
+        "output y [N m] = e(a) + e(b);",
+        "output y [rad/s] = f(j) * r;",
+        "output z [1] = sin(q(b)) + p(a);",
+        "var th [rad] = int(f(j));",
+        "coords [th, p(a), q(b)];",
+        "Se s = u;",
+        "Sf s = u;",
+        "MSe s = u * cos(th);",
+        "I a = J;",
+        "I a : electrical = 1/k;",
+        "C b = 1/k;",
+        "C b { e = k*q + q^3; }",
+        "R c = r;",
+        "R c { f = sqrt(abs(e)) * sign(e); }",
+        "TF g = r;",
+        "GY g = 0.1;",
+        "MTF g = th;",
+        "0 j;",
+        "1 j;",
+        "1 w : translational;",
+        "RF fld(2) { e[1] = f[2]; e[2] = f[1]; }",
+        "IF fld(2) { mass[1,1] = J; mass[2,1] = J; mass[2,2] = 1; }",
+        "spring_damper_rot sd(k = k, d = 1);",
+        "dc_motor mot(R_a = r);",
+        "nothing x;",
+        "bond s -> j -> a, b, c;",
+        "bond j -> g -> w;",
+        "bond w -> sd.a;",
+        "bond sd.b -> j;",
+        "bond mot.shaft -> j;",
+        "bond s -> mot.v;",
+        "bond j -> fld[1];",
+        "bond w -> fld[2];",
+        "bond j -> fld[3];",
+        "bond x: j -> a stroke! a;",
+        "bond a -> a;",
+        "port p = j;",
+    ];
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+        #[test]
+        fn any_mix_of_statements_lowers_and_explains_itself(picks in proptest::collection::vec(0..FRAGMENTS.len(), 0..24)) {
+            let body: Vec<&str> = picks.iter().map(|&i| FRAGMENTS[i]).collect();
+            let text = format!("import \"std.bg\";\nmodel m {{\n{}\n}}\n", body.join("\n"));
+            let (models, diags, sources) = lower_text(&text);
+            prop_assert_eq!(models.len(), 1);
+            for d in &diags {
+                let span = d.primary_span();
+                prop_assert!(span.is_some(), "{}: no primary label\n{}", d.code.0, text);
+                prop_assert!(d.help.is_some(), "{}: no help\n{}", d.code.0, text);
+                // Labels lie inside their files.
+                for l in &d.labels {
+                    let len = sources.get(l.span.file).map(|f| f.text.len()).unwrap_or(0);
+                    prop_assert!(l.span.end as usize <= len, "{:?} out of its file\n{}", l, text);
+                }
+            }
+            // A model without errors keeps the IR invariants.
+            if !has_errors(&diags) {
+                prop_assert_eq!(validate(&models[0]), Ok(()), "{}", text);
+            }
+        }
+    }
+}

@@ -562,3 +562,53 @@ fn simulate_errors_are_reported() {
     assert_eq!(code, 1);
     assert!(err.contains("choose a larger --dt-out"), "{err}");
 }
+
+#[test]
+fn every_solver_follows_the_step_response() {
+    // The analytic response of `mass_spring_damper_step_response_is_the_analytic_one`, at rtol 1e-8: each
+    // method stays within 5e-7 m of it (the response peaks at 0.024 m) and keeps the energy balance to 1e-6 J.
+    let (m, k, d, f) = (2.0f64, 800.0f64, 4.0f64, 10.0f64);
+    let wn = (k / m).sqrt();
+    let z = d / (2.0 * (k * m).sqrt());
+    let wd = wn * (1.0 - z * z).sqrt();
+    for solver in ["bdf", "esdirk34", "tr_bdf2", "tsit45"] {
+        let csv = simulate(&[
+            &corpus("oscillator.bg"),
+            "--input",
+            "F=10*step(0.1)",
+            "--t-end",
+            "2",
+            "--dt-out",
+            "0.01",
+            "--rtol",
+            "1e-8",
+            "--atol",
+            "1e-11",
+            "--solver",
+            solver,
+        ]);
+        let (t, q) = (csv.col("t"), csv.col("q_spring"));
+        let (e, dis, sup) = (
+            csv.col("energy"),
+            csv.col("dissipated"),
+            csv.col("supplied"),
+        );
+        for i in 0..t.len() {
+            let tau = (t[i] - 0.1).max(0.0);
+            let decay = (-z * wn * tau).exp();
+            let x = f / k
+                * (1.0 - decay * ((wd * tau).cos() + z / (1.0 - z * z).sqrt() * (wd * tau).sin()));
+            assert!(
+                (q[i] - x).abs() < 5e-7,
+                "{solver}, t = {}: {} vs {x}",
+                t[i],
+                q[i]
+            );
+            assert!(
+                (e[i] + dis[i] - sup[i]).abs() < 1e-6,
+                "{solver}, t = {}",
+                t[i]
+            );
+        }
+    }
+}

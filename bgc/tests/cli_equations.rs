@@ -612,3 +612,41 @@ fn every_solver_follows_the_step_response() {
         }
     }
 }
+
+#[test]
+fn declared_coordinates_symbolically_and_their_errors() {
+    let v = ok_json(&[
+        "statespace",
+        &repo("models/back_support.bg"),
+        "--coords",
+        "declared",
+        "--symbolic",
+    ]);
+    let a = &v["A"];
+    assert_eq!(a.as_array().map(Vec::len), Some(7));
+    assert_eq!(a[0], serde_json::json!(["0", "1", "0", "0", "0", "0", "0"]));
+    // d(f_rotor)/dt: the gearbox spring acts through k_g/r_g on the merged inertia J_m + J_g.
+    assert_eq!(a[1][0], "-k_g/((J_m + J_g)*r_g^2)");
+    assert_eq!(a[1][2], "k_g/((J_m + J_g)*r_g)");
+    let (code, _, err) = bgc(&[
+        "statespace",
+        &corpus("oscillator.bg"),
+        "--coords",
+        "declared",
+    ]);
+    assert_eq!(code, 1);
+    assert!(err.contains("the model declares no coordinates"), "{err}");
+    let (code, _, err) = bgc(&[
+        "statespace",
+        &repo("models/back_support.bg"),
+        "--coords",
+        "declared",
+        "--at",
+        "tau_m=1",
+    ]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("--at applies to the energy coordinates only"),
+        "{err}"
+    );
+}

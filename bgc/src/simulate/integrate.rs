@@ -341,3 +341,51 @@ fn solver_error(time: f64, e: DiffsolError) -> SimError {
         message: e.to_string(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn opts(t_end: f64, dt_out: f64) -> RunOptions {
+        RunOptions {
+            t_end,
+            dt_out,
+            method: Method::Bdf,
+            rtol: 1e-6,
+            atol: 1e-9,
+            max_steps: 1000,
+        }
+    }
+
+    #[test]
+    fn samples_end_exactly_at_t_end() {
+        assert_eq!(
+            opts(1.0, 0.3).sample_times(),
+            [0.0, 0.3, 0.6, 0.8999999999999999, 1.0]
+        );
+        let t = opts(1.0, 0.1).sample_times();
+        assert_eq!(t.len(), 11);
+        assert_eq!(t.last(), Some(&1.0));
+        assert_eq!(opts(1.0, 5.0).sample_times(), [0.0, 1.0]);
+    }
+
+    #[test]
+    fn settings_are_checked() {
+        assert!(opts(1.0, 0.1).check().is_ok());
+        for bad in [
+            opts(0.0, 0.1),
+            opts(1.0, -0.1),
+            opts(f64::NAN, 0.1),
+            opts(f64::INFINITY, 0.1),
+        ] {
+            assert!(
+                matches!(bad.check(), Err(SimError::BadSetting { .. })),
+                "{bad:?}"
+            );
+        }
+        assert!(matches!(
+            opts(1.0, 1e-12).check(),
+            Err(SimError::TooManyRows { .. })
+        ));
+    }
+}

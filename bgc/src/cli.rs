@@ -2,6 +2,9 @@
 
 mod commands;
 mod io;
+mod model;
+mod params;
+mod simulate;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::ffi::OsString;
@@ -48,6 +51,37 @@ pub enum DrawFormat {
     Dot,
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum EquationsFormat {
+    Text,
+    /// LaTeX `align` blocks.
+    Latex,
+    Json,
+}
+
+/// The state coordinates of `bgc statespace`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Coords {
+    /// The energy variables (momenta, displacements) of the storages in integral causality.
+    Energy,
+    /// The coordinates the model declares with `coords`.
+    Declared,
+}
+
+/// The integration methods of `bgc simulate`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Solver {
+    /// Variable-order BDF, for stiff models.
+    Bdf,
+    /// ESDIRK3(4), stiff, one-step.
+    Esdirk34,
+    /// TR-BDF2, stiff, low order.
+    #[value(name = "tr_bdf2")]
+    TrBdf2,
+    /// Tsitouras 5(4), explicit, for non-stiff models.
+    Tsit45,
+}
+
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Check .bg files: syntax, names, structure, domains and units.
@@ -78,6 +112,69 @@ enum Command {
         output: Option<PathBuf>,
         #[arg(long, value_enum, default_value_t = DrawFormat::Svg)]
         format: DrawFormat,
+    },
+    /// The state equations ẋ = f(x, u, t), the outputs and the energy terms of a model.
+    Equations {
+        file: PathBuf,
+        /// Only this model of the file.
+        #[arg(long)]
+        model: Option<String>,
+        #[arg(long, value_enum, default_value_t = EquationsFormat::Text)]
+        format: EquationsFormat,
+    },
+    /// The linear state space A, B, C, D of a model (its linearisation at --at for a nonlinear model).
+    Statespace {
+        file: PathBuf,
+        /// Only this model of the file.
+        #[arg(long)]
+        model: Option<String>,
+        /// A parameter value other than the default, in SI units (repeatable).
+        #[arg(long = "param", value_name = "NAME=VALUE", value_parser = params::parse_assignment)]
+        params: Vec<params::Assignment>,
+        /// The state coordinates.
+        #[arg(long, value_enum, default_value_t = Coords::Energy)]
+        coords: Coords,
+        /// Entries as expressions of the parameters (those given with --param are put in as numbers).
+        #[arg(long)]
+        symbolic: bool,
+        #[arg(long, value_enum, default_value_t = ReportFormat::Json)]
+        format: ReportFormat,
+        /// The operating point of a nonlinear model: energy states and inputs by name, comma-separated; those not
+        /// given are 0.
+        #[arg(long, value_name = "NAME=VALUE,...", value_delimiter = ',', value_parser = params::parse_assignment)]
+        at: Vec<params::Assignment>,
+    },
+    /// Simulate a model and print CSV: t, the states, the outputs, energy (stored), dissipated (in the resistors
+    /// since t = 0) and supplied (by the sources since t = 0).
+    Simulate {
+        file: PathBuf,
+        /// Only this model of the file.
+        #[arg(long)]
+        model: Option<String>,
+        /// The end time in seconds (the run starts at t = 0).
+        #[arg(long, value_name = "T", allow_hyphen_values = true)]
+        t_end: f64,
+        /// The sampling interval of the rows; t-end/1000 when absent.
+        #[arg(long, value_name = "DT", allow_hyphen_values = true)]
+        dt_out: Option<f64>,
+        /// A parameter value other than the default, in SI units (repeatable).
+        #[arg(long = "param", value_name = "NAME=VALUE", value_parser = params::parse_assignment)]
+        params: Vec<params::Assignment>,
+        /// An input signal as an expression of t: numbers, t, pi, + - * / ^, step(t0), ramp(t0), sin, cos, tan,
+        /// exp, sqrt, abs, min, max (repeatable). Inputs not given are 0.
+        #[arg(long = "input", value_name = "NAME=EXPR", value_parser = params::parse_assignment)]
+        inputs: Vec<params::Assignment>,
+        /// An initial state value (a state name as in the CSV header; repeatable). States not given start at 0.
+        #[arg(long = "x0", value_name = "STATE=VALUE", value_parser = params::parse_assignment)]
+        x0: Vec<params::Assignment>,
+        #[arg(long, value_enum, default_value_t = Solver::Bdf)]
+        solver: Solver,
+        /// Relative tolerance.
+        #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
+        rtol: f64,
+        /// Absolute tolerance (all states and the energy quadratures).
+        #[arg(long, default_value_t = 1e-9, allow_hyphen_values = true)]
+        atol: f64,
     },
     /// Print .bg files in the canonical layout (in place), or with --check report the files that differ.
     Fmt {
@@ -122,6 +219,53 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
             output,
             format,
         } => commands::draw(&file, model.as_deref(), output.as_deref(), format, color),
+        Command::Equations {
+            file,
+            model,
+            format,
+        } => model::equations(&file, model.as_deref(), format, color),
+        Command::Statespace {
+            file,
+            model,
+            params,
+            coords,
+            symbolic,
+            format,
+            at,
+        } => {
+            let args = model::StateSpaceArgs {
+                params: &params,
+                coords,
+                symbolic,
+                format,
+                at: &at,
+            };
+            model::statespace(&file, model.as_deref(), &args, color)
+        }
+        Command::Simulate {
+            file,
+            model,
+            t_end,
+            dt_out,
+            params,
+            inputs,
+            x0,
+            solver,
+            rtol,
+            atol,
+        } => {
+            let args = simulate::SimulateArgs {
+                t_end,
+                dt_out,
+                params: &params,
+                inputs: &inputs,
+                x0: &x0,
+                solver,
+                rtol,
+                atol,
+            };
+            simulate::simulate(&file, model.as_deref(), &args, color)
+        }
     };
     ExitCode::from(status as u8)
 }

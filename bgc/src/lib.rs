@@ -13,6 +13,7 @@ pub mod draw;
 pub mod equations;
 pub mod ir;
 pub mod lower;
+pub mod simulate;
 pub mod span;
 pub mod symbolic;
 pub mod syntax;

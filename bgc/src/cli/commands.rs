@@ -120,7 +120,7 @@ fn emit(sources: &SourceMap, diags: &[Diagnostic], format: DiagFormat, color: bo
     }
 }
 
-fn count_line(diags: &[Diagnostic]) -> String {
+pub(super) fn count_line(diags: &[Diagnostic]) -> String {
     let errors = diags
         .iter()
         .filter(|d| d.severity == Severity::Error)
@@ -137,15 +137,15 @@ fn count_line(diags: &[Diagnostic]) -> String {
 }
 
 /// A file through the front end: its sources, the one model asked for, and what the front end said.
-struct Loaded {
-    sources: SourceMap,
-    model: bgc::ir::Model,
-    diags: Vec<Diagnostic>,
+pub(super) struct Loaded {
+    pub(super) sources: SourceMap,
+    pub(super) model: bgc::ir::Model,
+    pub(super) diags: Vec<Diagnostic>,
 }
 
 /// Reads, parses and lowers `path` and picks one model (the one named, or the only one). Prints the diagnostics
 /// and returns the status to exit with when the file cannot be used.
-fn load_one(path: &Path, wanted: Option<&str>, color: bool) -> Result<Loaded, Status> {
+pub(super) fn load_one(path: &Path, wanted: Option<&str>, color: bool) -> Result<Loaded, Status> {
     let mut sources = SourceMap::new();
     let (id, decode_diag) = match read_source(&mut sources, path) {
         Ok(x) => x,

@@ -1,0 +1,366 @@
+//! `bgc equations` and `bgc statespace`: the equations stage and the linear state space of one model.
+
+use super::commands::{Loaded, count_line, load_one};
+use super::io::{stderr, stderrln, stdout, stdoutln};
+use super::params::{Assignment, assign, param_values};
+use super::{Coords, EquationsFormat, ReportFormat, Status};
+use bgc::diagnostic::{has_errors, render};
+use bgc::equations::sym::{self, Ex, Sym};
+use bgc::equations::{
+    self, CoordsError, Equations, Jacobians, LinearError, NumericStateSpace, StateSelection,
+};
+use serde_json::{Value, json};
+use std::path::Path;
+
+/// A model through the front end, causality and the equations stage.
+pub(super) struct Derived {
+    pub loaded: Loaded,
+    pub eqs: Equations,
+}
+
+/// Loads `path`, picks the model and derives its equations. Diagnostics are printed; with `strict`, an error
+/// among them ends the command (status 1).
+pub(super) fn derive_one(
+    path: &Path,
+    wanted: Option<&str>,
+    color: bool,
+    strict: bool,
+) -> Result<(Derived, bool), Status> {
+    let loaded = load_one(path, wanted, color)?;
+    let (causality, mut diags) = bgc::causality::analyse(&loaded.model);
+    let (eqs, eq_diags) = equations::derive(&loaded.model, &causality);
+    diags.extend(eq_diags);
+    let mut all = loaded.diags.clone();
+    all.extend(diags);
+    stderr(&render::to_text(&loaded.sources, &all, color));
+    let failed = has_errors(&all);
+    if failed {
+        stderrln(&count_line(&all));
+        if strict {
+            return Err(Status::InputErrors);
+        }
+    }
+    Ok((Derived { loaded, eqs }, failed))
+}
+
+/// `bgc equations FILE`
+pub fn equations(
+    path: &Path,
+    wanted: Option<&str>,
+    format: EquationsFormat,
+    color: bool,
+) -> Status {
+    // The equations are printed even when some could not be derived: the diagnostics say which are missing.
+    let (d, failed) = match derive_one(path, wanted, color, false) {
+        Ok(x) => x,
+        Err(s) => return s,
+    };
+    match format {
+        EquationsFormat::Text => stdout(&equations::to_text(&d.eqs)),
+        EquationsFormat::Latex => stdout(&equations::to_latex(&d.eqs)),
+        EquationsFormat::Json => stdoutln(
+            &serde_json::to_string_pretty(&equations::to_json(&d.eqs))
+                .unwrap_or_else(|_| "{}".into()),
+        ),
+    }
+    if failed {
+        Status::InputErrors
+    } else {
+        Status::Ok
+    }
+}
+
+/// The options of `bgc statespace`.
+pub struct StateSpaceArgs<'a> {
+    pub params: &'a [Assignment],
+    pub coords: Coords,
+    pub symbolic: bool,
+    pub format: ReportFormat,
+    pub at: &'a [Assignment],
+}
+
+/// `bgc statespace FILE`
+pub fn statespace(
+    path: &Path,
+    wanted: Option<&str>,
+    args: &StateSpaceArgs<'_>,
+    color: bool,
+) -> Status {
+    let (d, _) = match derive_one(path, wanted, color, true) {
+        Ok(x) => x,
+        Err(s) => return s,
+    };
+    match state_space(&d, args) {
+        Ok(v) => {
+            match args.format {
+                ReportFormat::Json => stdout(&json_rows(&v)),
+                ReportFormat::Text => stdout(&text(&v)),
+            }
+            Status::Ok
+        }
+        Err(msg) => {
+            stderrln(&format!("error: {msg}"));
+            Status::InputErrors
+        }
+    }
+}
+
+fn state_space(d: &Derived, args: &StateSpaceArgs<'_>) -> Result<Value, String> {
+    let eqs = &d.eqs;
+    let params = param_values(&d.loaded.model, args.params)?;
+    match args.coords {
+        Coords::Energy => energy_coords(eqs, &params, args),
+        Coords::Declared => {
+            if !args.at.is_empty() {
+                return Err("--at applies to the energy coordinates only; the declared coordinates are defined for linear models".into());
+            }
+            let declared = |e: CoordsError| match e {
+                CoordsError::Linear(
+                    l @ (LinearError::NotLinear { .. } | LinearError::Affine { .. }),
+                ) => format!(
+                    "the state space in declared coordinates needs a linear model: {l}; use --coords energy with --at"
+                ),
+                other => format!("no state space in declared coordinates: {other}"),
+            };
+            if args.symbolic {
+                let j = equations::declared_state_space_symbolic(eqs).map_err(declared)?;
+                Ok(symbolic_json(
+                    eqs,
+                    &j,
+                    &fixed_params(eqs, args.params, &params),
+                ))
+            } else {
+                let ss = equations::declared_state_space(eqs, &params).map_err(declared)?;
+                Ok(numeric_json(&ss))
+            }
+        }
+    }
+}
+
+/// The state space in the energy variables: exact for a linear model, the linearisation at `--at` otherwise. When
+/// the rates need an integrated flow (an angle in a modulated transformer), the integrated flows join the state.
+fn energy_coords(
+    eqs: &Equations,
+    params: &[f64],
+    args: &StateSpaceArgs<'_>,
+) -> Result<Value, String> {
+    let selection = match equations::jacobians(eqs, StateSelection::Energy) {
+        Err(LinearError::NeedsIntegratedState { .. }) => StateSelection::All,
+        _ => StateSelection::Energy,
+    };
+    let n = eqs.state_count(selection);
+    let state_names: Vec<String> = (0..n).map(|i| eqs.sym_name(Sym::State(i))).collect();
+    let (x0, u0) = operating_point(eqs, &state_names, args.at)?;
+    let linear = match equations::linear_state_space(eqs, selection) {
+        Ok(j) => Ok(j),
+        Err(e @ (LinearError::NotLinear { .. } | LinearError::Affine { .. })) => Err(e),
+        Err(e) => return Err(format!("no state space: {e}")),
+    };
+    if let Err(why) = &linear
+        && args.at.is_empty()
+    {
+        return Err(format!(
+            "the model is not linear ({why}): give an operating point with --at NAME=VALUE,... (states: {}; inputs: \
+             {}; those not given are 0)",
+            list(&state_names),
+            list(&eqs.inputs)
+        ));
+    }
+    let fixed = fixed_params(eqs, args.params, params);
+    if args.symbolic {
+        let j = match linear {
+            Ok(j) => j,
+            Err(_) => {
+                let j = equations::jacobians(eqs, selection).map_err(|e| e.to_string())?;
+                at_point(&j, &x0, &u0)
+            }
+        };
+        return Ok(symbolic_json(eqs, &j, &fixed));
+    }
+    let ss = match linear {
+        Ok(j) => equations::evaluate_at(eqs, &j, params, &x0, &u0, 0.0),
+        Err(_) => equations::linearise(eqs, selection, params, &x0, &u0, 0.0),
+    }
+    .map_err(|e| format!("no state space: {e}"))?;
+    Ok(numeric_json(&ss))
+}
+
+fn list(names: &[String]) -> String {
+    if names.is_empty() {
+        "none".into()
+    } else {
+        names.join(", ")
+    }
+}
+
+/// The operating point from `--at`: state values and input values by name, 0 for those not given.
+fn operating_point(
+    eqs: &Equations,
+    state_names: &[String],
+    at: &[Assignment],
+) -> Result<(Vec<f64>, Vec<f64>), String> {
+    let mut x0 = vec![0.0; state_names.len()];
+    let mut u0 = vec![0.0; eqs.inputs.len()];
+    let mut names: Vec<String> = state_names.to_vec();
+    names.extend(eqs.inputs.iter().cloned());
+    let mut values = vec![0.0; names.len()];
+    assign("state or input", &names, &mut values, at)?;
+    let (xs, us) = values.split_at(state_names.len().min(values.len()));
+    x0.copy_from_slice(xs);
+    u0.copy_from_slice(us);
+    Ok((x0, u0))
+}
+
+/// The Jacobians with the operating point put in for the states, inputs and time.
+fn at_point(j: &Jacobians, x0: &[f64], u0: &[f64]) -> Jacobians {
+    let put = |m: &[Vec<Ex>]| -> Vec<Vec<Ex>> {
+        m.iter()
+            .map(|row| {
+                row.iter()
+                    .map(|e| {
+                        sym::subst(e, &mut |s| match s {
+                            Sym::State(i) => x0.get(i).map(|v| Ex::Num(*v)),
+                            Sym::Input(i) => u0.get(i).map(|v| Ex::Num(*v)),
+                            Sym::Time => Some(Ex::zero()),
+                            _ => None,
+                        })
+                    })
+                    .collect()
+            })
+            .collect()
+    };
+    Jacobians {
+        states: j.states.clone(),
+        inputs: j.inputs.clone(),
+        outputs: j.outputs.clone(),
+        dfdx: put(&j.dfdx),
+        dfdu: put(&j.dfdu),
+        dhdx: put(&j.dhdx),
+        dhdu: put(&j.dhdu),
+    }
+}
+
+/// The parameters given with `--param`, to put into symbolic entries as numbers.
+fn fixed_params(eqs: &Equations, given: &[Assignment], values: &[f64]) -> Vec<Option<f64>> {
+    eqs.params
+        .iter()
+        .enumerate()
+        .map(|(i, (name, _))| {
+            given
+                .iter()
+                .any(|a| a.name == *name)
+                .then(|| values.get(i).copied())
+                .flatten()
+        })
+        .collect()
+}
+
+fn symbolic_json(eqs: &Equations, j: &Jacobians, fixed: &[Option<f64>]) -> Value {
+    let render = |m: &[Vec<Ex>]| -> Vec<Vec<String>> {
+        m.iter()
+            .map(|row| {
+                row.iter()
+                    .map(|e| {
+                        let e = sym::subst(e, &mut |s| match s {
+                            Sym::Param(i) => fixed.get(i).copied().flatten().map(Ex::Num),
+                            _ => None,
+                        });
+                        equations::expr_text(eqs, &e)
+                    })
+                    .collect()
+            })
+            .collect()
+    };
+    json!({
+        "states": j.states,
+        "inputs": j.inputs,
+        "outputs": j.outputs,
+        "A": render(&j.dfdx),
+        "B": render(&j.dfdu),
+        "C": render(&j.dhdx),
+        "D": render(&j.dhdu),
+    })
+}
+
+fn numeric_json(ss: &NumericStateSpace) -> Value {
+    json!({
+        "states": ss.states,
+        "inputs": ss.inputs,
+        "outputs": ss.outputs,
+        "A": ss.a,
+        "B": ss.b,
+        "C": ss.c,
+        "D": ss.d,
+    })
+}
+
+/// The JSON form with the keys in reading order and one matrix row per line.
+fn json_rows(v: &Value) -> String {
+    let compact = |x: Option<&Value>| {
+        x.and_then(|x| serde_json::to_string(x).ok())
+            .unwrap_or_else(|| "null".into())
+    };
+    let mut out = String::from("{\n");
+    for k in ["states", "inputs", "outputs"] {
+        out.push_str(&format!("  \"{k}\": {},\n", compact(v.get(k))));
+    }
+    let matrices = ["A", "B", "C", "D"];
+    for (i, m) in matrices.iter().enumerate() {
+        let rows: Vec<String> = v
+            .get(*m)
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+            .map(|r| format!("    {}", compact(Some(r))))
+            .collect();
+        let sep = if i + 1 == matrices.len() { "" } else { "," };
+        if rows.is_empty() {
+            out.push_str(&format!("  \"{m}\": []{sep}\n"));
+        } else {
+            out.push_str(&format!("  \"{m}\": [\n{}\n  ]{sep}\n", rows.join(",\n")));
+        }
+    }
+    out.push_str("}\n");
+    out
+}
+
+/// The text form: the names, then each matrix with one row per line.
+fn text(v: &Value) -> String {
+    let names = |k: &str| {
+        let list: Vec<&str> = v
+            .get(k)
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+            .filter_map(Value::as_str)
+            .collect();
+        if list.is_empty() {
+            "(none)".to_string()
+        } else {
+            list.join(", ")
+        }
+    };
+    let mut out = format!(
+        "states: {}\ninputs: {}\noutputs: {}\n",
+        names("states"),
+        names("inputs"),
+        names("outputs")
+    );
+    for m in ["A", "B", "C", "D"] {
+        out.push_str(&format!("\n{m} =\n"));
+        for row in v.get(m).and_then(Value::as_array).into_iter().flatten() {
+            let cells: Vec<String> = row
+                .as_array()
+                .into_iter()
+                .flatten()
+                .map(|c| match c {
+                    Value::Number(n) => format!("{:>13.6e}", n.as_f64().unwrap_or(f64::NAN)),
+                    Value::String(s) => format!("[{s}]"),
+                    other => other.to_string(),
+                })
+                .collect();
+            out.push_str(&format!("  {}\n", cells.join(" ")));
+        }
+    }
+    out
+}

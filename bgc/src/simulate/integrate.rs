@@ -1,0 +1,391 @@
+//! Integration of a [`System`] with diffsol on dynamic (nalgebra) vectors.
+//!
+//! The run is split at the inputs' breakpoints (the times of `step` and `ramp`): a fresh solver starts at each,
+//! so a jump never enters an implicit method's step history, and within a segment `[a, b)` the inputs are
+//! evaluated at times strictly before `b`, as the solver's last stage at `b` would otherwise see the jump. States
+//! are reported at the sample times by the solver's dense output (interpolation of the accepted steps, of the
+//! method's order). The Jacobian handed to the implicit methods is the symbolic one of the equations, or finite
+//! differences when a rate uses a function without a derivative.
+
+use std::cell::{Cell, RefCell};
+
+use diffsol::error::DiffsolError;
+use diffsol::{
+    NalgebraLU, NalgebraMat, NalgebraVec, OdeBuilder, OdeEquations, OdeSolverMethod,
+    OdeSolverStopReason, Vector,
+};
+
+use super::{SimError, System};
+
+type M = NalgebraMat<f64>;
+type Ls = NalgebraLU<f64>;
+
+/// The integration method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Method {
+    /// Variable-order variable-step BDF: for stiff models. The default.
+    #[default]
+    Bdf,
+    /// ESDIRK3(4): stiff, one-step.
+    Esdirk34,
+    /// TR-BDF2: stiff, robust, low order.
+    TrBdf2,
+    /// Tsitouras 5(4) explicit Runge–Kutta: for non-stiff models.
+    Tsit45,
+}
+
+/// The settings of a run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RunOptions {
+    pub t_end: f64,
+    /// The sampling interval of the rows.
+    pub dt_out: f64,
+    pub method: Method,
+    pub rtol: f64,
+    pub atol: f64,
+    /// Upper bound on internal steps per segment.
+    pub max_steps: usize,
+}
+
+/// The most rows a run produces.
+pub const MAX_ROWS: usize = 10_000_000;
+
+impl RunOptions {
+    fn check(&self) -> Result<(), SimError> {
+        let positive: [(&'static str, f64); 4] = [
+            ("t_end", self.t_end),
+            ("dt_out", self.dt_out),
+            ("rtol", self.rtol),
+            ("atol", self.atol),
+        ];
+        for (name, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(SimError::BadSetting {
+                    name,
+                    value,
+                    reason: "it must be finite and positive",
+                });
+            }
+        }
+        let rows = (self.t_end / self.dt_out).floor() + 2.0;
+        if rows > MAX_ROWS as f64 {
+            return Err(SimError::TooManyRows {
+                rows,
+                limit: MAX_ROWS,
+            });
+        }
+        Ok(())
+    }
+
+    /// The sample times: `0, dt, 2 dt, …` up to `t_end`, and `t_end` itself.
+    pub fn sample_times(&self) -> Vec<f64> {
+        let n = (self.t_end / self.dt_out * (1.0 + 1e-12)).floor() as usize;
+        let mut times: Vec<f64> = (0..=n).map(|k| k as f64 * self.dt_out).collect();
+        if times
+            .last()
+            .is_none_or(|&last| (self.t_end - last) > 1e-9 * self.t_end)
+        {
+            times.push(self.t_end);
+        } else if let Some(last) = times.last_mut() {
+            *last = self.t_end;
+        }
+        times
+    }
+}
+
+/// A run's result: the sample times and, per time, the row of [`System::row`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Trajectory {
+    pub columns: Vec<String>,
+    pub times: Vec<f64>,
+    pub rows: Vec<Vec<f64>>,
+}
+
+/// Integrates `system` from the model state `x0` at `t = 0` (the energy quadratures start at zero).
+pub fn run(system: &System, x0: &[f64], opts: &RunOptions) -> Result<Trajectory, SimError> {
+    opts.check()?;
+    let n = system.state_count();
+    if x0.len() != n {
+        return Err(SimError::Dimension {
+            what: "initial state",
+            expected: n,
+            got: x0.len(),
+        });
+    }
+    let mut y: Vec<f64> = x0.iter().copied().chain([0.0, 0.0]).collect();
+    let times = opts.sample_times();
+    let mut u = Vec::new();
+    let mut stack = Vec::new();
+    let mut rows = Vec::with_capacity(times.len());
+    let first = system.row(&y, 0.0, &mut u, &mut stack);
+    if let Some(i) = first.iter().position(|v| !v.is_finite()) {
+        let columns = system.columns();
+        return Err(SimError::NonFiniteStart {
+            what: columns.get(i).cloned().unwrap_or_default(),
+        });
+    }
+    rows.push(first);
+    let mut bounds = vec![0.0];
+    bounds.extend(system.breakpoints(opts.t_end));
+    bounds.push(opts.t_end);
+    let mut next = 1;
+    for w in bounds.windows(2) {
+        let (a, b) = match w {
+            [a, b] => (*a, *b),
+            _ => continue,
+        };
+        let start = next;
+        while times.get(next).is_some_and(|&t| t <= b) {
+            next += 1;
+        }
+        let wanted = times.get(start..next).unwrap_or(&[]);
+        let last = b >= opts.t_end;
+        let mut states = Vec::with_capacity(wanted.len());
+        y = segment(system, &y, a, b, last, wanted, opts, &mut states)?;
+        for (t, ys) in wanted.iter().zip(&states) {
+            rows.push(system.row(ys, *t, &mut u, &mut stack));
+        }
+    }
+    Ok(Trajectory {
+        columns: system.columns(),
+        times,
+        rows,
+    })
+}
+
+/// Integrates `[a, b]` from `y0`, pushing the extended state at `wanted` times; returns the state at `b`.
+#[allow(clippy::too_many_arguments)]
+fn segment(
+    system: &System,
+    y0: &[f64],
+    a: f64,
+    b: f64,
+    last: bool,
+    wanted: &[f64],
+    opts: &RunOptions,
+    out: &mut Vec<Vec<f64>>,
+) -> Result<Vec<f64>, SimError> {
+    let dim = y0.len();
+    // Inputs are evaluated before a breakpoint `b`, never at it (see the module docs).
+    let t_max = if last {
+        f64::INFINITY
+    } else {
+        b - b.abs() * 4.0 * f64::EPSILON
+    };
+    let scratch = RefCell::new((Vec::new(), Vec::new(), vec![0.0; dim], vec![0.0; dim]));
+    let bad: Cell<Option<(f64, usize)>> = Cell::new(None);
+    let rhs = |y: &[f64], _p: &[f64], t: f64, dy: &mut [f64]| {
+        let mut s = scratch.borrow_mut();
+        let (u, stack, _, _) = &mut *s;
+        system.inputs_at(t.min(t_max), u);
+        system.rhs(y, u, t, dy, stack);
+        if bad.get().is_none()
+            && let Some(i) = dy.iter().position(|v| !v.is_finite())
+        {
+            bad.set(Some((t, i)));
+        }
+    };
+    let jac = |y: &[f64], _p: &[f64], t: f64, v: &[f64], jv: &mut [f64]| {
+        let mut s = scratch.borrow_mut();
+        let (u, stack, f0, f1) = &mut *s;
+        let tu = t.min(t_max);
+        system.inputs_at(tu, u);
+        if system.jacobian_times(y, u, t, v, jv, stack).is_some() {
+            return;
+        }
+        // Finite differences along v.
+        let norm_v = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if norm_v == 0.0 {
+            jv.iter_mut().for_each(|x| *x = 0.0);
+            return;
+        }
+        let norm_y = y.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let h = f64::EPSILON.sqrt() * (1.0 + norm_y) / norm_v;
+        let shifted: Vec<f64> = y.iter().zip(v).map(|(y, v)| y + h * v).collect();
+        system.rhs(y, u, t, f0, stack);
+        system.rhs(&shifted, u, t, f1, stack);
+        for ((j, a), b) in jv.iter_mut().zip(f0.iter()).zip(f1.iter()) {
+            *j = (b - a) / h;
+        }
+    };
+    let init_state = y0.to_vec();
+    let init = move |_p: &[f64], _t: f64, y: &mut [f64]| {
+        for (d, s) in y.iter_mut().zip(&init_state) {
+            *d = *s;
+        }
+    };
+    let problem = OdeBuilder::<M>::new()
+        .t0(a)
+        .rtol(opts.rtol)
+        .atol([opts.atol])
+        .rhs_implicit(rhs, jac)
+        .init(init, dim)
+        .build()
+        .map_err(|e| solver_error(a, e))?;
+    let ctx = Drive {
+        system,
+        bad: &bad,
+        from: a,
+        to: b,
+        wanted,
+        max_steps: opts.max_steps,
+    };
+    match opts.method {
+        Method::Bdf => {
+            let s = problem.bdf::<Ls>().map_err(|e| ctx.failure(a, e))?;
+            ctx.drive(s, out)
+        }
+        Method::Esdirk34 => {
+            let s = problem.esdirk34::<Ls>().map_err(|e| ctx.failure(a, e))?;
+            ctx.drive(s, out)
+        }
+        Method::TrBdf2 => {
+            let s = problem.tr_bdf2::<Ls>().map_err(|e| ctx.failure(a, e))?;
+            ctx.drive(s, out)
+        }
+        Method::Tsit45 => {
+            let s = problem.tsit45().map_err(|e| ctx.failure(a, e))?;
+            ctx.drive(s, out)
+        }
+    }
+}
+
+struct Drive<'c> {
+    system: &'c System,
+    bad: &'c Cell<Option<(f64, usize)>>,
+    from: f64,
+    to: f64,
+    wanted: &'c [f64],
+    max_steps: usize,
+}
+
+impl Drive<'_> {
+    fn name(&self, i: usize) -> String {
+        match i.checked_sub(self.system.state_count()) {
+            None => self.system.states.get(i).cloned().unwrap_or_default(),
+            Some(0) => "dissipated".into(),
+            Some(_) => "supplied".into(),
+        }
+    }
+
+    /// A solver error, attributed to the model when it had returned a non-finite derivative.
+    fn failure(&self, time: f64, e: DiffsolError) -> SimError {
+        match self.bad.get() {
+            Some((time, i)) => SimError::NonFiniteDerivative {
+                time,
+                state: self.name(i),
+            },
+            None => solver_error(time, e),
+        }
+    }
+
+    fn drive<'a, Eqn, S>(
+        &self,
+        mut solver: S,
+        out: &mut Vec<Vec<f64>>,
+    ) -> Result<Vec<f64>, SimError>
+    where
+        Eqn: OdeEquations<T = f64, V = NalgebraVec<f64>> + 'a,
+        S: OdeSolverMethod<'a, Eqn>,
+    {
+        solver
+            .set_stop_time(self.to)
+            .map_err(|e| self.failure(self.from, e))?;
+        let mut next = 0;
+        for _ in 0..self.max_steps {
+            let reason = solver
+                .step()
+                .map_err(|e| self.failure(solver.state().t, e))?;
+            let t_now = solver.state().t;
+            let y = solver.state().y.clone_as_vec();
+            if let Some(i) = y.iter().position(|v| !v.is_finite()) {
+                return Err(match self.bad.get() {
+                    Some((time, i)) => SimError::NonFiniteDerivative {
+                        time,
+                        state: self.name(i),
+                    },
+                    None => SimError::NonFiniteState {
+                        time: t_now,
+                        state: self.name(i),
+                    },
+                });
+            }
+            let reached = matches!(reason, OdeSolverStopReason::TstopReached);
+            while let Some(&t) = self.wanted.get(next) {
+                if reached && t >= self.to {
+                    out.push(y.clone());
+                } else if t <= t_now {
+                    let v = solver.interpolate(t).map_err(|e| self.failure(t, e))?;
+                    out.push(v.clone_as_vec());
+                } else {
+                    break;
+                }
+                next += 1;
+            }
+            if reached {
+                return Ok(y);
+            }
+        }
+        Err(SimError::TooManySteps {
+            from: self.from,
+            to: self.to,
+            time: solver.state().t,
+            max_steps: self.max_steps,
+        })
+    }
+}
+
+fn solver_error(time: f64, e: DiffsolError) -> SimError {
+    SimError::Solver {
+        time,
+        message: e.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn opts(t_end: f64, dt_out: f64) -> RunOptions {
+        RunOptions {
+            t_end,
+            dt_out,
+            method: Method::Bdf,
+            rtol: 1e-6,
+            atol: 1e-9,
+            max_steps: 1000,
+        }
+    }
+
+    #[test]
+    fn samples_end_exactly_at_t_end() {
+        assert_eq!(
+            opts(1.0, 0.3).sample_times(),
+            [0.0, 0.3, 0.6, 0.8999999999999999, 1.0]
+        );
+        let t = opts(1.0, 0.1).sample_times();
+        assert_eq!(t.len(), 11);
+        assert_eq!(t.last(), Some(&1.0));
+        assert_eq!(opts(1.0, 5.0).sample_times(), [0.0, 1.0]);
+    }
+
+    #[test]
+    fn settings_are_checked() {
+        assert!(opts(1.0, 0.1).check().is_ok());
+        for bad in [
+            opts(0.0, 0.1),
+            opts(1.0, -0.1),
+            opts(f64::NAN, 0.1),
+            opts(f64::INFINITY, 0.1),
+        ] {
+            assert!(
+                matches!(bad.check(), Err(SimError::BadSetting { .. })),
+                "{bad:?}"
+            );
+        }
+        assert!(matches!(
+            opts(1.0, 1e-12).check(),
+            Err(SimError::TooManyRows { .. })
+        ));
+    }
+}

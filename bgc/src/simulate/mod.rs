@@ -1,0 +1,283 @@
+//! Simulation of derived equations at run time, for models whose size is only known when the file is read.
+//!
+//! The state equations `ẋ = f(x, u, p, t)` of [`crate::equations`] are compiled into flat programs
+//! ([`program`]) and integrated with diffsol on dynamic vectors ([`integrate`], behind the `cli` feature). The
+//! integrated vector is the model state extended by two quadrature states,
+//!
+//! ```text
+//! Ė_diss = Σ_R e·f          (power dissipated in the resistors)
+//! Ė_sup  = Σ_sources e·f    (power delivered by the sources)
+//! ```
+//!
+//! so that the energies dissipated and supplied since the start are integrated to the solver's tolerance instead
+//! of being summed from samples. With the stored energy `E(x)`, every trajectory of a model whose terms are all
+//! known satisfies `E + E_diss − E_sup = E(x0)`; the CLI prints the three columns so that this balance can be
+//! checked.
+//!
+//! Energy terms the equations stage could not express (a stored energy of a non-polynomial law, a source's power
+//! that needs the time derivative of an input) are left out of their sums; [`System::new`] returns a warning that
+//! names each one.
+
+pub mod input;
+#[cfg(feature = "cli")]
+pub mod integrate;
+pub mod program;
+
+use crate::equations::sym::{self, Ex, Sym, add};
+use crate::equations::{EnergyKind, Equations};
+use input::Signal;
+use program::{CompileError, Layout, Program, Values};
+
+/// Why a simulation could not be set up or run.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SimError {
+    #[error("{what} could not be derived, so the model cannot be simulated")]
+    Incomplete { what: String },
+    #[error("{what} cannot be simulated: {reason}")]
+    Compile { what: String, reason: CompileError },
+    #[error("expected {expected} {what} values, got {got}")]
+    Dimension {
+        what: &'static str,
+        expected: usize,
+        got: usize,
+    },
+    #[error("{name} = {value} is not allowed: {reason}")]
+    BadSetting {
+        name: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+    #[error(
+        "the sampling gives {rows} rows, more than the limit of {limit}; choose a larger --dt-out"
+    )]
+    TooManyRows { rows: f64, limit: usize },
+    #[error("the initial {what} is not finite")]
+    NonFiniteStart { what: String },
+    #[error("the derivative of `{state}` became non-finite at t = {time}")]
+    NonFiniteDerivative { time: f64, state: String },
+    #[error("`{state}` became non-finite at t = {time}")]
+    NonFiniteState { time: f64, state: String },
+    #[error("the solver failed at t = {time}: {message}")]
+    Solver { time: f64, message: String },
+    #[error(
+        "the solver took {max_steps} steps between t = {from} and t = {to} and stopped at t = {time}"
+    )]
+    TooManySteps {
+        from: f64,
+        to: f64,
+        time: f64,
+        max_steps: usize,
+    },
+}
+
+/// The compiled equations of a model at fixed parameter values, with its input signals.
+#[derive(Clone, Debug)]
+pub struct System {
+    /// The state names (all states: energy states, then integrated flows).
+    pub states: Vec<String>,
+    /// The output names.
+    pub outputs: Vec<String>,
+    params: Vec<f64>,
+    inputs: Vec<Signal>,
+    /// `f_i` for the model states, then the dissipated and the supplied power.
+    rates: Vec<Program>,
+    /// Nonzero entries `(row, column, ∂rate_row/∂x_column)` of the Jacobian of `rates`; `None` when a rate uses
+    /// a function without a derivative (the Jacobian is then taken by finite differences).
+    jacobian: Option<Vec<(usize, usize, Program)>>,
+    outputs_h: Vec<Program>,
+    stored: Program,
+}
+
+impl System {
+    /// Compiles the equations at parameter values `params` (in [`Equations::params`] order) with one signal per
+    /// input. Returns the system and the warnings about energy terms left out of the energy columns.
+    pub fn new(
+        eqs: &Equations,
+        params: Vec<f64>,
+        inputs: Vec<Signal>,
+    ) -> Result<(System, Vec<String>), SimError> {
+        check_len("parameter", eqs.params.len(), params.len())?;
+        check_len("input", eqs.inputs.len(), inputs.len())?;
+        let n = eqs.states.len();
+        let layout = Layout {
+            params: params.len(),
+            states: n,
+            inputs: inputs.len(),
+        };
+        let name = |s: Sym| eqs.sym_name(s);
+        let compile = |e: &Ex, what: &str| {
+            Program::compile(e, layout, &name).map_err(|reason| SimError::Compile {
+                what: what.to_string(),
+                reason,
+            })
+        };
+        let mut rate_exprs = Vec::with_capacity(n + 2);
+        for (i, f) in eqs.f.iter().enumerate() {
+            let state = eqs.sym_name(Sym::State(i));
+            let e = f.clone().ok_or_else(|| SimError::Incomplete {
+                what: format!("the rate of `{state}`"),
+            })?;
+            rate_exprs.push((e, format!("the rate of `{state}`")));
+        }
+        let mut warnings = Vec::new();
+        let mut sum =
+            |kind: EnergyKind| {
+                let mut terms = Vec::new();
+                for term in eqs.energy.iter().filter(|t| t.kind == kind) {
+                    match &term.value {
+                    Some(v) if Program::compile(v, layout, &name).is_ok() => terms.push(v.clone()),
+                    _ => warnings.push(format!(
+                        "the {} {} of `{}` has no expression and is left out of the `{}` column",
+                        kind.name(),
+                        if kind == EnergyKind::Stored { "energy" } else { "power" },
+                        term.element,
+                        match kind {
+                            EnergyKind::Stored => "energy",
+                            EnergyKind::Dissipated => "dissipated",
+                            EnergyKind::Supplied => "supplied",
+                        }
+                    )),
+                }
+                }
+                add(terms)
+            };
+        let stored = sum(EnergyKind::Stored);
+        rate_exprs.push((sum(EnergyKind::Dissipated), "the dissipated power".into()));
+        rate_exprs.push((sum(EnergyKind::Supplied), "the supplied power".into()));
+        let rates = rate_exprs
+            .iter()
+            .map(|(e, what)| compile(e, what))
+            .collect::<Result<Vec<_>, _>>()?;
+        let jacobian = symbolic_jacobian(&rate_exprs, n, &compile);
+        let mut outputs_h = Vec::with_capacity(eqs.outputs.len());
+        for o in &eqs.outputs {
+            let what = format!("output `{}`", o.name);
+            let e = o
+                .explicit
+                .as_ref()
+                .ok_or_else(|| SimError::Incomplete { what: what.clone() })?;
+            outputs_h.push(compile(e, &what)?);
+        }
+        let system = System {
+            states: (0..n).map(|i| eqs.sym_name(Sym::State(i))).collect(),
+            outputs: eqs.outputs.iter().map(|o| o.name.clone()).collect(),
+            params,
+            inputs,
+            rates,
+            jacobian,
+            outputs_h,
+            stored: compile(&stored, "the stored energy")?,
+        };
+        Ok((system, warnings))
+    }
+
+    /// The number of model states.
+    pub fn state_count(&self) -> usize {
+        self.states.len()
+    }
+
+    /// The input values at `t`.
+    pub fn inputs_at(&self, t: f64, out: &mut Vec<f64>) {
+        out.clear();
+        out.extend(self.inputs.iter().map(|s| s.eval(t)));
+    }
+
+    /// The times in `(0, t_end)` at which an input may jump or kink, sorted, without repeats.
+    pub fn breakpoints(&self, t_end: f64) -> Vec<f64> {
+        let mut b = Vec::new();
+        self.inputs.iter().for_each(|s| s.breakpoints(&mut b));
+        b.retain(|t| t.is_finite() && *t > 0.0 && *t < t_end);
+        b.sort_by(f64::total_cmp);
+        b.dedup();
+        b
+    }
+
+    fn values<'a>(&'a self, y: &'a [f64], u: &'a [f64], t: f64) -> Values<'a> {
+        Values {
+            params: &self.params,
+            states: y.get(..self.states.len()).unwrap_or(y),
+            inputs: u,
+            t,
+        }
+    }
+
+    /// The derivative of the extended state `y = [x, E_diss, E_sup]` at time `t` with inputs `u`.
+    pub fn rhs(&self, y: &[f64], u: &[f64], t: f64, dy: &mut [f64], stack: &mut Vec<f64>) {
+        let v = self.values(y, u, t);
+        for (d, p) in dy.iter_mut().zip(&self.rates) {
+            *d = p.eval(&v, stack);
+        }
+    }
+
+    /// `J v` for the Jacobian `J = ∂rhs/∂y`; `None` when it has no symbolic form.
+    pub fn jacobian_times(
+        &self,
+        y: &[f64],
+        u: &[f64],
+        t: f64,
+        v: &[f64],
+        jv: &mut [f64],
+        stack: &mut Vec<f64>,
+    ) -> Option<()> {
+        let entries = self.jacobian.as_ref()?;
+        let vals = self.values(y, u, t);
+        jv.iter_mut().for_each(|x| *x = 0.0);
+        for (r, c, p) in entries {
+            if let (Some(out), Some(vc)) = (jv.get_mut(*r), v.get(*c)) {
+                *out += p.eval(&vals, stack) * vc;
+            }
+        }
+        Some(())
+    }
+
+    /// One row of output: the states, the outputs, the stored energy, then the dissipated and supplied energy.
+    pub fn row(&self, y: &[f64], t: f64, u: &mut Vec<f64>, stack: &mut Vec<f64>) -> Vec<f64> {
+        self.inputs_at(t, u);
+        let n = self.states.len();
+        let v = self.values(y, u, t);
+        let mut row = Vec::with_capacity(n + self.outputs_h.len() + 3);
+        row.extend(y.iter().take(n));
+        row.extend(self.outputs_h.iter().map(|p| p.eval(&v, stack)));
+        row.push(self.stored.eval(&v, stack));
+        row.extend(y.iter().skip(n).take(2));
+        row
+    }
+
+    /// The CSV header matching [`System::row`], after `t`.
+    pub fn columns(&self) -> Vec<String> {
+        let mut c = self.states.clone();
+        c.extend(self.outputs.iter().cloned());
+        c.extend(["energy", "dissipated", "supplied"].map(String::from));
+        c
+    }
+}
+
+fn check_len(what: &'static str, expected: usize, got: usize) -> Result<(), SimError> {
+    if expected == got {
+        Ok(())
+    } else {
+        Err(SimError::Dimension {
+            what,
+            expected,
+            got,
+        })
+    }
+}
+
+/// The nonzero entries of `∂rate/∂x` over the model states (the quadrature states enter no rate).
+fn symbolic_jacobian(
+    rates: &[(Ex, String)],
+    n: usize,
+    compile: &dyn Fn(&Ex, &str) -> Result<Program, SimError>,
+) -> Option<Vec<(usize, usize, Program)>> {
+    let mut entries = Vec::new();
+    for (r, (e, what)) in rates.iter().enumerate() {
+        for c in 0..n {
+            let d = sym::diff(e, Sym::State(c)).ok()?;
+            if !d.is_zero() {
+                entries.push((r, c, compile(&d, what).ok()?));
+            }
+        }
+    }
+    Some(entries)
+}

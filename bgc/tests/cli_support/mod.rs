@@ -1,0 +1,112 @@
+//! Helpers of the CLI tests: running `bgc` and reading its JSON and CSV output.
+// Each test crate uses a part of these.
+#![allow(dead_code)]
+
+use serde_json::Value;
+use std::path::PathBuf;
+use std::process::Command;
+
+pub fn repo(path: &str) -> String {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    root.join("..").join(path).display().to_string()
+}
+
+pub fn corpus(name: &str) -> String {
+    repo(&format!("bgc/tests/corpus/{name}"))
+}
+
+/// Runs `bgc` and returns the exit code, standard output and standard error.
+pub fn bgc(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_bgc"))
+        .args(args)
+        .arg("--color=never")
+        .output()
+        .expect("bgc runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+pub fn ok_json(args: &[&str]) -> Value {
+    let (code, out, err) = bgc(args);
+    assert_eq!(code, 0, "stderr: {err}");
+    serde_json::from_str(&out).expect("valid JSON")
+}
+
+pub fn matrix(v: &Value, key: &str) -> Vec<Vec<f64>> {
+    v[key]
+        .as_array()
+        .expect("matrix")
+        .iter()
+        .map(|r| {
+            r.as_array()
+                .expect("row")
+                .iter()
+                .map(|x| x.as_f64().expect("number"))
+                .collect()
+        })
+        .collect()
+}
+
+pub fn names(v: &Value, key: &str) -> Vec<String> {
+    v[key]
+        .as_array()
+        .expect("names")
+        .iter()
+        .map(|x| x.as_str().expect("name").to_string())
+        .collect()
+}
+
+pub fn assert_close(got: &[Vec<f64>], want: &[Vec<f64>], rel: f64) {
+    assert_eq!(got.len(), want.len());
+    for (r, (g, w)) in got.iter().zip(want).enumerate() {
+        assert_eq!(g.len(), w.len());
+        for (c, (g, w)) in g.iter().zip(w).enumerate() {
+            assert!(
+                (g - w).abs() <= rel * w.abs().max(1.0),
+                "[{r}][{c}]: got {g}, want {w}"
+            );
+        }
+    }
+}
+
+/// A simulation's CSV: the header and the rows.
+pub struct Csv {
+    pub header: Vec<String>,
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl Csv {
+    pub fn parse(text: &str) -> Csv {
+        let mut lines = text.lines();
+        let header = lines
+            .next()
+            .expect("header")
+            .split(',')
+            .map(String::from)
+            .collect();
+        let rows = lines
+            .map(|l| l.split(',').map(|x| x.parse().expect("number")).collect())
+            .collect();
+        Csv { header, rows }
+    }
+
+    pub fn col(&self, name: &str) -> Vec<f64> {
+        let i = self
+            .header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name}"));
+        self.rows.iter().map(|r| r[i]).collect()
+    }
+}
+
+pub fn simulate(args: &[&str]) -> Csv {
+    let mut all = vec!["simulate"];
+    all.extend_from_slice(args);
+    let (code, out, err) = bgc(&all);
+    assert_eq!(code, 0, "stderr: {err}");
+    Csv::parse(&out)
+}

@@ -176,6 +176,8 @@ enum Command {
         #[arg(long, default_value_t = 1e-9, allow_hyphen_values = true)]
         atol: f64,
     },
+    /// Print the Rust module that `bgc::build` generates for FILE (the same text, byte for byte).
+    Rust { file: PathBuf },
     /// Print .bg files in the canonical layout (in place), or with --check report the files that differ.
     Fmt {
         #[arg(required = true)]
@@ -207,6 +209,7 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
     };
     let status = match cli.command {
         Command::Check { files, format } => commands::check(&files, format, color),
+        Command::Rust { file } => commands::rust(&file, color),
         Command::Fmt { files, check } => commands::fmt(&files, check, color),
         Command::Causality {
             file,

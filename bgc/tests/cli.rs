@@ -260,3 +260,37 @@ fn fmt_refuses_a_file_with_syntax_errors_and_leaves_it_alone() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `bgc rust FILE` prints exactly what the build-script API writes for the same file.
+#[test]
+fn rust_command_prints_what_the_build_script_generates() {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/back_support.bg");
+    let model = model.canonicalize().unwrap_or(model);
+    let name = model.display().to_string();
+    let run = bgc(&fixtures_dir(), &["rust", &name]);
+    assert_eq!(run.status, 0, "{}", run.transcript());
+    let out = scratch("rust");
+    let generated = bgc::build::Config::new()
+        .out_dir(&out)
+        .cargo_output(false)
+        .compile(&[&model])
+        .unwrap_or_else(|e| panic!("{e}"));
+    let written = std::fs::read_to_string(&generated[0].output).unwrap_or_default();
+    assert_eq!(run.stdout, written);
+    assert!(
+        written.contains("pub fn rhs_into("),
+        "no rhs in the generated module"
+    );
+    let bad = bgc(
+        &fixtures_dir(),
+        &["rust", "invalid/BG0302_domain_mismatch.bg"],
+    );
+    assert_eq!(bad.status, 1, "{}", bad.transcript());
+    assert!(
+        bad.stderr
+            .contains("invalid/BG0302_domain_mismatch.bg:8:18"),
+        "{}",
+        bad.transcript()
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -256,3 +256,32 @@ pub fn draw(
     }
     Status::Ok
 }
+
+/// `bgc rust FILE`: the generated Rust module on standard output.
+pub fn rust(path: &Path, color: bool) -> Status {
+    let mut sources = SourceMap::new();
+    let (id, decode_diag) = match read_source(&mut sources, path) {
+        Ok(x) => x,
+        Err(e) => {
+            stderrln(&format!("error: cannot read {}: {e}", path.display()));
+            return Status::UsageOrIo;
+        }
+    };
+    if let Some(d) = decode_diag {
+        stderr(&render::to_text(&sources, &[d], color));
+        return Status::InputErrors;
+    }
+    match bgc::codegen::compile(&mut sources, id, &mut FsLoader) {
+        Ok(compiled) => {
+            // Named as `bgc::build` names it, so that both print the same text.
+            let name = path.display().to_string();
+            stdout(&bgc::codegen::rust::generate(&compiled, &name));
+            Status::Ok
+        }
+        Err(diags) => {
+            stderr(&render::to_text(&sources, &diags, color));
+            stderrln(&count_line(&diags));
+            Status::InputErrors
+        }
+    }
+}

@@ -137,3 +137,41 @@ pub fn rig_angular_acceleration(
     rig.rhs(t, x, &SVector::zeros(), &mut dx);
     dx.get(layout.momentum).copied().unwrap_or(f64::NAN) / rig.params().J_p
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A name the model lacks is an error naming the model, the kind and the name, not a wrong column.
+    #[test]
+    fn a_missing_name_is_an_error_naming_it() {
+        let err = position(
+            "rehab_leg",
+            "output",
+            &rehab_leg::OUTPUT_NAMES,
+            "omega_knee",
+        );
+        assert_eq!(
+            err,
+            Err(RehabError::ModelLayout {
+                model: "rehab_leg",
+                kind: "output",
+                name: "omega_knee",
+            })
+        );
+        let text = err.map_or_else(|e| e.to_string(), |i| i.to_string());
+        assert_eq!(
+            text,
+            "the generated rehab_leg model has no output named `omega_knee`"
+        );
+        assert_eq!(
+            position(
+                "rehab_leg",
+                "output",
+                &rehab_leg::OUTPUT_NAMES,
+                "omega_calf"
+            ),
+            Ok(4)
+        );
+    }
+}

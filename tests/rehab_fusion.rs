@@ -9,6 +9,7 @@ use bgc_runtime::model::ContinuousModel;
 use bgc_runtime::noise::Rng;
 use bgc_workspace::rehab::RehabError;
 use bgc_workspace::rehab::experiment::{DEG2_PER_RAD2, Setup, run_leg, run_rig};
+use bgc_workspace::rehab::generated::{pendulum_rig_model, rehab_leg_model};
 use bgc_workspace::rehab::pipeline::{estimate_sources, fuse};
 use bgc_workspace::rehab::plant::{pendulum_rig, rehab_leg};
 use bgc_workspace::rehab::sensors::{CameraSpec, GRAVITY, ImuSpec, capture_frames, sample_imu};
@@ -111,7 +112,7 @@ fn gait_curves_pass_through_the_normative_points() {
 #[test]
 fn simulated_leg_follows_the_standard_curves() {
     let leg = rehab_leg();
-    let truth = leg_truth(&leg, LegGeometry::default(), 4.0, 1e-3);
+    let truth = leg_truth(&rehab_leg_model(), LegGeometry::default(), 4.0, 1e-3);
     assert!(truth.is_ok());
     let Ok(truth) = truth else { return };
     for t in [0.5, 1.25, 2.0, 3.7] {
@@ -172,8 +173,7 @@ fn rig_twist_carries_the_torque_that_moves_the_pendulum() {
 /// turning at a constant rate the unit's x axis also reads the centripetal r ω² and z the tangential term is zero.
 #[test]
 fn accelerometer_reads_gravity_and_the_motion_at_its_radius() {
-    let leg = rehab_leg();
-    let truth = leg_truth(&leg, LegGeometry::default(), 3.0, 1e-3);
+    let truth = leg_truth(&rehab_leg_model(), LegGeometry::default(), 3.0, 1e-3);
     assert!(truth.is_ok());
     let Ok(truth) = truth else { return };
     let spec = ImuSpec {
@@ -211,7 +211,7 @@ fn accelerometer_reads_gravity_and_the_motion_at_its_radius() {
 /// vision 19.96 deg², as the example prints).
 #[test]
 fn weights_of_eq_27_match_a_hand_computation_on_the_rig_variances() {
-    let rig = run_rig(&pendulum_rig(), &Setup::rig(), 1);
+    let rig = run_rig(&pendulum_rig_model(), &Setup::rig(), 1);
     assert!(rig.is_ok(), "{rig:?}");
     let Ok(rig) = rig else { return };
     let [vi, vv] = rig.variances;
@@ -244,10 +244,15 @@ fn weights_of_eq_27_match_a_hand_computation_on_the_rig_variances() {
 #[test]
 fn fusion_beats_each_single_source_on_several_seeds() {
     for seed in [1, 7, 42, 1234, 98765] {
-        let rig = run_rig(&pendulum_rig(), &Setup::rig(), seed);
+        let rig = run_rig(&pendulum_rig_model(), &Setup::rig(), seed);
         assert!(rig.is_ok(), "{rig:?}");
         let Ok(rig) = rig else { return };
-        let leg = run_leg(&rehab_leg(), &Setup::leg(), &rig.calibration, seed + 1);
+        let leg = run_leg(
+            &rehab_leg_model(),
+            &Setup::leg(),
+            &rig.calibration,
+            seed + 1,
+        );
         assert!(leg.is_ok(), "{leg:?}");
         let Ok([thigh, calf]) = leg else { return };
         for run in [&rig.segment, &thigh, &calf] {
@@ -266,9 +271,9 @@ fn fusion_beats_each_single_source_on_several_seeds() {
 
 #[test]
 fn same_seed_same_figures_and_another_seed_differs() {
-    let a = run_rig(&pendulum_rig(), &Setup::rig(), 3).map(|r| r.segment.figures);
-    let b = run_rig(&pendulum_rig(), &Setup::rig(), 3).map(|r| r.segment.figures);
-    let c = run_rig(&pendulum_rig(), &Setup::rig(), 4).map(|r| r.segment.figures);
+    let a = run_rig(&pendulum_rig_model(), &Setup::rig(), 3).map(|r| r.segment.figures);
+    let b = run_rig(&pendulum_rig_model(), &Setup::rig(), 3).map(|r| r.segment.figures);
+    let c = run_rig(&pendulum_rig_model(), &Setup::rig(), 4).map(|r| r.segment.figures);
     assert!(a.is_ok());
     assert_eq!(a, b);
     assert_ne!(a, c);
@@ -279,10 +284,10 @@ fn same_seed_same_figures_and_another_seed_differs() {
 /// remaining source wherever one source is missing.
 #[test]
 fn lost_frames_and_nan_samples_fall_back_to_the_remaining_source() {
-    let rig = run_rig(&pendulum_rig(), &Setup::rig(), 1);
+    let rig = run_rig(&pendulum_rig_model(), &Setup::rig(), 1);
     let Ok(rig) = rig else { panic!("{rig:?}") };
     let setup = Setup::leg();
-    let truth = leg_truth(&rehab_leg(), LegGeometry::default(), 8.0, 1e-3);
+    let truth = leg_truth(&rehab_leg_model(), LegGeometry::default(), 8.0, 1e-3);
     let Ok(truth) = truth else {
         panic!("{truth:?}")
     };
@@ -359,7 +364,7 @@ fn lost_frames_and_nan_samples_fall_back_to_the_remaining_source() {
 
 #[test]
 fn bad_settings_are_refused_with_their_name() {
-    let truth = rig_truth(&pendulum_rig(), RigGeometry::default(), 1.0, 1e-3);
+    let truth = rig_truth(&pendulum_rig_model(), RigGeometry::default(), 1.0, 1e-3);
     let Ok(truth) = truth else {
         panic!("{truth:?}")
     };
@@ -390,7 +395,12 @@ fn bad_settings_are_refused_with_their_name() {
         })
     ));
     assert!(matches!(
-        rig_truth(&pendulum_rig(), RigGeometry::default(), f64::NAN, 1e-3),
+        rig_truth(
+            &pendulum_rig_model(),
+            RigGeometry::default(),
+            f64::NAN,
+            1e-3
+        ),
         Err(RehabError::BadSetting { name: "t_end", .. })
     ));
 }
@@ -399,7 +409,7 @@ fn bad_settings_are_refused_with_their_name() {
 /// and each frame arrives `latency` after its capture.
 #[test]
 fn noise_free_markers_give_the_segment_angle() {
-    let truth = leg_truth(&rehab_leg(), LegGeometry::default(), 3.0, 1e-3);
+    let truth = leg_truth(&rehab_leg_model(), LegGeometry::default(), 3.0, 1e-3);
     let Ok(truth) = truth else {
         panic!("{truth:?}")
     };
@@ -421,5 +431,265 @@ fn noise_free_markers_give_the_segment_angle() {
             .state(1, f.arrival - camera.latency)
             .map_or(f64::NAN, |s| s.angle);
         assert!((f.angle - angle).abs() < 1e-9, "t = {}", f.arrival);
+    }
+}
+
+// The generated models against the hand-derived reference.
+
+/// Both generated models keep the layout the study reads: energy states first (the rig's coupling twist and
+/// pendulum momentum; the leg has none, both inertias being in derivative causality), then the integrated flows.
+#[test]
+fn generated_models_have_the_layout_the_study_reads() {
+    use bgc_models::{pendulum_rig, rehab_leg};
+    use bgc_workspace::rehab::generated::{LegLayout, RigLayout};
+    assert_eq!(
+        pendulum_rig::STATE_NAMES,
+        ["q_coupling", "p_pendulum", "theta", "theta_m"]
+    );
+    assert_eq!(pendulum_rig::N_ENERGY_STATES, 2);
+    assert_eq!(
+        pendulum_rig::OUTPUT_NAMES,
+        ["theta_pend", "omega_pend", "theta_motor"]
+    );
+    assert_eq!(rehab_leg::STATE_NAMES, ["phi_hip", "phi_knee"]);
+    assert_eq!(rehab_leg::N_ENERGY_STATES, 0);
+    let rig = RigLayout::of_generated();
+    assert_eq!(
+        rig,
+        Ok(RigLayout {
+            twist: 0,
+            momentum: 1,
+            rotor: 3,
+            angle: 0,
+            rate: 1,
+        })
+    );
+    let leg = LegLayout::of_generated();
+    assert_eq!(
+        leg,
+        Ok(LegLayout {
+            thigh_angle: 0,
+            calf_angle: 2,
+            thigh_rate: 3,
+            calf_rate: 4,
+        })
+    );
+}
+
+/// The generated `Params::default()` are the hand-derived reference's values (the `.bg` defaults in SI units).
+#[test]
+fn generated_defaults_are_the_reference_parameters() {
+    let g = *pendulum_rig_model().params();
+    let h = pendulum_rig().params;
+    for (name, a, b) in [
+        ("A_ref", g.A_ref, h.a_ref),
+        ("T_ref", g.T_ref, h.t_ref),
+        ("k_s", g.k_s, h.k_s),
+        ("d_s", g.d_s, h.d_s),
+        ("J_p", g.J_p, h.j_p),
+        ("b_p", g.b_p, h.b_p),
+        ("m_p", g.m_p, h.m_p),
+        ("l_p", g.l_p, h.l_p),
+        ("g", g.g, h.g),
+    ] {
+        assert!(close(a, b, 1e-15), "{name}: {a} vs {b}");
+    }
+    let g = *rehab_leg_model().params();
+    let h = rehab_leg().params;
+    assert!(close(g.T_gait, h.hip.period, 1e-15));
+    assert!(close(g.J_t, h.j_t, 1e-15) && close(g.J_c, h.j_c, 1e-15));
+    assert!(close(g.h0, h.hip.c0, 1e-15) && close(g.k0, h.knee.c0, 1e-15));
+    let hip = [
+        (g.ha1, g.hb1),
+        (g.ha2, g.hb2),
+        (g.ha3, g.hb3),
+        (g.ha4, g.hb4),
+    ];
+    let knee = [
+        (g.ka1, g.kb1),
+        (g.ka2, g.kb2),
+        (g.ka3, g.kb3),
+        (g.ka4, g.kb4),
+    ];
+    for i in 0..4 {
+        assert!(close(hip[i].0, h.hip.a[i], 1e-15) && close(hip[i].1, h.hip.b[i], 1e-15));
+        assert!(close(knee[i].0, h.knee.a[i], 1e-15) && close(knee[i].1, h.knee.b[i], 1e-15));
+    }
+}
+
+/// The rig with a stiff coupling and heavier damping in both forms (the parameters are set on each side by name).
+fn stiff_rigs() -> (
+    bgc_workspace::rehab::generated::PendulumRigModel,
+    bgc_workspace::rehab::plant::PendulumRig,
+) {
+    let mut hand = pendulum_rig();
+    hand.params.k_s = 2.5e3;
+    hand.params.d_s = 2.0;
+    hand.params.m_p = 0.5;
+    let generated =
+        bgc_workspace::rehab::generated::PendulumRigModel::new(bgc_models::pendulum_rig::Params {
+            k_s: 2.5e3,
+            d_s: 2.0,
+            m_p: 0.5,
+            ..bgc_models::pendulum_rig::Params::default()
+        });
+    assert!(generated.is_ok(), "{generated:?}");
+    (generated.unwrap_or_default(), hand)
+}
+
+/// At random states and times the generated right-hand sides and outputs equal the hand-derived ones (same state
+/// order, see the layout test), and so does the pendulum's angular acceleration `ṗ / J_p` the truth reads off.
+#[test]
+fn generated_and_hand_derived_right_hand_sides_agree_at_random_states() {
+    use bgc_workspace::rehab::generated::{RigLayout, rig_angular_acceleration};
+    let layout = RigLayout::of_generated();
+    assert!(layout.is_ok());
+    let Ok(layout) = layout else { return };
+    let u = SVector::<f64, 0>::zeros();
+    let mut rng = Rng::new(7);
+    let (stiff_gen, stiff_hand) = stiff_rigs();
+    let rigs = [
+        (pendulum_rig_model(), pendulum_rig()),
+        (stiff_gen, stiff_hand),
+    ];
+    for (generated, hand) in &rigs {
+        for _ in 0..200 {
+            let t = 10.0 * rng.uniform();
+            let x = SVector::<f64, 4>::from_fn(|i, _| {
+                // Twist within ±0.1 rad, momentum within ±0.05 N m s, angles within ±π.
+                let scale = [0.1, 0.05, std::f64::consts::PI, std::f64::consts::PI];
+                scale.get(i).copied().unwrap_or(0.0) * (2.0 * rng.uniform() - 1.0)
+            });
+            let (mut dg, mut dh) = (SVector::<f64, 4>::zeros(), SVector::<f64, 4>::zeros());
+            generated.rhs(t, &x, &u, &mut dg);
+            hand.rhs(t, &x, &u, &mut dh);
+            let (mut yg, mut yh) = (SVector::<f64, 3>::zeros(), SVector::<f64, 3>::zeros());
+            generated.outputs(t, &x, &u, &mut yg);
+            hand.outputs(t, &x, &u, &mut yh);
+            for i in 0..4 {
+                assert!(
+                    close(dg[i], dh[i], 1e-12),
+                    "rig dx[{i}] at t = {t}: {dg} vs {dh}"
+                );
+            }
+            for i in 0..3 {
+                assert!(close(yg[i], yh[i], 1e-12), "rig y[{i}] at t = {t}");
+            }
+            let acc = rig_angular_acceleration(generated, &layout, t, &x);
+            assert!(close(acc, dh[1] / hand.params.j_p, 1e-12), "t = {t}");
+        }
+    }
+    let (generated, hand) = (rehab_leg_model(), rehab_leg());
+    for _ in 0..200 {
+        let t = 10.0 * rng.uniform();
+        let x = SVector::<f64, 2>::new(2.0 * rng.uniform() - 1.0, 2.0 * rng.uniform() - 1.0);
+        let (mut dg, mut dh) = (SVector::<f64, 2>::zeros(), SVector::<f64, 2>::zeros());
+        generated.rhs(t, &x, &u, &mut dg);
+        hand.rhs(t, &x, &u, &mut dh);
+        let (mut yg, mut yh) = (SVector::<f64, 5>::zeros(), SVector::<f64, 5>::zeros());
+        generated.outputs(t, &x, &u, &mut yg);
+        hand.outputs(t, &x, &u, &mut yh);
+        for i in 0..2 {
+            assert!(close(dg[i], dh[i], 1e-12), "leg dx[{i}] at t = {t}");
+        }
+        for i in 0..5 {
+            assert!(
+                close(yg[i], yh[i], 1e-12),
+                "leg y[{i}] at t = {t}: {yg} vs {yh}"
+            );
+        }
+    }
+}
+
+/// Simulated over 5 s through the same solver, the generated and hand-derived rigs (defaults and the stiff
+/// variant) and legs give the same angles and rates; `rig_initial_state` is the reference's transient-free start.
+#[test]
+fn generated_and_hand_derived_models_give_the_same_trajectories() {
+    use bgc_runtime::sim::{SolverOptions, simulate_open_loop};
+    use bgc_workspace::rehab::generated::{RigLayout, rig_initial_state};
+    let opts = SolverOptions {
+        rtol: 1e-10,
+        atol: 1e-12,
+        ..SolverOptions::default()
+    };
+    let times: Vec<f64> = (0..=500).map(|k| k as f64 * 0.01).collect();
+    let zero_u = |_: f64| SVector::<f64, 0>::zeros();
+    let layout = RigLayout::of_generated();
+    assert!(layout.is_ok());
+    let Ok(layout) = layout else { return };
+    let (stiff_gen, stiff_hand) = stiff_rigs();
+    let mut worst: f64 = 0.0;
+    for (generated, hand) in [
+        (pendulum_rig_model(), pendulum_rig()),
+        (stiff_gen, stiff_hand),
+    ] {
+        let x0 = rig_initial_state(&generated, &layout);
+        assert_eq!(x0, Ok(hand.initial_state()));
+        let x0 = x0.unwrap_or_else(|_| SVector::zeros());
+        let tg = simulate_open_loop(&generated, 0.0, &x0, zero_u, &times, &opts);
+        let th = simulate_open_loop(&hand, 0.0, &hand.initial_state(), zero_u, &times, &opts);
+        assert!(tg.is_ok() && th.is_ok());
+        let (Ok(tg), Ok(th)) = (tg, th) else { return };
+        assert_eq!(tg.outputs.len(), times.len());
+        assert_eq!(th.outputs.len(), times.len());
+        // The pendulum swings (the comparison is not of two resting states).
+        let swing = tg.outputs.iter().map(|y| y[0].abs()).fold(0.0, f64::max);
+        assert!(swing > 0.4, "{swing}");
+        for (yg, yh) in tg.outputs.iter().zip(&th.outputs) {
+            worst = worst.max((yg[0] - yh[0]).abs()).max((yg[2] - yh[2]).abs());
+            assert!((yg[1] - yh[1]).abs() < 1e-6, "rate {} vs {}", yg[1], yh[1]);
+        }
+    }
+    assert!(worst < 1e-8, "rig angles differ by {worst} rad");
+
+    let (generated, hand) = (rehab_leg_model(), rehab_leg());
+    let x0 = SVector::<f64, 2>::zeros();
+    let tg = simulate_open_loop(&generated, 0.0, &x0, zero_u, &times, &opts);
+    let th = simulate_open_loop(&hand, 0.0, &x0, zero_u, &times, &opts);
+    assert!(tg.is_ok() && th.is_ok());
+    let (Ok(tg), Ok(th)) = (tg, th) else { return };
+    let mut worst: f64 = 0.0;
+    for (yg, yh) in tg.outputs.iter().zip(&th.outputs) {
+        for i in 0..3 {
+            worst = worst.max((yg[i] - yh[i]).abs());
+        }
+        assert!((yg[3] - yh[3]).abs() < 1e-12 && (yg[4] - yh[4]).abs() < 1e-12);
+    }
+    assert!(worst < 1e-8, "leg angles differ by {worst} rad");
+}
+
+/// The truth the study simulates from the generated rig equals the hand-derived rig's trajectory, and its angular
+/// acceleration is the reference's `ṗ / J_p` at the reference's states.
+#[test]
+fn rig_truth_from_the_generated_model_follows_the_reference() {
+    use bgc_runtime::sim::{SolverOptions, simulate_open_loop};
+    let truth = rig_truth(&pendulum_rig_model(), RigGeometry::default(), 3.0, 1e-3);
+    assert!(truth.is_ok(), "{truth:?}");
+    let Ok(truth) = truth else { return };
+    let hand = pendulum_rig();
+    let times = [0.0, 0.37, 1.0, 1.9, 2.5, 3.0];
+    let opts = SolverOptions {
+        rtol: 1e-10,
+        atol: 1e-12,
+        ..SolverOptions::default()
+    };
+    let zero_u = |_: f64| SVector::<f64, 0>::zeros();
+    let th = simulate_open_loop(&hand, 0.0, &hand.initial_state(), zero_u, &times, &opts);
+    assert!(th.is_ok());
+    let Ok(th) = th else { return };
+    for ((&t, x), y) in times.iter().zip(&th.states).zip(&th.outputs) {
+        let s = truth.state(0, t);
+        assert!(s.is_some());
+        let Some(s) = s else { return };
+        let mut dx = SVector::<f64, 4>::zeros();
+        hand.rhs(t, x, &SVector::zeros(), &mut dx);
+        assert!((s.angle - y[0]).abs() < 1e-7, "angle at {t}");
+        assert!((s.rate - y[1]).abs() < 1e-6, "rate at {t}");
+        assert!(
+            (s.accel - dx[1] / hand.params.j_p).abs() < 1e-4,
+            "accel at {t}: {} vs {}",
+            s.accel,
+            dx[1] / hand.params.j_p
+        );
     }
 }

@@ -16,8 +16,8 @@ use bgc_workspace::rehab::RehabError;
 use bgc_workspace::rehab::experiment::{
     DEG2_PER_RAD2, Figures, SegmentRun, Setup, run_leg, run_rig,
 };
+use bgc_workspace::rehab::generated::{pendulum_rig_model, rehab_leg_model};
 use bgc_workspace::rehab::pipeline::ImuFilterTuning;
-use bgc_workspace::rehab::plant::{pendulum_rig, rehab_leg};
 use serde::Serialize;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -212,9 +212,9 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         smoothing_q: q,
         ..Setup::leg()
     };
-    let rig = run_rig(&pendulum_rig(), &rig_setup, args.seed)?;
+    let rig = run_rig(&pendulum_rig_model(), &rig_setup, args.seed)?;
     let leg = run_leg(
-        &rehab_leg(),
+        &rehab_leg_model(),
         &leg_setup,
         &rig.calibration,
         args.seed.wrapping_add(1),

@@ -25,6 +25,12 @@ pub enum RehabError {
     },
     /// Too few finite samples to compute a figure.
     TooFewSamples { what: &'static str, count: usize },
+    /// A generated model lacks a state or output the study reads (the `.bg` file renamed or removed it).
+    ModelLayout {
+        model: &'static str,
+        kind: &'static str,
+        name: &'static str,
+    },
 }
 
 impl fmt::Display for RehabError {
@@ -41,6 +47,12 @@ impl fmt::Display for RehabError {
             } => write!(f, "invalid setting `{name}` = {value}: {reason}"),
             RehabError::TooFewSamples { what, count } => {
                 write!(f, "too few finite samples for {what} ({count})")
+            }
+            RehabError::ModelLayout { model, kind, name } => {
+                write!(
+                    f,
+                    "the generated {model} model has no {kind} named `{name}`"
+                )
             }
         }
     }

@@ -13,8 +13,8 @@
 //! smoothing gains (with `q` = 1 deg² per sample E_fusion on the rig rises from 9.4 to 18.3 deg²).
 
 use super::error::RehabError;
+use super::generated::{PendulumRigModel, RehabLegModel};
 use super::pipeline::{ImuFilterTuning, SourceEstimates, error_variance, estimate_sources, fuse};
-use super::plant::{PendulumRig, RehabLeg};
 use super::sensors::{CameraSpec, ImuSpec, capture_frames, sample_imu};
 use super::sensors::{Frame, ImuSample};
 use super::truth::{LegGeometry, RigGeometry, Truth, leg_truth, rig_truth};
@@ -231,7 +231,7 @@ pub struct Calibration {
 /// The rig run, as the paper calibrates on its test platform: the accelerometer-angle variance (Eq. 28) becomes
 /// the IMU filter's `R`; the IMU and vision variances (Eq. 28) give the weights of Eq. 27; then the fusion runs
 /// with them.
-pub fn run_rig(rig: &PendulumRig, setup: &Setup, seed: u64) -> Result<RigRun, RehabError> {
+pub fn run_rig(rig: &PendulumRigModel, setup: &Setup, seed: u64) -> Result<RigRun, RehabError> {
     let truth = rig_truth(rig, RigGeometry::default(), setup.t_end, setup.truth_dt)?;
     let rec = record(&truth, 0, setup, seed)?;
     let mut accel = ErrorVariance::new();
@@ -293,7 +293,7 @@ pub fn run_rig(rig: &PendulumRig, setup: &Setup, seed: u64) -> Result<RigRun, Re
 
 /// The exoskeleton test without load with the rig's calibration: thigh and calf.
 pub fn run_leg(
-    leg: &RehabLeg,
+    leg: &RehabLegModel,
     setup: &Setup,
     calibration: &Calibration,
     seed: u64,

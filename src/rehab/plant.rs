@@ -1,8 +1,10 @@
-//! The plants of the measurement-system example, one function per `.bg` model, each returning a
-//! [`ContinuousModel`]: [`pendulum_rig`] (`models/pendulum_rig.bg`) and [`rehab_leg`] (`models/rehab_leg.bg`).
+//! Hand-derived implementations of the measurement-system example's two `.bg` models, one function per model,
+//! each returning a [`ContinuousModel`]: [`pendulum_rig`] (`models/pendulum_rig.bg`) and [`rehab_leg`]
+//! (`models/rehab_leg.bg`).
 //!
-//! These are hand-derived implementations of the models' bond-graph equations; they stay as the independent
-//! reference that the models generated from the `.bg` files are tested against. Parameter values are those of the
+//! The study simulates the models generated from the `.bg` files ([`super::generated`]); these implementations of
+//! the models' bond-graph equations, written independently of the compiler, are the reference those are tested
+//! against (same state and output order, same trajectories). Parameter values are those of the
 //! `.bg` defaults in SI units (a test checks that they agree).
 //!
 //! **Pendulum rig.** Integral causality on the coupling `C` (stiffness `k_s`) and the pendulum `I` (`J_p`); the

@@ -7,17 +7,25 @@
 //! `a = a_P + r φ̈ (cos φ, sin φ) + r φ̇² (−sin φ, cos φ)`,
 //!
 //! the tangential and centripetal accelerations the paper neglects in Eq. 2 (Sec. 2.3.1 notes they bias the
-//! accelerometer's gravity direction). The angle and rate come from the model's outputs on a fine time grid, the
-//! angular acceleration by central differences of the rate on that grid (second order; one-sided at the ends).
+//! accelerometer's gravity direction).
 //!
-//! Rig: one segment, the pendulum about a fixed pivot. Leg (exoskeleton without load, frame fixed): the thigh
-//! about the fixed hip and the calf about the knee, which is carried by the thigh at distance `L_t`:
-//! `P_knee = L_t (sin θ, −cos θ)` with the acceleration of the formula above at `r = L_t`.
+//! The plants are the models generated from the `.bg` files ([`super::generated`]), simulated on a fine time grid;
+//! the angle and rate of each segment are the model's outputs there.
+//!
+//! Rig: one segment, the pendulum about a fixed pivot; its angular acceleration is `ṗ / J_p` from the model's
+//! right-hand side at the simulated states. Leg (exoskeleton without load, frame fixed): the thigh about the fixed
+//! hip and the calf about the knee, which is carried by the thigh at distance `L_t`: `P_knee = L_t (sin θ, −cos θ)`
+//! with the acceleration of the formula above at `r = L_t`. The leg's states are the integrated motor flows, so
+//! its right-hand side gives rates, not accelerations: those are central differences of the rate on the grid
+//! (second order; one-sided at the ends).
 
 use super::error::{RehabError, positive};
-use super::plant::{PendulumRig, RehabLeg};
+use super::generated::{
+    LegLayout, PendulumRigModel, RehabLegModel, RigLayout, rig_angular_acceleration,
+    rig_initial_state,
+};
 use bgc_runtime::model::ContinuousModel;
-use bgc_runtime::sim::{SolverOptions, simulate_open_loop};
+use bgc_runtime::sim::{SolverOptions, Trajectory, simulate_open_loop};
 use nalgebra::SVector;
 
 /// The motion of one segment at the grid times of its [`Truth`].
@@ -166,33 +174,52 @@ fn simulate<M: ContinuousModel<NX, 0, NY>, const NX: usize, const NY: usize>(
     name: &'static str,
     x0: &SVector<f64, NX>,
     times: &[f64],
-) -> Result<Vec<SVector<f64, NY>>, RehabError> {
+) -> Result<Trajectory<NX, 0, NY>, RehabError> {
     let opts = SolverOptions {
         rtol: 1e-9,
         atol: 1e-11,
         ..SolverOptions::default()
     };
-    simulate_open_loop(model, 0.0, x0, |_| SVector::<f64, 0>::zeros(), times, &opts)
-        .map(|tr| tr.outputs)
-        .map_err(|source| RehabError::Simulation {
+    simulate_open_loop(model, 0.0, x0, |_| SVector::<f64, 0>::zeros(), times, &opts).map_err(
+        |source| RehabError::Simulation {
             model: name,
             source,
-        })
+        },
+    )
 }
 
-/// The true motion of the rig's pendulum from `0` to `t_end`, on a grid of step `dt`.
+/// Column `i` of a series of vectors (NaN where `i` is out of range, which the layouts rule out).
+fn column<const N: usize>(v: &[SVector<f64, N>], i: usize) -> Vec<f64> {
+    v.iter()
+        .map(|x| x.get(i).copied().unwrap_or(f64::NAN))
+        .collect()
+}
+
+/// The true motion of the rig's pendulum from `0` to `t_end`, on a grid of step `dt`, simulated from the generated
+/// model and started without a transient ([`rig_initial_state`]).
 pub fn rig_truth(
-    rig: &PendulumRig,
+    rig: &PendulumRigModel,
     geometry: RigGeometry,
     t_end: f64,
     dt: f64,
 ) -> Result<Truth, RehabError> {
     positive("marker_length", geometry.marker_length)?;
+    let layout = RigLayout::of_generated()?;
     let times = grid(t_end, dt)?;
-    let y = simulate(rig, "pendulum_rig", &rig.initial_state(), &times)?;
-    let angle: Vec<f64> = y.iter().map(|v| v[0]).collect();
-    let rate: Vec<f64> = y.iter().map(|v| v[1]).collect();
-    let accel = derivative(&rate, dt);
+    let tr = simulate(
+        rig,
+        "pendulum_rig",
+        &rig_initial_state(rig, &layout)?,
+        &times,
+    )?;
+    let angle = column(&tr.outputs, layout.angle);
+    let rate = column(&tr.outputs, layout.rate);
+    let accel: Vec<f64> = tr
+        .times
+        .iter()
+        .zip(&tr.states)
+        .map(|(&t, x)| rig_angular_acceleration(rig, &layout, t, x))
+        .collect();
     let n = times.len();
     Ok(Truth {
         times,
@@ -209,20 +236,24 @@ pub fn rig_truth(
 }
 
 /// The true motion of the thigh (segment 0) and calf (segment 1) from `0` to `t_end`, on a grid of step `dt`.
+///
+/// The generated model's states are the motors' integrated flows, zero at `t = 0`; its outputs add the curves'
+/// values at `t = 0`.
 pub fn leg_truth(
-    leg: &RehabLeg,
+    leg: &RehabLegModel,
     geometry: LegGeometry,
     t_end: f64,
     dt: f64,
 ) -> Result<Truth, RehabError> {
     positive("thigh_length", geometry.thigh_length)?;
     positive("calf_length", geometry.calf_length)?;
+    let layout = LegLayout::of_generated()?;
     let times = grid(t_end, dt)?;
-    let y = simulate(leg, "rehab_leg", &SVector::<f64, 2>::zeros(), &times)?;
-    let thigh: Vec<f64> = y.iter().map(|v| v[0]).collect();
-    let calf: Vec<f64> = y.iter().map(|v| v[2]).collect();
-    let thigh_rate: Vec<f64> = y.iter().map(|v| v[3]).collect();
-    let calf_rate: Vec<f64> = y.iter().map(|v| v[4]).collect();
+    let tr = simulate(leg, "rehab_leg", &SVector::zeros(), &times)?;
+    let thigh = column(&tr.outputs, layout.thigh_angle);
+    let calf = column(&tr.outputs, layout.calf_angle);
+    let thigh_rate = column(&tr.outputs, layout.thigh_rate);
+    let calf_rate = column(&tr.outputs, layout.calf_rate);
     let thigh_acc = derivative(&thigh_rate, dt);
     let calf_acc = derivative(&calf_rate, dt);
     let n = times.len();

@@ -77,11 +77,11 @@ pub fn plots(s: &Study, dir: &Path) -> Result<usize, Box<dyn std::error::Error>>
             "motor velocity",
         ),
     ] {
-        let plant = column(&mc.plant, index);
+        let bond_graph = column(&mc.bond_graph, index);
         let eq1 = column(&mc.block_diagram, index);
         let printed = column(&mc.block_diagram_as_printed, index);
-        let diff = difference(&plant, &eq1);
-        let diff_label = format!("Eq. 3 − Eq. 1 ({quantity})");
+        let diff = difference(&bond_graph, &eq1);
+        let diff_label = format!("bond graph − Eq. 1 ({quantity})");
         let diff_unit = unit.replace('(', "difference (");
         plots::draw(
             &dir.join(file),
@@ -90,7 +90,12 @@ pub fn plots(s: &Study, dir: &Path) -> Result<usize, Box<dyn std::error::Error>>
                     title,
                     unit,
                     vec![
-                        line("plant, Eq. 3 (bond graph)", t, &plant, BLUE_),
+                        line(
+                            "bond graph, generated from back_support.bg",
+                            t,
+                            &bond_graph,
+                            BLUE_,
+                        ),
                         dashed("block diagram, Eq. 1 with b_g/r_g²", t, &eq1, ORANGE),
                         line("Eq. 1 with b_g/r_g as printed", t, &printed, GREY),
                     ],

@@ -67,7 +67,10 @@ pub fn print_table(s: &Study) {
     let mc = &s.model_check;
     println!("Back-support exoskeleton (Shojaei Barjuei et al., Designs 2020, 4, 53)");
     println!("  {:<52} {:<34} paper", "", "bgc");
-    println!("1. Model check, Eq. 3 vs Eq. 1 (τ_m = 0.1 N m, θ̇_h = 0.05 rad/s after 0.1 s, 1 s)");
+    println!(
+        "1. Model check, generated bond-graph model (back_support.bg) vs Eq. 1 (τ_m = 0.1 N m, θ̇_h = 0.05 rad/s \
+         after 0.1 s, 1 s)"
+    );
     row(
         "max |Δ sensor torque|, Eq. 1 with b_g/r_g²",
         format!("{:.2e} N m", mc.max_torque_difference),

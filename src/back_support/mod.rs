@@ -4,8 +4,8 @@
 //! them and its integration test checks them.
 //!
 //! - [`params`]: the physical parameters;
-//! - [`plant`]: the plant (Eq. 3; replaced by the model generated from `models/back_support.bg` once the
-//!   compiler produces it) and the 6-state design model in angles relative to the trunk;
+//! - [`plant`]: the plant (Eq. 3), taken from the model bgc generates from `models/back_support.bg`, and the
+//!   6-state design model in angles relative to the trunk;
 //! - [`block_diagram`]: Eq. 1, coded independently, and [`model_check`]: Sec. 5.1;
 //! - [`lqr`]: Eqs. 10–17; [`observer`]: Eqs. 4–9 with the noise of Sec. 4;
 //! - [`scenario`]: the lifting task of Sec. 5.2; [`robustness`]: margins and disturbance rejection.
@@ -27,6 +27,7 @@ use bgc_runtime::analysis::AnalysisError;
 use bgc_runtime::design::DesignError;
 use bgc_runtime::estimation::EstimationError;
 use bgc_runtime::linalg::{DiscretizeError, PbhError, RiccatiError};
+use bgc_runtime::model::ParamError;
 use bgc_runtime::sim::SimError;
 use bgc_runtime::statespace::StateSpaceError;
 
@@ -47,6 +48,8 @@ pub enum BackSupportError {
     Setup {
         what: &'static str,
     },
+    /// The generated model refused the parameters.
+    ModelParameter(ParamError),
     StateSpace(StateSpaceError),
     Simulation(SimError),
     Design(DesignError),
@@ -71,6 +74,7 @@ impl fmt::Display for BackSupportError {
                  {residual:e}); the relative-angle design model does not apply"
             ),
             BackSupportError::Setup { what } => write!(f, "{what}"),
+            BackSupportError::ModelParameter(e) => write!(f, "generated model: {e}"),
             BackSupportError::StateSpace(e) => write!(f, "state-space model: {e}"),
             BackSupportError::Simulation(e) => write!(f, "simulation: {e}"),
             BackSupportError::Design(e) => write!(f, "LQR design: {e}"),
@@ -96,6 +100,7 @@ macro_rules! from_error {
 }
 
 from_error!(
+    ParamError => ModelParameter,
     StateSpaceError => StateSpace,
     SimError => Simulation,
     DesignError => Design,

@@ -1,15 +1,18 @@
-//! The plant: the linear state space of Eq. 3 in the paper's coordinates, and the 6-state design model.
+//! The plant: the linear state space of Eq. 3 in the paper's coordinates, taken from the model the bgc compiler
+//! generates from `models/back_support.bg` (the bond graph of Fig. 6), and the 6-state design model.
 //!
 //! State `x = [θ_m, θ̇_m, θ_s_int, θ̇_s_int, θ_s_ext, θ̇_s_ext, θ_h]` (Eq. 2), inputs `u = [τ_m, θ̇_h]`, outputs
 //! `y = [y_v, y_t, y_b]`: the motor velocity `θ̇_m`, the sensor torque `k_s (θ_s_int − θ_s_ext) + d_s (θ̇_s_int −
 //! θ̇_s_ext)` (Eq. 5) and the torque on the human body `k_eh (θ_s_ext − θ_h) + d_eh (θ̇_s_ext − θ̇_h)` (Eq. 6).
 //!
-//! [`plant`] is the single source of the plant model for everything else in [`super`]. It is coded here by hand
-//! from Eq. 3, with the gearbox friction entering the motor equation as `b_g / r_g²` (the bond graph of Fig. 6
-//! puts `b_g` on the gearbox output, which reflects to the motor through the transformer squared). The model
-//! the bgc compiler generates from `models/back_support.bg` (the bond graph of Fig. 6, with the same state
-//! coordinates, inputs and outputs in the same order) replaces this hand-coded matrix in [`plant`] once the
-//! compiler pipeline produces it; [`super::block_diagram`] (Eq. 1, coded independently) stays as the check.
+//! [`plant`] is the single source of the plant model for everything else in [`super`]: it maps [`Params`] onto
+//! the generated `bgc_models::back_support::Params` ([`generated_params`]) and reads `A, B, C, D` from the
+//! generated `state_space_declared`, whose coordinates (`coords` in the `.bg` file) are the seven above, in
+//! that order, with the inputs and outputs in the order above ([`plant`] checks the generated names). In the
+//! bond graph `R: b_g` sits after the gearbox transformer, where it sees the output velocity `θ̇_m / r_g`, so it
+//! reaches the motor line as `b_g / r_g²`, as in Eq. 3. The integration test holds these matrices against Eq. 3
+//! coded by hand; [`super::block_diagram`] (Eq. 1, coded independently) is the check of Sec. 5.1
+//! ([`super::model_check`]), which simulates the generated 10-state model itself ([`bond_graph_model`]).
 //!
 //! # The design model
 //!
@@ -28,6 +31,8 @@ use nalgebra::{DMatrix, SMatrix, SVector};
 
 use bgc_runtime::model::ContinuousModel;
 use bgc_runtime::statespace::StateSpace;
+
+use bgc_models::back_support as generated;
 
 use super::BackSupportError;
 use super::params::Params;
@@ -69,47 +74,71 @@ pub struct Plant {
     pub d: SMatrix<f64, NY, NU>,
 }
 
-/// The plant of Eq. 3 for the given parameters (see the module docs).
-pub fn plant(p: &Params) -> Result<Plant, BackSupportError> {
+/// The coordinates, inputs and outputs the generated model must declare, in this order, for its
+/// `state_space_declared` to be Eq. 3 in the coordinates of Eq. 2.
+pub const GENERATED_COORDS: [&str; NX] = [
+    "theta_m",
+    "f_rotor",
+    "theta_sint",
+    "f_sensor_in",
+    "theta_sext",
+    "f_sensor_out",
+    "theta_h",
+];
+/// The inputs `[τ_m, θ̇_h]` as the generated model names them.
+pub const GENERATED_INPUTS: [&str; NU] = ["tau_m", "omega_h"];
+/// The outputs `[y_v, y_t, y_b]` as the generated model names them.
+pub const GENERATED_OUTPUTS: [&str; NY] = ["omega_m", "tau_s", "tau_h"];
+
+/// The generated model's parameters for the study's (same quantities, same SI units).
+pub fn generated_params(p: &Params) -> generated::Params {
+    generated::Params {
+        J_m: p.j_m,
+        J_g: p.j_g,
+        b_f: p.b_f,
+        r_g: p.r_g,
+        b_g: p.b_g,
+        k_g: p.k_g,
+        d_g: p.d_g,
+        J_sint: p.j_s_int,
+        k_s: p.k_s,
+        d_s: p.d_s,
+        J_sext: p.j_s_ext,
+        k_eh: p.k_eh,
+        d_eh: p.d_eh,
+        J_h: p.j_h,
+        b_h: p.b_h,
+    }
+}
+
+/// The model generated from `models/back_support.bg` (10 states: 6 energy states, then the angles
+/// `θ_m, θ_s_int, θ_s_ext, θ_h`), with the given parameters.
+pub fn bond_graph_model(p: &Params) -> Result<generated::Model, BackSupportError> {
     p.validate()?;
-    let j = p.j_motor();
-    let rg = p.r_g;
-    let (jsi, jse) = (p.j_s_int, p.j_s_ext);
-    #[rustfmt::skip]
-    let a = SMatrix::<f64, NX, NX>::from_row_slice(&[
-        0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0,
-        -p.k_g / (j * rg * rg), -(p.b_f * rg * rg + p.b_g + p.d_g) / (j * rg * rg),
-            p.k_g / (j * rg), p.d_g / (j * rg), 0.0, 0.0, 0.0,
-        0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0,
-        p.k_g / (jsi * rg), p.d_g / (jsi * rg), -(p.k_g + p.k_s) / jsi, -(p.d_g + p.d_s) / jsi,
-            p.k_s / jsi, p.d_s / jsi, 0.0,
-        0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0,
-        0.0, 0.0, p.k_s / jse, p.d_s / jse, -(p.k_eh + p.k_s) / jse, -(p.d_eh + p.d_s) / jse,
-            p.k_eh / jse,
-        0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
-    ]);
-    #[rustfmt::skip]
-    let b = SMatrix::<f64, NX, NU>::from_row_slice(&[
-        0.0, 0.0,
-        1.0 / j, 0.0,
-        0.0, 0.0,
-        0.0, 0.0,
-        0.0, 0.0,
-        0.0, p.d_eh / jse,
-        0.0, 1.0,
-    ]);
-    #[rustfmt::skip]
-    let c = SMatrix::<f64, NY, NX>::from_row_slice(&[
-        0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0,
-        0.0, 0.0, p.k_s, p.d_s, -p.k_s, -p.d_s, 0.0,
-        0.0, 0.0, 0.0, 0.0, p.k_eh, p.d_eh, -p.k_eh,
-    ]);
-    #[rustfmt::skip]
-    let d = SMatrix::<f64, NY, NU>::from_row_slice(&[
-        0.0, 0.0,
-        0.0, 0.0,
-        0.0, -p.d_eh,
-    ]);
+    check_generated_names()?;
+    Ok(generated::Model::new(generated_params(p))?)
+}
+
+/// Refuses a generated model whose coordinates, inputs or outputs are not those of Eq. 2 in the study's order.
+fn check_generated_names() -> Result<(), BackSupportError> {
+    if generated::COORD_NAMES != GENERATED_COORDS {
+        return Err(BackSupportError::Setup {
+            what: "the generated back_support model's coordinates are not those of Eq. 2 in order",
+        });
+    }
+    if generated::INPUT_NAMES != GENERATED_INPUTS || generated::OUTPUT_NAMES != GENERATED_OUTPUTS {
+        return Err(BackSupportError::Setup {
+            what: "the generated back_support model's inputs or outputs are not [τ_m, θ̇_h] and [y_v, y_t, y_b]",
+        });
+    }
+    Ok(())
+}
+
+/// The plant of Eq. 3 for the given parameters: the generated model's state space in the declared coordinates
+/// (see the module docs).
+pub fn plant(p: &Params) -> Result<Plant, BackSupportError> {
+    let model = bond_graph_model(p)?;
+    let (a, b, c, d) = generated::state_space_declared(model.params());
     Ok(Plant { a, b, c, d })
 }
 

@@ -169,7 +169,8 @@ fn print_report(r: &Report) {
     );
     println!();
     println!(
-        "E [deg^2]             vision      IMU   fusion   accel(Eq.2) | paper: vision      IMU   fusion"
+        "{:<9} {:>14} {:>8} {:>8} {:>13} | {:>13} {:>8} {:>8}",
+        "E [deg^2]", "vision", "IMU", "fusion", "accel(Eq.2)", "paper: vision", "IMU", "fusion"
     );
     for s in &r.segments {
         let f = s.figures_deg2;
@@ -178,7 +179,7 @@ fn print_report(r: &Report) {
             None => "    (Eq. 29 not in the text)".to_string(),
         };
         println!(
-            "{:<8} {:>15.2} {:>8.2} {:>8.2} {:>13.2} | {}",
+            "{:<9} {:>14.2} {:>8.2} {:>8.2} {:>13.2} | {}",
             s.name, f.e_vision, f.e_imu, f.e_fusion, f.e_accel, paper
         );
     }

@@ -208,7 +208,7 @@ pub const N_PARAMS: usize = {np};
             np = eqs.params.len(),
         );
         let states: Vec<String> = eqs.states.iter().map(|s| s.name.clone()).collect();
-        let outputs: Vec<String> = eqs.outputs.iter().map(|o| o.name.clone()).collect();
+        let outputs = output_names(eqs);
         let params: Vec<String> = eqs.params.iter().map(|p| p.0.clone()).collect();
         self.name_array("STATE_NAMES", "N_STATES", "states", &states);
         self.name_array("INPUT_NAMES", "N_INPUTS", "inputs", &eqs.inputs.clone());
@@ -448,13 +448,7 @@ pub type OutJacU = SMatrix<f64, N_OUTPUTS, N_INPUTS>;
             self.out,
             "{FN_ALLOW}\npub fn outputs_into(p: &Params, t: f64, x: &State, u: &Inputs, y: &mut Outputs) {{"
         );
-        let names: Vec<String> = self
-            .m
-            .equations
-            .outputs
-            .iter()
-            .map(|o| o.name.clone())
-            .collect();
+        let names: Vec<String> = output_names(&self.m.equations);
         let b = self.plan.outputs.clone();
         self.block(&b, &|i| names.get(i).cloned().unwrap_or_default(), "y");
         self.line("}");
@@ -508,13 +502,7 @@ pub type OutJacU = SMatrix<f64, N_OUTPUTS, N_INPUTS>;
             .iter()
             .map(|s| s.name().to_string())
             .collect();
-        let ys: Vec<String> = self
-            .m
-            .equations
-            .outputs
-            .iter()
-            .map(|o| o.name.clone())
-            .collect();
+        let ys: Vec<String> = output_names(&self.m.equations);
         let plan = self.plan;
         self.matrix_fn(
             ("jac_x_into", "Writes `∂f/∂x` into `jac`.", "JacX"),
@@ -579,13 +567,7 @@ pub type OutJacU = SMatrix<f64, N_OUTPUTS, N_INPUTS>;
                 "    let {mutable}{var} = SMatrix::<f64, {rows}, {cols}>::zeros();"
             );
         }
-        let ys: Vec<String> = self
-            .m
-            .equations
-            .outputs
-            .iter()
-            .map(|o| o.name.clone())
-            .collect();
+        let ys: Vec<String> = output_names(&self.m.equations);
         let us: Vec<String> = self.m.equations.inputs.clone();
         for (var, m, rows, cols) in [
             ("a", &ss.a, &ss.states, &ss.states),
@@ -787,4 +769,9 @@ enum Rule {
     Positive(&'static str),
     NonNegative,
     NonZero,
+}
+
+/// The outputs' names, in output order.
+fn output_names(eqs: &crate::equations::Equations) -> Vec<String> {
+    eqs.outputs.iter().map(|o| o.name.clone()).collect()
 }

@@ -261,6 +261,10 @@ pub struct Param {
     pub unit_text: String,
     pub description: Option<String>,
     pub doc: Vec<String>,
+    /// For a parameter whose default (or instance override) refers to other parameters: that expression, in SI
+    /// units. Such a parameter is derived: its value follows the parameters it refers to (see
+    /// [`Model::param_values`]).
+    pub derived: Option<Expr>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -309,6 +313,56 @@ pub struct SpanTable {
     /// For nodes that come from a component instance: the instance declaration.
     pub node_instances: Vec<Option<Span>>,
     pub model: Span,
+}
+
+impl Expr {
+    /// The value of an expression of constants and parameters, with the parameters' values from `param`; `None`
+    /// when it uses anything else (a state, an input, `t`) or a parameter without a value.
+    pub fn eval_const(&self, param: &dyn Fn(ParamId) -> Option<f64>) -> Option<f64> {
+        Some(match self {
+            Expr::Const(v) => *v,
+            Expr::Param(id) => param(*id)?,
+            Expr::Neg(a) => -a.eval_const(param)?,
+            Expr::Binary(op, a, b) => {
+                let (a, b) = (a.eval_const(param)?, b.eval_const(param)?);
+                match op {
+                    BinOp::Add => a + b,
+                    BinOp::Sub => a - b,
+                    BinOp::Mul => a * b,
+                    BinOp::Div => a / b,
+                    BinOp::Pow => a.powf(b),
+                }
+            }
+            Expr::Call(f, args) => {
+                let vals = args
+                    .iter()
+                    .map(|a| a.eval_const(param))
+                    .collect::<Option<Vec<_>>>()?;
+                crate::equations::sym::eval_func(*f, &vals)?
+            }
+            _ => return None,
+        })
+    }
+}
+
+impl Model {
+    /// The parameter values with some given (`given[i] = Some(v)`, indexed like [`Model::params`]) and the rest
+    /// at their defaults, derived parameters recomputed from the values before them. A given value always wins,
+    /// also for a derived parameter.
+    pub fn param_values(&self, given: &[Option<f64>]) -> Vec<f64> {
+        let mut values: Vec<f64> = Vec::with_capacity(self.params.len());
+        for (i, p) in self.params.iter().enumerate() {
+            let v = match (given.get(i).copied().flatten(), &p.derived) {
+                (Some(v), _) => v,
+                (None, Some(e)) => e
+                    .eval_const(&|j| values.get(j).copied())
+                    .unwrap_or(p.default),
+                (None, None) => p.default,
+            };
+            values.push(v);
+        }
+        values
+    }
 }
 
 /// A lowered, checked model. Parameter defaults and the constants of expressions are in SI base units; a declared

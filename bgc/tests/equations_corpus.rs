@@ -65,3 +65,31 @@ fn corpus_models() {
         insta::assert_snapshot!(format!("corpus_{name}_latex"), to_latex(&eqs));
     }
 }
+
+/// Every other model of models/ (back_support has its own test above): text and LaTeX snapshots, no errors.
+#[test]
+fn model_files() {
+    let dir = root().join("../models");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    files.retain(|p| p.extension().is_some_and(|e| e == "bg") && !p.ends_with("back_support.bg"));
+    files.sort();
+    assert!(files.len() >= 3, "models not found in {}", dir.display());
+    for path in files {
+        let name = path
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("model")
+            .to_string();
+        let (eqs, diags) = equations_of(&path);
+        let errors: Vec<String> = diags
+            .iter()
+            .filter(|d| d.is_error())
+            .map(|d| format!("{}: {}", d.code.0, d.message))
+            .collect();
+        assert!(errors.is_empty(), "{name}: {errors:?}");
+        insta::assert_snapshot!(format!("model_{name}_text"), to_text(&eqs));
+        insta::assert_snapshot!(format!("model_{name}_latex"), to_latex(&eqs));
+    }
+}

@@ -153,7 +153,11 @@ fn energy_coords(
     let (x0, u0) = operating_point(eqs, &state_names, args.at)?;
     let linear = match equations::linear_state_space(eqs, selection) {
         Ok(j) => Ok(j),
-        Err(e @ (LinearError::NotLinear { .. } | LinearError::Affine { .. })) => Err(e),
+        Err(
+            e @ (LinearError::NotLinear { .. }
+            | LinearError::Affine { .. }
+            | LinearError::MassMatrix { .. }),
+        ) => Err(e),
         Err(e) => return Err(format!("no state space: {e}")),
     };
     if let Err(why) = &linear
@@ -168,6 +172,9 @@ fn energy_coords(
     }
     let fixed = fixed_params(eqs, args.params, params);
     if args.symbolic {
+        if let Err(e @ LinearError::MassMatrix { .. }) = &linear {
+            return Err(format!("no symbolic state space: {e}"));
+        }
         let j = match linear {
             Ok(j) => j,
             Err(_) => {

@@ -2,7 +2,7 @@
 //! parameter values.
 
 use bgc::ir::{Expr, Model, Relation};
-use bgc::syntax::ast::{BinOp, ElementKind};
+use bgc::syntax::ast::ElementKind;
 
 /// A `NAME=VALUE` pair as given (the value is checked by the command, so that a bad number is an input error).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -64,8 +64,12 @@ pub fn assign(
 /// The parameter values: the defaults with the overrides, checked to be physical (see [`check_physical`]).
 pub fn param_values(model: &Model, given: &[Assignment]) -> Result<Vec<f64>, String> {
     let names: Vec<String> = model.params.iter().map(|p| p.name.clone()).collect();
-    let mut values: Vec<f64> = model.params.iter().map(|p| p.default).collect();
+    // The given values, marked by being set; the others follow from the defaults and the derived parameters.
+    let mut values: Vec<f64> = vec![f64::NAN; names.len()];
     assign("parameter", &names, &mut values, given)?;
+    let given_values: Vec<Option<f64>> =
+        values.iter().map(|v| (!v.is_nan()).then_some(*v)).collect();
+    let values = model.param_values(&given_values);
     check_physical(model, &values)?;
     Ok(values)
 }
@@ -100,27 +104,5 @@ pub fn check_physical(model: &Model, params: &[f64]) -> Result<(), String> {
 
 /// The value of an expression of constants and parameters; `None` when it uses anything else.
 fn eval_params(e: &Expr, params: &[f64]) -> Option<f64> {
-    Some(match e {
-        Expr::Const(v) => *v,
-        Expr::Param(i) => *params.get(*i)?,
-        Expr::Neg(a) => -eval_params(a, params)?,
-        Expr::Binary(op, a, b) => {
-            let (a, b) = (eval_params(a, params)?, eval_params(b, params)?);
-            match op {
-                BinOp::Add => a + b,
-                BinOp::Sub => a - b,
-                BinOp::Mul => a * b,
-                BinOp::Div => a / b,
-                BinOp::Pow => a.powf(b),
-            }
-        }
-        Expr::Call(f, args) => {
-            let vals = args
-                .iter()
-                .map(|a| eval_params(a, params))
-                .collect::<Option<Vec<_>>>()?;
-            bgc::equations::sym::eval_func(*f, &vals)?
-        }
-        _ => return None,
-    })
+    e.eval_const(&|i| params.get(i).copied())
 }

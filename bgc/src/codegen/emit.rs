@@ -71,6 +71,12 @@ fn convert_matrix(eqs: &Equations, m: &[Vec<Ex>]) -> Result<Vec<Vec<Expr>>, Adap
 
 /// The plan of a complete model.
 pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
+    if let Some(b) = eqs.mass.first() {
+        return Err(format!(
+            "the I-field `{}` gives its rates in mass-matrix form, which the code generator does not emit yet",
+            b.element
+        ));
+    }
     let mut f_ex = Vec::with_capacity(eqs.f.len());
     for (i, f) in eqs.f.iter().enumerate() {
         let name = eqs.states.get(i).map(|s| s.name.as_str()).unwrap_or("?");

@@ -32,6 +32,7 @@ use crate::ir::{Expr, Law, Model, PortVar, Relation, Target};
 use crate::syntax::ast::{BinOp, ElementKind};
 use petgraph::Direction;
 use petgraph::graph::{EdgeIndex, NodeIndex};
+use std::collections::HashMap;
 
 /// The definition of one bond variable.
 #[derive(Clone, Debug, PartialEq)]
@@ -62,8 +63,11 @@ pub(crate) struct Built {
     pub names: Vec<String>,
     /// The states: integral storages, then integrated flows.
     pub states: Vec<StateSpec>,
-    /// Per state: its rate in terms of bond variables (`ṗ = e`, `q̇ = s·f`, `θ̇ = integrand`).
+    /// Per state: its rate in terms of bond variables (`ṗ = e`, `q̇ = s·f`, `θ̇ = integrand`); for the flow states
+    /// of an I-field, the generalised force of its mass-matrix row.
     pub rates: Vec<Ex>,
+    /// The inertia matrices of the I-fields.
+    pub mass: Vec<super::field::MassBlock>,
 }
 
 /// The conversion context of IR expressions.
@@ -77,6 +81,12 @@ pub(crate) struct Ctx<'a> {
     pub energy_expr: Vec<Option<Ex>>,
     /// Per `var`: its state.
     pub var_state: Vec<usize>,
+    /// Per multiport field with states: the displacement state of each port.
+    pub field_q: HashMap<NodeIndex, Vec<usize>>,
+    /// Per I-field with states: the flow state of each port.
+    pub field_f: HashMap<NodeIndex, Vec<usize>>,
+    /// Per multiport field with states: the bond and own-flow sign of each port.
+    pub field_ports: HashMap<NodeIndex, Vec<(EdgeIndex, f64)>>,
 }
 
 /// Why an IR expression could not be converted.
@@ -172,6 +182,42 @@ impl Ctx<'_> {
         )))
     }
 
+    /// A port variable of a multiport field: its displacement or (I-field) flow state, or its bond's variable.
+    fn field_port(&self, node: NodeIndex, var: PortVar, port: u32) -> Result<Ex, ConvertError> {
+        let k = port as usize;
+        let state =
+            |m: &HashMap<NodeIndex, Vec<usize>>| m.get(&node).and_then(|v| v.get(k)).copied();
+        let bond = super::field::ports(self.model, node).and_then(|b| b.get(k).copied());
+        let missing = || {
+            ConvertError::Unsupported(format!(
+                "{}[{}] of the multiport field {} has no value in this causality",
+                match var {
+                    PortVar::Effort => "e",
+                    PortVar::Flow => "f",
+                    PortVar::Momentum => "p",
+                    PortVar::Displacement => "q",
+                },
+                k + 1,
+                self.node_name(node)
+            ))
+        };
+        match var {
+            PortVar::Displacement => state(&self.field_q)
+                .map(|s| Ex::S(Sym::State(s)))
+                .ok_or_else(missing),
+            PortVar::Flow => match state(&self.field_f) {
+                Some(s) => Ok(Ex::S(Sym::State(s))),
+                None => bond
+                    .map(|(b, s)| mul(vec![Ex::Num(s), Ex::S(Sym::Var(flow_var(b)))]))
+                    .ok_or_else(missing),
+            },
+            PortVar::Effort => bond
+                .map(|(b, _)| Ex::S(Sym::Var(effort_var(b))))
+                .ok_or_else(missing),
+            PortVar::Momentum => Err(missing()),
+        }
+    }
+
     /// Converts an IR expression; `outputs_seen` guards against outputs defined through each other.
     pub fn convert(&self, e: &Expr) -> Result<Ex, ConvertError> {
         self.convert_guarded(e, &mut Vec::new())
@@ -208,12 +254,7 @@ impl Ctx<'_> {
             Expr::Flow(t) => self.flow_of(*t)?,
             Expr::Momentum(n) => self.energy_of(*n, "p")?,
             Expr::Displacement(n) => self.energy_of(*n, "q")?,
-            Expr::FieldPort { node, .. } => {
-                return Err(ConvertError::Unsupported(format!(
-                    "the port variables of the multiport field {}",
-                    self.node_name(*node)
-                )));
-            }
+            Expr::FieldPort { node, var, port } => self.field_port(*node, *var, *port)?,
             Expr::Neg(a) => neg(self.convert_guarded(a, outputs_seen)?),
             Expr::Binary(op, a, b) => {
                 let a = self.convert_guarded(a, outputs_seen)?;
@@ -280,25 +321,30 @@ pub(crate) fn context<'a>(model: &'a Model, causality: &Causality) -> (Ctx<'a>, 
             kind,
             node: Some(s.node),
             var: None,
+            port: None,
         });
     }
-    let mut var_state = Vec::new();
+    let mut ctx = Ctx {
+        model,
+        port,
+        node_state,
+        energy_expr: vec![None; n],
+        var_state: Vec::new(),
+        field_q: HashMap::new(),
+        field_f: HashMap::new(),
+        field_ports: HashMap::new(),
+    };
+    super::field::add_states(&mut ctx, causality, &mut states);
     for (i, v) in model.vars.iter().enumerate() {
-        var_state.push(states.len());
+        ctx.var_state.push(states.len());
         states.push(StateSpec {
             name: sanitize(&v.name),
             kind: StateKind::Integrated,
             node: None,
             var: Some(i),
+            port: None,
         });
     }
-    let ctx = Ctx {
-        model,
-        port,
-        node_state,
-        energy_expr: vec![None; n],
-        var_state,
-    };
     (ctx, states)
 }
 
@@ -489,12 +535,19 @@ pub(crate) fn build(
         };
         rates.push(rate.unwrap_or(Ex::zero()));
     }
+    let mut mass = Vec::new();
+    for node in model.graph.node_indices() {
+        if let Some(block) = super::field::rates(model, ctx, node, &mut rates, diags) {
+            mass.push(block);
+        }
+    }
     Built {
         defs,
         definer,
         names: names(model),
         states,
         rates,
+        mass,
     }
 }
 
@@ -523,6 +576,9 @@ fn derivative_law(
         node_state: ctx.node_state.clone(),
         energy_expr: ctx.energy_expr.clone(),
         var_state: ctx.var_state.clone(),
+        field_q: ctx.field_q.clone(),
+        field_f: ctx.field_f.clone(),
+        field_ports: ctx.field_ports.clone(),
     };
     c.energy_expr[node.index()] = Some(Ex::S(placeholder));
     let g = c.convert(&l.rhs)?;
@@ -773,9 +829,7 @@ fn node_defs(
             }
         }
         ElementKind::CF | ElementKind::RF | ElementKind::IF => {
-            return Err(unsupported(
-                "multiport fields (CF, RF, IF) are not supported by the equations stage yet".into(),
-            ));
+            return super::field::defs(model, causality, ctx, node);
         }
     }
     Ok(out)

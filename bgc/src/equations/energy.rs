@@ -90,11 +90,23 @@ pub(crate) fn terms(
     ctx: &Ctx,
     resolver: &mut Resolver,
     rate_of: &dyn Fn(&Ex) -> Ex,
+    mass: &[super::field::MassBlock],
     diags: &mut Vec<Diagnostic>,
 ) -> Vec<EnergyTerm> {
     let mut out = Vec::new();
     for node in model.graph.node_indices() {
         let w = &model.graph[node];
+        if w.kind.is_field() {
+            if let Some((kind, raw)) = super::field::energy(model, ctx, node, mass, diags) {
+                let value = raw.and_then(|r| resolver.expr(&r).ok().map(|v| rate_of(&v)));
+                out.push(EnergyTerm {
+                    element: w.name.clone(),
+                    kind,
+                    value,
+                });
+            }
+            continue;
+        }
         let Some((b, s)) = ctx.port.get(node.index()).copied().flatten() else {
             continue;
         };

@@ -42,6 +42,12 @@ pub enum LinearError {
     Unbound { what: String, symbol: String },
     #[error("{what} evaluates to a non-finite number")]
     NonFinite { what: String },
+    #[error(
+        "the rates of `{element}` come from its mass matrix M(q) ẋ = F: they have no symbolic state space; linearise at an operating point instead"
+    )]
+    MassMatrix { element: String },
+    #[error("the mass matrix of `{element}` is singular at this point")]
+    SingularMass { element: String },
     #[error("expected {expected} {what} values, got {got}")]
     Dimension {
         what: &'static str,
@@ -176,7 +182,8 @@ fn jacobian(
         .collect()
 }
 
-/// The symbolic Jacobians `∂f/∂x, ∂f/∂u, ∂h/∂x, ∂h/∂u` of the selected state vector.
+/// The symbolic Jacobians `∂f/∂x, ∂f/∂u, ∂h/∂x, ∂h/∂u` of the selected state vector. For the mass-matrix rows of
+/// an I-field (see [`Equations::mass`]) the rows are those of the generalised forces `F`, not of the rates.
 pub fn jacobians(eqs: &Equations, selection: StateSelection) -> Result<Jacobians, LinearError> {
     let (f, h) = selected(eqs, selection)?;
     let n = f.len();
@@ -206,6 +213,11 @@ pub fn linear_state_space(
     eqs: &Equations,
     selection: StateSelection,
 ) -> Result<SymbolicStateSpace, LinearError> {
+    if let Some(b) = eqs.mass.first() {
+        return Err(LinearError::MassMatrix {
+            element: b.element.clone(),
+        });
+    }
     let j = jacobians(eqs, selection)?;
     let variable = |s: Sym| matches!(s, Sym::State(_) | Sym::Input(_) | Sym::Time);
     let check = |m: &[Vec<Ex>], name: &str, what: &str| -> Result<(), LinearError> {
@@ -346,7 +358,8 @@ pub fn numeric_state_space(
     )
 }
 
-/// The linearisation of any model at the operating point `(x0, u0, t0)`: the Jacobians evaluated there.
+/// The linearisation of any model at the operating point `(x0, u0, t0)`: the Jacobians evaluated there (for the
+/// mass-matrix rows of I-fields, those of the solved rates).
 pub fn linearise(
     eqs: &Equations,
     selection: StateSelection,
@@ -356,5 +369,14 @@ pub fn linearise(
     t0: f64,
 ) -> Result<NumericStateSpace, LinearError> {
     let j = jacobians(eqs, selection)?;
-    evaluate_at(eqs, &j, params, x0, u0, t0)
+    let mut ss = evaluate_at(eqs, &j, params, x0, u0, t0)?;
+    let value = |s: Sym| match s {
+        Sym::Param(i) => params.get(i).copied(),
+        Sym::State(i) => x0.get(i).copied(),
+        Sym::Input(i) => u0.get(i).copied(),
+        Sym::Time => Some(t0),
+        _ => None,
+    };
+    super::numeric::correct_mass_rows(eqs, &value, &mut ss)?;
+    Ok(ss)
 }

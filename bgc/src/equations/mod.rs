@@ -8,6 +8,8 @@
 //! 3. The rates and outputs are expressed in states, inputs, parameters and `t` by substitution in dependency order
 //!    (`resolve.rs`); algebraic loops are torn and solved when affine, storages in derivative causality contribute
 //!    `ẋ` terms, solved for by a symbolic linear solve (`solve.rs`).
+//!    Multiport fields are in [`field`]: an I-field gives the mass-matrix form `M(q) ẋ = F` for its flow states
+//!    ([`Equations::mass`]), solved numerically by its consumers ([`Equations::rates_at`]).
 //! 4. Readable forms keep intermediates (one per bond variable that is computed and not a mere copy of another).
 //!
 //! # Calling it
@@ -38,7 +40,7 @@
 //! | BG0602 | an output needs the time derivative of an input |
 //! | BG0603 | a nonlinear (or singular) algebraic loop |
 //! | BG0604 | derivative causality that cannot be resolved (nonlinear in the rates, singular, or a state rate needing the derivative of an input) |
-//! | BG0605 | a construct the equations stage does not support (multiport fields, ambiguous references) |
+//! | BG0605 | a construct the equations stage does not support (a field port in derivative causality, an R-field with mixed causality, an inertia matrix depending on more than the field's displacements, ambiguous references) |
 //! | BG0606 | declared coordinates that are not a linear, invertible function of the states |
 //! | BG0607 | the stored energy of a law that cannot be integrated symbolically (warning) |
 
@@ -46,9 +48,11 @@ mod bridge;
 mod build;
 mod coords;
 mod coords_symbolic;
-mod dense;
+pub(crate) mod dense;
 mod energy;
+mod field;
 mod linear;
+mod numeric;
 mod print;
 mod resolve;
 mod solve;
@@ -58,6 +62,7 @@ pub use bridge::{symbol, to_symbolic};
 pub use coords::{CoordsError, declared_state_space};
 pub use coords_symbolic::declared_state_space_symbolic;
 pub use energy::{EnergyKind, EnergyTerm};
+pub use field::MassBlock;
 pub use linear::{
     Jacobians, LinearError, NumericStateSpace, StateSelection, SymbolicStateSpace, evaluate_at,
     jacobians, linear_state_space, linearise, numeric_state_space,
@@ -92,6 +97,8 @@ pub enum StateKind {
     Displacement,
     /// A declared integrated flow (`var`).
     Integrated,
+    /// The flow of an I-field port (a generalised velocity; its rate comes from the mass-matrix form).
+    Velocity,
 }
 
 /// One state.
@@ -104,6 +111,8 @@ pub struct StateSpec {
     pub node: Option<NodeIndex>,
     /// The integrated flow (integrated states).
     pub var: Option<VarId>,
+    /// The port (0-based) of a multiport field's state.
+    pub port: Option<u32>,
 }
 
 /// A named intermediate variable in the readable equations.
@@ -134,6 +143,8 @@ pub struct Equations {
     pub model: String,
     /// Parameter names and default values (indexed by [`Sym::Param`]).
     pub params: Vec<(String, f64)>,
+    /// Per parameter: its expression in earlier parameters when it is derived (see [`crate::ir::Param::derived`]).
+    pub derived: Vec<Option<Ex>>,
     /// Input names (indexed by [`Sym::Input`]).
     pub inputs: Vec<String>,
     /// Energy states first, then one integrated state per `var`.
@@ -153,6 +164,9 @@ pub struct Equations {
     pub coords: Option<Vec<(String, Ex)>>,
     /// Stored energy, dissipated and supplied power of each element.
     pub energy: Vec<EnergyTerm>,
+    /// The inertia matrices of the I-fields: for the states of a block, `f` and `rates` hold the generalised
+    /// forces `F`, and `M ẋ_block = F` gives the rates ([`Equations::rates_at`] solves it numerically).
+    pub mass: Vec<MassBlock>,
     /// The intermediates at which algebraic loops were solved exactly: the readable intermediates around them are
     /// implicit (they refer to each other), the explicit rates and outputs are not.
     pub loops: Vec<String>,
@@ -237,6 +251,7 @@ fn empty_equations(model: &Model) -> Equations {
             .iter()
             .map(|p| (p.name.clone(), p.default))
             .collect(),
+        derived: vec![None; model.params.len()],
         inputs: model.inputs.iter().map(|i| i.name.clone()).collect(),
         states: Vec::new(),
         energy_states: 0,
@@ -247,6 +262,7 @@ fn empty_equations(model: &Model) -> Equations {
         outputs: Vec::new(),
         coords: None,
         energy: Vec::new(),
+        mass: Vec::new(),
         loops: Vec::new(),
     }
 }
@@ -269,6 +285,11 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
         return (eqs, diags);
     }
     let (mut ctx, states) = build::context(model, causality);
+    eqs.derived = model
+        .params
+        .iter()
+        .map(|p| p.derived.as_ref().and_then(|e| ctx.convert(e).ok()))
+        .collect();
     let built = build::build(model, causality, &mut ctx, states, &mut diags);
     eqs.energy_states = built
         .states
@@ -339,6 +360,28 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
             implicit.clone()
         }
     };
+    // A storage in derivative causality whose rate involves an I-field's flows would add to its inertia matrix;
+    // that coupling is not supported, and substituting `ẋ` of a mass-matrix row would be wrong.
+    let mass_states: Vec<usize> = built
+        .mass
+        .iter()
+        .flat_map(|b| b.states.iter().copied())
+        .collect();
+    let needs_mass_rate = |e: &Ex| mass_states.iter().any(|&j| e.contains(Sym::StateDot(j)));
+    if implicit.iter().any(needs_mass_rate) {
+        diags.push(with_span(
+            Diagnostic::error(
+                codes::DERIVATIVE_CAUSALITY,
+                "a storage in derivative causality is driven by the flows of an I-field; fold it into the field's inertia matrix",
+            ),
+            causality
+                .derivative()
+                .next()
+                .and_then(|s| model.spans.nodes.get(s.node.index())),
+            "this storage is in derivative causality",
+        ));
+        rate_ok.iter_mut().for_each(|ok| *ok = false);
+    }
     let rate_of = |e: &Ex| {
         sym::subst(e, &mut |s| match s {
             Sym::StateDot(j) => solved.get(j).cloned(),
@@ -386,6 +429,15 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
                 None
             }
             Ok(e) if e.any_sym(&|s| matches!(s, Sym::StateDot(_))) && !all_rates_ok => None,
+            Ok(e) if needs_mass_rate(&e) => {
+                let d = Diagnostic::error(
+                    codes::UNSUPPORTED,
+                    format!("output `{}` needs the acceleration of an I-field's port, which the equations give only through its mass matrix", out.name),
+                )
+                .with_help("measure a velocity or a displacement of the field, or an effort at a junction");
+                diags.push(with_span(d, model.spans.outputs.get(k), "this output"));
+                None
+            }
             Ok(e) => Some(rate_of(&e)),
             Err(e) => {
                 diags.push(resolve_diag(
@@ -417,7 +469,14 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
         );
     }
 
-    eqs.energy = energy::terms(model, &ctx, &mut resolver, &rate_of, &mut diags);
+    eqs.energy = energy::terms(
+        model,
+        &ctx,
+        &mut resolver,
+        &rate_of,
+        &built.mass,
+        &mut diags,
+    );
 
     // Readable forms.
     let output_values: Vec<Ex> = eqs.outputs.iter().map(|o| o.value.clone()).collect();
@@ -438,6 +497,7 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
         .map(|v| eqs.sym_name(Sym::Var(v)))
         .collect();
     eqs.states = built.states;
+    eqs.mass = built.mass;
     (eqs, diags)
 }
 

@@ -359,12 +359,46 @@ pub fn expr_latex(eqs: &Equations, e: &Ex) -> String {
     expr(eqs, e, Style::Latex)
 }
 
+/// The mass block and row of state `i`, when its rate is a row of an I-field's mass-matrix form.
+fn mass_row(eqs: &Equations, i: usize) -> Option<(&super::MassBlock, usize)> {
+    eqs.mass
+        .iter()
+        .find_map(|b| b.states.iter().position(|&j| j == i).map(|k| (b, k)))
+}
+
 /// The equations as text: one equation per line, grouped into states, intermediates and outputs.
 pub fn to_text(eqs: &Equations) -> String {
     let mut out = format!("model {}\n", eqs.model);
     out.push_str("states:\n");
-    for (s, r) in eqs.states.iter().zip(&eqs.rates) {
-        out.push_str(&format!("  d/dt {} = {}\n", s.name, expr_text(eqs, r)));
+    for (i, (s, r)) in eqs.states.iter().zip(&eqs.rates).enumerate() {
+        let lhs = match mass_row(eqs, i) {
+            Some((b, k)) => format!("[M_{} d/dt f_{}]_{}", b.element, b.element, k + 1),
+            None => format!("d/dt {}", s.name),
+        };
+        out.push_str(&format!("  {lhs} = {}\n", expr_text(eqs, r)));
+    }
+    for b in &eqs.mass {
+        out.push_str(&format!(
+            "mass matrix M_{} (symmetric), f_{} = [{}]:\n",
+            b.element,
+            b.element,
+            b.states
+                .iter()
+                .map(|&j| eqs.sym_name(Sym::State(j)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+        for (i, row) in b.matrix.iter().enumerate() {
+            for (j, m) in row.iter().enumerate().skip(i) {
+                out.push_str(&format!(
+                    "  M_{}[{},{}] = {}\n",
+                    b.element,
+                    i + 1,
+                    j + 1,
+                    expr_text(eqs, m)
+                ));
+            }
+        }
     }
     out.push_str("intermediates:\n");
     for i in &eqs.intermediates {
@@ -403,14 +437,33 @@ pub fn to_latex(eqs: &Equations) -> String {
         eqs.states
             .iter()
             .zip(&eqs.rates)
-            .map(|(s, r)| {
-                (
-                    format!("\\dot{{{}}}", latex_name(&s.name)),
-                    expr_latex(eqs, r),
-                )
+            .enumerate()
+            .map(|(i, (s, r))| {
+                let lhs = match mass_row(eqs, i) {
+                    Some((b, k)) => format!(
+                        "\\left[M_{{{}}} \\dot{{f}}_{{{}}}\\right]_{{{}}}",
+                        latex_name(&b.element),
+                        latex_name(&b.element),
+                        k + 1
+                    ),
+                    None => format!("\\dot{{{}}}", latex_name(&s.name)),
+                };
+                (lhs, expr_latex(eqs, r))
             })
             .collect(),
     );
+    for b in &eqs.mass {
+        let mut lines = Vec::new();
+        for (i, row) in b.matrix.iter().enumerate() {
+            for (j, m) in row.iter().enumerate().skip(i) {
+                lines.push((
+                    format!("M_{{{},{}{}}}", latex_name(&b.element), i + 1, j + 1),
+                    expr_latex(eqs, m),
+                ));
+            }
+        }
+        group(&format!("mass matrix of {}", b.element), lines);
+    }
     group(
         "intermediates",
         eqs.intermediates
@@ -449,6 +502,7 @@ pub fn to_json(eqs: &Equations) -> Value {
                 StateKind::Momentum => "momentum",
                 StateKind::Displacement => "displacement",
                 StateKind::Integrated => "integrated",
+                StateKind::Velocity => "velocity",
             },
             "rate": eqs.rates.get(i).map(|r| expr_text(eqs, r)),
             "explicit": text(eqs.f.get(i).unwrap_or(&None)),
@@ -465,6 +519,11 @@ pub fn to_json(eqs: &Equations) -> Value {
         })).collect::<Vec<_>>(),
         "coords": eqs.coords.as_ref().map(|c| c.iter().map(|(n, e)| json!({"name": n, "value": expr_text(eqs, e)})).collect::<Vec<_>>()),
         "loops": eqs.loops,
+        "mass": eqs.mass.iter().map(|b| json!({
+            "element": b.element,
+            "states": b.states.iter().map(|&j| eqs.sym_name(Sym::State(j))).collect::<Vec<_>>(),
+            "matrix": b.matrix.iter().map(|row| row.iter().map(|m| expr_text(eqs, m)).collect::<Vec<_>>()).collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
         "energy": eqs.energy.iter().map(|t| json!({
             "element": t.element,
             "kind": t.kind.name(),

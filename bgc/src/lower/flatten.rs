@@ -327,6 +327,7 @@ impl<'a> Builder<'a> {
             what,
         };
         let mut value = 0.0;
+        let mut derived = None;
         if let Some((ir_expr, q)) = self.expr(expr, cx) {
             match q {
                 Q::Dim(d) if unit_ok && d != unit.dim => {
@@ -359,6 +360,11 @@ impl<'a> Builder<'a> {
                 );
                 value = 0.0;
             }
+            let mut refs = Vec::new();
+            super::consteval::params_of(&ir_expr, &mut refs);
+            if !refs.is_empty() {
+                derived = Some(ir_expr);
+            }
         }
         let id = self.model.params.len();
         // A duplicate cannot be referred to; it is not reported as unused as well.
@@ -370,6 +376,7 @@ impl<'a> Builder<'a> {
             unit_text: text,
             description: p.description.clone(),
             doc: p.doc.clone(),
+            derived,
         });
         self.model.spans.params.push(p.span);
         self.params.push(ParamInfo {

@@ -86,6 +86,9 @@ pub struct System {
     jacobian: Option<Vec<(usize, usize, Program)>>,
     outputs_h: Vec<Program>,
     stored: Program,
+    /// The I-fields' mass blocks: the states whose rates solve `M ẋ_B = F` (their `rates` give `F`), and `M`
+    /// row-major.
+    mass: Vec<(Vec<usize>, Vec<Program>)>,
 }
 
 impl System {
@@ -148,7 +151,26 @@ impl System {
             .iter()
             .map(|(e, what)| compile(e, what))
             .collect::<Result<Vec<_>, _>>()?;
-        let jacobian = symbolic_jacobian(&rate_exprs, n, &compile);
+        // The symbolic Jacobian is that of `F` in the mass-matrix rows, not of the rates: leave it to finite
+        // differences there.
+        let jacobian = if eqs.has_mass() {
+            None
+        } else {
+            symbolic_jacobian(&rate_exprs, n, &compile)
+        };
+        let mut mass = Vec::with_capacity(eqs.mass.len());
+        for b in &eqs.mass {
+            let mut m = Vec::new();
+            for (i, row) in b.matrix.iter().enumerate() {
+                for (j, e) in row.iter().enumerate() {
+                    m.push(compile(
+                        e,
+                        &format!("M_{}[{},{}]", b.element, i + 1, j + 1),
+                    )?);
+                }
+            }
+            mass.push((b.states.clone(), m));
+        }
         let mut outputs_h = Vec::with_capacity(eqs.outputs.len());
         for o in &eqs.outputs {
             let what = format!("output `{}`", o.name);
@@ -167,6 +189,7 @@ impl System {
             jacobian,
             outputs_h,
             stored: compile(&stored, "the stored energy")?,
+            mass,
         };
         Ok((system, warnings))
     }
@@ -206,6 +229,28 @@ impl System {
         let v = self.values(y, u, t);
         for (d, p) in dy.iter_mut().zip(&self.rates) {
             *d = p.eval(&v, stack);
+        }
+        for (states, programs) in &self.mass {
+            let n = states.len();
+            let m: Vec<Vec<f64>> = programs
+                .chunks(n.max(1))
+                .map(|row| row.iter().map(|p| p.eval(&v, stack)).collect())
+                .collect();
+            let forces: Vec<Vec<f64>> = states
+                .iter()
+                .map(|&j| vec![dy.get(j).copied().unwrap_or(f64::NAN)])
+                .collect();
+            // A singular mass matrix leaves non-finite rates, which the integrator reports with the time.
+            let solved = crate::equations::dense::solve(&m, &forces);
+            for (k, &j) in states.iter().enumerate() {
+                if let Some(d) = dy.get_mut(j) {
+                    *d = solved
+                        .as_ref()
+                        .and_then(|x| x.get(k))
+                        .and_then(|r| r.first().copied())
+                        .unwrap_or(f64::NAN);
+                }
+            }
         }
     }
 

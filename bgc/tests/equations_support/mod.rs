@@ -53,6 +53,7 @@ impl Builder {
             unit_text: "1".into(),
             description: None,
             doc: Vec::new(),
+            derived: None,
         });
         self.model.spans.params.push(s);
         Expr::Param(self.model.params.len() - 1)

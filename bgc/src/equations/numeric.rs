@@ -1,0 +1,256 @@
+//! Numeric evaluation of the equations, including the mass-matrix rows of I-fields.
+//!
+//! For a model without I-fields the rates are `ẋ = f(x, u, p, t)` evaluated directly. The flow states of an
+//! I-field have `f` equal to the generalised forces `F`, and their rates solve `M(q) ẋ_B = F`. Linearising that
+//! form: `∂ẋ_B/∂x_k = M⁻¹ (∂F/∂x_k − (∂M/∂x_k) ẋ_B)` and `∂ẋ_B/∂u = M⁻¹ ∂F/∂u` (`M` does not depend on `u`).
+
+use super::dense::{self, Mat};
+use super::linear::{LinearError, NumericStateSpace};
+use super::sym::{self, Ex, Sym};
+use super::{Equations, MassBlock};
+
+/// Evaluates `e`, naming `what` in errors.
+fn value_of(
+    eqs: &Equations,
+    e: &Ex,
+    what: &dyn Fn() -> String,
+    value: &dyn Fn(Sym) -> Option<f64>,
+) -> Result<f64, LinearError> {
+    let v = sym::eval(e, value).map_err(|err| match err {
+        sym::EvalError::Unbound(s) => LinearError::Unbound {
+            what: what(),
+            symbol: eqs.sym_name(s),
+        },
+        sym::EvalError::Arity(f) => LinearError::NotDifferentiable {
+            what: what(),
+            func: f.name(),
+        },
+    })?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(LinearError::NonFinite { what: what() })
+    }
+}
+
+fn mass_at(
+    eqs: &Equations,
+    block: &MassBlock,
+    value: &dyn Fn(Sym) -> Option<f64>,
+) -> Result<Mat, LinearError> {
+    block
+        .matrix
+        .iter()
+        .enumerate()
+        .map(|(i, row)| {
+            row.iter()
+                .enumerate()
+                .map(|(j, m)| {
+                    let what = || format!("M_{}[{},{}]", block.element, i + 1, j + 1);
+                    value_of(eqs, m, &what, value)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Solves `M x = rhs` for one block (several right-hand sides as columns).
+fn solve_block(block: &MassBlock, m: &Mat, rhs: &Mat) -> Result<Mat, LinearError> {
+    dense::solve(m, rhs).ok_or_else(|| LinearError::SingularMass {
+        element: block.element.clone(),
+    })
+}
+
+impl Equations {
+    /// True when some rates come from the mass-matrix form of an I-field.
+    pub fn has_mass(&self) -> bool {
+        !self.mass.is_empty()
+    }
+
+    /// The parameter values with some given (`given[i] = Some(v)`) and the rest at their defaults, derived
+    /// parameters recomputed from the values before them; a given value always wins.
+    pub fn param_values(&self, given: &[Option<f64>]) -> Vec<f64> {
+        let mut values: Vec<f64> = Vec::with_capacity(self.params.len());
+        for (i, (_, default)) in self.params.iter().enumerate() {
+            let derived = self.derived.get(i).and_then(Option::as_ref);
+            let v = match (given.get(i).copied().flatten(), derived) {
+                (Some(v), _) => v,
+                (None, Some(e)) => sym::eval(e, &|s| match s {
+                    Sym::Param(j) => values.get(j).copied(),
+                    _ => None,
+                })
+                .unwrap_or(*default),
+                (None, None) => *default,
+            };
+            values.push(v);
+        }
+        values
+    }
+
+    /// The rates `ẋ` of all states at parameter values, state, input and time, with the mass-matrix rows solved.
+    pub fn rates_at(
+        &self,
+        params: &[f64],
+        x: &[f64],
+        u: &[f64],
+        t: f64,
+    ) -> Result<Vec<f64>, LinearError> {
+        check("parameter", self.params.len(), params.len())?;
+        check("state", self.states.len(), x.len())?;
+        check("input", self.inputs.len(), u.len())?;
+        let value = |s: Sym| point(s, params, x, u, t);
+        let mut dx = Vec::with_capacity(x.len());
+        for (i, f) in self.f.iter().enumerate() {
+            let what = || format!("the rate of `{}`", self.sym_name(Sym::State(i)));
+            let e = f
+                .as_ref()
+                .ok_or_else(|| LinearError::Incomplete { what: what() })?;
+            dx.push(value_of(self, e, &what, &value)?);
+        }
+        solve_mass_rows(self, &value, &mut dx)?;
+        Ok(dx)
+    }
+
+    /// The outputs `y` at parameter values, state, input and time.
+    pub fn outputs_at(
+        &self,
+        params: &[f64],
+        x: &[f64],
+        u: &[f64],
+        t: f64,
+    ) -> Result<Vec<f64>, LinearError> {
+        check("parameter", self.params.len(), params.len())?;
+        check("state", self.states.len(), x.len())?;
+        check("input", self.inputs.len(), u.len())?;
+        let value = |s: Sym| point(s, params, x, u, t);
+        self.outputs
+            .iter()
+            .map(|o| {
+                let what = || format!("output `{}`", o.name);
+                let e = o
+                    .explicit
+                    .as_ref()
+                    .ok_or_else(|| LinearError::Incomplete { what: what() })?;
+                value_of(self, e, &what, &value)
+            })
+            .collect()
+    }
+}
+
+fn point(s: Sym, params: &[f64], x: &[f64], u: &[f64], t: f64) -> Option<f64> {
+    match s {
+        Sym::Param(i) => params.get(i).copied(),
+        Sym::State(i) => x.get(i).copied(),
+        Sym::Input(i) => u.get(i).copied(),
+        Sym::Time => Some(t),
+        _ => None,
+    }
+}
+
+fn check(what: &'static str, expected: usize, got: usize) -> Result<(), LinearError> {
+    if expected == got {
+        Ok(())
+    } else {
+        Err(LinearError::Dimension {
+            what,
+            expected,
+            got,
+        })
+    }
+}
+
+/// Replaces the generalised forces in `dx` (the rows of each mass block) by the solved rates.
+pub(crate) fn solve_mass_rows(
+    eqs: &Equations,
+    value: &dyn Fn(Sym) -> Option<f64>,
+    dx: &mut [f64],
+) -> Result<(), LinearError> {
+    for block in &eqs.mass {
+        let m = mass_at(eqs, block, value)?;
+        let rhs: Mat = block
+            .states
+            .iter()
+            .map(|&j| vec![dx.get(j).copied().unwrap_or(0.0)])
+            .collect();
+        let sol = solve_block(block, &m, &rhs)?;
+        for (&j, row) in block.states.iter().zip(sol) {
+            if let (Some(slot), Some(v)) = (dx.get_mut(j), row.first()) {
+                *slot = *v;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Turns the Jacobians of the generalised forces in the block rows of `ss` (`∂F/∂x` in `a`, `∂F/∂u` in `b`) into
+/// those of the rates, at the point where `value` evaluates. The selected states are the first `ss.a.len()`.
+pub(crate) fn correct_mass_rows(
+    eqs: &Equations,
+    value: &dyn Fn(Sym) -> Option<f64>,
+    ss: &mut NumericStateSpace,
+) -> Result<(), LinearError> {
+    let n = ss.a.len();
+    for block in &eqs.mass {
+        if block.states.iter().any(|&j| j >= n) {
+            continue;
+        }
+        let m = mass_at(eqs, block, value)?;
+        // ẋ_B = M⁻¹ F at the point.
+        let mut forces = Vec::with_capacity(block.states.len());
+        for &j in &block.states {
+            let what = || format!("the rate of `{}`", eqs.sym_name(Sym::State(j)));
+            let f = eqs
+                .f
+                .get(j)
+                .cloned()
+                .flatten()
+                .ok_or_else(|| LinearError::Incomplete { what: what() })?;
+            forces.push(vec![value_of(eqs, &f, &what, value)?]);
+        }
+        let xb: Vec<f64> = solve_block(block, &m, &forces)?
+            .into_iter()
+            .map(|r| r.first().copied().unwrap_or(0.0))
+            .collect();
+        // Columns of ∂F/∂x − (∂M/∂x_k) ẋ_B, then of ∂F/∂u.
+        let empty = Vec::new();
+        let mut rhs: Mat = block
+            .states
+            .iter()
+            .map(|&row| {
+                let a = ss.a.get(row).unwrap_or(&empty);
+                let b = ss.b.get(row).unwrap_or(&empty);
+                a.iter().chain(b).copied().collect()
+            })
+            .collect();
+        for (i, (mrow, rrow)) in block.matrix.iter().zip(rhs.iter_mut()).enumerate() {
+            for (k, slot) in rrow.iter_mut().take(n).enumerate() {
+                for (j, (mij, xj)) in mrow.iter().zip(&xb).enumerate() {
+                    if !mij.contains(Sym::State(k)) {
+                        continue;
+                    }
+                    let d =
+                        sym::diff(mij, Sym::State(k)).map_err(|sym::NotDifferentiable(f)| {
+                            LinearError::NotDifferentiable {
+                                what: format!("M_{}[{},{}]", block.element, i + 1, j + 1),
+                                func: f.name(),
+                            }
+                        })?;
+                    let what = || format!("∂M_{}[{},{}]/∂x", block.element, i + 1, j + 1);
+                    *slot -= value_of(eqs, &d, &what, value)? * xj;
+                }
+            }
+        }
+        let sol = solve_block(block, &m, &rhs)?;
+        for (&row, srow) in block.states.iter().zip(sol) {
+            if let Some(a) = ss.a.get_mut(row) {
+                a.iter_mut().zip(&srow).for_each(|(x, v)| *x = *v);
+            }
+            if let Some(b) = ss.b.get_mut(row) {
+                b.iter_mut()
+                    .zip(srow.iter().skip(n))
+                    .for_each(|(x, v)| *x = *v);
+            }
+        }
+    }
+    Ok(())
+}

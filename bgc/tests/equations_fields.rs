@@ -272,3 +272,39 @@ fn non_conservative_c_field_gets_no_energy_and_a_warning() {
     let term = eqs.energy.iter().find(|t| t.element == "spring");
     assert_eq!(term.map(|t| t.value.is_none()), Some(true));
 }
+
+/// models/walking_leg.bg without friction, stiffness or actuation: over 5 s of large swinging (several periods of
+/// the leg as a pendulum), the kinetic energy plus the work done against gravity (the modulated gravity sources'
+/// supplied energy, counted negative when they take energy) stays at its start; without gravity the kinetic
+/// energy alone is conserved.
+#[test]
+fn walking_leg_conserves_energy_when_frictionless_and_unactuated() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/walking_leg.bg");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let (eqs, diags) = equations_of_text("walking_leg.bg", text);
+    assert!(errors(&diags).is_empty(), "{diags:?}");
+    let names: Vec<&str> = eqs.params.iter().map(|p| p.0.as_str()).collect();
+    let zero = [
+        "b0_knee", "b2_knee", "k_knee", "ts0_knee", "b0_hip", "b2_hip", "k_hip", "ts0_hip",
+    ];
+    for gravity in [true, false] {
+        let given: Vec<Option<f64>> = names
+            .iter()
+            .map(|n| (zero.contains(n) || (!gravity && *n == "g")).then_some(0.0))
+            .collect();
+        let p = eqs.param_values(&given);
+        let inputs = vec!["0"; eqs.inputs.len()];
+        let rows = simulate(&eqs, p, &inputs, &[0.2, 0.5, 0.6, 1.0, -2.0, 2.0], 5.0);
+        let (e0, _, _) = balance(&rows[0]);
+        let mut moved = 0.0f64;
+        for row in &rows {
+            let (e, d, s) = balance(row);
+            assert_eq!(d, 0.0);
+            moved = moved.max(s.abs());
+            let drift = (e + d - s - e0).abs() / e0;
+            assert!(drift < 1e-8, "gravity {gravity}: relative drift {drift} at {row:?}");
+        }
+        // With gravity the weights exchange energy with the chain; without, they do nothing.
+        assert_eq!(moved > 0.1 * e0, gravity, "exchanged {moved} of {e0}");
+    }
+}

@@ -193,33 +193,42 @@ fn linearisation_matches_finite_differences_of_the_rates() {
         eqs.rates_at(&p, x, u, 0.0)
             .unwrap_or_else(|e| panic!("{e}"))
     };
-    for k in 0..6 {
-        let h = 1e-6;
-        let (mut xp, mut xm) = (x0.to_vec(), x0.to_vec());
-        xp[k] += h;
-        xm[k] -= h;
-        let (fp, fm) = (rates(&xp, &u0), rates(&xm, &u0));
-        for r in 0..6 {
-            let fd = (fp[r] - fm[r]) / (2.0 * h);
+    // Central differences of the rates in the direction of state k or input c.
+    let central = |state: Option<usize>, input: Option<usize>, h: f64| {
+        let shifted = |sign: f64| {
+            let (mut x, mut u) = (x0.to_vec(), u0.clone());
+            state.and_then(|k| x.get_mut(k)).map(|v| *v += sign * h);
+            input.and_then(|c| u.get_mut(c)).map(|v| *v += sign * h);
+            rates(&x, &u)
+        };
+        let (fp, fm) = (shifted(1.0), shifted(-1.0));
+        fp.iter()
+            .zip(&fm)
+            .map(|(a, b)| (a - b) / (2.0 * h))
+            .collect::<Vec<f64>>()
+    };
+    let columns = (0..6)
+        .map(|k| {
+            (
+                format!("A[.][{k}]"),
+                central(Some(k), None, 1e-6),
+                ss.a.iter().map(|r| r[k]).collect::<Vec<_>>(),
+                1e-5,
+            )
+        })
+        .chain((0..eqs.inputs.len()).map(|c| {
+            (
+                format!("B[.][{c}]"),
+                central(None, Some(c), 1e-3),
+                ss.b.iter().map(|r| r[c]).collect(),
+                1e-6,
+            )
+        }));
+    for (what, fd, got, tol) in columns {
+        for (r, (fd, got)) in fd.iter().zip(&got).enumerate() {
             assert!(
-                (ss.a[r][k] - fd).abs() < 1e-5 * (1.0 + fd.abs()),
-                "A[{r}][{k}] = {}, central difference {fd}",
-                ss.a[r][k]
-            );
-        }
-    }
-    for c in 0..eqs.inputs.len() {
-        let h = 1e-3;
-        let (mut up, mut um) = (u0.clone(), u0.clone());
-        up[c] += h;
-        um[c] -= h;
-        let (fp, fm) = (rates(&x0, &up), rates(&x0, &um));
-        for r in 0..6 {
-            let fd = (fp[r] - fm[r]) / (2.0 * h);
-            assert!(
-                (ss.b[r][c] - fd).abs() < 1e-6 * (1.0 + fd.abs()),
-                "B[{r}][{c}] = {}, central difference {fd}",
-                ss.b[r][c]
+                (got - fd).abs() < tol * (1.0 + fd.abs()),
+                "{what} row {r} = {got}, central difference {fd}"
             );
         }
     }

@@ -10,7 +10,7 @@ use bgc::diagnostic::Diagnostic;
 use bgc::equations::{Equations, derive, to_latex, to_text};
 use bgc::lower::{MemoryLoader, lower};
 use bgc::span::SourceMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The equations of the single model of a file, with the diagnostics of lowering, causality and derivation.
 fn equations_of(path: &Path) -> (Equations, Vec<Diagnostic>) {
@@ -42,24 +42,11 @@ fn back_support_file() {
 #[test]
 fn corpus_models() {
     let dir = root().join("tests/corpus");
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
-        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
-        .unwrap_or_default();
-    files.retain(|p| p.extension().is_some_and(|e| e == "bg"));
-    files.sort();
+    let files = bg_files(&dir);
     assert!(files.len() >= 10, "corpus not found in {}", dir.display());
-    for path in files {
-        let name = path
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .unwrap_or("model")
-            .to_string();
+    for (name, path) in files {
         let (eqs, diags) = equations_of(&path);
-        let errors: Vec<String> = diags
-            .iter()
-            .filter(|d| d.is_error())
-            .map(|d| format!("{}: {}", d.code.0, d.message))
-            .collect();
+        let errors = errors(&diags);
         let text = format!("{}\nerrors: {errors:#?}\n", to_text(&eqs));
         insta::assert_snapshot!(format!("corpus_{name}_text"), text);
         insta::assert_snapshot!(format!("corpus_{name}_latex"), to_latex(&eqs));
@@ -70,26 +57,38 @@ fn corpus_models() {
 #[test]
 fn model_files() {
     let dir = root().join("../models");
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
-        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
-        .unwrap_or_default();
-    files.retain(|p| p.extension().is_some_and(|e| e == "bg") && !p.ends_with("back_support.bg"));
-    files.sort();
+    let mut files = bg_files(&dir);
+    files.retain(|(name, _)| name != "back_support");
     assert!(files.len() >= 3, "models not found in {}", dir.display());
-    for path in files {
-        let name = path
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .unwrap_or("model")
-            .to_string();
+    for (name, path) in files {
         let (eqs, diags) = equations_of(&path);
-        let errors: Vec<String> = diags
-            .iter()
-            .filter(|d| d.is_error())
-            .map(|d| format!("{}: {}", d.code.0, d.message))
-            .collect();
+        let errors = errors(&diags);
         assert!(errors.is_empty(), "{name}: {errors:?}");
         insta::assert_snapshot!(format!("model_{name}_text"), to_text(&eqs));
         insta::assert_snapshot!(format!("model_{name}_latex"), to_latex(&eqs));
     }
+}
+
+/// The `.bg` files of a folder with their stems, sorted.
+fn bg_files(dir: &Path) -> Vec<(String, PathBuf)> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    files.retain(|p| p.extension().is_some_and(|e| e == "bg"));
+    files.sort();
+    files
+        .into_iter()
+        .map(|p| {
+            let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or("model");
+            (stem.to_string(), p)
+        })
+        .collect()
+}
+
+fn errors(diags: &[Diagnostic]) -> Vec<String> {
+    diags
+        .iter()
+        .filter(|d| d.is_error())
+        .map(|d| format!("{}: {}", d.code.0, d.message))
+        .collect()
 }

@@ -302,7 +302,10 @@ fn walking_leg_conserves_energy_when_frictionless_and_unactuated() {
             assert_eq!(d, 0.0);
             moved = moved.max(s.abs());
             let drift = (e + d - s - e0).abs() / e0;
-            assert!(drift < 1e-8, "gravity {gravity}: relative drift {drift} at {row:?}");
+            assert!(
+                drift < 1e-8,
+                "gravity {gravity}: relative drift {drift} at {row:?}"
+            );
         }
         // With gravity the weights exchange energy with the chain; without, they do nothing.
         assert_eq!(moved > 0.1 * e0, gravity, "exchanged {moved} of {e0}");

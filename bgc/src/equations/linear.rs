@@ -264,7 +264,11 @@ pub fn linear_state_space(
     Ok(j)
 }
 
-fn check_len(what: &'static str, expected: usize, got: usize) -> Result<(), LinearError> {
+pub(crate) fn check_len(
+    what: &'static str,
+    expected: usize,
+    got: usize,
+) -> Result<(), LinearError> {
     if expected == got {
         Ok(())
     } else {
@@ -322,13 +326,7 @@ pub fn evaluate_at(
     check_len("parameter", eqs.params.len(), params.len())?;
     check_len("state", j.states.len(), x0.len())?;
     check_len("input", eqs.inputs.len(), u0.len())?;
-    let value = |s: Sym| match s {
-        Sym::Param(i) => params.get(i).copied(),
-        Sym::State(i) => x0.get(i).copied(),
-        Sym::Input(i) => u0.get(i).copied(),
-        Sym::Time => Some(t0),
-        _ => None,
-    };
+    let value = |s: Sym| super::numeric::point(s, params, x0, u0, t0);
     Ok(NumericStateSpace {
         states: j.states.clone(),
         inputs: j.inputs.clone(),
@@ -370,13 +368,7 @@ pub fn linearise(
 ) -> Result<NumericStateSpace, LinearError> {
     let j = jacobians(eqs, selection)?;
     let mut ss = evaluate_at(eqs, &j, params, x0, u0, t0)?;
-    let value = |s: Sym| match s {
-        Sym::Param(i) => params.get(i).copied(),
-        Sym::State(i) => x0.get(i).copied(),
-        Sym::Input(i) => u0.get(i).copied(),
-        Sym::Time => Some(t0),
-        _ => None,
-    };
+    let value = |s: Sym| super::numeric::point(s, params, x0, u0, t0);
     super::numeric::correct_mass_rows(eqs, &value, &mut ss)?;
     Ok(ss)
 }

@@ -5,7 +5,7 @@
 //! form: `∂ẋ_B/∂x_k = M⁻¹ (∂F/∂x_k − (∂M/∂x_k) ẋ_B)` and `∂ẋ_B/∂u = M⁻¹ ∂F/∂u` (`M` does not depend on `u`).
 
 use super::dense::{self, Mat};
-use super::linear::{LinearError, NumericStateSpace};
+use super::linear::{LinearError, NumericStateSpace, check_len as check};
 use super::sym::{self, Ex, Sym};
 use super::{Equations, MassBlock};
 
@@ -95,9 +95,7 @@ impl Equations {
         u: &[f64],
         t: f64,
     ) -> Result<Vec<f64>, LinearError> {
-        check("parameter", self.params.len(), params.len())?;
-        check("state", self.states.len(), x.len())?;
-        check("input", self.inputs.len(), u.len())?;
+        self.check_point(params, x, u)?;
         let value = |s: Sym| point(s, params, x, u, t);
         let mut dx = Vec::with_capacity(x.len());
         for (i, f) in self.f.iter().enumerate() {
@@ -111,6 +109,12 @@ impl Equations {
         Ok(dx)
     }
 
+    fn check_point(&self, params: &[f64], x: &[f64], u: &[f64]) -> Result<(), LinearError> {
+        check("parameter", self.params.len(), params.len())?;
+        check("state", self.states.len(), x.len())?;
+        check("input", self.inputs.len(), u.len())
+    }
+
     /// The outputs `y` at parameter values, state, input and time.
     pub fn outputs_at(
         &self,
@@ -119,9 +123,7 @@ impl Equations {
         u: &[f64],
         t: f64,
     ) -> Result<Vec<f64>, LinearError> {
-        check("parameter", self.params.len(), params.len())?;
-        check("state", self.states.len(), x.len())?;
-        check("input", self.inputs.len(), u.len())?;
+        self.check_point(params, x, u)?;
         let value = |s: Sym| point(s, params, x, u, t);
         self.outputs
             .iter()
@@ -137,25 +139,14 @@ impl Equations {
     }
 }
 
-fn point(s: Sym, params: &[f64], x: &[f64], u: &[f64], t: f64) -> Option<f64> {
+/// The value of a symbol at a point: parameters, states, inputs and time.
+pub(crate) fn point(s: Sym, params: &[f64], x: &[f64], u: &[f64], t: f64) -> Option<f64> {
     match s {
         Sym::Param(i) => params.get(i).copied(),
         Sym::State(i) => x.get(i).copied(),
         Sym::Input(i) => u.get(i).copied(),
         Sym::Time => Some(t),
         _ => None,
-    }
-}
-
-fn check(what: &'static str, expected: usize, got: usize) -> Result<(), LinearError> {
-    if expected == got {
-        Ok(())
-    } else {
-        Err(LinearError::Dimension {
-            what,
-            expected,
-            got,
-        })
     }
 }
 

@@ -197,8 +197,12 @@ fn linearisation_matches_finite_differences_of_the_rates() {
     let central = |state: Option<usize>, input: Option<usize>, h: f64| {
         let shifted = |sign: f64| {
             let (mut x, mut u) = (x0.to_vec(), u0.clone());
-            state.and_then(|k| x.get_mut(k)).map(|v| *v += sign * h);
-            input.and_then(|c| u.get_mut(c)).map(|v| *v += sign * h);
+            if let Some(v) = state.and_then(|k| x.get_mut(k)) {
+                *v += sign * h;
+            }
+            if let Some(v) = input.and_then(|c| u.get_mut(c)) {
+                *v += sign * h;
+            }
             rates(&x, &u)
         };
         let (fp, fm) = (shifted(1.0), shifted(-1.0));

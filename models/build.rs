@@ -4,7 +4,12 @@
 use std::path::PathBuf;
 
 /// The models of this crate, each with a module in `src/lib.rs`.
-const MODELS: &[&str] = &["back_support.bg", "pendulum_rig.bg", "rehab_leg.bg"];
+const MODELS: &[&str] = &[
+    "back_support.bg",
+    "pendulum_rig.bg",
+    "rehab_leg.bg",
+    "walking_leg.bg",
+];
 
 /// The compiler's corpus (`bgc/tests/corpus`), each with a module in `src/corpus.rs`.
 const CORPUS: &[&str] = &[

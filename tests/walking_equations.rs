@@ -237,3 +237,47 @@ fn linearisation_matches_finite_differences_of_the_rates() {
         }
     }
 }
+
+/// The Rust code generated from models/walking_leg.bg (crate `bgc_models`, mass matrix solved by Cholesky) against
+/// the Euler–Lagrange derivation, with the link masses changed through `Params` (the inertias follow them).
+#[test]
+fn generated_model_matches_the_euler_lagrange_derivation() {
+    use bgc_models::walking_leg as m;
+    let mut rng = Rng::new(19);
+    for case in 0..100 {
+        let base = LegSegments::paper_subject();
+        let masses = base.masses().map(|v| v * (0.8 + 0.4 * rng.uniform()));
+        let p = m::Params {
+            m_F: masses[0],
+            m_S: masses[1],
+            m_T: masses[2],
+            stance: 1.0,
+            ..m::Params::default()
+        };
+        p.validate().unwrap_or_else(|e| panic!("{e}"));
+        let q = Vector3::from_fn(|_, _| 1.5 * rng.normal());
+        let qd = Vector3::from_fn(|_, _| 4.0 * rng.normal());
+        let force = Vector2::new(50.0 * rng.normal(), 600.0 + 100.0 * rng.normal());
+        let tau = Vector3::new(0.0, 20.0 * rng.normal(), 20.0 * rng.normal());
+        let x = m::State::from_iterator(q.iter().chain(qd.iter()).copied());
+        // Inputs in INPUT_NAMES order: tau_a2, tau_a3, tau_h1, tau_h2, tau_h3, F_x, F_y.
+        let u = m::Inputs::from_column_slice(&[tau[1], tau[2], 0.0, 0.0, 0.0, force[0], force[1]]);
+        assert_eq!(
+            m::INPUT_NAMES,
+            [
+                "tau_a2", "tau_a3", "tau_h1", "tau_h2", "tau_h3", "F_x", "F_y"
+            ]
+        );
+        let dx = m::rhs(&p, 0.0, &x, &u);
+        let dynamics = LegDynamics::new(base.with_masses(masses));
+        let friction =
+            LegFriction::table8_right().torque(&[q[0], q[1], q[2]], &[qd[0], qd[1], qd[2]]);
+        let rhs = tau - Vector3::from(friction) - dynamics.ankle_jacobian(&q).transpose() * force;
+        let qdd = dynamics
+            .acceleration(&q, &qd, &rhs)
+            .unwrap_or_else(|| panic!("case {case}: singular M"));
+        for j in 0..3 {
+            assert_close(dx[3 + j], qdd[j], qdd.amax(), &format!("case {case}: q̈{j}"));
+        }
+    }
+}

@@ -12,6 +12,8 @@
 //!   trunk velocity; `state_space_declared` is the paper's Eq. (3).
 //! - [`pendulum_rig`]: the stepper-driven pendulum test rig of Yang et al. (Sensors 2018).
 //! - [`rehab_leg`]: the rehabilitation leg of the same paper.
+//! - [`walking_leg`]: the three-link leg of the lower-limb exoskeleton of Sado et al. (2018), an I-field with
+//!   `M(q)` whose rates are solved from the mass-matrix form; states `[q, q̇]`, free link masses.
 
 pub mod back_support {
     include!(concat!(env!("OUT_DIR"), "/back_support.rs"));
@@ -23,6 +25,10 @@ pub mod pendulum_rig {
 
 pub mod rehab_leg {
     include!(concat!(env!("OUT_DIR"), "/rehab_leg.rs"));
+}
+
+pub mod walking_leg {
+    include!(concat!(env!("OUT_DIR"), "/walking_leg.rs"));
 }
 
 #[doc(hidden)]

@@ -25,6 +25,7 @@ agreement! {
     back_support: bgc_models::back_support => "models/back_support.bg",
     pendulum_rig: bgc_models::pendulum_rig => "models/pendulum_rig.bg",
     rehab_leg: bgc_models::rehab_leg => "models/rehab_leg.bg",
+    walking_leg: bgc_models::walking_leg => "models/walking_leg.bg",
     dc_motor_load: corpus::dc_motor_load => "bgc/tests/corpus/dc_motor_load.bg",
     gear_train: corpus::gear_train => "bgc/tests/corpus/gear_train.bg",
     hydraulic_cylinder: corpus::hydraulic_cylinder => "bgc/tests/corpus/hydraulic_cylinder.bg",

@@ -67,6 +67,7 @@ power_balance! {
     series_rlc: corpus::series_rlc,
     two_tank: corpus::two_tank,
     pendulum_rig: bgc_models::pendulum_rig,
+    walking_leg: bgc_models::walking_leg,
 }
 
 /// The back-support model supplies power through a flow source whose power needs `d omega_h/dt`, so it has no

@@ -77,6 +77,7 @@ fn generated_functions_do_not_allocate() {
         bgc_models::back_support,
         bgc_models::pendulum_rig,
         bgc_models::rehab_leg,
+        bgc_models::walking_leg,
         bgc_models::corpus::dc_motor_load,
         bgc_models::corpus::gear_train,
         bgc_models::corpus::hydraulic_cylinder,
@@ -89,5 +90,5 @@ fn generated_functions_do_not_allocate() {
         bgc_models::corpus::series_rlc,
         bgc_models::corpus::two_tank,
     );
-    assert_eq!(n, 14);
+    assert_eq!(n, 15);
 }

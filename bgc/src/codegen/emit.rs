@@ -54,6 +54,8 @@ pub(crate) struct Plan {
     /// Stored energy, dissipated and supplied power: the terms `(element, value)`, or the elements without a closed
     /// form.
     pub energy: Vec<(EnergyKind, EnergyTerms)>,
+    /// The I-fields' mass-matrix blocks (their rows of `rhs`, `dfdx` and `dfdu` hold the forces `F`).
+    pub mass: Vec<super::mass::MassPlan>,
 }
 
 /// Checks that the equations are complete and convertible (what [`plan`] needs).
@@ -71,12 +73,6 @@ fn convert_matrix(eqs: &Equations, m: &[Vec<Ex>]) -> Result<Vec<Vec<Expr>>, Adap
 
 /// The plan of a complete model.
 pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
-    if let Some(b) = eqs.mass.first() {
-        return Err(format!(
-            "the I-field `{}` gives its rates in mass-matrix form, which the code generator does not emit yet",
-            b.element
-        ));
-    }
     let mut f_ex = Vec::with_capacity(eqs.f.len());
     for (i, f) in eqs.f.iter().enumerate() {
         let name = eqs.states.get(i).map(|s| s.name.as_str()).unwrap_or("?");
@@ -139,7 +135,9 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
             },
         ));
     }
+    let mass = super::mass::plan(eqs, &states)?;
     Ok(Plan {
+        mass,
         dfdx: Expr::jacobian(&f, &states),
         dfdu: Expr::jacobian(&f, &inputs),
         dhdx: Expr::jacobian(&h, &states),

@@ -14,6 +14,7 @@
 
 mod adapter;
 mod emit;
+mod mass;
 mod names;
 pub mod rust;
 

@@ -10,8 +10,33 @@ use std::collections::HashSet;
 
 /// The identifiers the generated functions use for themselves.
 pub const RESERVED: &[&str] = &[
-    "p", "t", "x", "u", "dx", "y", "jac", "v", "a", "b", "c", "d", "params", "index", "value",
-    "out", "terms", "bgc_sign", "bgc_min", "bgc_max",
+    "p",
+    "t",
+    "x",
+    "u",
+    "dx",
+    "y",
+    "jac",
+    "v",
+    "a",
+    "b",
+    "c",
+    "d",
+    "params",
+    "index",
+    "value",
+    "out",
+    "terms",
+    "bgc_sign",
+    "bgc_min",
+    "bgc_max",
+    "m",
+    "dm",
+    "force",
+    "rate",
+    "rows",
+    "solved",
+    "correction",
 ];
 
 const KEYWORDS: &[&str] = &[

@@ -5,7 +5,7 @@
 
 use bgc::equations::sym::{self, Ex, Sym};
 use bgc::equations::{
-    Equations, StateSelection, declared_state_space, evaluate_at, jacobians, numeric_state_space,
+    Equations, StateSelection, declared_state_space, jacobians, linearise, numeric_state_space,
 };
 use bgc::lower::{MemoryLoader, lower};
 use bgc::span::SourceMap;
@@ -118,6 +118,16 @@ pub fn check_agreement<M, const NX: usize, const NU: usize, const NY: usize>(
     assert_eq!(eqs.inputs.len(), NU, "{path}: inputs");
     assert_eq!(eqs.outputs.len(), NY, "{path}: outputs");
     let f: Vec<Ex> = eqs.f.iter().map(|e| e.clone().expect("rate")).collect();
+    // The generated `Params` has the free parameters as fields (in `Parametric` order); derived ones follow them.
+    let free: Vec<usize> = (0..eqs.params.len())
+        .filter(|&k| eqs.derived.get(k).is_none_or(Option::is_none))
+        .collect();
+    let free_names: Vec<&str> = free.iter().map(|&k| eqs.params[k].0.as_str()).collect();
+    assert_eq!(
+        model.param_names(),
+        free_names.as_slice(),
+        "{path}: parameters"
+    );
     let h: Vec<Ex> = eqs
         .outputs
         .iter()
@@ -134,20 +144,29 @@ pub fn check_agreement<M, const NX: usize, const NU: usize, const NY: usize>(
     let mut rng = Rng::new(0x5eed ^ path.len() as u64);
     for point in 0..100 {
         // New parameters every 10 points.
-        let params = if point % 10 == 0 {
-            perturbed(&mut model, &mut rng)
-        } else {
-            (0..eqs.params.len())
-                .map(|i| model.param(i).unwrap_or(f64::NAN))
-                .collect()
-        };
+        if point % 10 == 0 {
+            perturbed(&mut model, &mut rng);
+        }
+        let mut given = vec![None; eqs.params.len()];
+        for (i, &k) in free.iter().enumerate() {
+            given[k] = model.param(i);
+        }
+        let params = eqs.param_values(&given);
         let x = SVector::<f64, NX>::from_fn(|_, _| rng.uniform(-1.0, 1.0));
         let u = SVector::<f64, NU>::from_fn(|_, _| rng.uniform(-1.0, 1.0));
         let t = rng.uniform(0.0, 2.0);
         let mut dx = SVector::<f64, NX>::zeros();
         model.rhs(t, &x, &u, &mut dx);
+        // The compiler's rates: `f` itself, or for the rows of an I-field `M ẋ = F` solved numerically.
+        let rates = eqs
+            .rates_at(&params, x.as_slice(), u.as_slice(), t)
+            .unwrap_or_else(|e| panic!("{path}: {e}"));
         for (i, fi) in f.iter().enumerate() {
-            let want = eval(fi, &params, x.as_slice(), u.as_slice(), t);
+            let want = if eqs.has_mass() {
+                rates[i]
+            } else {
+                eval(fi, &params, x.as_slice(), u.as_slice(), t)
+            };
             assert!(
                 close(dx[i], want, 1e-12),
                 "{path}: rate {i} at point {point}: generated {}, compiler {want}",
@@ -172,11 +191,22 @@ pub fn check_agreement<M, const NX: usize, const NU: usize, const NY: usize>(
         model.jac_u(t, &x, &u, &mut bu);
         model.output_jac_x(t, &x, &u, &mut cx);
         model.output_jac_u(t, &x, &u, &mut du);
-        if let Some(j) = &symbolic_jac {
-            let num = evaluate_at(&eqs, j, &params, x.as_slice(), u.as_slice(), t)
-                .unwrap_or_else(|e| panic!("{path}: {e}"));
-            matrix_close(&format!("{path}: df/dx"), &ax, &num.a, 1e-12);
-            matrix_close(&format!("{path}: df/du"), &bu, &num.b, 1e-12);
+        if symbolic_jac.is_some() {
+            // The compiler's linearisation (for I-fields: the Jacobians of the solved rates).
+            let num = linearise(
+                &eqs,
+                StateSelection::All,
+                &params,
+                x.as_slice(),
+                u.as_slice(),
+                t,
+            )
+            .unwrap_or_else(|e| panic!("{path}: {e}"));
+            // Through a mass matrix both sides solve a linear system (Cholesky here, LU in the compiler): their
+            // rounding differs by a few ulps of the largest entry, which a small entry sees as a relative error.
+            let abs = if eqs.has_mass() { 1e-12 } else { 0.0 };
+            matrix_close_abs(&format!("{path}: df/dx"), &ax, &num.a, 1e-12, abs);
+            matrix_close_abs(&format!("{path}: df/du"), &bu, &num.b, 1e-12, abs);
             matrix_close(&format!("{path}: dh/dx"), &cx, &num.c, 1e-12);
             matrix_close(&format!("{path}: dh/du"), &du, &num.d, 1e-12);
         }

@@ -119,6 +119,9 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
         let mut terms = Vec::new();
         let mut missing = Vec::new();
         for t in eqs.energy.iter().filter(|t| t.kind == kind) {
+            // A term with an input's derivative (`Sym::InputDot`, the power of a source driving a storage in
+            // derivative causality) has no value in the generated functions, which take `u` but not `du/dt`: it
+            // does not convert and counts as missing, so no partial sum is generated.
             match t.value.as_ref().map(|v| to_symbolic(eqs, v)) {
                 Some(Ok(v)) => terms.push((t.element.clone(), v)),
                 _ => missing.push(t.element.clone()),

@@ -4,8 +4,11 @@
 //! so a jump never enters an implicit method's step history, and within a segment `[a, b)` the inputs are
 //! evaluated at times strictly before `b`, as the solver's last stage at `b` would otherwise see the jump. States
 //! are reported at the sample times by the solver's dense output (interpolation of the accepted steps, of the
-//! method's order). The Jacobian handed to the implicit methods is the symbolic one of the equations, or finite
-//! differences when a rate uses a function without a derivative.
+//! method's order). At a breakpoint the states are continuous but a jump of an input may change the stored energy
+//! (a flow source imposing an inertia's velocity): that jump, [`System::stored_jump`], is added to the `supplied`
+//! quadrature there, so `energy + dissipated − supplied` stays constant across steps. The Jacobian handed to the
+//! implicit methods is the symbolic one of the equations, or finite differences when a rate uses a function
+//! without a derivative.
 
 use std::cell::{Cell, RefCell};
 
@@ -142,6 +145,20 @@ pub fn run(system: &System, x0: &[f64], opts: &RunOptions) -> Result<Trajectory,
         let last = b >= opts.t_end;
         let mut states = Vec::with_capacity(wanted.len());
         y = segment(system, &y, a, b, last, wanted, opts, &mut states)?;
+        if !last {
+            // The row at `b` itself shows the inputs after their jump, so it gets the jump's energy too.
+            let jump = system.stored_jump(&y, just_before(b), b, &mut stack);
+            for (t, ys) in wanted.iter().zip(states.iter_mut()) {
+                if *t >= b
+                    && let Some(sup) = ys.get_mut(n + 1)
+                {
+                    *sup += jump;
+                }
+            }
+            if let Some(sup) = y.get_mut(n + 1) {
+                *sup += jump;
+            }
+        }
         for (t, ys) in wanted.iter().zip(&states) {
             rows.push(system.row(ys, *t, &mut u, &mut stack));
         }
@@ -167,11 +184,7 @@ fn segment(
 ) -> Result<Vec<f64>, SimError> {
     let dim = y0.len();
     // Inputs are evaluated before a breakpoint `b`, never at it (see the module docs).
-    let t_max = if last {
-        f64::INFINITY
-    } else {
-        b - b.abs() * 4.0 * f64::EPSILON
-    };
+    let t_max = if last { f64::INFINITY } else { just_before(b) };
     let scratch = RefCell::new((Vec::new(), Vec::new(), vec![0.0; dim], vec![0.0; dim]));
     let bad: Cell<Option<(f64, usize)>> = Cell::new(None);
     let rhs = |y: &[f64], _p: &[f64], t: f64, dy: &mut [f64]| {
@@ -248,6 +261,11 @@ fn segment(
             ctx.drive(s, out)
         }
     }
+}
+
+/// The latest time before the breakpoint `b` at which the inputs are evaluated in the segment that ends there.
+fn just_before(b: f64) -> f64 {
+    b - b.abs() * 4.0 * f64::EPSILON
 }
 
 struct Drive<'c> {

@@ -14,11 +14,21 @@
 //! known satisfies `E + E_diss − E_sup = E(x0)`; the CLI prints the three columns so that this balance can be
 //! checked.
 //!
-//! Energy terms the equations stage could not express (a stored energy of a non-polynomial law, a source's power
-//! that needs the time derivative of an input) are left out of their sums; [`System::new`] returns a warning that
-//! names each one.
+//! A source that drives a storage in derivative causality (a flow source imposing an inertia's velocity) delivers
+//! power through the time derivative of its input (`e·f = J·u̇·u`). The inputs are expressions of `t`, so their
+//! derivatives are too ([`Signal::derivative`]): the programs read the input vector `[u, u̇]` and the power is
+//! integrated like any other. A jump of an input (`step`) has no derivative; the energy it moves into the storage is
+//! the jump of the stored energy at the breakpoint, `E(x, u(b)) − E(x, u(b⁻))` at the (continuous) state, which the
+//! integrator adds to `supplied` there ([`System::stored_jump`]). That is the limit of a steep ramp when no
+//! resistor's power depends on the input's derivative (a resistor that carries an ideal jump's impulse would
+//! dissipate an unbounded energy in that limit; such a model has no meaningful response to a step and the
+//! dissipated column counts nothing at the jump).
+//!
+//! Energy terms the equations stage could not express (a stored energy of a non-polynomial law) are left out of
+//! their sums; [`System::new`] returns a warning that names each one.
 
 pub mod input;
+pub mod input_rate;
 #[cfg(feature = "cli")]
 pub mod integrate;
 pub mod program;
@@ -79,6 +89,8 @@ pub struct System {
     pub outputs: Vec<String>,
     params: Vec<f64>,
     inputs: Vec<Signal>,
+    /// `d/dt` of each input signal.
+    input_rates: Vec<Signal>,
     /// `f_i` for the model states, then the dissipated and the supplied power.
     rates: Vec<Program>,
     /// Nonzero entries `(row, column, ∂rate_row/∂x_column)` of the Jacobian of `rates`; `None` when a rate uses
@@ -91,6 +103,8 @@ pub struct System {
 impl System {
     /// Compiles the equations at parameter values `params` (in [`Equations::params`] order) with one signal per
     /// input. Returns the system and the warnings about energy terms left out of the energy columns.
+    ///
+    /// The programs read the inputs as `[u, u̇]`: [`Sym::InputDot`]`(j)` is compiled as input `n_inputs + j`.
     pub fn new(
         eqs: &Equations,
         params: Vec<f64>,
@@ -99,16 +113,22 @@ impl System {
         check_len("parameter", eqs.params.len(), params.len())?;
         check_len("input", eqs.inputs.len(), inputs.len())?;
         let n = eqs.states.len();
+        let n_inputs = inputs.len();
         let layout = Layout {
             params: params.len(),
             states: n,
-            inputs: inputs.len(),
+            inputs: 2 * n_inputs,
         };
-        let name = |s: Sym| eqs.sym_name(s);
+        let name = |s: Sym| match s {
+            Sym::Input(j) if j >= n_inputs => eqs.sym_name(Sym::InputDot(j - n_inputs)),
+            other => eqs.sym_name(other),
+        };
         let compile = |e: &Ex, what: &str| {
-            Program::compile(e, layout, &name).map_err(|reason| SimError::Compile {
-                what: what.to_string(),
-                reason,
+            Program::compile(&with_input_rates(e, n_inputs), layout, &name).map_err(|reason| {
+                SimError::Compile {
+                    what: what.to_string(),
+                    reason,
+                }
             })
         };
         let mut rate_exprs = Vec::with_capacity(n + 2);
@@ -125,7 +145,7 @@ impl System {
                 let mut terms = Vec::new();
                 for term in eqs.energy.iter().filter(|t| t.kind == kind) {
                     match &term.value {
-                    Some(v) if Program::compile(v, layout, &name).is_ok() => terms.push(v.clone()),
+                    Some(v) if compile(v, "").is_ok() => terms.push(v.clone()),
                     _ => warnings.push(format!(
                         "the {} {} of `{}` has no expression and is left out of the `{}` column",
                         kind.name(),
@@ -162,6 +182,7 @@ impl System {
             states: (0..n).map(|i| eqs.sym_name(Sym::State(i))).collect(),
             outputs: eqs.outputs.iter().map(|o| o.name.clone()).collect(),
             params,
+            input_rates: inputs.iter().map(Signal::derivative).collect(),
             inputs,
             rates,
             jacobian,
@@ -176,10 +197,23 @@ impl System {
         self.states.len()
     }
 
-    /// The input values at `t`.
+    /// The input values at `t`, then their time derivatives: `[u, u̇]`, the input vector the programs read.
     pub fn inputs_at(&self, t: f64, out: &mut Vec<f64>) {
         out.clear();
         out.extend(self.inputs.iter().map(|s| s.eval(t)));
+        out.extend(self.input_rates.iter().map(|s| s.eval(t)));
+    }
+
+    /// The jump of the stored energy at the extended state `y` when the inputs go from their values at `before`
+    /// to those at `after` (a breakpoint): the energy a jump of an input moves into the storages in derivative
+    /// causality, which the input's derivative cannot carry.
+    pub fn stored_jump(&self, y: &[f64], before: f64, after: f64, stack: &mut Vec<f64>) -> f64 {
+        let mut u = Vec::new();
+        self.inputs_at(after, &mut u);
+        let e_after = self.stored.eval(&self.values(y, &u, after), stack);
+        self.inputs_at(before, &mut u);
+        let e_before = self.stored.eval(&self.values(y, &u, before), stack);
+        e_after - e_before
     }
 
     /// The times in `(0, t_end)` at which an input may jump or kink, sorted, without repeats.
@@ -262,6 +296,17 @@ fn check_len(what: &'static str, expected: usize, got: usize) -> Result<(), SimE
             got,
         })
     }
+}
+
+/// `e` with each [`Sym::InputDot`]`(j)` renamed to the input `n_inputs + j` (the programs' `[u, u̇]` layout).
+fn with_input_rates(e: &Ex, n_inputs: usize) -> Ex {
+    if !e.any_sym(&|s| matches!(s, Sym::InputDot(_))) {
+        return e.clone();
+    }
+    sym::subst(e, &mut |s| match s {
+        Sym::InputDot(j) => Some(Ex::S(Sym::Input(n_inputs + j))),
+        _ => None,
+    })
 }
 
 /// The nonzero entries of `∂rate/∂x` over the model states (the quadrature states enter no rate).

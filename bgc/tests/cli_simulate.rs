@@ -390,3 +390,143 @@ fn every_solver_follows_the_step_response() {
         }
     }
 }
+
+#[test]
+fn a_diode_loop_is_solved_by_newton_at_every_step() {
+    // corpus/diode_rc.bg: u = 2 sin(4 pi t) charges C through R_s and a diode, i = I_s (exp(v_d/V_t) - 1) with
+    // u - q/C = R_s i + v_d: a nonlinear algebraic loop in the current. The reference solves the loop with brentq
+    // inside the right-hand side:
+    //   R, Is, Vt, C = 100.0, 1e-6, 0.05, 1e-3
+    //   u = lambda t: 2*np.sin(4*np.pi*t)
+    //   def current(q, t):
+    //       g = lambda i: Is*(np.exp((u(t) - q/C - R*i)/Vt) - 1) - i
+    //       return scipy.optimize.brentq(g, -Is, 1.0, xtol=1e-300, rtol=1e-15, maxiter=500)
+    //   sol = scipy.integrate.solve_ivp(lambda t, y: [current(y[0], t)], (0, 1), [0.0], method='DOP853',
+    //                                   rtol=1e-12, atol=1e-16, dense_output=True)
+    //   (t, sol.sol(t)[0], current(sol.sol(t)[0], t))
+    let reference = [
+        (0.05, 1.221142253384171e-04, 6.170698140284477e-03),
+        (0.1, 5.345596054896531e-04, 9.116555752244031e-03),
+        (0.2, 1.038153776714162e-03, 1.417993790833362e-05),
+        (0.3, 1.038090885879596e-03, -1e-06),
+        (0.5, 1.037890885879598e-03, -9.999999990320276e-07),
+        (0.6, 1.127678442667608e-03, 3.643815400005494e-03),
+        (0.75, 1.327821010630361e-03, -9.999999999970652e-07),
+        (1.0, 1.327571010630361e-03, -9.999999999970506e-07),
+    ];
+    let (code, out, err) = bgc(&[
+        "simulate",
+        &corpus("diode_rc.bg"),
+        "--input",
+        "u=2*sin(4*pi*t)",
+        "--t-end",
+        "1",
+        "--dt-out",
+        "0.05",
+        "--rtol",
+        "1e-10",
+        "--atol",
+        "1e-14",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let csv = Csv::parse(&out);
+    let (t, q, i, v_d) = (csv.col("t"), csv.col("q_cap"), csv.col("i"), csv.col("v_d"));
+    for (tr, qr, ir) in reference {
+        let k = t
+            .iter()
+            .position(|x| (x - tr).abs() < 1e-9)
+            .expect("a row at the reference time");
+        assert!(
+            (q[k] - qr).abs() <= 1e-8 * qr.abs(),
+            "t = {tr}: q = {}, want {qr}",
+            q[k]
+        );
+        // The current peaks near 9.1 mA; near the diode's cut-off it is a sensitive function of q.
+        assert!(
+            (i[k] - ir).abs() <= 1e-9,
+            "t = {tr}: i = {}, want {ir}",
+            i[k]
+        );
+    }
+    // Every row satisfies the loop's two laws: the diode's (to the Newton tolerance, 1e-12 of the residual's terms
+    // I_s exp(v_d/V_t) + I_s + |i|, about 2 |i|) and Kirchhoff's voltage law (exactly: v_d is computed from it).
+    for k in 0..t.len() {
+        let u = 2.0 * (4.0 * std::f64::consts::PI * t[k]).sin();
+        let diode = 1e-6 * ((v_d[k] / 0.05).exp() - 1.0);
+        let terms = 1e-6 * (v_d[k] / 0.05).exp() + 1e-6 + i[k].abs();
+        assert!(
+            (i[k] - diode).abs() <= 1e-12 * terms,
+            "t = {}: {} vs {diode}",
+            t[k],
+            i[k]
+        );
+        let kvl = u - q[k] / 1e-3 - 100.0 * i[k] - v_d[k];
+        assert!(kvl.abs() <= 1e-12 * u.abs().max(1.0), "t = {}: {kvl}", t[k]);
+    }
+    // The energy balance holds through the loop.
+    let (e, dis, sup) = (
+        csv.col("energy"),
+        csv.col("dissipated"),
+        csv.col("supplied"),
+    );
+    let scale = sup.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    for k in 0..t.len() {
+        assert!(
+            (e[k] + dis[k] - sup[k]).abs() <= 1e-8 * scale,
+            "t = {}",
+            t[k]
+        );
+    }
+}
+
+const NO_SOLUTION: &str = "/// A resistor with the law f = k e^2 (it conducts one way only) in series with R_s and a capacitor: the loop
+/// current i = k (u - q/C - R_s i)^2 has no real solution when u - q/C < -1/(4 R_s k).
+model valve_loop {
+    domain electrical;
+    param R_s = 1 [Ohm];
+    param k = 1 [A/V^2];
+    param C_v = 1 [F];
+    input u [V];
+
+    Se source = u;
+    1 loop_current;
+    R series = R_s;
+    R valve { f = k * e^2; }
+    C cap = C_v;
+
+    bond source -> loop_current -> series, valve, cap;
+}
+";
+
+#[test]
+fn a_loop_without_a_solution_stops_the_run_with_its_residual() {
+    let path = temp_model("valve_loop", NO_SOLUTION);
+    // u = -10 from the start: i^2 + 19 i + 100 = 0 has no real root; the smallest |r| over real i is
+    // 100 - 19^2/4 = 9.75 (at i = -9.5), which is where the damped iteration stops.
+    let (code, out, err) = bgc(&["simulate", &path, "--t-end", "1", "--input", "u=-10"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(out.is_empty());
+    assert!(
+        err.contains("the algebraic loop for `loop_f_valve` could not be solved at t = 0:"),
+        "{err}"
+    );
+    assert!(
+        err.contains("the residual of `loop_f_valve` is 9.750e0"),
+        "{err}"
+    );
+    // u = -0.2 - t: the two roots of i^2 - (2a + 1) i + a^2 = 0 (a = u - q) merge and vanish when a = -1/4, a
+    // little before t = 0.05 (q is slightly negative by then); the run stops there, not at the start.
+    let (code, _, err) = bgc(&["simulate", &path, "--t-end", "1", "--input", "u=-0.2 - t"]);
+    assert_eq!(code, 1, "{err}");
+    let time: f64 = err
+        .split("could not be solved at t = ")
+        .nth(1)
+        .and_then(|rest| rest.split(':').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("no time in {err}"));
+    assert!(time > 0.04 && time < 0.05, "{err}");
+    // With u = 0.5 the loop has its solution (the smaller root) and the run completes.
+    let (code, _, err) = bgc(&["simulate", &path, "--t-end", "1", "--input", "u=0.5"]);
+    assert_eq!(code, 0, "{err}");
+    let _ = std::fs::remove_file(&path);
+}

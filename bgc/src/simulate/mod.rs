@@ -277,7 +277,7 @@ impl System {
             .map_err(|e| SimError::AlgebraicLoop {
                 tears: e.tears.join("`, `"),
                 time: t,
-                reason: e.reason(),
+                reason: e.failure.kind.describe(),
                 iterations: e.failure.iterations,
                 worst: e.worst.clone(),
                 residual: e.failure.residual,

@@ -6,10 +6,11 @@
 //! programs over that vector. [`Loops::solve`] solves the blocks in order by damped Newton
 //! ([`crate::equations::newton`]), warm-started from the values the vector already holds (the previous
 //! evaluation's solution); when that fails it retries from zero before reporting the block, the time and the
-//! residual ([`LoopError`]).
+//! residual ([`LoopFailure`]).
 
 use super::program::{Program, Values};
-use crate::equations::newton::{self, Failure, Problem, Settings};
+use crate::equations::LoopFailure;
+use crate::equations::newton::{self, Problem, Settings};
 
 /// One compiled block.
 #[derive(Clone, Debug)]
@@ -38,16 +39,6 @@ pub struct BlockPrograms {
     pub jacobian: Vec<Program>,
 }
 
-/// A block that Newton's method could not solve.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LoopError {
-    /// The block's tear variables.
-    pub tears: Vec<String>,
-    /// The tear whose residual is largest.
-    pub worst: String,
-    pub failure: Failure,
-}
-
 impl Loops {
     /// Adds a block (after the blocks it refers to).
     pub fn push(&mut self, p: BlockPrograms) {
@@ -71,7 +62,7 @@ impl Loops {
         values: &Values<'_>,
         ext: &mut [f64],
         stack: &mut Vec<f64>,
-    ) -> Result<(), LoopError> {
+    ) -> Result<(), LoopFailure> {
         for block in &self.blocks {
             let mut z: Vec<f64> = block
                 .slots
@@ -91,7 +82,7 @@ impl Loops {
                 result = newton::solve(&mut problem, &mut z, Settings::default());
             }
             if let Err(failure) = result {
-                return Err(LoopError {
+                return Err(LoopFailure {
                     tears: block.names.clone(),
                     worst: block.names.get(failure.index).cloned().unwrap_or_default(),
                     failure,
@@ -100,13 +91,6 @@ impl Loops {
             problem.place(&z);
         }
         Ok(())
-    }
-}
-
-impl LoopError {
-    /// What went wrong, for messages.
-    pub fn reason(&self) -> &'static str {
-        self.failure.kind.describe()
     }
 }
 

@@ -12,45 +12,31 @@ use super::program::{Program, Values};
 use crate::equations::LoopFailure;
 use crate::equations::newton::{self, Problem, Settings};
 
-/// One compiled block.
-#[derive(Clone, Debug)]
-struct Block {
-    /// The tears' positions in the programs' input vector.
-    slots: Vec<usize>,
-    names: Vec<String>,
-    residuals: Vec<Program>,
-    scales: Vec<Program>,
-    /// Row-major `∂r_i/∂z_j`.
-    jacobian: Vec<Program>,
-}
-
 /// The compiled blocks of a model, in solving order.
 #[derive(Clone, Debug, Default)]
 pub struct Loops {
-    blocks: Vec<Block>,
+    blocks: Vec<BlockPrograms>,
 }
 
-/// The programs of one block, as [`Loops::push`] takes them.
+/// The compiled programs of one block.
+#[derive(Clone, Debug)]
 pub struct BlockPrograms {
+    /// The tears' positions in the programs' input vector.
     pub slots: Vec<usize>,
     pub names: Vec<String>,
     pub residuals: Vec<Program>,
     pub scales: Vec<Program>,
+    /// Row-major `∂r_i/∂z_j`.
     pub jacobian: Vec<Program>,
 }
 
 impl Loops {
     /// Adds a block (after the blocks it refers to).
-    pub fn push(&mut self, p: BlockPrograms) {
-        self.blocks.push(Block {
-            slots: p.slots,
-            names: p.names,
-            residuals: p.residuals,
-            scales: p.scales,
-            jacobian: p.jacobian,
-        });
+    pub fn push(&mut self, block: BlockPrograms) {
+        self.blocks.push(block);
     }
 
+    /// True when the model has no nonlinear algebraic loops.
     pub fn is_empty(&self) -> bool {
         self.blocks.is_empty()
     }
@@ -96,7 +82,7 @@ impl Loops {
 
 /// A block evaluated by its programs.
 struct Compiled<'a, 'v> {
-    block: &'a Block,
+    block: &'a BlockPrograms,
     values: &'a Values<'v>,
     ext: &'a mut [f64],
     stack: &'a mut Vec<f64>,

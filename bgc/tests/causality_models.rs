@@ -300,6 +300,8 @@ const CORPUS: &[(&str, usize, &[&str])] = &[
     // The capacitor; the three resistors form an algebraic loop after one arbitrary choice.
     ("resistive_network", 1, &["BG0520", "BG0530"]),
     ("oscillator", 2, &[]),
+    // The capacitor; the series resistor and the diode form a (nonlinear) algebraic loop.
+    ("diode_rc", 1, &["BG0520"]),
 ];
 
 #[test]

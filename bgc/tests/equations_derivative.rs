@@ -3,7 +3,8 @@
 mod equations_support;
 
 use bgc::causality::analyse;
-use bgc::equations::{StateSelection, derive, numeric_state_space, to_text};
+use bgc::equations::sym::{self, Sym};
+use bgc::equations::{StateSelection, derive, numeric_state_space, solve_all, to_text};
 use bgc::ir::Relation;
 use bgc::syntax::ast::ElementKind as K;
 use equations_support::*;
@@ -199,8 +200,10 @@ fn a_linear_algebraic_loop_is_solved_exactly() {
 }
 
 #[test]
-fn a_nonlinear_algebraic_loop_is_reported() {
-    // As the network above, with R2 a cubic conductance: the loop cannot be solved in closed form.
+fn a_nonlinear_algebraic_loop_is_kept_implicit_and_solves_kirchhoffs_law() {
+    // As the network above, with R2 a cubic conductance f = e^3/R2: the loop has no closed form. It becomes one
+    // tear block, and its numeric solution must satisfy the node equation at v = v_middle:
+    //   (u - v)/R1 = v^3/R2 + (v - q/C)/R3,   q̇ = (v - q/C)/R3.
     let mut model = resistive_network();
     let r2 = model.node_by_name("r2").expect("r2");
     let r2_param = bgc::ir::Expr::Param(1);
@@ -211,14 +214,39 @@ fn a_nonlinear_algebraic_loop_is_reported() {
     }]);
     let (causality, _) = analyse(&model);
     let (eqs, diags) = derive(&model, &causality);
-    let codes: Vec<&str> = diags
-        .iter()
-        .filter(|d| d.is_error())
-        .map(|d| d.code.0)
-        .collect();
+    assert!(diags.iter().all(|d| !d.is_error()), "{diags:?}");
+    assert_eq!(eqs.tear_blocks.len(), 1);
+    assert_eq!(eqs.tear_blocks[0].tears.len(), 1);
     assert!(
-        codes.contains(&"BG0603") || codes.contains(&"BG0601"),
-        "{diags:?}"
+        to_text(&eqs).contains("solve for loop_"),
+        "{}",
+        to_text(&eqs)
     );
-    assert!(eqs.f[0].is_none());
+    let (r1, r2, r3, cap) = (100.0, 220.0, 470.0, 1e-6);
+    let mut rng = Rng(5);
+    for _ in 0..6 {
+        let (q, u) = (6e-6 * (rng.next() - 0.5), 40.0 * (rng.next() - 0.5));
+        let base = |s: Sym| match s {
+            Sym::Param(i) => [r1, r2, r3, cap].get(i).copied(),
+            Sym::State(0) => Some(q),
+            Sym::Input(0) => Some(u),
+            Sym::Time => Some(0.0),
+            _ => None,
+        };
+        let tears = solve_all(&eqs, &base).expect("the loop solves");
+        let value = |s: Sym| match s {
+            Sym::Tear(_) => tears.iter().find(|(t, _)| *t == s).map(|(_, v)| *v),
+            other => base(other),
+        };
+        let explicit = eqs.outputs[0].explicit.as_ref().expect("v_middle");
+        let v = sym::eval(explicit, &value).expect("v_middle evaluates");
+        let (i1, i2, i3) = ((u - v) / r1, v.powi(3) / r2, (v - q / cap) / r3);
+        let scale = i1.abs() + i2.abs() + i3.abs();
+        assert!(
+            (i1 - i2 - i3).abs() <= 1e-10 * scale,
+            "q = {q}, u = {u}: v = {v}, {i1} != {i2} + {i3}"
+        );
+        let rate = sym::eval(eqs.f[0].as_ref().expect("rate"), &value).expect("rate evaluates");
+        assert!((rate - i3).abs() <= 1e-10 * scale, "{rate} vs {i3}");
+    }
 }

@@ -73,6 +73,19 @@ fn convert_matrix(eqs: &Equations, m: &[Vec<Ex>]) -> Result<Vec<Vec<Expr>>, Adap
 
 /// The plan of a complete model.
 pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
+    // The rates of a model with a nonlinear algebraic loop hold its tear variables, which only an iterative solve
+    // defines; generated code has none.
+    if !eqs.tear_blocks.is_empty() {
+        let tears: Vec<&str> = eqs
+            .tear_blocks
+            .iter()
+            .flat_map(|b| b.names.iter().map(String::as_str))
+            .collect();
+        return Err(format!(
+            "its nonlinear algebraic loop (solve for `{}`) needs an iterative solver, which generated code does not include; `bgc simulate` solves it by Newton's method",
+            tears.join("`, `")
+        ));
+    }
     let mut f_ex = Vec::with_capacity(eqs.f.len());
     for (i, f) in eqs.f.iter().enumerate() {
         let name = eqs.states.get(i).map(|s| s.name.as_str()).unwrap_or("?");
@@ -121,6 +134,9 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
         let mut terms = Vec::new();
         let mut missing = Vec::new();
         for t in eqs.energy.iter().filter(|t| t.kind == kind) {
+            // A term with an input's derivative (`Sym::InputDot`, the power of a source driving a storage in
+            // derivative causality) has no value in the generated functions, which take `u` but not `du/dt`: it
+            // does not convert and counts as missing, so no partial sum is generated.
             match t.value.as_ref().map(|v| to_symbolic(eqs, v)) {
                 Some(Ok(v)) => terms.push((t.element.clone(), v)),
                 _ => missing.push(t.element.clone()),

@@ -10,7 +10,9 @@
 //!   `jac_x_into`, `jac_u_into`, `output_jac_x_into`, `output_jac_u_into` from symbolic derivatives;
 //! - for a linear model `state_space(&Params) -> (A, B, C, D)` in the energy states and, when the model declares
 //!   coordinates, `state_space_declared`;
-//! - `stored_energy`, `dissipated_power`, `supplied_power` when every term has a closed form;
+//! - `stored_energy`, `dissipated_power`, `supplied_power` when every term has a closed form in `p, t, x, u` (the
+//!   power of a source that drives a storage in derivative causality needs the time derivative of its input,
+//!   which these functions do not take: such a model gets no `supplied_power`, and a comment names the source);
 //! - `Model`, which implements `bgc_runtime::model::ContinuousModel` and `Parametric`.
 //!
 //! The functions of the model take fixed-size values, allocate nothing, call only `f64` methods and never panic

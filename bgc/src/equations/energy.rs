@@ -6,6 +6,10 @@
 //!   coefficients do not depend on it; other laws are reported (`BG0607`) and get no expression.
 //! - Dissipated: `e·f` of each resistor (its own effort and flow, so positive for a passive resistor).
 //! - Supplied: `e·f` of each source along its bond's direction (positive when the source delivers power).
+//!
+//! A source that drives a storage in derivative causality (a flow source imposing an inertia's velocity) has an
+//! effort with the time derivative of its input in it (`e = J·dω/dt`): its power keeps that derivative as
+//! [`Sym::InputDot`], so that `dE/dt = supplied − dissipated` holds for every input, not only constant ones.
 
 use super::build::{Ctx, effort_var, flow_var};
 use super::codes;
@@ -41,8 +45,9 @@ impl EnergyKind {
 pub struct EnergyTerm {
     pub element: String,
     pub kind: EnergyKind,
-    /// Explicit in states, inputs, parameters and `t`; `None` when it has no closed form here (a diagnostic says
-    /// why).
+    /// Explicit in states, inputs, parameters and `t`, and, for the power of an element next to a storage in
+    /// derivative causality, the inputs' time derivatives ([`Sym::InputDot`]); `None` when it has no closed form
+    /// here (a diagnostic says why).
     pub value: Option<Ex>,
 }
 
@@ -173,18 +178,11 @@ pub(crate) fn terms(
             }
             _ => continue,
         };
-        let value = raw.and_then(|r| match resolver.expr(&r) {
-            Ok(v) if v.any_sym(&|s| matches!(s, Sym::InputDot(_))) => {
-                diags.push(warn(format!(
-                    "the {} power of `{}` is not computed: it needs the time derivative of an input",
-                    kind.name(),
-                    w.name
-                )));
-                None
-            }
-            Ok(v) => Some(rate_of(&v)),
-            Err(_) => None,
-        });
+        // A source or resistor next to a storage in derivative causality keeps the inputs' derivatives
+        // (`Sym::InputDot`): its power is `e·f` with `e = I·du/dt` (or `f = C·du/dt`), and leaving that out would
+        // break the energy balance whenever the input varies. A consumer supplies `du/dt` (the simulator
+        // differentiates the input signals) or leaves the term out and says so (generated code).
+        let value = raw.and_then(|r| resolver.expr(&r).ok().map(|v| rate_of(&v)));
         out.push(EnergyTerm {
             element: w.name.clone(),
             kind,

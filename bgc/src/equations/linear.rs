@@ -54,6 +54,22 @@ pub enum LinearError {
         expected: usize,
         got: usize,
     },
+    #[error(
+        "the model has a nonlinear algebraic loop solved numerically (for `{tears}`): its Jacobians have no closed form; linearise it at an operating point instead"
+    )]
+    ImplicitLoop { tears: String },
+    #[error(
+        "the algebraic loop for `{tears}` could not be solved at the operating point: {reason} (largest residual {residual:e})"
+    )]
+    LoopNotSolved {
+        tears: String,
+        reason: &'static str,
+        residual: f64,
+    },
+    #[error(
+        "the algebraic loop for `{tears}` is singular at the operating point: its solution does not depend smoothly on the states and inputs"
+    )]
+    SingularLoop { tears: String },
 }
 
 /// Symbolic Jacobians of `f` and `h`.
@@ -100,6 +116,38 @@ impl Equations {
             StateSelection::All => self.states.len(),
         }
     }
+}
+
+/// The tear variables (names) that the selected rates or the outputs hold, and where the first one is.
+fn implicit_in(eqs: &Equations, f: &[Ex], h: &[Ex]) -> Option<(String, String, String)> {
+    let tear = |e: &Ex| {
+        let mut found = None;
+        e.for_each_sym(&mut |s| {
+            if found.is_none() && matches!(s, Sym::Tear(_)) {
+                found = Some(s);
+            }
+        });
+        found
+    };
+    let names = || {
+        eqs.tear_blocks
+            .iter()
+            .flat_map(|b| b.names.iter().cloned())
+            .collect::<Vec<_>>()
+            .join("`, `")
+    };
+    for (i, e) in f.iter().enumerate() {
+        if let Some(z) = tear(e) {
+            let what = format!("the rate of `{}`", eqs.sym_name(Sym::State(i)));
+            return Some((what, eqs.sym_name(z), names()));
+        }
+    }
+    for (o, e) in eqs.outputs.iter().zip(h) {
+        if let Some(z) = tear(e) {
+            return Some((format!("output `{}`", o.name), eqs.sym_name(z), names()));
+        }
+    }
+    None
 }
 
 /// The selected rates and all outputs, explicit, checked for use of left-out states.
@@ -186,6 +234,9 @@ fn jacobian(
 /// an I-field (see [`Equations::mass`]) the rows are those of the generalised forces `F`, not of the rates.
 pub fn jacobians(eqs: &Equations, selection: StateSelection) -> Result<Jacobians, LinearError> {
     let (f, h) = selected(eqs, selection)?;
+    if let Some((_, _, tears)) = implicit_in(eqs, &f, &h) {
+        return Err(LinearError::ImplicitLoop { tears });
+    }
     let n = f.len();
     let xs: Vec<Sym> = (0..n).map(Sym::State).collect();
     let us: Vec<Sym> = (0..eqs.inputs.len()).map(Sym::Input).collect();
@@ -208,7 +259,7 @@ pub fn jacobians(eqs: &Equations, selection: StateSelection) -> Result<Jacobians
 }
 
 /// `A, B, C, D` of a linear model, as expressions of the parameters; an error names the first nonlinear or affine
-/// entry.
+/// entry. A rate or output that holds the unknown of a nonlinear algebraic loop is not linear.
 pub fn linear_state_space(
     eqs: &Equations,
     selection: StateSelection,
@@ -216,6 +267,19 @@ pub fn linear_state_space(
     if let Some(b) = eqs.mass.first() {
         return Err(LinearError::MassMatrix {
             element: b.element.clone(),
+        });
+    }
+    let (f, h) = selected(eqs, selection)?;
+    if let Some((entry, symbol, _)) = implicit_in(eqs, &f, &h) {
+        let what = if entry.starts_with("output") {
+            "h"
+        } else {
+            "f"
+        };
+        return Err(LinearError::NotLinear {
+            what: what.to_string(),
+            entry,
+            symbol,
         });
     }
     let j = jacobians(eqs, selection)?;
@@ -357,7 +421,8 @@ pub fn numeric_state_space(
 }
 
 /// The linearisation of any model at the operating point `(x0, u0, t0)`: the Jacobians evaluated there (for the
-/// mass-matrix rows of I-fields, those of the solved rates).
+/// mass-matrix rows of I-fields, those of the solved rates). A model with nonlinear algebraic loops has them solved
+/// at that point and differentiated by the implicit function theorem ([`super::tear`]).
 pub fn linearise(
     eqs: &Equations,
     selection: StateSelection,
@@ -366,6 +431,13 @@ pub fn linearise(
     u0: &[f64],
     t0: f64,
 ) -> Result<NumericStateSpace, LinearError> {
+    let (f, h) = selected(eqs, selection)?;
+    if implicit_in(eqs, &f, &h).is_some() {
+        check_len("parameter", eqs.params.len(), params.len())?;
+        check_len("state", f.len(), x0.len())?;
+        check_len("input", eqs.inputs.len(), u0.len())?;
+        return super::tear::linearise_implicit(eqs, &f, &h, params, x0, u0, t0);
+    }
     let j = jacobians(eqs, selection)?;
     let mut ss = evaluate_at(eqs, &j, params, x0, u0, t0)?;
     let value = |s: Sym| super::numeric::point(s, params, x0, u0, t0);

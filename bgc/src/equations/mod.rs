@@ -6,11 +6,16 @@
 //!    integrated flows (`var`s, named as declared); their rates are `ṗ = e`, `q̇ = f`, `θ̇ = integrand`.
 //! 2. Every node writes the causal equation of each bond variable it computes (`build.rs`).
 //! 3. The rates and outputs are expressed in states, inputs, parameters and `t` by substitution in dependency order
-//!    (`resolve.rs`); algebraic loops are torn and solved when affine, storages in derivative causality contribute
-//!    `ẋ` terms, solved for by a symbolic linear solve (`solve.rs`).
-//!    Multiport fields are in [`field`]: an I-field gives the mass-matrix form `M(q) ẋ = F` for its flow states
-//!    ([`Equations::mass`]), solved numerically by its consumers ([`Equations::rates_at`]).
-//! 4. Readable forms keep intermediates (one per bond variable that is computed and not a mere copy of another).
+//!    (`resolve.rs`); algebraic loops are torn and solved exactly when affine, storages in derivative causality
+//!    contribute `ẋ` terms, solved for by a symbolic linear solve (`solve.rs`). Multiport fields are in [`field`]:
+//!    an I-field gives the mass-matrix form `M(q) ẋ = F` for its flow states ([`Equations::mass`]), solved
+//!    numerically by its consumers ([`Equations::rates_at`]).
+//! 4. A nonlinear algebraic loop stays implicit (`tear.rs`): its tear variable `z` (`Sym::Tear`, printed
+//!    `loop_<variable>`) is an unknown of the equations, defined by a residual equation `0 = r(z, x, u, p, t)` in
+//!    [`Equations::tear_blocks`]. Rates, outputs and energy terms hold `z`; `bgc simulate` solves the blocks by
+//!    Newton's method ([`newton`]) at every evaluation, [`linearise`] uses the implicit function theorem, and code
+//!    generation refuses such a model.
+//! 5. Readable forms keep intermediates (one per bond variable that is computed and not a mere copy of another).
 //!
 //! # Calling it
 //! ```text
@@ -24,6 +29,7 @@
 //! linear_state_space(&eqs, StateSelection::Energy)                    // symbolic A, B, C, D
 //! jacobians(&eqs, sel) / linearise(&eqs, sel, &p, &x0, &u0, t0)       // nonlinear models
 //! eqs.f[i], eqs.outputs[k].explicit + to_symbolic(&eqs, e)            // `bgc simulate`, code generation
+//! eqs.tear_blocks, solve_all(&eqs, &values)                          // nonlinear loops: 0 = r(z, x, u, p, t)
 //! ```
 //! The states are `eqs.states` (energy states first, `eqs.energy_states` of them, then one per `var`); symbols
 //! in expressions are named by [`Equations::sym_name`].
@@ -38,7 +44,7 @@
 //! | BG0600 | the causality has conflicts: no equations |
 //! | BG0601 | a nonlinear law must be inverted for its causality and is not affine in the unknown |
 //! | BG0602 | an output needs the time derivative of an input |
-//! | BG0603 | a nonlinear (or singular) algebraic loop |
+//! | BG0603 | a singular algebraic loop (its loop gain is one), or a nonlinear one through a storage in derivative causality (nonlinear loops are otherwise kept as tear blocks) |
 //! | BG0604 | derivative causality that cannot be resolved (nonlinear in the rates, singular, or a state rate needing the derivative of an input) |
 //! | BG0605 | a construct the equations stage does not support (a field port in derivative causality, an R-field with mixed causality, an inertia matrix depending on more than the field's displacements, ambiguous references) |
 //! | BG0606 | declared coordinates that are not a linear, invertible function of the states |
@@ -52,11 +58,13 @@ pub(crate) mod dense;
 mod energy;
 mod field;
 mod linear;
+pub mod newton;
 mod numeric;
 mod print;
 mod resolve;
 mod solve;
 pub mod sym;
+pub mod tear;
 
 pub use bridge::{symbol, to_symbolic};
 pub use coords::{CoordsError, declared_state_space};
@@ -68,6 +76,8 @@ pub use linear::{
     jacobians, linear_state_space, linearise, numeric_state_space,
 };
 pub use print::{expr_latex, expr_text, to_json, to_latex, to_text};
+pub(crate) use tear::block_jacobian;
+pub use tear::{LoopFailure, TearBlock, residual_scale, solve_all};
 
 use crate::causality::Causality;
 use crate::diagnostic::Diagnostic;
@@ -170,6 +180,9 @@ pub struct Equations {
     /// The intermediates at which algebraic loops were solved exactly: the readable intermediates around them are
     /// implicit (they refer to each other), the explicit rates and outputs are not.
     pub loops: Vec<String>,
+    /// The nonlinear algebraic loops, kept implicit, in solving order: the explicit rates, outputs and energy terms
+    /// hold their tear variables ([`Sym::Tear`]), whose values solve `0 = r(z, x, u, p, t)`.
+    pub tear_blocks: Vec<TearBlock>,
 }
 
 impl Equations {
@@ -264,6 +277,7 @@ fn empty_equations(model: &Model) -> Equations {
         energy: Vec::new(),
         mass: Vec::new(),
         loops: Vec::new(),
+        tear_blocks: Vec::new(),
     }
 }
 
@@ -496,6 +510,7 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
         .into_iter()
         .map(|v| eqs.sym_name(Sym::Var(v)))
         .collect();
+    eqs.tear_blocks = tear::blocks(resolver.implicit_loops(), &|s| eqs.sym_name(s));
     eqs.states = built.states;
     eqs.mass = built.mass;
     (eqs, diags)
@@ -595,15 +610,16 @@ fn resolve_diag(model: &Model, built: &build::Built, e: &ResolveError, what: &st
             codes::UNSUPPORTED,
             format!("cannot derive {what}: nothing computes `{}`", var_name(*v)),
         ),
-        ResolveError::NonlinearLoop(v) | ResolveError::SingularLoop(v) => {
-            let kind = if matches!(e, ResolveError::NonlinearLoop(_)) {
-                "a nonlinear algebraic loop"
-            } else {
-                "a singular algebraic loop (its loop gain is one)"
-            };
-            let d = Diagnostic::error(codes::ALGEBRAIC_LOOP, format!("cannot derive {what}: {kind} through `{}`", var_name(*v)))
-                .with_note("linear algebraic loops are solved exactly; nonlinear ones need an iterative solver, which bgc does not generate yet")
-                .with_help("break the loop with a small storage element, or write the resistor law in the causal form the loop needs");
+        ResolveError::NonlinearLoop(v) => {
+            let d = Diagnostic::error(codes::ALGEBRAIC_LOOP, format!("cannot derive {what}: a nonlinear algebraic loop through `{}` passes a storage in derivative causality", var_name(*v)))
+                .with_note("a nonlinear loop is solved numerically for its torn variable, which needs the loop free of state and input derivatives")
+                .with_help("break the loop with a small storage element, or give the storage in derivative causality its own state");
+            with_span(d, definer_span(*v), "the loop passes here")
+        }
+        ResolveError::SingularLoop(v) => {
+            let d = Diagnostic::error(codes::ALGEBRAIC_LOOP, format!("cannot derive {what}: a singular algebraic loop (its loop gain is one) through `{}`", var_name(*v)))
+                .with_note("the loop's equations do not determine its variables: they are dependent or contradictory")
+                .with_help("break the loop with a small storage element, or change a resistance so that the loop gain differs from one");
             with_span(d, definer_span(*v), "the loop passes here")
         }
         ResolveError::HigherOrder(v) => with_span(

@@ -415,6 +415,21 @@ pub fn to_text(eqs: &Equations) -> String {
             eqs.loops.join(", ")
         ));
     }
+    if !eqs.tear_blocks.is_empty() {
+        out.push_str("algebraic loops, solved numerically (Newton's method):\n");
+        for b in &eqs.tear_blocks {
+            let residuals: Vec<String> = b.residuals.iter().map(|r| expr_text(eqs, r)).collect();
+            match residuals.as_slice() {
+                [one] => out.push_str(&format!("  solve for {}: 0 = {one}\n", b.names.join(", "))),
+                _ => {
+                    out.push_str(&format!("  solve for {}:\n", b.names.join(", ")));
+                    for r in residuals {
+                        out.push_str(&format!("    0 = {r}\n"));
+                    }
+                }
+            }
+        }
+    }
     out.push_str("outputs:\n");
     for o in &eqs.outputs {
         out.push_str(&format!("  {} = {}\n", o.name, expr_text(eqs, &o.value)));
@@ -479,6 +494,18 @@ pub fn to_latex(eqs: &Equations) -> String {
             })
             .collect(),
     );
+    for b in &eqs.tear_blocks {
+        group(
+            &format!(
+                "algebraic loop, solved numerically for {}",
+                b.names.join(", ")
+            ),
+            b.residuals
+                .iter()
+                .map(|r| ("0".to_string(), expr_latex(eqs, r)))
+                .collect(),
+        );
+    }
     group(
         "outputs",
         eqs.outputs
@@ -523,6 +550,10 @@ pub fn to_json(eqs: &Equations) -> Value {
             "element": b.element,
             "states": b.states.iter().map(|&j| eqs.sym_name(Sym::State(j))).collect::<Vec<_>>(),
             "matrix": b.matrix.iter().map(|row| row.iter().map(|m| expr_text(eqs, m)).collect::<Vec<_>>()).collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
+        "tear_blocks": eqs.tear_blocks.iter().map(|b| json!({
+            "tears": b.names,
+            "residuals": b.residuals.iter().map(|r| expr_text(eqs, r)).collect::<Vec<_>>(),
         })).collect::<Vec<_>>(),
         "energy": eqs.energy.iter().map(|t| json!({
             "element": t.element,

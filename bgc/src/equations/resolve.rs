@@ -7,7 +7,9 @@
 //!   for afterwards ([`super::solve`]); a `u̇` left in a state rate or an output is an error there.
 //! - An algebraic loop shows up as a variable needed while it is being computed. It is torn there: the inner use
 //!   gets the symbol `Tear(v)`, and when `v = E(Tear(v))` is complete it is solved exactly if `E` is affine in the
-//!   tear (`v = b / (1 - a)` for `E = a·v + b`); a nonlinear loop is refused.
+//!   tear (`v = b / (1 - a)` for `E = a·v + b`). Otherwise the loop stays implicit: `v` is the unknown `Tear(v)`
+//!   everywhere and the residual `0 = E(Tear(v)) − Tear(v)` is kept ([`Resolver::implicit_loops`]) for a numeric
+//!   solve ([`super::tear`]). A nonlinear loop through a storage in derivative causality is refused.
 
 use super::build::{Built, Def};
 use super::sym::{self, Ex, Sym, add, div, mul};
@@ -18,7 +20,8 @@ use crate::ir::Func;
 pub(crate) enum ResolveError {
     /// A bond variable that no node defines (only after a causality conflict).
     Undefined(usize),
-    /// An algebraic loop through this variable that is not affine in it.
+    /// A nonlinear algebraic loop through this variable whose residual holds a state or input derivative (a storage
+    /// in derivative causality on the loop).
     NonlinearLoop(usize),
     /// An algebraic loop through this variable whose gain is exactly one (a singular loop).
     SingularLoop(usize),
@@ -45,6 +48,8 @@ pub(crate) struct Resolver<'a> {
     cache: Vec<Option<Ex>>,
     mark: Vec<Mark>,
     torn: Vec<bool>,
+    /// The torn variables kept implicit, with their residuals `E(Tear(v)) − Tear(v)`, in the order they closed.
+    implicit: Vec<(usize, Ex)>,
     depth: usize,
 }
 
@@ -61,15 +66,23 @@ impl<'a> Resolver<'a> {
             cache: vec![None; n],
             mark: vec![Mark::New; n],
             torn: vec![false; n],
+            implicit: Vec::new(),
             depth: 0,
         }
     }
 
-    /// The bond variables at which algebraic loops were torn (and solved).
+    /// The bond variables at which algebraic loops were torn and solved exactly.
     pub fn torn(&self) -> Vec<usize> {
         (0..self.torn.len())
             .filter(|&v| self.torn[v] && self.mark[v] == Mark::Done)
+            .filter(|&v| !self.implicit.iter().any(|(w, _)| *w == v))
             .collect()
+    }
+
+    /// The nonlinear loops kept implicit: each torn variable `v` with its residual `r = E − Tear(v)`, `0 = r`, in
+    /// states, inputs, parameters, `t` and tear variables (its own and those of other implicit loops).
+    pub fn implicit_loops(&self) -> &[(usize, Ex)] {
+        &self.implicit
     }
 
     /// The value of bond variable `v`.
@@ -90,32 +103,76 @@ impl<'a> Resolver<'a> {
         self.mark[v] = Mark::Busy;
         let result = self.compute(v);
         self.depth -= 1;
-        let mut value = match result {
+        let value = match result.and_then(|value| self.close_loop(v, value)) {
             Ok(value) => value,
             Err(e) => {
-                self.mark[v] = Mark::New;
+                self.forget(v);
                 return Err(e);
             }
         };
-        if self.torn[v] {
-            let tear = Sym::Tear(v);
-            let (a, b) = sym::affine_in(&value, tear).ok_or(ResolveError::NonlinearLoop(v))?;
-            let gain = sym::sub(Ex::one(), a);
-            if gain.is_zero() {
-                return Err(ResolveError::SingularLoop(v));
-            }
-            value = div(b, gain);
-            // Values computed inside the loop hold the tear: replace it everywhere.
-            let solved = value.clone();
-            for slot in self.cache.iter_mut().flatten() {
-                if slot.contains(tear) {
-                    *slot = sym::subst(slot, &mut |s| (s == tear).then(|| solved.clone()));
-                }
-            }
-        }
         self.cache[v] = Some(value.clone());
         self.mark[v] = Mark::Done;
         Ok(value)
+    }
+
+    /// The value of `v` once computed: unchanged unless a loop was torn at `v`, in which case it is solved exactly
+    /// (affine in the tear) or kept implicit (nonlinear).
+    fn close_loop(&mut self, v: usize, value: Ex) -> Result<Ex, ResolveError> {
+        if !self.torn[v] {
+            return Ok(value);
+        }
+        let tear = Sym::Tear(v);
+        let Some((a, b)) = sym::affine_in(&value, tear) else {
+            if value.any_sym(&|s| matches!(s, Sym::StateDot(_) | Sym::InputDot(_))) {
+                return Err(ResolveError::NonlinearLoop(v));
+            }
+            let residual = sym::sub(value, Ex::S(tear));
+            self.implicit.push((v, residual));
+            return Ok(Ex::S(tear));
+        };
+        let gain = sym::sub(Ex::one(), a);
+        if gain.is_zero() {
+            return Err(ResolveError::SingularLoop(v));
+        }
+        let solved = div(b, gain);
+        // Values computed inside the loop, and the residuals of implicit loops inside it, hold the tear: replace it
+        // everywhere.
+        let mut replace = |e: &mut Ex| {
+            if e.contains(tear) {
+                *e = sym::subst(e, &mut |s| (s == tear).then(|| solved.clone()));
+            }
+        };
+        self.cache.iter_mut().flatten().for_each(&mut replace);
+        self.implicit.iter_mut().for_each(|(_, r)| replace(r));
+        Ok(solved)
+    }
+
+    /// Undoes a failed computation of `v`: `v` is new again, and so is everything computed inside it that holds
+    /// its tear, transitively through the implicit loops that hold it (they would refer to an unknown nothing
+    /// defines).
+    fn forget(&mut self, v: usize) {
+        self.mark[v] = Mark::New;
+        let mut dead = vec![v];
+        while let Some(d) = dead.pop() {
+            let tear = Sym::Tear(d);
+            for w in 0..self.cache.len() {
+                if self.cache[w].as_ref().is_some_and(|e| e.contains(tear)) {
+                    self.cache[w] = None;
+                    self.mark[w] = Mark::New;
+                }
+            }
+            let mut k = 0;
+            while k < self.implicit.len() {
+                if self.implicit[k].1.contains(tear) {
+                    let (w, _) = self.implicit.remove(k);
+                    self.cache[w] = None;
+                    self.mark[w] = Mark::New;
+                    dead.push(w);
+                } else {
+                    k += 1;
+                }
+            }
+        }
     }
 
     fn compute(&mut self, v: usize) -> Result<Ex, ResolveError> {

@@ -18,7 +18,8 @@ pub enum Sym {
     Param(usize),
     /// A model input.
     Input(usize),
-    /// The time derivative of an input (only appears transiently; an equation that keeps one is refused).
+    /// The time derivative of an input. Kept only in the power of an element next to a storage in derivative
+    /// causality (energy terms); a rate or output that keeps one is refused.
     InputDot(usize),
     /// A state (index into the equations' state list).
     State(usize),

@@ -11,8 +11,9 @@
 //! ```
 //!
 //! Functions: `step(t0)` (0 for `t < t0`, 1 from `t0` on), `ramp(t0)` (`max(t - t0, 0)`), `sin`, `cos`, `tan`,
-//! `exp`, `sqrt`, `abs`, `min(a, b)`, `max(a, b)`. The constant arguments of `step` and `ramp` are the signal's
-//! breakpoints: the integrator restarts there, so a jump is resolved exactly instead of by step rejection.
+//! `exp`, `ln`, `sqrt`, `abs`, `sign`, `min(a, b)`, `max(a, b)`. The constant arguments of `step` and `ramp` are
+//! the signal's breakpoints: the integrator restarts there, so a jump is resolved exactly instead of by step
+//! rejection. A signal's time derivative is [`Signal::derivative`] (module [`super::input_rate`]).
 
 use std::fmt;
 
@@ -43,10 +44,12 @@ pub enum SignalFunc {
     Abs,
     Min,
     Max,
+    Sign,
+    Ln,
 }
 
 impl SignalFunc {
-    const ALL: [(&'static str, SignalFunc, usize); 10] = [
+    const ALL: [(&'static str, SignalFunc, usize); 12] = [
         ("step", SignalFunc::Step, 1),
         ("ramp", SignalFunc::Ramp, 1),
         ("sin", SignalFunc::Sin, 1),
@@ -57,6 +60,8 @@ impl SignalFunc {
         ("abs", SignalFunc::Abs, 1),
         ("min", SignalFunc::Min, 2),
         ("max", SignalFunc::Max, 2),
+        ("sign", SignalFunc::Sign, 1),
+        ("ln", SignalFunc::Ln, 1),
     ];
 }
 
@@ -116,6 +121,16 @@ impl Signal {
                     SignalFunc::Abs => x.abs(),
                     SignalFunc::Min => x.min(y),
                     SignalFunc::Max => x.max(y),
+                    SignalFunc::Sign => {
+                        if x > 0.0 {
+                            1.0
+                        } else if x < 0.0 {
+                            -1.0
+                        } else {
+                            0.0
+                        }
+                    }
+                    SignalFunc::Ln => x.ln(),
                 }
             }
         }
@@ -146,7 +161,8 @@ impl Signal {
         }
     }
 
-    fn uses_time(&self) -> bool {
+    /// True when the value depends on `t`.
+    pub fn uses_time(&self) -> bool {
         match self {
             Signal::Num(_) => false,
             Signal::Time => true,
@@ -156,6 +172,8 @@ impl Signal {
             | Signal::Mul(a, b)
             | Signal::Div(a, b)
             | Signal::Pow(a, b) => a.uses_time() || b.uses_time(),
+            // `step(a)` and `ramp(a)` compare `t` with their argument.
+            Signal::Call(SignalFunc::Step | SignalFunc::Ramp, _) => true,
             Signal::Call(_, args) => args.iter().any(Signal::uses_time),
         }
     }
@@ -335,7 +353,7 @@ impl Parser {
             return Err(SignalError {
                 column: start + 1,
                 message: format!(
-                    "unknown name `{name}` (an input may use `t`, `pi`, numbers and step, ramp, sin, cos, tan, exp, sqrt, abs, min, max)"
+                    "unknown name `{name}` (an input may use `t`, `pi`, numbers and step, ramp, sin, cos, tan, exp, ln, sqrt, abs, sign, min, max)"
                 ),
             });
         };

@@ -4,8 +4,11 @@
 //! so a jump never enters an implicit method's step history, and within a segment `[a, b)` the inputs are
 //! evaluated at times strictly before `b`, as the solver's last stage at `b` would otherwise see the jump. States
 //! are reported at the sample times by the solver's dense output (interpolation of the accepted steps, of the
-//! method's order). The Jacobian handed to the implicit methods is the symbolic one of the equations, or finite
-//! differences when a rate uses a function without a derivative.
+//! method's order). At a breakpoint the states are continuous but a jump of an input may change the stored energy
+//! (a flow source imposing an inertia's velocity): that jump, [`System::stored_jump`], is added to the `supplied`
+//! quadrature there, so `energy + dissipated − supplied` stays constant across steps. The Jacobian handed to the
+//! implicit methods is the symbolic one of the equations, or finite differences when a rate uses a function
+//! without a derivative.
 
 use std::cell::{Cell, RefCell};
 
@@ -117,7 +120,7 @@ pub fn run(system: &System, x0: &[f64], opts: &RunOptions) -> Result<Trajectory,
     let mut u = Vec::new();
     let mut stack = Vec::new();
     let mut rows = Vec::with_capacity(times.len());
-    let first = system.row(&y, 0.0, &mut u, &mut stack);
+    let first = system.row(&y, 0.0, &mut u, &mut stack)?;
     if let Some(i) = first.iter().position(|v| !v.is_finite()) {
         let columns = system.columns();
         return Err(SimError::NonFiniteStart {
@@ -142,8 +145,22 @@ pub fn run(system: &System, x0: &[f64], opts: &RunOptions) -> Result<Trajectory,
         let last = b >= opts.t_end;
         let mut states = Vec::with_capacity(wanted.len());
         y = segment(system, &y, a, b, last, wanted, opts, &mut states)?;
+        if !last {
+            // The row at `b` itself shows the inputs after their jump, so it gets the jump's energy too.
+            let jump = system.stored_jump(&y, just_before(b), b, &mut stack)?;
+            for (t, ys) in wanted.iter().zip(states.iter_mut()) {
+                if *t >= b
+                    && let Some(sup) = ys.get_mut(n + 1)
+                {
+                    *sup += jump;
+                }
+            }
+            if let Some(sup) = y.get_mut(n + 1) {
+                *sup += jump;
+            }
+        }
         for (t, ys) in wanted.iter().zip(&states) {
-            rows.push(system.row(ys, *t, &mut u, &mut stack));
+            rows.push(system.row(ys, *t, &mut u, &mut stack)?);
         }
     }
     Ok(Trajectory {
@@ -167,18 +184,26 @@ fn segment(
 ) -> Result<Vec<f64>, SimError> {
     let dim = y0.len();
     // Inputs are evaluated before a breakpoint `b`, never at it (see the module docs).
-    let t_max = if last {
-        f64::INFINITY
-    } else {
-        b - b.abs() * 4.0 * f64::EPSILON
-    };
+    let t_max = if last { f64::INFINITY } else { just_before(b) };
     let scratch = RefCell::new((Vec::new(), Vec::new(), vec![0.0; dim], vec![0.0; dim]));
     let bad: Cell<Option<(f64, usize)>> = Cell::new(None);
+    // The latest failure of the algebraic loops' solve at a finite state, reported if the solver then gives up (it
+    // may recover from a failed trial step; evaluations at the non-finite states a failed step leads to are
+    // consequences, not causes).
+    let loop_failure: RefCell<Option<SimError>> = RefCell::new(None);
+    let evaluate = |y: &[f64], u: &mut Vec<f64>, t: f64, dy: &mut [f64], stack: &mut Vec<f64>| {
+        system.inputs_at(t.min(t_max), u);
+        if let Err(e) = system.rhs(y, u, t, dy, stack) {
+            dy.iter_mut().for_each(|d| *d = f64::NAN);
+            if y.iter().all(|v| v.is_finite()) {
+                *loop_failure.borrow_mut() = Some(e);
+            }
+        }
+    };
     let rhs = |y: &[f64], _p: &[f64], t: f64, dy: &mut [f64]| {
         let mut s = scratch.borrow_mut();
         let (u, stack, _, _) = &mut *s;
-        system.inputs_at(t.min(t_max), u);
-        system.rhs(y, u, t, dy, stack);
+        evaluate(y, u, t, dy, stack);
         if bad.get().is_none()
             && let Some(i) = dy.iter().position(|v| !v.is_finite())
         {
@@ -188,8 +213,7 @@ fn segment(
     let jac = |y: &[f64], _p: &[f64], t: f64, v: &[f64], jv: &mut [f64]| {
         let mut s = scratch.borrow_mut();
         let (u, stack, f0, f1) = &mut *s;
-        let tu = t.min(t_max);
-        system.inputs_at(tu, u);
+        system.inputs_at(t.min(t_max), u);
         if system.jacobian_times(y, u, t, v, jv, stack).is_some() {
             return;
         }
@@ -202,8 +226,8 @@ fn segment(
         let norm_y = y.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let h = f64::EPSILON.sqrt() * (1.0 + norm_y) / norm_v;
         let shifted: Vec<f64> = y.iter().zip(v).map(|(y, v)| y + h * v).collect();
-        system.rhs(y, u, t, f0, stack);
-        system.rhs(&shifted, u, t, f1, stack);
+        evaluate(y, u, t, f0, stack);
+        evaluate(&shifted, u, t, f1, stack);
         for ((j, a), b) in jv.iter_mut().zip(f0.iter()).zip(f1.iter()) {
             *j = (b - a) / h;
         }
@@ -225,6 +249,7 @@ fn segment(
     let ctx = Drive {
         system,
         bad: &bad,
+        loop_failure: &loop_failure,
         from: a,
         to: b,
         wanted,
@@ -250,9 +275,15 @@ fn segment(
     }
 }
 
+/// The latest time before the breakpoint `b` at which the inputs are evaluated in the segment that ends there.
+fn just_before(b: f64) -> f64 {
+    b - b.abs() * 4.0 * f64::EPSILON
+}
+
 struct Drive<'c> {
     system: &'c System,
     bad: &'c Cell<Option<(f64, usize)>>,
+    loop_failure: &'c RefCell<Option<SimError>>,
     from: f64,
     to: f64,
     wanted: &'c [f64],
@@ -268,8 +299,12 @@ impl Drive<'_> {
         }
     }
 
-    /// A solver error, attributed to the model when it had returned a non-finite derivative.
+    /// A solver error, attributed to the model when its algebraic loops could not be solved or it had returned a
+    /// non-finite derivative.
     fn failure(&self, time: f64, e: DiffsolError) -> SimError {
+        if let Some(loop_error) = self.loop_failure.borrow().clone() {
+            return loop_error;
+        }
         match self.bad.get() {
             Some((time, i)) => SimError::NonFiniteDerivative {
                 time,
@@ -299,6 +334,9 @@ impl Drive<'_> {
             let t_now = solver.state().t;
             let y = solver.state().y.clone_as_vec();
             if let Some(i) = y.iter().position(|v| !v.is_finite()) {
+                if let Some(loop_error) = self.loop_failure.borrow().clone() {
+                    return Err(loop_error);
+                }
                 return Err(match self.bad.get() {
                     Some((time, i)) => SimError::NonFiniteDerivative {
                         time,

@@ -14,18 +14,37 @@
 //! known satisfies `E + E_diss − E_sup = E(x0)`; the CLI prints the three columns so that this balance can be
 //! checked.
 //!
-//! Energy terms the equations stage could not express (a stored energy of a non-polynomial law, a source's power
-//! that needs the time derivative of an input) are left out of their sums; [`System::new`] returns a warning that
-//! names each one.
+//! A source that drives a storage in derivative causality (a flow source imposing an inertia's velocity) delivers
+//! power through the time derivative of its input (`e·f = J·u̇·u`). The inputs are expressions of `t`, so their
+//! derivatives are too ([`Signal::derivative`]): the programs read the input vector `[u, u̇]` and the power is
+//! integrated like any other. A jump of an input (`step`) has no derivative; the energy it moves into the storage is
+//! the jump of the stored energy at the breakpoint, `E(x, u(b)) − E(x, u(b⁻))` at the (continuous) state, which the
+//! integrator adds to `supplied` there ([`System::stored_jump`]). That is the limit of a steep ramp when no
+//! resistor's power depends on the input's derivative (a resistor that carries an ideal jump's impulse would
+//! dissipate an unbounded energy in that limit; such a model has no meaningful response to a step and the
+//! dissipated column counts nothing at the jump).
+//!
+//! A model with nonlinear algebraic loops ([`Equations::tear_blocks`]) has tear variables `z` in its rates,
+//! outputs and energy terms: the programs read them after the inputs (`[u, u̇, z]`), and every evaluation first
+//! solves the loops at the current state and time by Newton's method, warm-started from the previous solution
+//! ([`newton`]). When that fails the run stops with [`SimError::AlgebraicLoop`], which names the tear variables,
+//! the time and the residual. The rates' Jacobian is then taken by finite differences (the rates depend on the
+//! states also through the loops' solution).
+//!
+//! Energy terms the equations stage could not express (a stored energy of a non-polynomial law) are left out of
+//! their sums; [`System::new`] returns a warning that names each one.
 
 pub mod input;
+pub mod input_rate;
 #[cfg(feature = "cli")]
 pub mod integrate;
+pub mod newton;
 pub mod program;
 
 use crate::equations::sym::{self, Ex, Sym, add};
-use crate::equations::{EnergyKind, Equations};
+use crate::equations::{EnergyKind, Equations, block_jacobian, residual_scale};
 use input::Signal;
+use newton::{BlockPrograms, Loops};
 use program::{CompileError, Layout, Program, Values};
 
 /// Why a simulation could not be set up or run.
@@ -57,6 +76,19 @@ pub enum SimError {
     NonFiniteDerivative { time: f64, state: String },
     #[error("`{state}` became non-finite at t = {time}")]
     NonFiniteState { time: f64, state: String },
+    #[error(
+        "the algebraic loop for `{tears}` could not be solved at t = {time}: after {iterations} Newton iterations {reason}; the residual of `{worst}` is {residual:.3e}"
+    )]
+    AlgebraicLoop {
+        tears: String,
+        time: f64,
+        reason: &'static str,
+        iterations: usize,
+        worst: String,
+        residual: f64,
+    },
+    #[error("the algebraic loop for `{tears}` cannot be solved: {reason}")]
+    LoopSetup { tears: String, reason: String },
     #[error("the solver failed at t = {time}: {message}")]
     Solver { time: f64, message: String },
     #[error(
@@ -79,6 +111,8 @@ pub struct System {
     pub outputs: Vec<String>,
     params: Vec<f64>,
     inputs: Vec<Signal>,
+    /// `d/dt` of each input signal.
+    input_rates: Vec<Signal>,
     /// `f_i` for the model states, then the dissipated and the supplied power.
     rates: Vec<Program>,
     /// Nonzero entries `(row, column, ∂rate_row/∂x_column)` of the Jacobian of `rates`; `None` when a rate uses
@@ -89,11 +123,18 @@ pub struct System {
     /// The I-fields' mass blocks: the states whose rates solve `M ẋ_B = F` (their `rates` give `F`), and `M`
     /// row-major.
     mass: Vec<(Vec<usize>, Vec<Program>)>,
+    /// The nonlinear algebraic loops, solved before every evaluation.
+    loops: Loops,
+    /// The length of the programs' input vector `[u, u̇, z]`.
+    ext_len: usize,
 }
 
 impl System {
     /// Compiles the equations at parameter values `params` (in [`Equations::params`] order) with one signal per
     /// input. Returns the system and the warnings about energy terms left out of the energy columns.
+    ///
+    /// The programs read the inputs as `[u, u̇, z]`: [`Sym::InputDot`]`(j)` is compiled as input `n_inputs + j`,
+    /// the `k`-th tear variable of the loops (in block order) as input `2 n_inputs + k`.
     pub fn new(
         eqs: &Equations,
         params: Vec<f64>,
@@ -102,16 +143,31 @@ impl System {
         check_len("parameter", eqs.params.len(), params.len())?;
         check_len("input", eqs.inputs.len(), inputs.len())?;
         let n = eqs.states.len();
+        let n_inputs = inputs.len();
+        let tears: Vec<Sym> = eqs
+            .tear_blocks
+            .iter()
+            .flat_map(|b| b.tears.iter().copied())
+            .collect();
+        let ext_len = 2 * n_inputs + tears.len();
         let layout = Layout {
             params: params.len(),
             states: n,
-            inputs: inputs.len(),
+            inputs: ext_len,
         };
-        let name = |s: Sym| eqs.sym_name(s);
+        let name = |s: Sym| match s {
+            Sym::Input(j) if j >= 2 * n_inputs => tears
+                .get(j - 2 * n_inputs)
+                .map_or_else(|| format!("input{j}"), |&z| eqs.sym_name(z)),
+            Sym::Input(j) if j >= n_inputs => eqs.sym_name(Sym::InputDot(j - n_inputs)),
+            other => eqs.sym_name(other),
+        };
         let compile = |e: &Ex, what: &str| {
-            Program::compile(e, layout, &name).map_err(|reason| SimError::Compile {
-                what: what.to_string(),
-                reason,
+            Program::compile(&exogenous(e, n_inputs, &tears), layout, &name).map_err(|reason| {
+                SimError::Compile {
+                    what: what.to_string(),
+                    reason,
+                }
             })
         };
         let mut rate_exprs = Vec::with_capacity(n + 2);
@@ -128,7 +184,7 @@ impl System {
                 let mut terms = Vec::new();
                 for term in eqs.energy.iter().filter(|t| t.kind == kind) {
                     match &term.value {
-                    Some(v) if Program::compile(v, layout, &name).is_ok() => terms.push(v.clone()),
+                    Some(v) if compile(v, "").is_ok() => terms.push(v.clone()),
                     _ => warnings.push(format!(
                         "the {} {} of `{}` has no expression and is left out of the `{}` column",
                         kind.name(),
@@ -151,12 +207,13 @@ impl System {
             .iter()
             .map(|(e, what)| compile(e, what))
             .collect::<Result<Vec<_>, _>>()?;
-        // The symbolic Jacobian is that of `F` in the mass-matrix rows, not of the rates: leave it to finite
-        // differences there.
-        let jacobian = if eqs.has_mass() {
-            None
-        } else {
+        let loops = compile_loops(eqs, 2 * n_inputs, &compile)?;
+        // The symbolic Jacobian is that of `F` in the mass-matrix rows, not of the rates, and does not see the
+        // loops' unknowns move: leave both to finite differences.
+        let jacobian = if loops.is_empty() && !eqs.has_mass() {
             symbolic_jacobian(&rate_exprs, n, &compile)
+        } else {
+            None
         };
         let mut mass = Vec::with_capacity(eqs.mass.len());
         for b in &eqs.mass {
@@ -184,12 +241,15 @@ impl System {
             states: (0..n).map(|i| eqs.sym_name(Sym::State(i))).collect(),
             outputs: eqs.outputs.iter().map(|o| o.name.clone()).collect(),
             params,
+            input_rates: inputs.iter().map(Signal::derivative).collect(),
             inputs,
             rates,
             jacobian,
             outputs_h,
             stored: compile(&stored, "the stored energy")?,
             mass,
+            loops,
+            ext_len,
         };
         Ok((system, warnings))
     }
@@ -199,10 +259,68 @@ impl System {
         self.states.len()
     }
 
-    /// The input values at `t`.
+    /// Writes the input values at `t` and their time derivatives into the programs' input vector `[u, u̇, z]`,
+    /// sized to fit; the tear slots `z` keep their values (the next loop solve starts from them).
     pub fn inputs_at(&self, t: f64, out: &mut Vec<f64>) {
-        out.clear();
-        out.extend(self.inputs.iter().map(|s| s.eval(t)));
+        out.resize(self.ext_len, 0.0);
+        let values = self
+            .inputs
+            .iter()
+            .chain(&self.input_rates)
+            .map(|s| s.eval(t));
+        for (slot, v) in out.iter_mut().zip(values) {
+            *slot = v;
+        }
+    }
+
+    /// Solves the nonlinear algebraic loops at the extended state `y` and time `t`, with the inputs already in
+    /// `u` ([`System::inputs_at`]), writing the tear variables into `u`'s tear slots.
+    pub fn solve_loops(
+        &self,
+        y: &[f64],
+        u: &mut [f64],
+        t: f64,
+        stack: &mut Vec<f64>,
+    ) -> Result<(), SimError> {
+        if self.loops.is_empty() {
+            return Ok(());
+        }
+        let values = Values {
+            params: &self.params,
+            states: y.get(..self.states.len()).unwrap_or(y),
+            inputs: &[],
+            t,
+        };
+        self.loops
+            .solve(&values, u, stack)
+            .map_err(|e| SimError::AlgebraicLoop {
+                tears: e.tears.join("`, `"),
+                time: t,
+                reason: e.failure.kind.describe(),
+                iterations: e.failure.iterations,
+                worst: e.worst.clone(),
+                residual: e.failure.residual,
+            })
+    }
+
+    /// The jump of the stored energy at the extended state `y` when the inputs go from their values at `before`
+    /// to those at `after` (a breakpoint): the energy a jump of an input moves into the storages in derivative
+    /// causality, which the input's derivative cannot carry.
+    pub fn stored_jump(
+        &self,
+        y: &[f64],
+        before: f64,
+        after: f64,
+        stack: &mut Vec<f64>,
+    ) -> Result<f64, SimError> {
+        let mut u = Vec::new();
+        self.inputs_at(after, &mut u);
+        self.solve_loops(y, &mut u, after, stack)?;
+        let e_after = self.stored.eval(&self.values(y, &u, after), stack);
+        self.inputs_at(before, &mut u);
+        self.solve_loops(y, &mut u, before, stack)?;
+        let e_before = self.stored.eval(&self.values(y, &u, before), stack);
+        Ok(e_after - e_before)
     }
 
     /// The times in `(0, t_end)` at which an input may jump or kink, sorted, without repeats.
@@ -224,8 +342,17 @@ impl System {
         }
     }
 
-    /// The derivative of the extended state `y = [x, E_diss, E_sup]` at time `t` with inputs `u`.
-    pub fn rhs(&self, y: &[f64], u: &[f64], t: f64, dy: &mut [f64], stack: &mut Vec<f64>) {
+    /// The derivative of the extended state `y = [x, E_diss, E_sup]` at time `t` with the inputs in `u`
+    /// ([`System::inputs_at`]); the algebraic loops are solved first (into `u`).
+    pub fn rhs(
+        &self,
+        y: &[f64],
+        u: &mut [f64],
+        t: f64,
+        dy: &mut [f64],
+        stack: &mut Vec<f64>,
+    ) -> Result<(), SimError> {
+        self.solve_loops(y, u, t, stack)?;
         let v = self.values(y, u, t);
         for (d, p) in dy.iter_mut().zip(&self.rates) {
             *d = p.eval(&v, stack);
@@ -252,9 +379,11 @@ impl System {
                 }
             }
         }
+        Ok(())
     }
 
-    /// `J v` for the Jacobian `J = ∂rhs/∂y`; `None` when it has no symbolic form.
+    /// `J v` for the Jacobian `J = ∂rhs/∂y`; `None` when it has no symbolic form (a rate uses a function without a
+    /// derivative, or the model has algebraic loops).
     pub fn jacobian_times(
         &self,
         y: &[f64],
@@ -276,8 +405,15 @@ impl System {
     }
 
     /// One row of output: the states, the outputs, the stored energy, then the dissipated and supplied energy.
-    pub fn row(&self, y: &[f64], t: f64, u: &mut Vec<f64>, stack: &mut Vec<f64>) -> Vec<f64> {
+    pub fn row(
+        &self,
+        y: &[f64],
+        t: f64,
+        u: &mut Vec<f64>,
+        stack: &mut Vec<f64>,
+    ) -> Result<Vec<f64>, SimError> {
         self.inputs_at(t, u);
+        self.solve_loops(y, u, t, stack)?;
         let n = self.states.len();
         let v = self.values(y, u, t);
         let mut row = Vec::with_capacity(n + self.outputs_h.len() + 3);
@@ -285,7 +421,7 @@ impl System {
         row.extend(self.outputs_h.iter().map(|p| p.eval(&v, stack)));
         row.push(self.stored.eval(&v, stack));
         row.extend(y.iter().skip(n).take(2));
-        row
+        Ok(row)
     }
 
     /// The CSV header matching [`System::row`], after `t`.
@@ -307,6 +443,61 @@ fn check_len(what: &'static str, expected: usize, got: usize) -> Result<(), SimE
             got,
         })
     }
+}
+
+/// `e` with each [`Sym::InputDot`]`(j)` renamed to the input `n_inputs + j` and each tear `tears[k]` to the input
+/// `2 n_inputs + k` (the programs' `[u, u̇, z]` layout).
+fn exogenous(e: &Ex, n_inputs: usize, tears: &[Sym]) -> Ex {
+    if !e.any_sym(&|s| matches!(s, Sym::InputDot(_) | Sym::Tear(_))) {
+        return e.clone();
+    }
+    sym::subst(e, &mut |s| match s {
+        Sym::InputDot(j) => Some(Ex::S(Sym::Input(n_inputs + j))),
+        Sym::Tear(_) => tears
+            .iter()
+            .position(|&z| z == s)
+            .map(|k| Ex::S(Sym::Input(2 * n_inputs + k))),
+        _ => None,
+    })
+}
+
+/// The programs of the tear blocks: residuals, their scales and `∂r/∂z`, with the tears at `offset + k`.
+fn compile_loops(
+    eqs: &Equations,
+    offset: usize,
+    compile: &dyn Fn(&Ex, &str) -> Result<Program, SimError>,
+) -> Result<Loops, SimError> {
+    let mut loops = Loops::default();
+    let mut k = offset;
+    for block in &eqs.tear_blocks {
+        let tears = block.names.join("`, `");
+        let what = format!("the algebraic loop for `{tears}`");
+        let jacobian = block_jacobian(block).ok_or_else(|| SimError::LoopSetup {
+            tears: tears.clone(),
+            reason: "its residuals use a function without a derivative (min or max), which Newton's method needs"
+                .into(),
+        })?;
+        let all = |es: &[Ex]| {
+            es.iter()
+                .map(|e| compile(e, &what))
+                .collect::<Result<Vec<_>, _>>()
+        };
+        let scales: Vec<Ex> = block
+            .residuals
+            .iter()
+            .zip(&block.tears)
+            .map(|(r, &z)| residual_scale(r, z))
+            .collect();
+        loops.push(BlockPrograms {
+            slots: (k..k + block.tears.len()).collect(),
+            names: block.names.clone(),
+            residuals: all(&block.residuals)?,
+            scales: all(&scales)?,
+            jacobian: all(&jacobian)?,
+        });
+        k += block.tears.len();
+    }
+    Ok(loops)
 }
 
 /// The nonzero entries of `∂rate/∂x` over the model states (the quadrature states enter no rate).

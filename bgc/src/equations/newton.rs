@@ -1,0 +1,307 @@
+//! Damped Newton's method for a small system of nonlinear equations `r(z) = 0` (the nonlinear algebraic loops of
+//! [`super::tear`]).
+//!
+//! Each iteration solves `J(z_k) Δ = −r(z_k)` (Gaussian elimination with partial pivoting) and takes
+//! `z_{k+1} = z_k + λ Δ` with the first `λ = 1, 1/2, 1/4, …` that passes the Armijo test
+//! `φ(z_k + λΔ) ≤ (1 − 10⁻⁴ λ) φ(z_k)` on `φ(z) = Σ (r_i(z)/w_i)²`, the weights `w_i` being the residual scales at
+//! `z_k`. The damping keeps a steep law (a diode's exponential) from throwing the iterate where it overflows.
+//!
+//! Convergence is tested on the residual: `|r_i(z)| ≤ rtol · s_i(z)` for every `i`, where `s_i` is the scale of
+//! residual `i`, the sum of the magnitudes of its terms ([`super::tear::residual_scale`]). The test is free of units
+//! and reachable in floating point (a residual cannot be computed more accurately than `ε · s_i`). It is checked
+//! after at least one Newton step, so a warm start that already passes is polished to the quadratic rate's
+//! accuracy, which keeps finite differences of the solution smooth.
+
+// Index loops read like the textbook elimination they implement.
+#![allow(clippy::needless_range_loop)]
+
+/// A system `r(z) = 0` of `size()` equations in as many unknowns.
+pub trait Problem {
+    fn size(&self) -> usize;
+    /// Writes `r(z)` and the residual scales `s(z)`.
+    fn residual(&mut self, z: &[f64], r: &mut [f64], scale: &mut [f64]);
+    /// Writes the Jacobian `∂r/∂z` at `z`, row-major (`jac[i·n + j] = ∂r_i/∂z_j`).
+    fn jacobian(&mut self, z: &[f64], jac: &mut [f64]);
+}
+
+/// The settings of a solve.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// The residual tolerance relative to the residual scale.
+    pub rtol: f64,
+    /// The most Newton iterations.
+    pub max_iterations: usize,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            rtol: 1e-12,
+            max_iterations: 100,
+        }
+    }
+}
+
+/// Why a solve failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FailureKind {
+    /// No damped step decreases the residual: a local minimum of the residual that is not a root (often: the
+    /// equations have no solution there).
+    NoDescent,
+    /// The iterations ran out.
+    IterationLimit,
+    /// `∂r/∂z` is singular at the iterate.
+    Singular,
+    /// The residual or the Jacobian is not finite at the iterate.
+    NonFinite,
+}
+
+impl FailureKind {
+    /// A short description for messages.
+    pub fn describe(self) -> &'static str {
+        match self {
+            FailureKind::NoDescent => {
+                "no damped step decreases the residual any more (the equations may have no solution here)"
+            }
+            FailureKind::IterationLimit => "the iteration limit was reached",
+            FailureKind::Singular => "the Jacobian of the residuals is singular",
+            FailureKind::NonFinite => "the residuals are not finite",
+        }
+    }
+}
+
+/// A failed solve: why, after how many iterations, and the largest residual (absolute value, and which).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Failure {
+    pub kind: FailureKind,
+    pub iterations: usize,
+    /// `|r_index|` at the last iterate (NaN when not finite).
+    pub residual: f64,
+    pub index: usize,
+}
+
+/// The largest `|r_i|` and its index (a non-finite entry counts as the largest).
+fn worst(r: &[f64]) -> (f64, usize) {
+    let mut best = (0.0, 0);
+    for (i, v) in r.iter().enumerate() {
+        if !v.is_finite() {
+            return (f64::NAN, i);
+        }
+        if v.abs() > best.0 {
+            best = (v.abs(), i);
+        }
+    }
+    best
+}
+
+fn merit(r: &[f64], w: &[f64]) -> f64 {
+    r.iter().zip(w).map(|(r, w)| (r / w).powi(2)).sum()
+}
+
+/// Solves `problem` from the initial guess in `z`, in place. Returns the number of iterations.
+pub fn solve(
+    problem: &mut dyn Problem,
+    z: &mut [f64],
+    settings: Settings,
+) -> Result<usize, Failure> {
+    let n = problem.size().min(z.len());
+    let z = &mut z[..n];
+    let (mut r, mut s) = (vec![0.0; n], vec![0.0; n]);
+    let (mut r_try, mut s_try) = (vec![0.0; n], vec![0.0; n]);
+    let mut jac = vec![0.0; n * n];
+    let mut step = vec![0.0; n];
+    let mut trial = vec![0.0; n];
+    let fail = |kind, iterations, r: &[f64]| {
+        let (residual, index) = worst(r);
+        Failure {
+            kind,
+            iterations,
+            residual,
+            index,
+        }
+    };
+    problem.residual(z, &mut r, &mut s);
+    for k in 0..=settings.max_iterations {
+        if r.iter().chain(&s).any(|v| !v.is_finite()) {
+            return Err(fail(FailureKind::NonFinite, k, &r));
+        }
+        let converged = r.iter().zip(&s).all(|(r, s)| r.abs() <= settings.rtol * s);
+        if converged && (k > 0 || r.iter().all(|v| *v == 0.0)) {
+            return Ok(k);
+        }
+        if k == settings.max_iterations {
+            break;
+        }
+        problem.jacobian(z, &mut jac);
+        if jac.iter().any(|v| !v.is_finite()) {
+            return Err(fail(FailureKind::NonFinite, k, &r));
+        }
+        step.iter_mut().zip(&r).for_each(|(d, r)| *d = -r);
+        if !lu_solve(&mut jac, &mut step, n) {
+            return Err(fail(FailureKind::Singular, k, &r));
+        }
+        let w: Vec<f64> = s.iter().map(|s| if *s > 0.0 { *s } else { 1.0 }).collect();
+        let phi0 = merit(&r, &w);
+        let mut lambda = 1.0;
+        let mut accepted = false;
+        for _ in 0..40 {
+            for i in 0..n {
+                trial[i] = z[i] + lambda * step[i];
+            }
+            problem.residual(&trial, &mut r_try, &mut s_try);
+            let phi = merit(&r_try, &w);
+            if phi.is_finite() && phi <= (1.0 - 1e-4 * lambda) * phi0 {
+                accepted = true;
+                break;
+            }
+            lambda /= 2.0;
+        }
+        if !accepted {
+            // At the rounding floor no step decreases the residual: a converged iterate stays as it is.
+            if converged {
+                return Ok(k);
+            }
+            return Err(fail(FailureKind::NoDescent, k, &r));
+        }
+        z.copy_from_slice(&trial);
+        std::mem::swap(&mut r, &mut r_try);
+        std::mem::swap(&mut s, &mut s_try);
+    }
+    Err(fail(
+        FailureKind::IterationLimit,
+        settings.max_iterations,
+        &r,
+    ))
+}
+
+/// Solves `a x = b` in place (`a` row-major `n × n`, overwritten; `b` becomes `x`). False when a pivot is zero or
+/// below `1e-14` times the largest entry of its column before elimination.
+fn lu_solve(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
+    if a.len() < n * n || b.len() < n {
+        return false;
+    }
+    for col in 0..n {
+        let column_scale = (0..n).fold(0.0f64, |m, i| m.max(a[i * n + col].abs()));
+        let Some(pivot) =
+            (col..n).max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs()))
+        else {
+            return false;
+        };
+        let p = a[pivot * n + col];
+        if p == 0.0 || p.abs() <= 1e-14 * column_scale {
+            return false;
+        }
+        if pivot != col {
+            for j in 0..n {
+                a.swap(pivot * n + j, col * n + j);
+            }
+            b.swap(pivot, col);
+        }
+        for i in col + 1..n {
+            let factor = a[i * n + col] / p;
+            if factor == 0.0 {
+                continue;
+            }
+            for j in col..n {
+                a[i * n + j] -= factor * a[col * n + j];
+            }
+            b[i] -= factor * b[col];
+        }
+    }
+    for i in (0..n).rev() {
+        let mut acc = b[i];
+        for j in i + 1..n {
+            acc -= a[i * n + j] * b[j];
+        }
+        b[i] = acc / a[i * n + i];
+    }
+    b.iter().all(|v| v.is_finite())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `r(z) = (z0² + z1² − 4, exp(z0) + z1 − 1)` with scales the magnitudes of the terms.
+    struct Circle;
+
+    impl Problem for Circle {
+        fn size(&self) -> usize {
+            2
+        }
+        fn residual(&mut self, z: &[f64], r: &mut [f64], s: &mut [f64]) {
+            r[0] = z[0] * z[0] + z[1] * z[1] - 4.0;
+            s[0] = z[0] * z[0] + z[1] * z[1] + 4.0;
+            r[1] = z[0].exp() + z[1] - 1.0;
+            s[1] = z[0].exp() + z[1].abs() + 1.0;
+        }
+        fn jacobian(&mut self, z: &[f64], j: &mut [f64]) {
+            j.copy_from_slice(&[2.0 * z[0], 2.0 * z[1], z[0].exp(), 1.0]);
+        }
+    }
+
+    #[test]
+    fn finds_the_intersection_of_a_circle_and_an_exponential() {
+        // The root near (1, -1.7): scipy.optimize.fsolve(lambda z: [z[0]**2 + z[1]**2 - 4,
+        // np.exp(z[0]) + z[1] - 1], [1, -1.7], xtol=1e-14) = [1.00416874, -1.72963729].
+        let mut z = [1.0, -1.7];
+        let k = solve(&mut Circle, &mut z, Settings::default());
+        assert!(k.is_ok(), "{k:?}");
+        assert!((z[0] - 1.004_168_74).abs() < 1e-8, "{z:?}");
+        assert!((z[1] + 1.729_637_29).abs() < 1e-8, "{z:?}");
+        let (mut r, mut s) = ([0.0; 2], [0.0; 2]);
+        Circle.residual(&z, &mut r, &mut s);
+        assert!(r[0].abs() < 1e-12 * s[0] && r[1].abs() < 1e-12 * s[1]);
+    }
+
+    /// `r(z) = z² + 1`: no real root.
+    struct NoRoot;
+
+    impl Problem for NoRoot {
+        fn size(&self) -> usize {
+            1
+        }
+        fn residual(&mut self, z: &[f64], r: &mut [f64], s: &mut [f64]) {
+            r[0] = z[0] * z[0] + 1.0;
+            s[0] = z[0] * z[0] + 1.0;
+        }
+        fn jacobian(&mut self, z: &[f64], j: &mut [f64]) {
+            j[0] = 2.0 * z[0];
+        }
+    }
+
+    #[test]
+    fn an_equation_without_a_root_fails_with_its_residual() {
+        let mut z = [0.5];
+        let err = solve(&mut NoRoot, &mut z, Settings::default());
+        match err {
+            Err(f) => {
+                assert!(matches!(
+                    f.kind,
+                    FailureKind::NoDescent | FailureKind::Singular
+                ));
+                // z² + 1 ≥ 1 everywhere.
+                assert!(f.residual >= 1.0, "{f:?}");
+                assert_eq!(f.index, 0);
+            }
+            Ok(k) => panic!("converged in {k} iterations to {z:?}"),
+        }
+        // From z = 0 the Jacobian is singular at once.
+        let mut z = [0.0];
+        assert_eq!(
+            solve(&mut NoRoot, &mut z, Settings::default()).map_err(|f| f.kind),
+            Err(FailureKind::Singular)
+        );
+    }
+
+    #[test]
+    fn solves_small_linear_systems() {
+        // [[0, 2], [3, 1]] x = [4, 5]: x = (1, 2), with a pivot swap.
+        let mut a = [0.0, 2.0, 3.0, 1.0];
+        let mut b = [4.0, 5.0];
+        assert!(lu_solve(&mut a, &mut b, 2));
+        assert!((b[0] - 1.0).abs() < 1e-15 && (b[1] - 2.0).abs() < 1e-15);
+        let mut singular = [1.0, 2.0, 2.0, 4.0];
+        assert!(!lu_solve(&mut singular, &mut [1.0, 1.0], 2));
+    }
+}

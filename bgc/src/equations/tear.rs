@@ -1,0 +1,393 @@
+//! Nonlinear algebraic loops, kept implicit and solved numerically.
+//!
+//! Where the resolver tears a loop at a bond variable `v` and the loop is not affine in it (a diode's exponential
+//! in series with a resistor), `v` becomes an unknown of the equations, the tear variable `z = Tear(v)` (printed
+//! `loop_<v>`), defined by its residual equation
+//!
+//! ```text
+//! 0 = r(z, x, u, p, t) = E(z, x, u, p, t) − z
+//! ```
+//!
+//! where `E` is what the loop computes for `v` from the torn value. Rates, outputs and energy terms hold `z`
+//! symbolically; whoever evaluates them solves the residuals first. Residuals that hold each other's tears are
+//! grouped into blocks (strongly connected components of "refers to"), ordered so that a block refers only to its
+//! own tears and those of earlier blocks: the blocks are solved in turn, each by Newton's method
+//! ([`super::newton`]) with the analytic Jacobian `∂r/∂z` of the residuals.
+//!
+//! Linearisation at an operating point uses the implicit function theorem: with `r(z(x, u), x, u) = 0`,
+//! `dz/dx = −(∂r/∂z)⁻¹ ∂r/∂x` and `dz/du = −(∂r/∂z)⁻¹ ∂r/∂u`, so `A = ∂f/∂x + ∂f/∂z dz/dx`,
+//! `B = ∂f/∂u + ∂f/∂z dz/du`, and the same for `C`, `D` ([`super::linearise`]).
+
+use super::Equations;
+use super::dense::{self, Mat};
+use super::linear::{LinearError, NumericStateSpace};
+use super::newton::{self, Failure, Problem, Settings};
+use super::sym::{self, Ex, Sym};
+use petgraph::graph::DiGraph;
+
+/// One block of nonlinear algebraic equations solved together: `0 = r(z, x, u, p, t)` for its tear variables `z`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TearBlock {
+    /// The unknowns, `Sym::Tear(v)` for the torn bond variable `v`. Rates, outputs and energy terms hold these
+    /// symbols: their values are the block's solution.
+    pub tears: Vec<Sym>,
+    /// The tears' printable names (`loop_<variable>`, as [`Equations::sym_name`] gives them).
+    pub names: Vec<String>,
+    /// One residual per tear, in states, inputs, parameters, `t`, this block's tears and earlier blocks' tears.
+    pub residuals: Vec<Ex>,
+}
+
+/// The blocks of the implicit loops `(v, r)` (tear variable `v`, residual `r`), in solving order.
+pub(crate) fn blocks(implicit: &[(usize, Ex)], name: &dyn Fn(Sym) -> String) -> Vec<TearBlock> {
+    // Edge i -> j: residual i refers to the tear of loop j. Tarjan's algorithm lists the strongly connected
+    // components in reverse topological order of the edges, that is each block after the blocks it refers to.
+    let mut graph = DiGraph::<usize, ()>::new();
+    let nodes: Vec<_> = (0..implicit.len()).map(|k| graph.add_node(k)).collect();
+    for (i, (_, r)) in implicit.iter().enumerate() {
+        for (j, (w, _)) in implicit.iter().enumerate() {
+            if r.contains(Sym::Tear(*w))
+                && let (Some(&a), Some(&b)) = (nodes.get(i), nodes.get(j))
+            {
+                graph.add_edge(a, b, ());
+            }
+        }
+    }
+    petgraph::algo::tarjan_scc(&graph)
+        .into_iter()
+        .map(|component| {
+            let mut members: Vec<usize> = component
+                .into_iter()
+                .filter_map(|n| graph.node_weight(n).copied())
+                .collect();
+            members.sort_unstable();
+            let chosen: Vec<&(usize, Ex)> =
+                members.iter().filter_map(|&k| implicit.get(k)).collect();
+            let tears: Vec<Sym> = chosen.iter().map(|(v, _)| Sym::Tear(*v)).collect();
+            TearBlock {
+                names: tears.iter().map(|&s| name(s)).collect(),
+                residuals: chosen.iter().map(|(_, r)| r.clone()).collect(),
+                tears,
+            }
+        })
+        .collect()
+}
+
+/// The scale of residual `r` for the convergence test of [`super::newton`]: the sum of the magnitudes of its
+/// terms (`|a| + |b| + |z|` for `r = a + b − z`), plus the magnitude of its own tear `z`. A residual cannot be
+/// computed more accurately than about `ε` times this.
+pub fn residual_scale(r: &Ex, own: Sym) -> Ex {
+    let abs = |e: &Ex| sym::call(crate::ir::Func::Abs, vec![e.clone()]);
+    let mut terms: Vec<Ex> = match r {
+        Ex::Add(ts) => ts.iter().map(abs).collect(),
+        other => vec![abs(other)],
+    };
+    terms.push(abs(&Ex::S(own)));
+    sym::add(terms)
+}
+
+/// A block's residuals evaluated by the tree evaluator, the other symbols' values given.
+struct TreeBlock<'a> {
+    block: &'a TearBlock,
+    scales: Vec<Ex>,
+    jacobian: Vec<Ex>,
+    value: &'a dyn Fn(Sym) -> Option<f64>,
+}
+
+impl TreeBlock<'_> {
+    fn at(&self, z: &[f64], e: &Ex) -> f64 {
+        let tears = &self.block.tears;
+        sym::eval(e, &|s| match tears.iter().position(|&t| t == s) {
+            Some(k) => z.get(k).copied(),
+            None => (self.value)(s),
+        })
+        .unwrap_or(f64::NAN)
+    }
+}
+
+impl Problem for TreeBlock<'_> {
+    fn size(&self) -> usize {
+        self.block.tears.len()
+    }
+
+    fn residual(&mut self, z: &[f64], r: &mut [f64], scale: &mut [f64]) {
+        for (out, e) in r.iter_mut().zip(&self.block.residuals) {
+            *out = self.at(z, e);
+        }
+        for (out, e) in scale.iter_mut().zip(&self.scales) {
+            *out = self.at(z, e);
+        }
+    }
+
+    fn jacobian(&mut self, z: &[f64], jac: &mut [f64]) {
+        for (out, e) in jac.iter_mut().zip(&self.jacobian) {
+            *out = self.at(z, e);
+        }
+    }
+}
+
+/// `∂r_i/∂z_j` of a block, row-major; `None` when a residual uses a function without a derivative.
+pub(crate) fn block_jacobian(block: &TearBlock) -> Option<Vec<Ex>> {
+    let mut out = Vec::with_capacity(block.tears.len().pow(2));
+    for r in &block.residuals {
+        for &z in &block.tears {
+            out.push(sym::diff(r, z).ok()?);
+        }
+    }
+    Some(out)
+}
+
+/// A block that could not be solved.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoopFailure {
+    /// The block's tear names.
+    pub tears: Vec<String>,
+    /// The tear whose residual is largest.
+    pub worst: String,
+    pub failure: Failure,
+}
+
+impl LoopFailure {
+    /// `loop_a, loop_b`.
+    pub fn tear_list(&self) -> String {
+        self.tears.join("`, `")
+    }
+}
+
+/// Solves every block at the values `value` of the other symbols (parameters, states, inputs, `t`), from `z = 0`.
+/// Returns each tear with its value.
+pub fn solve_all(
+    eqs: &Equations,
+    value: &dyn Fn(Sym) -> Option<f64>,
+) -> Result<Vec<(Sym, f64)>, LoopFailure> {
+    let mut solved: Vec<(Sym, f64)> = Vec::new();
+    for block in &eqs.tear_blocks {
+        let known = |s: Sym| match solved.iter().find(|(t, _)| *t == s) {
+            Some((_, v)) => Some(*v),
+            None => value(s),
+        };
+        let failure = |failure: Failure| LoopFailure {
+            tears: block.names.clone(),
+            worst: block.names.get(failure.index).cloned().unwrap_or_default(),
+            failure,
+        };
+        let no_derivative = Failure {
+            kind: newton::FailureKind::NonFinite,
+            iterations: 0,
+            residual: f64::NAN,
+            index: 0,
+        };
+        let jacobian = block_jacobian(block).ok_or_else(|| failure(no_derivative))?;
+        let mut problem = TreeBlock {
+            block,
+            scales: block
+                .residuals
+                .iter()
+                .zip(&block.tears)
+                .map(|(r, &z)| residual_scale(r, z))
+                .collect(),
+            jacobian,
+            value: &known,
+        };
+        let mut z = vec![0.0; block.tears.len()];
+        newton::solve(&mut problem, &mut z, Settings::default()).map_err(failure)?;
+        solved.extend(block.tears.iter().copied().zip(z));
+    }
+    Ok(solved)
+}
+
+/// The linearisation at `(x0, u0, t0)` of the selected rates `f` and outputs `h` (explicit in states, inputs,
+/// parameters, `t` and tears) of a model with tear blocks, by the implicit function theorem.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn linearise_implicit(
+    eqs: &Equations,
+    f: &[Ex],
+    h: &[Ex],
+    params: &[f64],
+    x0: &[f64],
+    u0: &[f64],
+    t0: f64,
+) -> Result<NumericStateSpace, LinearError> {
+    let n = f.len();
+    for block in &eqs.tear_blocks {
+        for (r, name) in block.residuals.iter().zip(&block.names) {
+            for j in n..eqs.states.len() {
+                if r.contains(Sym::State(j)) {
+                    return Err(LinearError::NeedsIntegratedState {
+                        what: format!("the algebraic loop for `{name}`"),
+                        state: eqs.sym_name(Sym::State(j)),
+                    });
+                }
+            }
+        }
+    }
+    let base = |s: Sym| match s {
+        Sym::Param(i) => params.get(i).copied(),
+        Sym::State(i) if i < n => x0.get(i).copied(),
+        Sym::Input(i) => u0.get(i).copied(),
+        Sym::Time => Some(t0),
+        _ => None,
+    };
+    let tears = solve_all(eqs, &base).map_err(|e| LinearError::LoopNotSolved {
+        tears: e.tear_list(),
+        reason: e.failure.kind.describe(),
+        residual: e.failure.residual,
+    })?;
+    let value = |s: Sym| match s {
+        Sym::Tear(_) => tears.iter().find(|(t, _)| *t == s).map(|(_, v)| *v),
+        other => base(other),
+    };
+    let zs: Vec<Sym> = tears.iter().map(|(t, _)| *t).collect();
+    let xs: Vec<Sym> = (0..n).map(Sym::State).collect();
+    let us: Vec<Sym> = (0..eqs.inputs.len()).map(Sym::Input).collect();
+    let residuals: Vec<Ex> = eqs
+        .tear_blocks
+        .iter()
+        .flat_map(|b| b.residuals.iter().cloned())
+        .collect();
+    let names = zs
+        .iter()
+        .map(|&z| eqs.sym_name(z))
+        .collect::<Vec<_>>()
+        .join("`, `");
+    let numeric = |rows: &[Ex], vars: &[Sym], what: &str| -> Result<Mat, LinearError> {
+        rows.iter()
+            .map(|e| {
+                vars.iter()
+                    .map(|&v| {
+                        let d = sym::diff(e, v).map_err(|sym::NotDifferentiable(func)| {
+                            LinearError::NotDifferentiable {
+                                what: what.to_string(),
+                                func: func.name(),
+                            }
+                        })?;
+                        let x = sym::eval(&d, &value).map_err(|err| match err {
+                            sym::EvalError::Unbound(s) => LinearError::Unbound {
+                                what: what.to_string(),
+                                symbol: eqs.sym_name(s),
+                            },
+                            sym::EvalError::Arity(func) => LinearError::NotDifferentiable {
+                                what: what.to_string(),
+                                func: func.name(),
+                            },
+                        })?;
+                        if x.is_finite() {
+                            Ok(x)
+                        } else {
+                            Err(LinearError::NonFinite {
+                                what: what.to_string(),
+                            })
+                        }
+                    })
+                    .collect()
+            })
+            .collect()
+    };
+    let loop_what = format!("the algebraic loop for `{names}`");
+    let rz = numeric(&residuals, &zs, &loop_what)?;
+    let mut rxu = numeric(&residuals, &[xs.clone(), us.clone()].concat(), &loop_what)?;
+    rxu.iter_mut().flatten().for_each(|v| *v = -*v);
+    // [dz/dx, dz/du] = −(∂r/∂z)⁻¹ [∂r/∂x, ∂r/∂u]
+    let dz = dense::solve(&rz, &rxu).ok_or(LinearError::SingularLoop { tears: names })?;
+    let total = |rows: &[Ex], what: &str| -> Result<(Mat, Mat), LinearError> {
+        let direct = numeric(rows, &[xs.clone(), us.clone()].concat(), what)?;
+        let through = dense::mul(&numeric(rows, &zs, what)?, &dz);
+        let sum: Mat = direct
+            .iter()
+            .zip(&through)
+            .map(|(a, b)| a.iter().zip(b).map(|(a, b)| a + b).collect())
+            .collect();
+        let split = |row: &Vec<f64>| {
+            let (x, u) = row.split_at(n.min(row.len()));
+            (x.to_vec(), u.to_vec())
+        };
+        Ok(sum.iter().map(split).unzip())
+    };
+    let (a, b) = total(f, "f")?;
+    let (c, d) = total(h, "h")?;
+    Ok(NumericStateSpace {
+        states: (0..n).map(|i| eqs.sym_name(Sym::State(i))).collect(),
+        inputs: eqs.inputs.clone(),
+        outputs: eqs.outputs.iter().map(|o| o.name.clone()).collect(),
+        a,
+        b,
+        c,
+        d,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::equations::sym::{add, mul, pow, sub};
+
+    fn z(v: usize) -> Ex {
+        Ex::S(Sym::Tear(v))
+    }
+
+    #[test]
+    fn coupled_loops_form_one_block_after_the_blocks_they_use() {
+        // Loop 7 refers to loop 3 only; loops 3 and 5 refer to each other.
+        let implicit = vec![
+            (7, sub(mul(vec![Ex::Num(2.0), z(3)]), z(7))),
+            (3, sub(pow(z(5), Ex::Num(2.0)), z(3))),
+            (5, sub(add(vec![z(3), Ex::S(Sym::State(0))]), z(5))),
+        ];
+        let b = blocks(&implicit, &|s| format!("{s:?}"));
+        assert_eq!(b.len(), 2);
+        assert_eq!(b[0].tears, [Sym::Tear(3), Sym::Tear(5)]);
+        assert_eq!(b[1].tears, [Sym::Tear(7)]);
+        assert_eq!(b[1].names, ["Tear(7)"]);
+        assert_eq!(b[1].residuals[0], implicit[0].1);
+    }
+
+    #[test]
+    fn a_block_of_two_tears_is_solved_jointly() {
+        // z3 = z5^2, z5 = z3 + x - 1 with x = 0.75, so z5^2 - z5 - 0.25 = 0: from z = 0 Newton finds
+        // z5 = (1 - sqrt 2)/2, z3 = z5^2 (the root nearer the start).
+        let block = TearBlock {
+            tears: vec![Sym::Tear(3), Sym::Tear(5)],
+            names: vec!["a".into(), "b".into()],
+            residuals: vec![
+                sub(pow(z(5), Ex::Num(2.0)), z(3)),
+                sub(add(vec![z(3), Ex::S(Sym::State(0)), Ex::Num(-1.0)]), z(5)),
+            ],
+        };
+        let value = |s: Sym| (s == Sym::State(0)).then_some(0.75);
+        let mut problem = TreeBlock {
+            block: &block,
+            scales: block
+                .residuals
+                .iter()
+                .zip(&block.tears)
+                .map(|(r, &t)| residual_scale(r, t))
+                .collect(),
+            jacobian: block_jacobian(&block).unwrap_or_default(),
+            value: &value,
+        };
+        let mut zs = [0.0, 0.0];
+        let k = newton::solve(&mut problem, &mut zs, Settings::default());
+        assert!(k.is_ok(), "{k:?}");
+        let b = (1.0 - 2f64.sqrt()) / 2.0;
+        assert!((zs[1] - b).abs() < 1e-14, "{zs:?}");
+        assert!((zs[0] - b * b).abs() < 1e-14, "{zs:?}");
+    }
+
+    #[test]
+    fn the_scale_sums_the_magnitudes_of_the_terms() {
+        // r = 3 - 5 x - z at x = 1, z = -2: |3| + |-5| + |2| + |z| = 12.
+        let r = sub(
+            add(vec![
+                Ex::Num(3.0),
+                mul(vec![Ex::Num(-5.0), Ex::S(Sym::State(0))]),
+            ]),
+            z(1),
+        );
+        let s = residual_scale(&r, Sym::Tear(1));
+        let v = sym::eval(&s, &|s| match s {
+            Sym::State(0) => Some(1.0),
+            Sym::Tear(1) => Some(-2.0),
+            _ => None,
+        });
+        assert_eq!(v, Ok(12.0));
+    }
+}

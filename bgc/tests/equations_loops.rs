@@ -1,0 +1,217 @@
+//! Nonlinear algebraic loops kept implicit: the tear block of corpus/diode_rc.bg, its printed forms, its numeric
+//! solution, the linearisation by the implicit function theorem against a hand derivation, and the consumers that
+//! refuse it (symbolic state spaces, code generation).
+
+use bgc::causality::analyse;
+use bgc::equations::sym::{self, Sym};
+use bgc::equations::{
+    Equations, LinearError, StateSelection, derive, jacobians, linear_state_space, linearise,
+    numeric_state_space, solve_all, to_json, to_latex, to_text,
+};
+use bgc::lower::{MemoryLoader, lower};
+use bgc::span::SourceMap;
+
+const PARAMS: [f64; 4] = [100.0, 1e-6, 0.05, 1e-3];
+
+fn diode_rc() -> Equations {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/corpus/diode_rc.bg");
+    let text = std::fs::read_to_string(path).expect("corpus file");
+    let mut sources = SourceMap::new();
+    let root = sources.add(path, text);
+    let (models, diags) = lower(&mut sources, root, &mut MemoryLoader::new());
+    assert!(diags.iter().all(|d| !d.is_error()), "{diags:?}");
+    let (causality, _) = analyse(&models[0]);
+    let (eqs, diags) = derive(&models[0], &causality);
+    assert!(diags.iter().all(|d| !d.is_error()), "{diags:?}");
+    eqs
+}
+
+#[test]
+fn the_diode_loop_is_one_tear_block_in_the_loop_current() {
+    let eqs = diode_rc();
+    assert!(eqs.complete());
+    assert!(eqs.loops.is_empty(), "not solved exactly");
+    assert_eq!(eqs.tear_blocks.len(), 1);
+    let block = &eqs.tear_blocks[0];
+    assert_eq!(block.names, ["loop_f_diode"]);
+    let z = block.tears[0];
+    assert_eq!(eqs.sym_name(z), "loop_f_diode");
+    // The rate of q is the loop current itself.
+    assert_eq!(eqs.f[0].as_ref(), Some(&sym::Ex::S(z)));
+    // r(z) = I_s (exp((u - q/C - R_s z)/V_t) - 1) - z, checked at a point against that formula.
+    let (q, u, zv) = (3e-4, 1.2, 2e-3);
+    let value = |s: Sym| match s {
+        Sym::Param(i) => PARAMS.get(i).copied(),
+        Sym::State(0) => Some(q),
+        Sym::Input(0) => Some(u),
+        Sym::Tear(_) => Some(zv),
+        _ => None,
+    };
+    let r = sym::eval(&block.residuals[0], &value).expect("residual evaluates");
+    let want = 1e-6 * (((u - q / 1e-3 - 100.0 * zv) / 0.05).exp() - 1.0) - zv;
+    assert!((r - want).abs() <= 1e-13 * want.abs(), "{r} vs {want}");
+    // The printers show it.
+    let text = to_text(&eqs);
+    assert!(
+        text.contains(
+            "algebraic loops, solved numerically (Newton's method):\n  solve for loop_f_diode: 0 = "
+        ),
+        "{text}"
+    );
+    assert!(to_latex(&eqs).contains("% algebraic loop, solved numerically for loop_f_diode"));
+    let json = to_json(&eqs);
+    assert_eq!(json["tear_blocks"][0]["tears"][0], "loop_f_diode");
+    assert!(
+        json["tear_blocks"][0]["residuals"][0]
+            .as_str()
+            .is_some_and(|r| r.contains("exp(")),
+        "{json}"
+    );
+}
+
+#[test]
+fn the_loop_is_solved_at_a_point_as_brentq_solves_it() {
+    // q = 1e-4 C, u = 1 V: u - q/C = 0.9 = R_s i + V_t ln(1 + i/I_s). scipy:
+    //   brentq(lambda i: Is*(np.exp((u0 - q0/C - R*i)/Vt) - 1) - i, -Is, 1.0, xtol=1e-300, rtol=1e-15)
+    //   = 0.004765333667421019
+    let eqs = diode_rc();
+    let value = |s: Sym| match s {
+        Sym::Param(i) => PARAMS.get(i).copied(),
+        Sym::State(0) => Some(1e-4),
+        Sym::Input(0) => Some(1.0),
+        Sym::Time => Some(0.0),
+        _ => None,
+    };
+    let z = solve_all(&eqs, &value).expect("solves");
+    assert_eq!(z.len(), 1);
+    // The Newton tolerance (1e-12 of the residual's terms, about 2 i) over |dr/di| = 1 + R_s g' = 10.5 bounds the
+    // error by 1e-15.
+    assert!((z[0].1 - 0.004765333667421019).abs() < 2e-15, "{z:?}");
+    // Reverse bias: the current is -I_s to within exp(-(0.1 + 3)/V_t) ~ 1e-27.
+    let reverse = |s: Sym| match s {
+        Sym::Input(0) => Some(-3.0),
+        other => value(other),
+    };
+    let z = solve_all(&eqs, &reverse).expect("solves");
+    assert!((z[0].1 + 1e-6).abs() < 1e-20, "{z:?}");
+}
+
+#[test]
+fn linearisation_follows_the_implicit_function_theorem() {
+    // With g(v) = I_s (exp(v/V_t) - 1), g' = (i + I_s)/V_t at the solution, differentiating
+    // u - q/C = R_s i + v_d and i = g(v_d):
+    //   di/dq = -g'/(C (1 + R_s g')) = A,   di/du = g'/(1 + R_s g') = B,
+    //   dv_d/dq = -R_s A - 1/C,              dv_d/du = 1 - R_s B.
+    // At q = 1e-4, u = 1 with i from brentq (above):
+    //   gp = (i0 + Is)/Vt; A = -gp/(C*(1 + R*gp)); B = gp/(1 + R*gp)
+    //   = -9.050572881294748, 0.009050572881294747; -R*A - 1/C = -94.94271187052516; 1 - R*B = 0.09494271187052528
+    let eqs = diode_rc();
+    let ss =
+        linearise(&eqs, StateSelection::Energy, &PARAMS, &[1e-4], &[1.0], 0.0).expect("linearises");
+    let close = |got: f64, want: f64| (got - want).abs() <= 1e-9 * want.abs();
+    assert!(close(ss.a[0][0], -9.050572881294748), "{ss:?}");
+    assert!(close(ss.b[0][0], 0.009050572881294747), "{ss:?}");
+    assert_eq!(ss.outputs, ["i", "v_d"]);
+    assert!(close(ss.c[0][0], -9.050572881294748), "{ss:?}");
+    assert!(close(ss.c[1][0], -94.94271187052516), "{ss:?}");
+    assert!(close(ss.d[0][0], 0.009050572881294747), "{ss:?}");
+    assert!(close(ss.d[1][0], 0.09494271187052528), "{ss:?}");
+    // The same by central differences of the loop's solution, as a check of the theorem itself.
+    let current = |q: f64, u: f64| {
+        let value = |s: Sym| match s {
+            Sym::Param(i) => PARAMS.get(i).copied(),
+            Sym::State(0) => Some(q),
+            Sym::Input(0) => Some(u),
+            _ => None,
+        };
+        solve_all(&eqs, &value).expect("solves")[0].1
+    };
+    let h = 1e-9;
+    let fd_a = (current(1e-4 + h, 1.0) - current(1e-4 - h, 1.0)) / (2.0 * h);
+    assert!(
+        (fd_a - ss.a[0][0]).abs() < 1e-5 * ss.a[0][0].abs(),
+        "{fd_a}"
+    );
+}
+
+#[test]
+fn symbolic_state_spaces_refuse_the_loop() {
+    let eqs = diode_rc();
+    match linear_state_space(&eqs, StateSelection::Energy) {
+        Err(LinearError::NotLinear { entry, symbol, .. }) => {
+            assert_eq!(entry, "the rate of `q_cap`");
+            assert_eq!(symbol, "loop_f_diode");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(matches!(
+        numeric_state_space(&eqs, StateSelection::Energy, &PARAMS),
+        Err(LinearError::NotLinear { .. })
+    ));
+    let err = jacobians(&eqs, StateSelection::Energy).expect_err("no closed form");
+    assert!(matches!(err, LinearError::ImplicitLoop { .. }));
+    assert!(err.to_string().contains("`loop_f_diode`"), "{err}");
+}
+
+#[test]
+fn a_loop_without_a_solution_at_the_operating_point_is_an_error() {
+    // A one-way conductance f = k e^2 in series with R_s and C: i = k (u - q/C - R_s i)^2 has no real root when
+    // u - q/C < -1/(4 R_s k); with R_s = k = C = 1, q = 0 and u = -10, i^2 + 19 i + 100 = 0.
+    let text = "model valve_loop {
+    domain electrical;
+    param R_s = 1 [Ohm];
+    param k = 1 [A/V^2];
+    param C_v = 1 [F];
+    input u [V];
+    Se source = u;
+    1 loop_current;
+    R series = R_s;
+    R valve { f = k * e^2; }
+    C cap = C_v;
+    bond source -> loop_current -> series, valve, cap;
+}";
+    let mut sources = SourceMap::new();
+    let root = sources.add("valve_loop.bg", text);
+    let (models, _) = lower(&mut sources, root, &mut MemoryLoader::new());
+    let (causality, _) = analyse(&models[0]);
+    let (eqs, diags) = derive(&models[0], &causality);
+    assert!(diags.iter().all(|d| !d.is_error()), "{diags:?}");
+    let p = eqs.default_params();
+    let err = linearise(&eqs, StateSelection::Energy, &p, &[0.0], &[-10.0], 0.0)
+        .expect_err("no solution");
+    assert!(
+        matches!(&err, LinearError::LoopNotSolved { tears, .. } if tears == "loop_f_valve"),
+        "{err:?}"
+    );
+    // The smallest |r| over real i is 100 - 19^2/4 = 9.75, where the damped iteration stops.
+    assert!(err.to_string().contains("largest residual 9.75"), "{err}");
+    // At u = 0.5 the loop has a solution, i = a + 1/2 - sqrt(a + 1/4) for a = u - q/C = 0.5 (the smaller root).
+    let ss = linearise(&eqs, StateSelection::Energy, &p, &[0.0], &[0.5], 0.0).expect("solves");
+    // di/dq = -di/da = -(1 - 1/(2 sqrt(a + 1/4))) at a = 0.5.
+    let want = -(1.0 - 0.5 / 0.75f64.sqrt());
+    assert!(
+        (ss.a[0][0] - want).abs() < 1e-12,
+        "{} vs {want}",
+        ss.a[0][0]
+    );
+}
+
+#[test]
+fn code_generation_refuses_a_model_with_a_tear_block() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/corpus/diode_rc.bg");
+    let text = std::fs::read_to_string(path).expect("corpus file");
+    let mut sources = SourceMap::new();
+    let root = sources.add("diode_rc.bg", text);
+    let diags = match bgc::codegen::compile(&mut sources, root, &mut MemoryLoader::new()) {
+        Ok(_) => panic!("generated code for a model with a nonlinear loop"),
+        Err(diags) => diags,
+    };
+    let err = diags.iter().find(|d| d.is_error()).expect("an error");
+    assert_eq!(err.code.0, "BG0701");
+    assert!(
+        err.message
+            .contains("nonlinear algebraic loop (solve for `loop_f_diode`)"),
+        "{}",
+        err.message
+    );
+}

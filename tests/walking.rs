@@ -1,6 +1,7 @@
 //! The walking exoskeleton (Sado et al. 2018): the hand-derived leg dynamics against physics and against the
-//! `.bg` model, the gait supervisor on the synthetic wearer's insoles, the dual UKF's mass estimates and the
-//! closed loop's figures (shorter runs than the example's 20 s, stated per test, to keep debug builds fast).
+//! `.bg` model, the stance leg's ground reaction and the plant's consistency with the wearer's gait, the
+//! passive ankle in the computed torque, the motors' limits, the gait supervisor on the synthetic wearer's
+//! insoles, the dual UKF's mass estimates and the closed loop's figures (shorter runs than the example's 20 s, stated per test, to keep debug builds fast).
 
 use bgc::ir::{Expr, Relation};
 use bgc::lower::{MemoryLoader, lower};
@@ -11,7 +12,9 @@ use bgc_runtime::noise::Rng;
 use bgc_runtime::sim::{Method, SolverOptions, simulate_open_loop};
 use bgc_workspace::walking::anthropometry::{LegFriction, LegSegments};
 use bgc_workspace::walking::dynamics::LegDynamics;
-use bgc_workspace::walking::plant::{LegModel, join};
+use bgc_workspace::walking::plant::{
+    LegModel, MOTOR_PEAK_TORQUE, WalkingPlant, join, passive_ankle_torque,
+};
 use bgc_workspace::walking::scenario::{SensorNoise, WalkingConfig, run};
 use bgc_workspace::walking::wearer::{STANCE_FRACTION, Wearer, WearerConfig};
 use nalgebra::{Matrix3, Vector2, Vector3};
@@ -382,8 +385,8 @@ fn supervisor_follows_the_gait_of_the_synthetic_wearer() {
 }
 
 /// Noise-free, no torso load, 4 s: the masses, started 20 % too heavy, converge to the leg's (mean over the
-/// last second within 1 %; the one-period averages of the torque observation leave a little modelling
-/// error).
+/// last second within 0.5 %; the run gives 0.1 % or better: the one-period averages of the torque
+/// observation leave a little modelling error).
 #[test]
 fn dual_ukf_masses_converge_on_a_noise_free_run() {
     let mut cfg = WalkingConfig::paper(4.0);
@@ -398,14 +401,27 @@ fn dual_ukf_masses_converge_on_a_noise_free_run() {
         );
         let estimate = out.masses.final_mean[i];
         assert!(
-            (estimate - m).abs() < 0.01 * m,
+            (estimate - m).abs() < 0.005 * m,
             "m{} = {estimate} kg, true {m} kg",
             i + 1
         );
     }
+    // Without the torso the thigh is the same in stance and swing, and so is its estimate.
+    let m = &out.masses;
+    assert!(
+        (m.m3_stance_mean - truth[2]).abs() < 0.01 * truth[2],
+        "{m:?}"
+    );
+    assert!(
+        (m.m3_swing_mean - truth[2]).abs() < 0.01 * truth[2],
+        "{m:?}"
+    );
 }
 
-/// Noise-free with the 8 kg torso load, 4 s: m₃ follows the load on and off the thigh (Fig. 17).
+/// Noise-free with the 8 kg torso load, 4 s: m₃ follows the load on and off the thigh (Fig. 17). The
+/// forgetting factor's memory (about 50 ms) makes the estimate lag the load, which comes on and goes off
+/// within 120 ms: in single support it sits about 0.9 kg below the loaded thigh, in swing 0.7 kg above the
+/// bare one (bounds: 1.2 kg).
 #[test]
 fn dual_ukf_thigh_mass_follows_the_torso_load() {
     let mut cfg = WalkingConfig::paper(4.0);
@@ -414,42 +430,74 @@ fn dual_ukf_thigh_mass_follows_the_torso_load() {
     let m = &out.masses;
     assert_eq!(m.m3_true_stance - m.m3_true_swing, 8.0);
     assert!(
-        m.m3_stance_mean > 14.5,
-        "m3 in single support {}",
-        m.m3_stance_mean
+        (m.m3_stance_mean - m.m3_true_stance).abs() < 1.2,
+        "m3 in single support {} (true {})",
+        m.m3_stance_mean,
+        m.m3_true_stance
     );
-    assert!(m.m3_swing_mean < 9.5, "m3 in swing {}", m.m3_swing_mean);
+    assert!(
+        (m.m3_swing_mean - m.m3_true_swing).abs() < 1.2,
+        "m3 in swing {} (true {})",
+        m.m3_swing_mean,
+        m.m3_true_swing
+    );
     assert!((m.final_mean[0] - m.true_swing[0]).abs() < 0.02 * m.true_swing[0]);
     assert!((m.final_mean[1] - m.true_swing[1]).abs() < 0.02 * m.true_swing[1]);
 }
 
 /// The example's closed loop with the paper's sensor noise, 6 s (the example runs 20 s): the Table 7 and
-/// Table 9 figures and the masses stay within the bounds the 20 s run meets with margin.
+/// Table 9 figures, the motors and the masses stay within bounds about twice the figures the run gives
+/// (Table 9: knee 0.026° and 0.91 °/s, hip 0.011° and 0.36 °/s; the paper's 0.242° and 0.318 °/s, 0.020° and
+/// 0.085 °/s).
 #[test]
 fn closed_loop_figures_within_bounds() {
     let cfg = WalkingConfig::paper(6.0);
     let out = run(&cfg).unwrap_or_else(|e| panic!("{e}"));
     for row in &out.table7 {
         // Innovations: small (σ of the sensors is 0.89°), zero-mean and white.
-        assert!(row.mean_residual_deg.abs() < 0.1, "{row:?}");
+        assert!(row.mean_residual_deg.abs() < 0.2, "{row:?}");
         assert!(row.mean_residual_autocorrelation.abs() < 0.1, "{row:?}");
         assert!(row.mean_position_error_deg.abs() < 0.2, "{row:?}");
-        // Joint speeds reach 150–350 °/s; a mean velocity error of a few °/s is 1–2 % of that.
-        assert!(row.mean_velocity_error_deg_s.abs() < 5.0, "{row:?}");
         assert!(row.position_outside_one_sigma_percent < 45.0, "{row:?}");
     }
     for row in out.table7.iter().filter(|r| r.joint != "ankle") {
         assert!(row.position_outside_one_sigma_percent > 15.0, "{row:?}");
+        // Knee and hip speeds reach 330 and 180 °/s; the mean velocity error is a fraction of a °/s.
+        assert!(row.mean_velocity_error_deg_s.abs() < 1.0, "{row:?}");
     }
+    // The foot is light (0.012 kg m² about the ankle): the torque sensors' noise moves its speed by about
+    // 1.5 °/s per filter period, more than the paper's P_v allows for, and the ankle's velocity error wanders
+    // (mean 5 °/s over this run; the joint reaches 240 °/s).
+    let ankle = &out.table7[0];
+    assert!(ankle.mean_velocity_error_deg_s.abs() < 10.0, "{ankle:?}");
     let nis = out.mean_nis.unwrap_or(f64::NAN);
     assert!(
         (1.0..3.0).contains(&nis),
         "mean NIS {nis} for 3 measurements"
     );
-    for row in &out.table9 {
-        assert!(row.position_rmse_deg < 1.0, "{row:?}");
-        assert!(row.velocity_rmse_deg_s < 15.0, "{row:?}");
+    let [ankle, knee, hip] = [&out.table9[0], &out.table9[1], &out.table9[2]];
+    assert!(knee.position_rmse_deg < 0.06, "{knee:?}");
+    assert!(knee.velocity_rmse_deg_s < 2.0, "{knee:?}");
+    assert!(hip.position_rmse_deg < 0.025, "{hip:?}");
+    assert!(hip.velocity_rmse_deg_s < 0.8, "{hip:?}");
+    // The exoskeleton moves with the wearer: within 0.3° at the knee and hip (0.14° and 0.16° in this run,
+    // the filter's position estimate being 0.6° off); the passive ankle is carried by the wearer.
+    for row in [knee, hip] {
+        assert!(row.wearer_position_rmse_deg < 0.3, "{row:?}");
     }
+    assert!(ankle.wearer_position_rmse_deg < 0.05, "{ankle:?}");
+    // The motors stay within their ratings in more than 99 % of the periods and deliver their share.
+    let a = &out.actuators;
+    assert_eq!(a.peak_torque[0], 0.0);
+    assert!(
+        a.peak_torque[1] <= 17.0 && a.peak_torque[2] <= 38.0,
+        "{a:?}"
+    );
+    assert!(
+        a.saturated_percent[1] < 1.0 && a.saturated_percent[2] < 1.0,
+        "{a:?}"
+    );
+    assert!(a.rms_torque[1] > 3.0 && a.rms_torque[2] > 6.0, "{a:?}");
     assert_eq!(out.transitions.len(), 21);
     let m = &out.masses;
     assert!(m.m3_stance_mean - m.m3_swing_mean > 5.0, "{m:?}");
@@ -525,6 +573,152 @@ fn synthetic_wearer_kinematics_are_consistent_and_realistic() {
     );
 }
 
+fn worn_leg(assistance: [f64; 3]) -> WalkingPlant {
+    WalkingPlant {
+        leg: LegModel::new(LegSegments::paper_subject(), LegFriction::table8_right()),
+        wearer: Wearer::new(&WearerConfig {
+            duration: 6.0,
+            assistance,
+            ..WearerConfig::default()
+        }),
+    }
+}
+
+/// The ground reaction of the stance leg (Eq. 2): both insoles together carry the body weight at every
+/// instant; the right foot's reaction has the vertical component `W · share`, points from the ankle
+/// through the hip, so it exerts no torque about the hip, and loads the knee with `λ l_T l_S sin θ₂`
+/// (`λ = R_y / (−p_y)`, derived by hand in `plant.rs`'s docs); `Jᵀ R` is the virtual work of `R` on the
+/// ankle point (central differences of the ankle position).
+#[test]
+fn ground_reaction_carries_the_body_weight_through_the_hip() {
+    let plant = worn_leg([0.0; 3]);
+    let w = &plant.wearer;
+    let d = plant.leg.dynamics;
+    let s = d.segments;
+    let mut loaded = 0;
+    for k in 0..5000 {
+        let t = k as f64 * 1e-3;
+        let (r, l) = w.insoles(t);
+        let total = r.heel + r.ball + l.heel + l.ball;
+        assert!(
+            (total - w.body_weight).abs() < 1e-9 * w.body_weight,
+            "t = {t}: {total}"
+        );
+        let share = w.support_share(t);
+        assert!((0.0..=1.0).contains(&share));
+        assert!(((r.heel + r.ball) - share * w.body_weight).abs() < 1e-9 * w.body_weight);
+        assert_eq!(share, w.torso_load(t));
+        let q = w.intended(t).q;
+        let reaction = plant.ground_reaction(t, &q);
+        assert!((reaction[1] - share * w.body_weight).abs() < 1e-9 * w.body_weight);
+        let torque = plant.ground_torque(t, &q);
+        let ankle = d.ankle_position(&q);
+        let lambda = reaction[1] / -ankle[1];
+        let knee = lambda * s.thigh.length * s.shank.length * q[1].sin();
+        assert!(torque[0].abs() < 1e-9, "ankle {torque:?}");
+        assert!(torque[2].abs() < 1e-9 * w.body_weight, "hip {torque:?}");
+        assert!(
+            (torque[1] - knee).abs() < 1e-9 * w.body_weight,
+            "knee {torque:?} vs {knee}"
+        );
+        let h = 1e-6;
+        for j in 0..3 {
+            let e = Vector3::ith(j, h);
+            let dp = (d.ankle_position(&(q + e)) - d.ankle_position(&(q - e))) / (2.0 * h);
+            assert!((reaction.dot(&dp) - torque[j]).abs() < 1e-5 * w.body_weight);
+        }
+        if !w.right_in_stance(t) {
+            assert_eq!(reaction, Vector2::zeros(), "t = {t}");
+        } else if share == 1.0 {
+            loaded += 1;
+        }
+    }
+    // Single support: 12 % to 50 % of each of the five cycles.
+    assert!(
+        (1800..2000).contains(&loaded),
+        "{loaded} ms in single support"
+    );
+}
+
+/// The wearer alone walks the leg: with no motor torque and the wearer supplying the whole joint torque
+/// the gait needs (Eqs. 2–3 inverse dynamics less the ground's `Jᵀ R`), the simulated leg (torso on the
+/// thigh, ground reaction, friction) stays on the wearer's trajectory for 3 s, swing and stance.
+#[test]
+fn wearer_alone_walks_the_leg_along_the_gait() {
+    let plant = worn_leg([0.0; 3]);
+    let start = plant.wearer.intended(0.0);
+    let x0 = join(&start.q, &start.qd);
+    let times: Vec<f64> = (0..=300).map(|i| i as f64 * 0.01).collect();
+    let opts = SolverOptions {
+        method: Method::Tsit45,
+        rtol: 1e-10,
+        atol: 1e-12,
+        max_steps: 1_000_000,
+    };
+    let traj = simulate_open_loop(&plant, 0.0, &x0, |_| Vector3::zeros(), &times, &opts)
+        .unwrap_or_else(|e| panic!("simulation failed: {e}"));
+    let worst = times
+        .iter()
+        .zip(&traj.states)
+        .map(|(&t, x)| (x.fixed_rows::<3>(0) - plant.wearer.intended(t).q).amax())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-6, "largest deviation {worst:e} rad");
+    // With the whole demand left to the motors, the wearer's torque is only the braces' correction.
+    let assisted = worn_leg([0.0, 1.0, 1.0]);
+    let t = 3.2;
+    let w = assisted.wearer.intended(t);
+    let human = assisted.human_torque(t, &join(&w.q, &w.qd));
+    assert!(
+        human[1].abs() < 1e-12 && human[2].abs() < 1e-12,
+        "{human:?}"
+    );
+    assert!((human[0] - assisted.joint_torque_demand(t)[0]).abs() < 1e-12);
+}
+
+/// Eq. (28) made deliverable with the passive ankle: the ankle entry is zero and, under the model, the knee
+/// and hip get exactly the commanded accelerations while the ankle moves as its own torque makes it.
+#[test]
+fn passive_ankle_torque_keeps_the_commanded_knee_and_hip_accelerations() {
+    let d = leg();
+    let mut rng = Rng::new(15);
+    for _ in 0..100 {
+        let (q, qd) = random_state(&mut rng);
+        let u = Vector3::from_fn(|_, _| 20.0 * rng.normal());
+        let m = d.mass_matrix(&q);
+        let bias = d.coriolis_torque(&q, &qd) + d.gravity_torque(&q);
+        let tau = m * u + bias;
+        let delivered =
+            passive_ankle_torque(&m, &tau).unwrap_or_else(|| panic!("M00 = {}", m[(0, 0)]));
+        assert_eq!(delivered[0], 0.0);
+        let qdd = d
+            .acceleration(&q, &qd, &delivered)
+            .unwrap_or_else(|| panic!("M(q) singular at {q:?}"));
+        let scale = u.amax().max(1.0);
+        assert!((qdd[1] - u[1]).abs() < 1e-9 * scale, "{qdd:?} vs {u:?}");
+        assert!((qdd[2] - u[2]).abs() < 1e-9 * scale, "{qdd:?} vs {u:?}");
+        assert!((qdd[0] - (u[0] - tau[0] / m[(0, 0)])).abs() < 1e-9 * scale);
+    }
+    assert_eq!(
+        passive_ankle_torque(&Matrix3::zeros(), &Vector3::zeros()),
+        None
+    );
+}
+
+/// The motors deliver at most their ratings (17 N m knee, 38 N m hip, none at the passive ankle), and a
+/// non-finite command delivers nothing.
+#[test]
+fn motors_deliver_at_most_their_ratings() {
+    assert_eq!(MOTOR_PEAK_TORQUE, [0.0, 17.0, 38.0]);
+    let u = Vector3::new(5.0, -30.0, 20.0);
+    assert_eq!(WalkingPlant::actuator(&u), Vector3::new(0.0, -17.0, 20.0));
+    assert!(WalkingPlant::saturates(&u));
+    assert!(!WalkingPlant::saturates(&Vector3::new(100.0, 17.0, -38.0)));
+    assert_eq!(
+        WalkingPlant::actuator(&Vector3::new(1.0, f64::NAN, f64::INFINITY)),
+        Vector3::zeros()
+    );
+}
+
 /// Settings out of their domain are refused with the setting's name, not a panic.
 #[test]
 fn bad_settings_are_refused() {
@@ -572,6 +766,15 @@ fn bad_settings_are_refused() {
     let mut cfg = base;
     cfg.estimator.torque_error_std[0] = f64::INFINITY;
     assert!(refused(cfg).contains("torque_error_std"));
+    for bandwidth in [0.0, 500.0, f64::NAN] {
+        assert_eq!(
+            refused(WalkingConfig {
+                reference_bandwidth: bandwidth,
+                ..base
+            }),
+            "reference_bandwidth"
+        );
+    }
 }
 
 /// The leg's masses as runtime parameters: read, set (the inertia follows the mass) and refused when

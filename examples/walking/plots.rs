@@ -1,5 +1,7 @@
-//! SVG analogs of the paper's Figs. 11–14, 16 and 17, and the supervisor's view of the gait.
+//! SVG analogs of the paper's Figs. 11–14, 16 and 17, the joint torques, and the supervisor's view of the
+//! gait with the ground reaction of the stance leg.
 
+use bgc_workspace::walking::plant::MOTOR_PEAK_TORQUE;
 use bgc_workspace::walking::scenario::{ControlSample, FilterSample, WalkingConfig, WalkingRun};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -388,9 +390,9 @@ fn state_number(label: &str) -> f64 {
 }
 
 fn supervisor(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
-    let root = SVGBackend::new(path, (1200, 700)).into_drawing_area();
+    let root = SVGBackend::new(path, (1200, 1000)).into_drawing_area();
     root.fill(&WHITE)?;
-    let areas = root.split_evenly((2, 1));
+    let areas = root.split_evenly((3, 1));
     let s = control_in(r, window(cfg));
     let index = |f: fn(&ControlSample) -> Option<f64>| -> Vec<(f64, f64)> {
         // An unloaded foot has no P: the line breaks there.
@@ -418,6 +420,65 @@ fn supervisor(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()
             series(&s, |x| (x.t, state_number(x.state))),
         )],
     )?;
+    panel(
+        &areas[2],
+        "Ground reaction on the right foot (Eq. 2), from the insoles, along the leg's axis",
+        "time (s)",
+        "force (N)",
+        &[
+            line(
+                "R_y (up)",
+                ESTIMATE,
+                2,
+                series(&s, |x| (x.t, x.ground_reaction[1])),
+            ),
+            line(
+                "R_x (forward)",
+                REFERENCE,
+                2,
+                series(&s, |x| (x.t, x.ground_reaction[0])),
+            ),
+        ],
+    )?;
+    root.present()?;
+    Ok(())
+}
+
+fn torques(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
+    let root = SVGBackend::new(path, (1200, 800)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let areas = root.split_evenly((2, 1));
+    let s = control_in(r, window(cfg));
+    for (row, (j, name)) in JOINTS.iter().enumerate() {
+        let j = *j;
+        let rating = MOTOR_PEAK_TORQUE[j];
+        panel(
+            &areas[row],
+            &format!("{name} torques: motor (rated ±{rating} N m) and wearer"),
+            "time (s)",
+            "torque (N m)",
+            &[
+                line(
+                    "wearer (brace sensors)",
+                    INTENT,
+                    2,
+                    series(&s, |x| (x.t, x.human_torque[j])),
+                ),
+                line(
+                    "motor command",
+                    BOUND,
+                    1,
+                    series(&s, |x| (x.t, x.commanded_torque[j])),
+                ),
+                line(
+                    "motor delivered",
+                    ESTIMATE,
+                    2,
+                    series(&s, |x| (x.t, x.actuator_torque[j])),
+                ),
+            ],
+        )?;
+    }
     root.present()?;
     Ok(())
 }
@@ -433,6 +494,7 @@ pub fn write_all(r: &WalkingRun, cfg: &WalkingConfig, dir: &Path) -> PlotResult<
         "fig16_tracking.svg",
         "fig17_masses.svg",
         "supervisor.svg",
+        "torques.svg",
     ];
     fig11(r, cfg, &dir.join(files[0]))?;
     fig12(r, cfg, &dir.join(files[1]))?;
@@ -441,5 +503,6 @@ pub fn write_all(r: &WalkingRun, cfg: &WalkingConfig, dir: &Path) -> PlotResult<
     fig16(r, cfg, &dir.join(files[4]))?;
     fig17(r, &dir.join(files[5]))?;
     supervisor(r, cfg, &dir.join(files[6]))?;
+    torques(r, cfg, &dir.join(files[7]))?;
     Ok(files.iter().map(|f| f.to_string()).collect())
 }

@@ -1,8 +1,9 @@
 //! Settings of the walking scenario and its errors.
 
-use super::anthropometry::LegSegments;
+use super::anthropometry::{LegFriction, LegSegments};
 use super::estimator::DualUkfConfig;
-use super::wearer::WearerConfig;
+use super::plant::{LegModel, MOTOR_PEAK_TORQUE, WalkingPlant};
+use super::wearer::{Wearer, WearerConfig};
 use bgc_runtime::control::{ControlError, GaitThresholds};
 use bgc_runtime::estimation::EstimationError;
 use bgc_runtime::sim::SimError;
@@ -117,7 +118,11 @@ pub struct WalkingConfig {
     /// Impedance target `M_r = I`, `B_r = 2 ζ ω I`, `K_r = ω² I`: `ω` (rad/s) and `ζ`.
     pub impedance_frequency: f64,
     pub impedance_damping_ratio: f64,
-    /// Feed the filter's acceleration estimate forward as `q̈_d` of Eq. (29) (see the module docs).
+    /// Bandwidth `ω_r` (rad/s) of the reference filter between the dual UKF's predictions and Eq. (29)
+    /// (see [`super::reference`]).
+    pub reference_bandwidth: f64,
+    /// Feed the control-rate prediction's acceleration forward through the reference filter (see
+    /// [`super::reference`]); without it the reference lags the gait by about `2/ω_r`.
     pub acceleration_feedforward: bool,
     pub supervisor: GaitThresholds,
     /// Seed of the sensor noise.
@@ -133,10 +138,24 @@ impl WalkingConfig {
     /// standard deviation). The masses start `mass_error` too heavy; `λ_RLS = 0.8` per 10 ms step (a memory
     /// of about 50 ms, short enough to follow the torso load on and off within a stance phase; the paper
     /// does not print its value). The sensor noise is [`SensorNoise::paper`].
+    ///
+    /// Control settings the paper does not print: the impedance target of Eq. (29) is critically damped at
+    /// 10 Hz (`M_r = I`, so the error dynamics are `ë + 2ω ė + ω² e = 0` per joint; a bandwidth for a
+    /// 1 kHz joint loop that leaves the motors below their ratings in nearly every period), the reference
+    /// filter at 2 Hz (fast enough to follow the prediction's drift between corrections, slow enough to keep
+    /// the corrections' jitter out of the motors). The wearer leaves to the exoskeleton the share of the gait
+    /// torque its motors can deliver ([`sized_assistance`]) from 0.5 s on.
     pub fn paper(duration: f64) -> Self {
         let segments = LegSegments::paper_subject();
         let mass_error = 0.2;
         let m = segments.masses();
+        let assist_from = 0.5;
+        let mut wearer = WearerConfig {
+            duration: duration + 1.0,
+            assistance_onset: assist_from,
+            ..WearerConfig::default()
+        };
+        wearer.assistance = sized_assistance(&segments, &wearer);
         WalkingConfig {
             duration,
             control_period: 1e-3,
@@ -144,11 +163,8 @@ impl WalkingConfig {
             warmup: 1.0,
             mass_error,
             learn_from: 0.5,
-            assist_from: 0.5,
-            wearer: WearerConfig {
-                duration: duration + 1.0,
-                ..WearerConfig::default()
-            },
+            assist_from,
+            wearer,
             noise: SensorNoise::paper(),
             estimator: DualUkfConfig {
                 sample_time: 1e-2,
@@ -165,11 +181,38 @@ impl WalkingConfig {
                 torque_error_std: [0.05, 0.3, 1.0],
                 min_mass_fraction: 0.1,
             },
-            impedance_frequency: 2.0 * std::f64::consts::PI * 4.0,
+            impedance_frequency: 2.0 * std::f64::consts::PI * 10.0,
             impedance_damping_ratio: 1.0,
+            reference_bandwidth: 2.0 * std::f64::consts::PI * 2.0,
             acceleration_feedforward: true,
             supervisor: GaitThresholds::default(),
             seed: 7,
         }
     }
+}
+
+/// Fraction of a motor's rating that the assisted share of the nominal gait's peak torque may take; the
+/// rest is headroom for the controller's corrections and the cycle-to-cycle variation.
+pub const ASSISTANCE_MARGIN: f64 = 0.8;
+
+/// The share of the gait torque each motor can take along the nominal gait (no cycle-to-cycle variation):
+/// `a_j = min(1, ASSISTANCE_MARGIN · rated_j / peak_j |τ_gait,j|)`, zero at the passive ankle.
+pub fn sized_assistance(segments: &LegSegments, wearer: &WearerConfig) -> [f64; 3] {
+    let nominal = WalkingPlant {
+        leg: LegModel::new(*segments, LegFriction::table8_right()),
+        wearer: Wearer::new(&WearerConfig {
+            rate_variation: 0.0,
+            amplitude_variation: 0.0,
+            duration: 2.0,
+            ..*wearer
+        }),
+    };
+    let peak = nominal.peak_joint_torque_demand(0.0, 1.0, 1001);
+    std::array::from_fn(|j| {
+        if MOTOR_PEAK_TORQUE[j] > 0.0 && peak[j] > 0.0 {
+            (ASSISTANCE_MARGIN * MOTOR_PEAK_TORQUE[j] / peak[j]).min(1.0)
+        } else {
+            0.0
+        }
+    })
 }

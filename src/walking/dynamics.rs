@@ -9,8 +9,9 @@
 //! `q = [θ₁, θ₂, θ₃]` = ankle dorsiflexion, knee flexion, hip flexion (rad), the paper's order. The chain is
 //! rooted at the hip (Eq. 1's swing leg, pivoted at a hip that does not accelerate); Eq. (2) keeps the same
 //! coordinates and terms for stance ("all terms are as defined in Eq. (1)"), adds the torso mass to the
-//! thigh ([`LegDynamics::with_thigh_load`]) and the ground reaction as `−Jᵀ F` ([`LegDynamics::ankle_jacobian`]):
-//! the ground pivots the stance leg through that contact force. (Re-rooting the chain at the ankle with the
+//! thigh ([`LegDynamics::with_thigh_load`]) and the ground reaction as `−Jᵀ F` ([`LegDynamics::ankle_jacobian`]),
+//! where `F` is the force the foot exerts on the ground: the ground's reaction on the foot, `R = −F`,
+//! enters as `+Jᵀ R`. The ground pivots the stance leg through that contact force. (Re-rooting the chain at the ankle with the
 //! torso lumped on the thigh would leave nothing distal to the hip joint, a singular `M(q)`.)
 //! Absolute link angles, counter-clockwise from the downward vertical with the subject facing `+x`:
 //!
@@ -211,8 +212,9 @@ impl LegDynamics {
         )
     }
 
-    /// The Jacobian `J = ∂p_ankle/∂q` of the ankle point, through which a ground reaction `F` acts as
-    /// `−Jᵀ F` (Eq. 2).
+    /// The Jacobian `J = ∂p_ankle/∂q` of the ankle point. A force `R` applied to the foot at the ankle
+    /// point (the ground's reaction) does the generalised work of `Jᵀ R` (virtual work `Rᵀ J δq`); Eq. (2)
+    /// writes it `−Jᵀ F` with `F = −R` the force of the foot on the ground.
     pub fn ankle_jacobian(&self, q: &Vector3<f64>) -> Matrix2x3<f64> {
         let phi = link_angles(q);
         let (lt, ls) = (self.segments.thigh.length, self.segments.shank.length);

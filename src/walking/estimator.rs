@@ -1,33 +1,39 @@
-//! The dual UKF of Sado et al. (2018), Eqs. 6–27, built from two runtime UKFs.
+//! The dual UKF of Sado et al. (2018), Eqs. 6–27, on the runtime's [`DualUkf`] with separate observations
+//! for its two filters ([`DualUkf::step_separate`]).
 //!
 //! - **State filter** (Eqs. 6–22): `x = [q, q̇]`, observed through the joint position sensors
 //!   (`y = q + n`). The time update integrates Eq. (8) with the current mass estimate `ŵ` over one filter
 //!   period, in sub-steps of classical Runge–Kutta that each hold one joint-torque reading of the elapsed
-//!   period (`u = τ_a + τ_h − Jᵀ F` as the joint torque sensors read it).
+//!   period (`u = τ_a + τ_h − Jᵀ F` as the joint torque sensors and insoles give it).
 //! - **Parameter filter** (Eqs. 23–27): `w = [m₁, m₂, m₃]` (foot, shank, thigh), a random walk whose
 //!   process-noise covariance is the RLS-forgetting choice of Eq. (27), `P_r = (λ⁻¹ − 1) P_w`, so the time
 //!   update is `P_w⁻ = P_w / λ`. Its observation is the torque output of Eqs. (24)–(25):
-//!   `d = Y(x, w) + e = M(q; w) q̈ + C(q, q̇; w) q̇ + G(q; w) + τ_f(q, q̇) + e` ([`TorqueObservation`]): the
-//!   mean torque on the exoskeleton's links over the period with their kinematics at mid-period and the mean
-//!   acceleration, read from the torque sensors, encoders and motor rpm.
+//!   `d = Y(x, w) + e = M(q; w) q̈ + C(q, q̇; w) q̇ + G(q; w) + τ̄_f + e` ([`TorqueObservation`]): the
+//!   mean generalised torque on the exoskeleton's links over the period (actuators, braces and the ground
+//!   reaction's `Jᵀ R`), with their kinematics at mid-period and the mean acceleration, read from the torque
+//!   sensors, insoles, encoders and motor rpm. The friction `τ̄_f` of Eq. (3) does not depend on the masses;
+//!   it is averaged over the period at the measured joint speeds (its Coulomb term changes within a few
+//!   milliseconds around a speed reversal, so evaluating it once at the mid-period speed leaves a bias
+//!   that the parameter filter reads as mass: 0.4 kg on m₃ in stance in a noise-free run).
 //!
 //! Why not the state filter's own `x̂` and `q̈̂` in `Y`: the state filter's velocity is dominated by its model
 //! (the paper's `P_v` trusts the model far more than the 0.9° position sensors), so its acceleration is the
 //! model's own `M(ŵ)⁻¹(u − …)` and `Y(x̂, q̈̂, ŵ) ≈ u` at whatever `ŵ` is: the torque residual carries almost
 //! no information about the masses. With the noise-free gait the masses settled 8 kg off that way. The
-//! information about `w` is in measured kinematics, so `Y` is evaluated on them.
+//! information about `w` is in measured kinematics, so `Y` is evaluated on them (the runtime's `Y(x̂, u, w)`
+//! is given them and ignores `x̂`).
 //!
 //! The two filters alternate as in the paper's Fig. 5: the state step uses the latest `ŵ`, the parameter
-//! step the state it produced. (The runtime's `DualUkf` feeds one measurement vector to both filters; the
-//! paper observes the state through positions and the parameters through torque, hence two filters here.)
+//! step follows it.
 //!
-//! Masses below `min_mass_fraction` of their nominal values are clamped when the state filter uses them,
+//! Masses below `min_mass_fraction` of their initial values are clamped when the state filter uses them,
 //! so that `M(q)` stays positive definite whatever the parameter filter does; the estimate itself is not
 //! altered.
 
 use super::anthropometry::{LegFriction, LegSegments};
 use super::plant::{LegModel, join, split};
-use bgc_runtime::estimation::{EstimationError, SigmaPoints, UnscentedKalmanFilter};
+use bgc_runtime::estimation::dual_ukf::{DualUkf, ParameterObservation};
+use bgc_runtime::estimation::{EstimationError, SigmaPoints, UnscentedKalmanFilter, UpdateOutcome};
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
@@ -72,6 +78,8 @@ pub struct TorqueObservation {
     pub qd: Vector3<f64>,
     /// Mean acceleration over the period (rad/s²).
     pub qdd: Vector3<f64>,
+    /// Mean friction torque `τ_f` of Eq. (3) over the period at the measured joint angles and speeds (N m).
+    pub friction: Vector3<f64>,
 }
 
 /// One step's outputs.
@@ -88,8 +96,7 @@ pub struct DualStep {
 /// The dual UKF.
 #[derive(Clone, Debug)]
 pub struct DualEstimator {
-    state: UnscentedKalmanFilter<6, 3, 3, 13>,
-    params: UnscentedKalmanFilter<3, 3, 3, 7>,
+    filter: DualUkf<6, 3, 3, 3, 13, 7>,
     segments: LegSegments,
     friction: LegFriction,
     cfg: DualUkfConfig,
@@ -98,6 +105,12 @@ pub struct DualEstimator {
 
 fn torque_noise(cfg: &DualUkfConfig) -> Matrix3<f64> {
     Matrix3::from_diagonal(&Vector3::from(cfg.torque_error_std.map(|s| s * s)))
+}
+
+/// The masses clamped from below at `min_mass_fraction` of the initial ones.
+fn clamp_masses(cfg: &DualUkfConfig, w: &Vector3<f64>) -> Vector3<f64> {
+    let floor = Vector3::from(cfg.initial_masses) * cfg.min_mass_fraction;
+    w.zip_map(&floor, f64::max)
 }
 
 fn diag6(d: &[f64; 6], scale: [f64; 6]) -> Matrix6<f64> {
@@ -170,16 +183,15 @@ impl DualEstimator {
         )?;
         let w0 = Vector3::from(cfg.initial_masses);
         let pw0 = Matrix3::from_diagonal(&Vector3::from(cfg.initial_mass_std).map(|s| s * s));
-        let params = UnscentedKalmanFilter::new(
+        let filter = DualUkf::new(
+            state,
             SigmaPoints::new(cfg.alpha, cfg.beta, cfg.kappa)?,
-            Matrix3::zeros(),
-            torque_noise(&cfg),
             w0,
             pw0,
+            cfg.forgetting,
         )?;
         Ok(DualEstimator {
-            state,
-            params,
+            filter,
             segments,
             friction,
             cfg,
@@ -187,20 +199,15 @@ impl DualEstimator {
         })
     }
 
-    /// The leg model at masses `w`.
-    fn model(&self, w: &Vector3<f64>) -> LegModel {
-        LegModel::new(self.segments.with_masses([w[0], w[1], w[2]]), self.friction)
-    }
-
     /// The masses the state filter and the controller use: the estimate, clamped from below.
     pub fn usable_masses(&self) -> Vector3<f64> {
-        let floor = Vector3::from(self.cfg.initial_masses) * self.cfg.min_mass_fraction;
-        self.params.state().zip_map(&floor, f64::max)
+        clamp_masses(&self.cfg, self.filter.parameters())
     }
 
     /// The leg model at the usable masses.
     pub fn estimated_model(&self) -> LegModel {
-        self.model(&self.usable_masses())
+        let w = self.usable_masses();
+        LegModel::new(self.segments.with_masses([w[0], w[1], w[2]]), self.friction)
     }
 
     /// One filter period: `torques` are the joint-torque readings of the elapsed period, in order (at least
@@ -227,72 +234,63 @@ impl DualEstimator {
         {
             return Err(EstimationError::NonFiniteInput { index: i });
         }
-        let mean_torque = torques.iter().sum::<Vector3<f64>>() / n as f64;
-        let period = self.cfg.sample_time;
-        let h = period / n as f64;
-        let model = self.estimated_model();
-        let mut state = self.state.clone();
-        let previous = *state.state();
-        state.predict(&mean_torque, |x, _| {
-            torques.iter().fold(*x, |x, tau| model.rk4_step(&x, tau, h))
-        })?;
-        let outcome = state.update(y, &mean_torque, |x, _| x.fixed_rows::<3>(0).into_owned())?;
-        let nis = match outcome {
-            bgc_runtime::estimation::UpdateOutcome::Accepted { nis, .. } => Some(nis),
-            bgc_runtime::estimation::UpdateOutcome::Rejected { .. } => None,
-        };
-        let (_, qd0) = split(&previous);
-        let (_, qd1) = split(state.state());
-        let acceleration = (qd1 - qd0) / period;
-
-        let mut params = self.params.clone();
         if let Some(obs) = torque {
-            self.update_parameters(&mut params, obs)?;
+            let values = [obs.q, obs.qd, obs.qdd, obs.friction];
+            if let Some(index) = values
+                .iter()
+                .flat_map(|v| v.iter())
+                .position(|v| !v.is_finite())
+            {
+                return Err(EstimationError::NonFiniteInput { index });
+            }
         }
-
-        let step = DualStep {
-            innovation: *state.innovation(),
-            innovation_covariance: *state.innovation_covariance(),
-            nis,
+        let mean_torque = torques.iter().sum::<Vector3<f64>>() / n as f64;
+        let h = self.cfg.sample_time / n as f64;
+        let (segments, friction, cfg) = (self.segments, self.friction, self.cfg);
+        let model =
+            |w: &Vector3<f64>| LegModel::new(segments.with_masses([w[0], w[1], w[2]]), friction);
+        let observation = torque.map(|obs| ParameterObservation {
+            d: obs.torque,
+            noise: torque_noise(&cfg),
+        });
+        let outcome = self.filter.step_separate(
+            &mean_torque,
+            y,
+            observation.as_ref(),
+            |x, _, w| {
+                let leg = model(&clamp_masses(&cfg, w));
+                torques.iter().fold(*x, |x, tau| leg.rk4_step(&x, tau, h))
+            },
+            |x, _, _| x.fixed_rows::<3>(0).into_owned(),
+            |_, _, w| match torque {
+                Some(obs) => model(w).dynamics.inverse(&obs.q, &obs.qd, &obs.qdd) + obs.friction,
+                None => Vector3::zeros(),
+            },
+        )?;
+        let nis = match outcome.state {
+            UpdateOutcome::Accepted { nis, .. } => Some(nis),
+            UpdateOutcome::Rejected { .. } => None,
         };
-        self.state = state;
-        self.params = params;
-        self.acceleration = acceleration;
-        Ok(step)
-    }
-
-    /// Eq. 27 time update, then the torque observation of Eqs. 24–25.
-    fn update_parameters(
-        &self,
-        params: &mut UnscentedKalmanFilter<3, 3, 3, 7>,
-        obs: &TorqueObservation,
-    ) -> Result<(), EstimationError> {
-        let values = [obs.torque, obs.q, obs.qd, obs.qdd];
-        if let Some(index) = values
-            .iter()
-            .flat_map(|v| v.iter())
-            .position(|v| !v.is_finite())
-        {
-            return Err(EstimationError::NonFiniteInput { index });
-        }
-        let forgetting_noise = params.covariance() * (1.0 / self.cfg.forgetting - 1.0);
-        let r_d = torque_noise(&self.cfg);
-        params.set_noise(forgetting_noise, r_d)?;
-        params.predict(&obs.torque, |w, _| *w)?;
-        params.update(&obs.torque, &obs.torque, |w, _| {
-            self.model(w).torque(&obs.q, &obs.qd, &obs.qdd)
-        })?;
-        Ok(())
+        // The model's acceleration at the new estimate under the latest torque reading: the filter's
+        // prediction of q̈ at this instant (a difference of successive velocity estimates would lag by half
+        // a period and carry the velocity corrections).
+        let latest = torques.last().copied().unwrap_or(mean_torque);
+        self.acceleration = split(&self.estimated_model().derivative(&self.state(), &latest)).1;
+        Ok(DualStep {
+            innovation: *self.filter.innovation(),
+            innovation_covariance: *self.filter.innovation_covariance(),
+            nis,
+        })
     }
 
     /// `x̂ = [q̂, q̂̇]` (rad, rad/s).
     pub fn state(&self) -> Vector6<f64> {
-        *self.state.state()
+        *self.filter.state()
     }
 
     /// The state covariance.
     pub fn covariance(&self) -> Matrix6<f64> {
-        *self.state.covariance()
+        *self.filter.state_covariance()
     }
 
     /// The estimated acceleration of the last period (rad/s²).
@@ -302,12 +300,12 @@ impl DualEstimator {
 
     /// The mass estimate `[m₁, m₂, m₃]` (kg).
     pub fn masses(&self) -> Vector3<f64> {
-        *self.params.state()
+        *self.filter.parameters()
     }
 
     /// The mass covariance.
     pub fn mass_covariance(&self) -> Matrix3<f64> {
-        *self.params.covariance()
+        *self.filter.parameter_covariance()
     }
 
     /// The filter period (s).
@@ -321,7 +319,7 @@ impl DualEstimator {
         q: &Vector3<f64>,
         qd: &Vector3<f64>,
     ) -> Result<(), EstimationError> {
-        let p = *self.state.covariance();
-        self.state.set_state(join(q, qd), p)
+        let p = *self.filter.state_covariance();
+        self.filter.state_filter_mut().set_state(join(q, qd), p)
     }
 }

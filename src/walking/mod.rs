@@ -9,6 +9,7 @@
 //! - [`plant`]: the leg as a runtime `ContinuousModel`, alone and worn by the wearer;
 //! - [`wearer`]: the synthetic wearer (trajectories, insoles, torso load, human torque);
 //! - [`estimator`]: the dual UKF;
+//! - [`reference`]: the controller's reference at the control rate from the filter's predictions;
 //! - [`scenario`]: the closed loop, its settings and records, and the figures of Tables 7 and 9.
 
 pub mod anthropometry;
@@ -17,5 +18,6 @@ pub mod dynamics;
 pub mod estimator;
 pub mod plant;
 mod records;
+pub mod reference;
 pub mod scenario;
 pub mod wearer;

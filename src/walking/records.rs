@@ -3,11 +3,12 @@
 
 use super::anthropometry::LegSegments;
 use super::config::{AUTOCORRELATION_LAGS, DEG, JOINTS, WalkingConfig, WalkingError};
+use super::plant::MOTOR_PEAK_TORQUE;
 use super::plant::join;
 use super::wearer::Wearer;
 use bgc_runtime::control::JointReference;
 use bgc_runtime::estimation::health::FilterHealth;
-use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix6, Vector2, Vector3, Vector6};
 use serde::Serialize;
 
 /// One dual UKF step, in degrees.
@@ -42,8 +43,12 @@ pub struct ControlSample {
     pub q: [f64; 3],
     pub qd: [f64; 3],
     pub q_intended: [f64; 3],
-    /// Actuator torque (N m).
+    /// Actuator torque delivered (N m).
     pub actuator_torque: [f64; 3],
+    /// Torque the controller commanded before the motors' limits (N m).
+    pub commanded_torque: [f64; 3],
+    /// Ground reaction on the right foot the controller used, `(R_x, R_y)` (N).
+    pub ground_reaction: [f64; 2],
     /// Human torque read by the brace torque sensors (N m).
     pub human_torque: [f64; 3],
     /// Supervisor state S1–S4.
@@ -106,6 +111,20 @@ pub struct MassSummary {
     pub m3_true_swing: f64,
 }
 
+/// What the motors did after the warm-up.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ActuatorSummary {
+    /// Largest delivered torque per joint (N m).
+    pub peak_torque: [f64; 3],
+    /// Largest commanded torque per joint, before the limits (N m).
+    pub peak_command: [f64; 3],
+    /// RMS of the delivered torque per joint (N m).
+    pub rms_torque: [f64; 3],
+    /// Percentage of control periods in which the command exceeded the joint's rating (the passive ankle:
+    /// not counted, 0).
+    pub saturated_percent: [f64; 3],
+}
+
 /// Everything a walking run produced.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct WalkingRun {
@@ -113,7 +132,12 @@ pub struct WalkingRun {
     pub table9: Vec<JointTracking>,
     pub masses: MassSummary,
     pub mean_nis: Option<f64>,
-    pub peak_actuator_torque: [f64; 3],
+    pub actuators: ActuatorSummary,
+    /// Share of the gait torque the wearer left to the exoskeleton, per joint.
+    pub assistance: [f64; 3],
+    /// Largest joint torque the gait needed (muscles and motors together) after the warm-up, per joint
+    /// (N m).
+    pub peak_joint_torque_demand: [f64; 3],
     pub transitions: Vec<TransitionRecord>,
     pub supervisor_faults: u64,
     #[serde(skip)]
@@ -153,7 +177,9 @@ pub(super) struct PendingControl {
     pub(super) k: usize,
     pub(super) reference: JointReference<3>,
     pub(super) actuator: Vector3<f64>,
+    pub(super) demanded: Vector3<f64>,
     pub(super) human_torque: Vector3<f64>,
+    pub(super) ground_reaction: Vector2<f64>,
     pub(super) state: &'static str,
     pub(super) right_mode: &'static str,
     pub(super) right_index: Option<f64>,
@@ -235,21 +261,31 @@ pub(super) fn filter_records(
     })
 }
 
-/// The control records with the leg's true states, Table 9 and the peak actuator torques.
+/// The control records with the leg's true states, Table 9 and what the motors did.
+pub(super) struct ControlSummary {
+    pub(super) samples: Vec<ControlSample>,
+    pub(super) table9: Vec<JointTracking>,
+    pub(super) actuators: ActuatorSummary,
+}
+
+/// The control records with the leg's true states, Table 9 and the actuator figures.
 pub(super) fn control_records(
     pending: &[PendingControl],
     states: &[Vector6<f64>],
     cfg: &WalkingConfig,
     wearer: &Wearer,
-) -> (Vec<ControlSample>, Vec<JointTracking>, [f64; 3]) {
+) -> ControlSummary {
     let truth = |k: usize| -> Option<Vector6<f64>> { states.get(k).copied() };
     let mut control_samples = Vec::with_capacity(pending.len());
     let mut sq_pos = [0.0; 3];
     let mut sq_vel = [0.0; 3];
     let mut sq_pos_w = [0.0; 3];
     let mut sq_vel_w = [0.0; 3];
+    let mut sq_torque = [0.0; 3];
+    let mut saturated = [0usize; 3];
     let mut counted = 0usize;
     let mut peak = [0.0f64; 3];
+    let mut peak_command = [0.0f64; 3];
     for p in pending {
         let t = p.k as f64 * cfg.control_period;
         let Some(x) = truth(p.k) else { continue };
@@ -262,7 +298,12 @@ pub(super) fn control_records(
                 sq_vel[j] += ((p.reference.qd[j] - qd[j]) / DEG).powi(2);
                 sq_pos_w[j] += ((intended.q[j] - q[j]) / DEG).powi(2);
                 sq_vel_w[j] += ((intended.qd[j] - qd[j]) / DEG).powi(2);
+                sq_torque[j] += p.actuator[j].powi(2);
                 peak[j] = peak[j].max(p.actuator[j].abs());
+                if MOTOR_PEAK_TORQUE[j] > 0.0 {
+                    peak_command[j] = peak_command[j].max(p.demanded[j].abs());
+                    saturated[j] += usize::from(p.demanded[j].abs() > MOTOR_PEAK_TORQUE[j]);
+                }
             }
             counted += 1;
         }
@@ -274,6 +315,8 @@ pub(super) fn control_records(
             qd: deg3(&qd),
             q_intended: deg3(&intended.q),
             actuator_torque: [p.actuator[0], p.actuator[1], p.actuator[2]],
+            commanded_torque: [p.demanded[0], p.demanded[1], p.demanded[2]],
+            ground_reaction: [p.ground_reaction[0], p.ground_reaction[1]],
             human_torque: [p.human_torque[0], p.human_torque[1], p.human_torque[2]],
             state: p.state,
             right_mode: p.right_mode,
@@ -291,7 +334,16 @@ pub(super) fn control_records(
             wearer_velocity_rmse_deg_s: (sq_vel_w[j] / denominator).sqrt(),
         })
         .collect();
-    (control_samples, table9, peak)
+    ControlSummary {
+        samples: control_samples,
+        table9,
+        actuators: ActuatorSummary {
+            peak_torque: peak,
+            peak_command,
+            rms_torque: sq_torque.map(|s| (s / denominator).sqrt()),
+            saturated_percent: saturated.map(|c| 100.0 * c as f64 / denominator),
+        },
+    }
 }
 
 fn mean(values: impl Iterator<Item = f64>) -> f64 {

@@ -4,8 +4,17 @@
 //!
 //! Rates: the plant is integrated by the runtime's sampled-data simulator with a 1 ms zero-order hold; the
 //! impedance controller and the supervisor run every 1 ms, the dual UKF every `filter_decimation` samples
-//! (10 ms by default). Between filter steps the reference is the filter's prediction
-//! `q_d(t) = q̂ + q̂̇ τ + ½ q̈̂ τ²`, `q̇_d = q̂̇ + q̈̂ τ`, `q̈_d = q̈̂` (`τ` since the last filter step).
+//! (10 ms by default). Between filter steps the filter's model runs on at the control rate from its last
+//! posterior with the torque readings as they arrive, and the reference follows that prediction through
+//! the second-order reference filter of [`super::reference`].
+//!
+//! The controller is Eq. (28) with the estimated masses, the friction of Eq. (3) compensated, the measured
+//! brace torque `τ_h` subtracted and, while the right insole reads a load, the stance term of Eq. (2): the
+//! ground reaction from the insole total (its vertical component) directed along the leg
+//! ([`super::plant::axial_reaction`]) at the encoders' posture. Eq. (28) also asks for an ankle torque,
+//! which no motor delivers; the knee and hip torques absorb the passive ankle's own motion instead
+//! ([`super::plant::passive_ankle_torque`]). The motors deliver at most their rated torques; the run
+//! counts the control periods in which the command exceeded them.
 //!
 //! Figures of merit, computed after a warm-up (default 1 s, while the filter converges from the paper's
 //! initial guess):
@@ -14,29 +23,37 @@
 //!   autocorrelation over lags 1–20 (the runtime's `FilterHealth`), the mean state error `x − x̂` (with `x`
 //!   the wearer's joint angles and speeds, which the filter estimates) for position and velocity and the
 //!   percentage of filter steps on which it exceeded `√P_ii`;
-//! - Table 9: per joint, the RMS difference between the reference (the filter's prediction) and the leg's
-//!   actual position and velocity, over all 1 ms samples.
+//! - Table 9: per joint, the RMS difference between the reference (the filter's prediction at the control
+//!   rate) and the leg's actual position and velocity, over all 1 ms samples.
 
-pub use super::config::{AUTOCORRELATION_LAGS, JOINTS, SensorNoise, WalkingConfig, WalkingError};
+pub use super::config::{
+    ASSISTANCE_MARGIN, AUTOCORRELATION_LAGS, JOINTS, SensorNoise, WalkingConfig, WalkingError,
+    sized_assistance,
+};
 pub use super::records::{
-    ControlSample, FilterSample, JointHealth, JointTracking, MassSummary, TransitionRecord,
-    WalkingRun,
+    ActuatorSummary, ControlSample, FilterSample, JointHealth, JointTracking, MassSummary,
+    TransitionRecord, WalkingRun,
 };
 
 use super::anthropometry::{LegFriction, LegSegments};
 use super::config::DEG;
 use super::estimator::DualEstimator;
 use super::estimator::TorqueObservation;
-use super::plant::{FrictionCompensated, LegModel, PLANT_OUTPUTS, WalkingPlant, join};
+use super::plant::{
+    ComputedTorqueModel, LegModel, PLANT_OUTPUTS, WalkingPlant, axial_reaction, join,
+    passive_ankle_torque,
+};
 use super::records::{
     PendingControl, PendingFilter, control_records, filter_records, summarize_masses,
     transition_label,
 };
-use super::wearer::Wearer;
+use super::reference::{ControlRatePredictor, ReferenceFilter};
+use super::wearer::{Wearer, WearerConfig};
 use bgc_runtime::control::{
-    GaitSupervisor, GrfSample, ImpedanceController, ImpedanceGains, JointReference, JointState,
-    Leg, LegMode,
+    ControlError, GaitSupervisor, GrfSample, ImpedanceController, ImpedanceGains, JointState, Leg,
+    LegMode,
 };
+use bgc_runtime::estimation::EstimationError;
 use bgc_runtime::noise::Rng;
 use bgc_runtime::sim::{Method, SampledLoopConfig, SolverOptions, simulate_sampled_loop};
 use nalgebra::{Matrix3, SVector, Vector3};
@@ -74,7 +91,11 @@ pub fn run(cfg: &WalkingConfig) -> Result<WalkingRun, WalkingError> {
     }
     let segments = LegSegments::paper_subject();
     let friction = LegFriction::table8_right();
-    let wearer = Wearer::new(&cfg.wearer);
+    // The wearer hands the assisted share over when the exoskeleton starts assisting.
+    let wearer = Wearer::new(&WearerConfig {
+        assistance_onset: cfg.assist_from,
+        ..cfg.wearer
+    });
     let plant = WalkingPlant {
         leg: LegModel::new(segments, friction),
         wearer: wearer.clone(),
@@ -116,12 +137,14 @@ pub fn run(cfg: &WalkingConfig) -> Result<WalkingRun, WalkingError> {
     };
 
     let mut insole_rng = Rng::new(cfg.seed ^ 0x5eed_1a5e);
+    let mut reference_filter = ReferenceFilter::new(cfg.reference_bandwidth, cfg.control_period)?;
     let mut torque_buffer: Vec<Vector3<f64>> = Vec::with_capacity(cfg.filter_decimation);
-    let x0 = estimator.state();
-    let mut anchor = (0.0, x0, Vector3::<f64>::zeros());
+    let mut predictor = ControlRatePredictor {
+        model: estimator.estimated_model(),
+        state: estimator.state(),
+    };
     let mut failure: Option<WalkingError> = None;
-    let mut last_actuator = Vector3::<f64>::zeros();
-    let mut last_human = Vector3::<f64>::zeros();
+    let mut last_link_torque = Vector3::<f64>::zeros();
     let mut link_torque_sum = Vector3::<f64>::zeros();
     let mut period_start = JointState {
         q: start.q,
@@ -131,6 +154,10 @@ pub fn run(cfg: &WalkingConfig) -> Result<WalkingRun, WalkingError> {
         Vec::with_capacity(samples / cfg.filter_decimation);
     let mut pending_control: Vec<PendingControl> = Vec::with_capacity(samples + 1);
     let mut transitions = Vec::new();
+    // What the controller knows of the leg besides the masses: its geometry and the friction of Table 8.
+    let known_leg = plant.leg;
+    let mut last_friction = Vector3::<f64>::zeros();
+    let mut friction_sum = Vector3::<f64>::zeros();
 
     let mut control = |k: usize, t: f64, y: &SVector<f64, PLANT_OUTPUTS>| -> Vector3<f64> {
         if failure.is_some() {
@@ -142,48 +169,6 @@ pub fn run(cfg: &WalkingConfig) -> Result<WalkingRun, WalkingError> {
             q: Vector3::new(y[9], y[10], y[11]),
             qd: Vector3::new(y[12], y[13], y[14]),
         };
-        if k > 0 {
-            torque_buffer.push(Vector3::new(y[3], y[4], y[5]));
-            // Torque on the links over the elapsed control period: the held actuator torque and the brace
-            // torque (trapezoidal mean of its two readings).
-            link_torque_sum += last_actuator + (last_human + human_torque) * 0.5;
-        }
-        if k > 0 && k.is_multiple_of(cfg.filter_decimation) {
-            let observation = TorqueObservation {
-                torque: link_torque_sum / cfg.filter_decimation as f64,
-                q: (period_start.q + state.q) * 0.5,
-                qd: (period_start.qd + state.qd) * 0.5,
-                qdd: (state.qd - period_start.qd) / estimator.sample_time(),
-            };
-            let learn = (t >= cfg.learn_from).then_some(&observation);
-            link_torque_sum = Vector3::zeros();
-            period_start = state;
-            match estimator.step(&torque_buffer, &q_sensor, learn) {
-                Ok(step) => {
-                    pending_filter.push(PendingFilter {
-                        k,
-                        measured: q_sensor,
-                        estimate: estimator.state(),
-                        covariance: estimator.covariance(),
-                        residual: step.innovation,
-                        residual_covariance: step.innovation_covariance,
-                        masses: estimator.masses(),
-                        mass_covariance: estimator.mass_covariance(),
-                    });
-                    let qdd = if cfg.acceleration_feedforward {
-                        estimator.acceleration()
-                    } else {
-                        Vector3::zeros()
-                    };
-                    anchor = (t, estimator.state(), qdd);
-                }
-                Err(source) => {
-                    failure = Some(WalkingError::Estimation { time: t, source });
-                    return Vector3::zeros();
-                }
-            }
-            torque_buffer.clear();
-        }
         let (right, left) = wearer.insoles(t);
         // Force-sensing insoles read no negative force.
         let mut noisy = |g: GrfSample| GrfSample {
@@ -200,16 +185,79 @@ pub fn run(cfg: &WalkingConfig) -> Result<WalkingRun, WalkingError> {
                 right_cycle_fraction: wearer.cycle_fraction(t, false),
             });
         }
-        let tau = t - anchor.0;
-        let (x, qdd) = (anchor.1, anchor.2);
-        let q_hat = x.fixed_rows::<3>(0).into_owned();
-        let qd_hat = x.fixed_rows::<3>(3).into_owned();
-        let reference = JointReference {
-            q: q_hat + qd_hat * tau + qdd * (0.5 * tau * tau),
-            qd: qd_hat + qdd * tau,
-            qdd,
+        // The stance term of Eq. (2) while the right insole reads a load (P of Eq. 30 is defined).
+        let ground_reaction = if step.right_index.is_some() {
+            axial_reaction(
+                right.heel + right.ball,
+                &known_leg.dynamics.ankle_position(&state.q),
+            )
+        } else {
+            nalgebra::Vector2::zeros()
         };
-        let dynamics = FrictionCompensated(estimator.estimated_model());
+        let ground_torque =
+            known_leg.dynamics.ankle_jacobian(&state.q).transpose() * ground_reaction;
+        let friction = known_leg.friction_torque(&state.q, &state.qd);
+        if k > 0 {
+            torque_buffer.push(Vector3::new(y[3], y[4], y[5]));
+            // Generalised torque on the links over the elapsed control period: the held actuator torque,
+            // the brace torque and the ground reaction (trapezoidal means of their two readings).
+            link_torque_sum += last_link_torque + (human_torque + ground_torque) * 0.5;
+            friction_sum += (last_friction + friction) * 0.5;
+        }
+        last_friction = friction;
+        if k > 0 && k.is_multiple_of(cfg.filter_decimation) {
+            let observation = TorqueObservation {
+                torque: link_torque_sum / cfg.filter_decimation as f64,
+                q: (period_start.q + state.q) * 0.5,
+                qd: (period_start.qd + state.qd) * 0.5,
+                qdd: (state.qd - period_start.qd) / estimator.sample_time(),
+                friction: friction_sum / cfg.filter_decimation as f64,
+            };
+            let learn = (t >= cfg.learn_from).then_some(&observation);
+            link_torque_sum = Vector3::zeros();
+            friction_sum = Vector3::zeros();
+            period_start = state;
+            match estimator.step(&torque_buffer, &q_sensor, learn) {
+                Ok(step) => {
+                    pending_filter.push(PendingFilter {
+                        k,
+                        measured: q_sensor,
+                        estimate: estimator.state(),
+                        covariance: estimator.covariance(),
+                        residual: step.innovation,
+                        residual_covariance: step.innovation_covariance,
+                        masses: estimator.masses(),
+                        mass_covariance: estimator.mass_covariance(),
+                    });
+                    predictor.restart(estimator.estimated_model(), estimator.state());
+                }
+                Err(source) => {
+                    failure = Some(WalkingError::Estimation { time: t, source });
+                    return Vector3::zeros();
+                }
+            }
+            torque_buffer.clear();
+        }
+        let Some(mut target) =
+            predictor.advance(&Vector3::new(y[3], y[4], y[5]), cfg.control_period)
+        else {
+            failure = Some(WalkingError::Estimation {
+                time: t,
+                source: EstimationError::NonFiniteModelOutput {
+                    function: "control-rate prediction",
+                    sigma_point: 0,
+                },
+            });
+            return Vector3::zeros();
+        };
+        if !cfg.acceleration_feedforward {
+            target.qdd = Vector3::zeros();
+        }
+        let reference = reference_filter.next(&target);
+        let dynamics = ComputedTorqueModel {
+            leg: estimator.estimated_model(),
+            ground_torque,
+        };
         let command = match controller.torque(&dynamics, &state, &reference, &human_torque) {
             Ok(c) => c,
             Err(source) => {
@@ -217,13 +265,23 @@ pub fn run(cfg: &WalkingConfig) -> Result<WalkingRun, WalkingError> {
                 return Vector3::zeros();
             }
         };
-        let actuator = if t >= cfg.assist_from {
-            WalkingPlant::actuator(&command.torque)
-        } else {
-            Vector3::zeros()
+        let Some(deliverable) = passive_ankle_torque(
+            &dynamics.leg.dynamics.mass_matrix(&state.q),
+            &command.unlimited_torque,
+        ) else {
+            failure = Some(WalkingError::Control {
+                time: t,
+                source: ControlError::NonFiniteModel { term: "M(q)" },
+            });
+            return Vector3::zeros();
         };
-        last_actuator = actuator;
-        last_human = human_torque;
+        let assisting = t >= cfg.assist_from;
+        let (actuator, demanded) = if assisting {
+            (WalkingPlant::actuator(&deliverable), deliverable)
+        } else {
+            (Vector3::zeros(), Vector3::zeros())
+        };
+        last_link_torque = actuator + (human_torque + ground_torque) * 0.5;
         if k == 0 {
             period_start = state;
         }
@@ -231,7 +289,9 @@ pub fn run(cfg: &WalkingConfig) -> Result<WalkingRun, WalkingError> {
             k,
             reference,
             actuator,
+            demanded,
             human_torque,
+            ground_reaction,
             state: step.state.label(),
             right_mode: match step.state.mode(Leg::Right) {
                 LegMode::Swing => "swing",
@@ -250,18 +310,21 @@ pub fn run(cfg: &WalkingConfig) -> Result<WalkingRun, WalkingError> {
     let supervisor_faults = supervisor.fault_count();
     let filtered = filter_records(&pending_filter, cfg, &wearer, &segments)?;
     let (filter, table7, mean_nis) = (filtered.samples, filtered.table7, filtered.mean_nis);
-    let (control, table9, peak_actuator_torque) =
-        control_records(&pending_control, &trajectory.states, cfg, &wearer);
+    let control_summary = control_records(&pending_control, &trajectory.states, cfg, &wearer);
     let masses = summarize_masses(&filter, cfg, &segments, &wearer);
     Ok(WalkingRun {
         table7,
-        table9,
+        table9: control_summary.table9,
         masses,
         mean_nis,
-        peak_actuator_torque,
+        actuators: control_summary.actuators,
+        assistance: wearer.assistance.into(),
+        peak_joint_torque_demand: plant
+            .peak_joint_torque_demand(cfg.warmup, cfg.duration, samples + 1)
+            .into(),
         transitions,
         supervisor_faults,
         filter,
-        control,
+        control: control_summary.samples,
     })
 }

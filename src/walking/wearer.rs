@@ -14,29 +14,45 @@
 //! `s(τ) = 6τ⁵ − 15τ⁴ + 10τ³`, so that `q`, `q̇` and `q̈` stay continuous. The phase is the closed-form
 //! integral of the blended rate.
 //!
-//! # Insoles
+//! # Insoles and the body weight
 //!
-//! Heel (`F₁`) and ball (`F₂`) forces of each foot, half the body weight each in flat foot: heel only for
-//! the first 3 % of the cycle (heel strike, `P ≈ 1`), the ball loading by 7 % (heel flat, `P ≈ 0` within
-//! ±0.08), the heel unloading from 53 % to 57 % (heel off, `P ≈ −1`) and the ball unloading by toe-off
-//! at 62 %. Heel rise in normal gait starts near 40 % of the cycle (Winter 2009); it is put after the
-//! contralateral heel strike here because the automaton of Table 3 needs it: its events `p2`/`p4` require one
-//! foot in heel flat while the other strikes, and `p1`/`p3` one foot in heel off while the other is flat.
+//! Heel (`F₁`) and ball (`F₂`) force shapes of each foot: heel only for the first 3 % of the cycle (heel
+//! strike, `P ≈ 1`), the ball loading by 7 % (heel flat, `P ≈ 0` within ±0.08), the heel unloading from 53 %
+//! to 57 % (heel off, `P ≈ −1`) and the ball unloading by toe-off at 62 %. Heel rise in normal gait starts
+//! near 40 % of the cycle (Winter 2009); it is put after the contralateral heel strike here because the
+//! automaton of Table 3 needs it: its events `p2`/`p4` require one foot in heel flat while the other
+//! strikes, and `p1`/`p3` one foot in heel off while the other is flat.
 //!
-//! # Torso load (Eq. 2)
+//! The two feet carry the body weight `W` between them: each foot's shapes are scaled by
+//! `W / (total shape of both feet)`, so the insole totals add up to `W` at every instant and a foot's share
+//! ([`Wearer::support_share`]) rises from 0 to 1 over the loading response (double support, 0–12 % of its
+//! cycle), is 1 in single support and falls back to 0 over pre-swing (50–62 %). The scaling leaves the
+//! index `P` of Eq. (30), a ratio within one foot, unchanged.
 //!
-//! The torso mass rests on the stance leg's thigh: the load fraction rises from 0 to 1 over the loading
-//! response (double support, 0–12 %), stays 1 in single support and falls to 0 over pre-swing (50–62 %),
-//! with the quintic smoothstep.
+//! # Torso load and ground reaction (Eq. 2)
+//!
+//! The torso mass rests on the thigh of the leg that carries the body: the load fraction on the right thigh
+//! is the right foot's support share. The ground reaction on the right foot has the vertical component
+//! `W · share` and points from the ankle through the hip (the leg's axis: the inverted pendulum of walking,
+//! whose ground reaction points at the body's centre of mass), see [`super::plant::axial_reaction`].
 //!
 //! # Human torque
 //!
-//! The wearer's limbs follow `q_w`; the braces, a spring and damper per joint, pass
-//! `τ_h = K_b (q_w − q) + B_b (q̇_w − q̇)` to the lumped leg. The passive ankle gets no help from the
-//! exoskeleton, so at the ankle the wearer also supplies the inverse-dynamics torque along `q_w`.
+//! The wearer's muscles supply their share of the joint torque the gait needs, and the braces, a spring and
+//! damper per joint, pass their correction to the lumped leg:
+//!
+//! ```text
+//! τ_h = (1 − a(t)) ⊙ τ_gait(t) + K_b (q_w − q) + B_b (q̇_w − q̇)
+//! ```
+//!
+//! with `τ_gait` the torque the joints need along `q_w` (Eqs. 2–3 inverse dynamics minus the ground
+//! reaction's `Jᵀ R`, computed by [`super::plant::WalkingPlant::joint_torque_demand`]) and `a` the share the
+//! wearer leaves to the exoskeleton once it assists: zero at the passive ankle, and at the knee and hip
+//! what the motors can deliver (the scenario sizes it to their ratings, `scenario::sized_assistance`).
+//! The wearer hands that share over gradually, with the quintic smoothstep over [`ASSISTANCE_RAMP`]
+//! seconds from the onset of assistance.
 
 use super::anthropometry::{BODY_MASS, GRAVITY, TORSO_MASS};
-use super::plant::LegModel;
 use bgc_runtime::control::GrfSample;
 use bgc_runtime::noise::Rng;
 use nalgebra::Vector3;
@@ -76,6 +92,9 @@ pub const SHAPES_DEG: [[f64; 13]; 3] = [
 
 /// Fraction of the cycle in stance (heel strike at 0, toe-off here).
 pub const STANCE_FRACTION: f64 = 0.62;
+
+/// Seconds over which the wearer hands the assisted share of the torque to the exoskeleton.
+pub const ASSISTANCE_RAMP: f64 = 0.25;
 
 /// The quintic smoothstep and its first two derivatives at `τ ∈ [0, 1]` (clamped outside).
 fn smoothstep(tau: f64) -> (f64, f64, f64) {
@@ -135,6 +154,11 @@ pub struct WearerConfig {
     pub torso_mass: f64,
     /// Body weight (N), shared by the insoles.
     pub body_weight: f64,
+    /// Share of the gait torque per joint (ankle, knee, hip) the wearer leaves to the exoskeleton once it
+    /// assists, in `[0, 1]`.
+    pub assistance: [f64; 3],
+    /// When the exoskeleton starts assisting (s).
+    pub assistance_onset: f64,
 }
 
 impl Default for WearerConfig {
@@ -147,6 +171,8 @@ impl Default for WearerConfig {
             gains: HumanGains::default(),
             torso_mass: TORSO_MASS,
             body_weight: BODY_MASS * GRAVITY,
+            assistance: [0.0; 3],
+            assistance_onset: 0.0,
         }
     }
 }
@@ -163,6 +189,8 @@ pub struct Wearer {
     pub gains: HumanGains,
     pub torso_mass: f64,
     pub body_weight: f64,
+    pub assistance: Vector3<f64>,
+    pub assistance_onset: f64,
 }
 
 impl Wearer {
@@ -199,6 +227,8 @@ impl Wearer {
             gains: cfg.gains,
             torso_mass: cfg.torso_mass,
             body_weight: cfg.body_weight,
+            assistance: Vector3::from(cfg.assistance),
+            assistance_onset: cfg.assistance_onset,
         }
     }
 
@@ -275,22 +305,14 @@ impl Wearer {
         self.cycle_fraction(t, false) < STANCE_FRACTION
     }
 
-    /// Fraction of the torso load on the right thigh (0 in swing, 1 in single support).
+    /// Fraction of the torso load on the right thigh: the right foot's support share.
     pub fn torso_load(&self, t: f64) -> f64 {
-        let p = self.cycle_fraction(t, false);
-        if p < 0.12 {
-            smoothstep(p / 0.12).0
-        } else if p < 0.5 {
-            1.0
-        } else if p < STANCE_FRACTION {
-            1.0 - smoothstep((p - 0.5) / (STANCE_FRACTION - 0.5)).0
-        } else {
-            0.0
-        }
+        self.support_share(t)
     }
 
-    /// Noise-free insole forces of one foot at cycle fraction `p`.
-    pub fn insole(&self, p: f64) -> GrfSample {
+    /// Noise-free, unscaled insole force shapes of one foot at cycle fraction `p` (half the body weight on
+    /// each sensor in flat foot).
+    fn insole_shape(&self, p: f64) -> GrfSample {
         if !(0.0..STANCE_FRACTION).contains(&p) {
             return GrfSample {
                 heel: 0.0,
@@ -306,27 +328,55 @@ impl Wearer {
         }
     }
 
-    /// Noise-free insole forces of (right, left) feet at time `t`.
-    pub fn insoles(&self, t: f64) -> (GrfSample, GrfSample) {
-        (
-            self.insole(self.cycle_fraction(t, false)),
-            self.insole(self.cycle_fraction(t, true)),
-        )
+    /// The right foot's share of the body weight at time `t` (0 in swing, 1 in single support).
+    pub fn support_share(&self, t: f64) -> f64 {
+        let total = |g: GrfSample| g.heel + g.ball;
+        let right = total(self.insole_shape(self.cycle_fraction(t, false)));
+        let left = total(self.insole_shape(self.cycle_fraction(t, true)));
+        if right + left > 0.0 {
+            right / (right + left)
+        } else {
+            0.0
+        }
     }
 
-    /// The wearer's joint torque `τ_h` in state `(q, q̇)` at time `t`, for the leg `leg` (with its current
-    /// torso load).
+    /// Noise-free insole forces of (right, left) feet at time `t`: the shapes scaled so that both feet
+    /// together carry the body weight.
+    pub fn insoles(&self, t: f64) -> (GrfSample, GrfSample) {
+        let right = self.insole_shape(self.cycle_fraction(t, false));
+        let left = self.insole_shape(self.cycle_fraction(t, true));
+        let total = right.heel + right.ball + left.heel + left.ball;
+        let scale = if total > 0.0 {
+            self.body_weight / total
+        } else {
+            0.0
+        };
+        let scaled = |g: GrfSample| GrfSample {
+            heel: g.heel * scale,
+            ball: g.ball * scale,
+        };
+        (scaled(right), scaled(left))
+    }
+
+    /// The share of the gait torque the wearer leaves to the exoskeleton at time `t`.
+    pub fn assistance_at(&self, t: f64) -> Vector3<f64> {
+        let ramp = smoothstep((t - self.assistance_onset) / ASSISTANCE_RAMP).0;
+        self.assistance * ramp
+    }
+
+    /// The wearer's joint torque `τ_h` in state `(q, q̇)` at time `t`, given the joint torque `demand` the
+    /// gait needs at `t` along the wearer's own trajectory.
     pub fn human_torque(
         &self,
         t: f64,
         q: &Vector3<f64>,
         qd: &Vector3<f64>,
-        leg: &LegModel,
+        demand: &Vector3<f64>,
     ) -> Vector3<f64> {
         let w = self.intended(t);
         let steer = self.gains.stiffness.component_mul(&(w.q - q))
             + self.gains.damping.component_mul(&(w.qd - qd));
-        let ankle_feedforward = leg.torque(&w.q, &w.qd, &w.qdd)[0];
-        steer + Vector3::new(ankle_feedforward, 0.0, 0.0)
+        let own_share = Vector3::repeat(1.0) - self.assistance_at(t);
+        own_share.component_mul(demand) + steer
     }
 }

@@ -29,17 +29,34 @@
 //! dual filter of this form can learn them; a semi-implicit discretisation, a velocity or force measurement,
 //! or the paper's torque observation (Eq. 25) makes them observable.
 //!
-//! Both filters see the same measurement. The paper's own observation for the parameters is a joint torque
-//! (Eqs. 24–25); a model that measures such a quantity includes it in `y` and `h`.
+//! # Separate observations
+//!
+//! In the paper the two filters observe different things: the state filter the position sensors (Eq. 7),
+//! the parameter filter a torque output `d = Y(x, w) + e` (Eqs. 24–25). [`DualUkf::step_separate`] takes
+//! that form: the state filter updates with `y` through `h(x, u, w)` as above, and the parameter filter
+//! with its own observation `d` ([`ParameterObservation`], with the covariance `P_e` of `e`) through
+//! `Y(x̂, u, w)` evaluated at the state filter's new estimate `x̂`:
+//!
+//! 4'. sigma points `Wᵢ` of `(ŵ⁻, P_w⁻)`, `dᵢ = Y(x̂, u, Wᵢ)`, `S_d = Σ W⁽ᶜ⁾ (dᵢ − d̂)(dᵢ − d̂)ᵀ + P_e`,
+//!    `K_w = P_wd S_d⁻¹`, `ŵ = ŵ⁻ + K_w (d − d̂)`.
+//!
+//! This is the same recursion as running a second UKF on `w` with identity dynamics, process noise
+//! `(λ⁻¹ − 1) P_w` and measurement function `Y(x̂, u, ·)` after the state UKF's update (the unit tests check
+//! that equivalence). Without an observation `d` the parameters are held (no forgetting without data).
+//!
+//! In [`DualUkf::step`] both filters see the same measurement `y`; a model whose parameter observation is
+//! a separate quantity, such as the paper's torque, can also include it in `y` and `h` there, at the price
+//! of one innovation covariance for both.
 //!
 //! A non-finite measurement is rejected by both filters; the state is then the prediction and the parameters
 //! are left as they were (no forgetting without data). Each filter gates its own NIS. A step that returns an
 //! error changes nothing, also on a [`Parametric`] model (whose parameters are set to `ŵ` only when the step
 //! succeeds).
 
+use super::dense::symmetrise;
 use super::fault::{
     CovarianceRepair, EstimationError, FaultPolicy, UpdateOutcome, check_estimate,
-    repair_covariance,
+    check_positive_semidefinite, repair_covariance,
 };
 use super::sigma::{MeanFn, SigmaPoints, subtract, weighted_mean};
 use super::ukf::UnscentedKalmanFilter;
@@ -225,6 +242,29 @@ pub struct DualOutcome {
     pub state: UpdateOutcome,
     /// The parameter filter's measurement update.
     pub parameters: UpdateOutcome,
+}
+
+/// The parameter filter's own observation for [`DualUkf::step_separate`]: `d = Y(x, u, w) + e` (Eq. 24)
+/// with `e ~ N(0, P_e)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParameterObservation<const ND: usize> {
+    /// The observed output `d` (the paper's torque output of Eq. 25).
+    pub d: SVector<f64, ND>,
+    /// The covariance `P_e` of its error `e` (positive semi-definite; `S_d` must come out definite).
+    pub noise: SMatrix<f64, ND, ND>,
+}
+
+/// What a [`DualUkf::step_separate`] step did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SeparateOutcome<const ND: usize> {
+    /// A repair of the predicted state covariance.
+    pub state_prediction_repair: Option<CovarianceRepair>,
+    /// The state filter's measurement update.
+    pub state: UpdateOutcome,
+    /// The parameter filter's update; `None` when no parameter observation was given.
+    pub parameters: Option<UpdateOutcome>,
+    /// The parameter filter's innovation `d − d̂` (zero when it did not update).
+    pub parameter_innovation: SVector<f64, ND>,
 }
 
 /// A dual UKF over `NX` states and `NP` parameters (`NSX = 2 NX + 1`, `NSP = 2 NP + 1` sigma points).
@@ -425,6 +465,82 @@ impl<
         })
     }
 
+    /// One step with separate observations (module docs, "Separate observations"): the state filter
+    /// predicts with `f(x, u, w)` and updates with the measurement `y` through `h(x, u, w)`, both at the
+    /// prior parameters; then, if `observation` is given, the parameter filter forgets (Eq. 27) and updates
+    /// with `d` through `Y(x̂, u, w)` at the state filter's new estimate `x̂`. A non-finite `y` leaves the
+    /// state at its prediction; a non-finite `d` is rejected and leaves the parameters as they were (an
+    /// observation refused by the parameter filter's NIS gate keeps the forgetting, as in [`Self::step`]).
+    /// A step that returns an error changes nothing.
+    pub fn step_separate<const ND: usize, F, H, Y>(
+        &mut self,
+        u: &SVector<f64, NU>,
+        y: &SVector<f64, NY>,
+        observation: Option<&ParameterObservation<ND>>,
+        mut f: F,
+        mut h: H,
+        mut output: Y,
+    ) -> Result<SeparateOutcome<ND>, EstimationError>
+    where
+        F: FnMut(&SVector<f64, NX>, &SVector<f64, NU>, &SVector<f64, NP>) -> SVector<f64, NX>,
+        H: FnMut(&SVector<f64, NX>, &SVector<f64, NU>, &SVector<f64, NP>) -> SVector<f64, NY>,
+        Y: FnMut(&SVector<f64, NX>, &SVector<f64, NU>, &SVector<f64, NP>) -> SVector<f64, ND>,
+    {
+        check_input(u)?;
+        if let Some(obs) = observation {
+            check_positive_semidefinite("P_e", &obs.noise)?;
+        }
+        let w_prior = self.w;
+        let mut st = self.state.clone();
+        let state_prediction_repair = st.predict(u, |x, u| f(x, u, &w_prior))?;
+        let state = st.update(y, u, |x, u| h(x, u, &w_prior))?;
+
+        let mut w = w_prior;
+        let mut pw = self.pw;
+        let mut parameter_innovation = SVector::<f64, ND>::zeros();
+        let parameters = match observation {
+            None => None,
+            Some(obs) => match rejected_measurement(&obs.d) {
+                Some(rejected) => Some(rejected),
+                None => {
+                    pw /= self.forgetting;
+                    repair_covariance(&mut pw, self.param_policy.eigen_floor, FILTER)?;
+                    let x_post = *st.state();
+                    let wpts = self.param_points.generate(&w, &pw)?;
+                    let ds = evaluate_points("parameter observation function", |i| {
+                        output(&x_post, u, &wpts.column(i).into_owned())
+                    })?;
+                    let (d_hat, mut sd, pwd) = innovation_moments(
+                        &wpts,
+                        &w,
+                        subtract::<NP>,
+                        &ds,
+                        &SpaceFns::default(),
+                        Some(&obs.noise),
+                        &self.param_points,
+                    );
+                    symmetrise(&mut sd);
+                    let e = obs.d - d_hat;
+                    let (outcome, _) =
+                        kalman_correct(&mut w, &mut pw, &e, &sd, &pwd, &self.param_policy, FILTER)?;
+                    if outcome.is_accepted() {
+                        parameter_innovation = e;
+                    }
+                    Some(outcome)
+                }
+            },
+        };
+        self.state = st;
+        self.w = w;
+        self.pw = pw;
+        Ok(SeparateOutcome {
+            state_prediction_repair,
+            state,
+            parameters,
+            parameter_innovation,
+        })
+    }
+
     /// [`Self::step`] on a [`DiscreteModel`] + [`Parametric`] model, estimating its parameters `indices`
     /// (in the order of `w`). On success the model holds the new parameter estimate.
     pub fn step_parametric<M>(
@@ -488,3 +604,6 @@ impl<
         &self.param_innovation
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -281,3 +281,32 @@ fn generated_model_matches_the_euler_lagrange_derivation() {
         }
     }
 }
+
+/// The worn leg of the walking study (simulated on the generated model) against the hand-derived model with the
+/// same torques, torso load and ground reaction, along the synthetic wearer's gait.
+#[test]
+fn walking_plant_on_the_generated_model_matches_the_hand_model() {
+    use bgc_runtime::model::ContinuousModel;
+    use bgc_workspace::walking::plant::{LegModel, WalkingPlant, join};
+    use bgc_workspace::walking::wearer::{Wearer, WearerConfig};
+    let plant = WalkingPlant {
+        leg: LegModel::new(LegSegments::paper_subject(), LegFriction::table8_right()),
+        wearer: Wearer::new(&WearerConfig::default()),
+    };
+    let mut rng = Rng::new(23);
+    for k in 0..200 {
+        let t = 0.01 * k as f64;
+        let w = plant.wearer.intended(t);
+        let x = join(&w.q, &w.qd) + nalgebra::Vector6::from_fn(|_, _| 0.05 * rng.normal());
+        let u = Vector3::new(0.0, 30.0 * rng.normal(), 60.0 * rng.normal());
+        let mut dx = nalgebra::Vector6::zeros();
+        plant.rhs(t, &x, &u, &mut dx);
+        let (q, _) = bgc_workspace::walking::plant::split(&x);
+        let torque =
+            WalkingPlant::actuator(&u) + plant.human_torque(t, &x) + plant.ground_torque(t, &q);
+        let want = plant.leg_at(t).derivative(&x, &torque);
+        for i in 0..6 {
+            assert_close(dx[i], want[i], want.amax(), &format!("t = {t}: rate {i}"));
+        }
+    }
+}

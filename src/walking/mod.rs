@@ -4,8 +4,9 @@
 //! run against a synthetic wearer.
 //!
 //! - [`anthropometry`]: segment parameters and joint friction;
-//! - [`dynamics`]: the hand-derived Euler–Lagrange model `M(q)`, `C(q, q̇)`, `G(q)` (the reference that the
-//!   model generated from `models/walking_leg.bg` will be tested against; until then it is the plant);
+//! - [`dynamics`]: the hand-derived Euler–Lagrange model `M(q)`, `C(q, q̇)`, `G(q)`: the estimator's and the
+//!   controller's model, and the independent reference of the equations bgc derives from `models/walking_leg.bg`;
+//! - [`generated`]: the simulated leg on the model generated from `models/walking_leg.bg`;
 //! - [`plant`]: the leg as a runtime `ContinuousModel`, alone and worn by the wearer;
 //! - [`wearer`]: the synthetic wearer (trajectories, insoles, torso load, human torque);
 //! - [`estimator`]: the dual UKF;
@@ -16,6 +17,7 @@ pub mod anthropometry;
 mod config;
 pub mod dynamics;
 pub mod estimator;
+pub mod generated;
 pub mod plant;
 mod records;
 pub mod reference;

@@ -3,7 +3,8 @@
 //! [`LegModel`]: `M(q) q̈ + C(q, q̇) q̇ + G(q) + τ_f(q, q̇) = u`, where `u = τ_a + τ_h − Jᵀ F` is the total
 //! generalised torque of Eq. (8) and the output is `q` (the joint position sensors).
 //!
-//! [`WalkingPlant`]: the same leg worn by the synthetic wearer of [`super::wearer`]. The input is the
+//! [`WalkingPlant`]: the same leg worn by the synthetic wearer of [`super::wearer`], simulated on the model
+//! generated from `models/walking_leg.bg` ([`super::generated`]). The input is the
 //! exoskeleton's actuator command; the motors deliver it up to their rated torques
 //! ([`MOTOR_PEAK_TORQUE`], the passive ankle none). The wearer adds the human torque `τ_h(t, x)`, loads the
 //! thigh with the torso in stance and stands on the foot, whose ground reaction `R` enters as `Jᵀ R` (Eq. 2):
@@ -169,12 +170,15 @@ pub struct WalkingPlant {
 }
 
 impl WalkingPlant {
+    /// The torso mass (kg) on the thigh at time `t`.
+    pub fn thigh_load(&self, t: f64) -> f64 {
+        self.wearer.torso_load(t) * self.wearer.torso_mass
+    }
+
     /// The leg at time `t`, with the torso load the wearer carries on it then.
     pub fn leg_at(&self, t: f64) -> LegModel {
         let mut leg = self.leg;
-        leg.dynamics = leg
-            .dynamics
-            .with_thigh_load(self.wearer.torso_load(t) * self.wearer.torso_mass);
+        leg.dynamics = leg.dynamics.with_thigh_load(self.thigh_load(t));
         leg
     }
 
@@ -241,10 +245,17 @@ impl WalkingPlant {
 }
 
 impl ContinuousModel<6, 3, PLANT_OUTPUTS> for WalkingPlant {
+    /// The leg's motion from the model generated from `models/walking_leg.bg` ([`super::generated`]).
     fn rhs(&self, t: f64, x: &Vector6<f64>, u: &Vector3<f64>, dx: &mut Vector6<f64>) {
         let (q, _) = split(x);
-        let torque = Self::actuator(u) + self.human_torque(t, x) + self.ground_torque(t, &q);
-        *dx = self.leg_at(t).derivative(x, &torque);
+        *dx = super::generated::derivative(
+            &self.leg,
+            self.thigh_load(t),
+            x,
+            &Self::actuator(u),
+            &self.human_torque(t, x),
+            &self.ground_reaction(t, &q),
+        );
     }
     fn outputs(
         &self,

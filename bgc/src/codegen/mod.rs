@@ -14,6 +14,8 @@
 
 mod adapter;
 mod emit;
+mod format;
+mod layout;
 mod names;
 pub mod rust;
 

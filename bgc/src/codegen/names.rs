@@ -8,10 +8,46 @@
 
 use std::collections::HashSet;
 
-/// The identifiers the generated functions use for themselves.
+/// The identifiers the generated functions use for themselves, and the constants of the module (a `let` cannot
+/// shadow a constant).
 pub const RESERVED: &[&str] = &[
-    "p", "t", "x", "u", "dx", "y", "jac", "v", "a", "b", "c", "d", "params", "index", "value",
-    "out", "terms", "bgc_sign", "bgc_min", "bgc_max",
+    "p",
+    "t",
+    "x",
+    "u",
+    "dx",
+    "y",
+    "jac",
+    "v",
+    "a",
+    "b",
+    "c",
+    "d",
+    "params",
+    "index",
+    "value",
+    "values",
+    "name",
+    "next",
+    "out",
+    "terms",
+    "bgc_sign",
+    "bgc_min",
+    "bgc_max",
+    "bgc_powi",
+    "libm",
+    "core",
+    "N_STATES",
+    "N_ENERGY_STATES",
+    "N_INPUTS",
+    "N_OUTPUTS",
+    "N_PARAMS",
+    "N_COORDS",
+    "STATE_NAMES",
+    "INPUT_NAMES",
+    "OUTPUT_NAMES",
+    "PARAM_NAMES",
+    "COORD_NAMES",
 ];
 
 const KEYWORDS: &[&str] = &[

@@ -30,8 +30,9 @@ fn bgc_max(a: f64, b: f64) -> f64 {
     }
 }
 
-/// `x^n` by binary powering: the same multiplications in the same order on every platform
-/// (`f64::powi` is not in `core` and leaves the order to the compiler); `1 / x^|n|` for `n < 0`.
+/// `x^n` by binary powering (`1 / x^-n` for `n < 0`): the same multiplications in the same
+/// order on every platform (`f64::powi` is not in `core` and leaves their order to the
+/// compiler).
 #[inline]
 fn bgc_powi(x: f64, n: i32) -> f64 {
     let mut base = x;

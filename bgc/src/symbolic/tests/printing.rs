@@ -153,6 +153,8 @@ fn only_the_helpers_a_piece_of_code_calls_are_picked() {
     assert!(picked.starts_with("/// `sign(x)`"), "{picked}");
     assert!(picked.contains("fn bgc_sign(") && picked.contains("fn bgc_powi("));
     assert!(!picked.contains("fn bgc_min(") && !picked.contains("fn bgc_max("));
+    // Generated modules indent them by four spaces inside a `pub mod`: they must fit in 96 columns.
+    assert!(RUST_HELPERS.lines().all(|l| l.chars().count() <= 96));
     // All four, in file order, give the file back.
     let all = rust_helpers_used("bgc_sign( bgc_min( bgc_max( bgc_powi(");
     assert_eq!(all.trim_end(), RUST_HELPERS.trim_end());

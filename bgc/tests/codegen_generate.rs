@@ -1,6 +1,8 @@
 //! The text of generated modules: one module per model when a file has several, identifiers made valid,
 //! deterministic output, and the readable form with the equation above each line.
 
+mod codegen_support;
+
 use bgc::codegen::{self, rust};
 use bgc::lower::MemoryLoader;
 use bgc::span::SourceMap;
@@ -231,4 +233,30 @@ fn long_expressions_become_let_lines_under_their_equation() {
         .position(|l| l.trim_start().starts_with("// ∂(d/dt p_mass_x)/∂theta = "))
         .unwrap_or_else(|| panic!("{code}"));
     assert!(lines[start + 1].trim_start().starts_with("//     "));
+}
+
+#[test]
+fn energy_is_a_sum_of_named_terms_or_a_running_total_for_many_terms() {
+    let energy = |code: &str| {
+        let start = code.find("pub fn stored_energy").unwrap_or_default();
+        let end = code[start..]
+            .find("\n}\n")
+            .map_or(code.len(), |e| start + e);
+        code[start..end].to_string()
+    };
+    // Ten masses: 19 storages, one `let` each, then their sum.
+    let small = energy(&generate(&codegen_support::chain(10)));
+    assert!(
+        small.contains(
+            "    // mass0: 0.5*p_mass0^2/m0\n    let mass0 = 0.5 * bgc_powi(p_mass0, 2) / p.m0;\n"
+        ),
+        "{small}"
+    );
+    // (The 19-term sum takes two lines: its first part is bound to a temporary.)
+    assert!(small.contains(" = mass0 + spring0 + mass1 + "), "{small}");
+    // 130 masses: 259 storages, more than a function's `let`s: a running total in the same order.
+    let large = energy(&generate(&codegen_support::chain(130)));
+    assert!(large.contains("    // mass0: 0.5*p_mass0^2/m0\n    let mut total = 0.5 * bgc_powi(p_mass0, 2) / p.m0;\n"), "{large}");
+    assert_eq!(large.matches("    total += ").count(), 258);
+    assert!(large.ends_with("    total"), "{large}");
 }

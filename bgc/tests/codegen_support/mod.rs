@@ -1,5 +1,6 @@
 //! The models the generated-code tests run on: every `.bg` file of `models/` and of the compiler's corpus that
-//! compiles, and a file with two models and long names (the layout inside `pub mod`s).
+//! compiles, a file with two models and long names (the layout inside `pub mod`s) and a chain of 130 masses (the
+//! forms large models take).
 #![allow(dead_code)]
 
 use bgc::codegen::{self, rust};
@@ -48,6 +49,38 @@ model second {
     bond supply -> loop -> r, cap;
 }
 "#;
+
+/// A chain of `n` masses joined by springs and dampers, pushed at one end: `2n - 1` storages, so that for
+/// `n > 128` the stored energy has more terms than one function gets `let`s.
+pub fn chain(n: usize) -> String {
+    let mut text = String::from(
+        "model chain {\n    domain translational;\n    input F [N];\n    Se push = F;\n",
+    );
+    for i in 0..n {
+        text.push_str(&format!(
+            "    param m{i} = {} [kg];\n    I mass{i} = m{i};\n    1 v{i};\n",
+            1.0 + 0.01 * i as f64
+        ));
+        if i + 1 < n {
+            text.push_str(&format!(
+                "    param k{i} = {} [N/m];\n    C spring{i} = 1/k{i};\n    R damper{i} = 0.5;\n    0 j{i};\n    1 rel{i};\n",
+                100 + i
+            ));
+        }
+    }
+    text.push_str("    bond push -> v0;\n");
+    for i in 0..n {
+        text.push_str(&format!("    bond v{i} -> mass{i};\n"));
+        if i + 1 < n {
+            text.push_str(&format!(
+                "    bond v{i} -> j{i};\n    bond j{i} -> v{};\n    bond j{i} -> rel{i} -> spring{i}, damper{i};\n",
+                i + 1
+            ));
+        }
+    }
+    text.push_str("    output x0 [m/s] = f(v0);\n}\n");
+    text
+}
 
 /// The files the models crate generates (which must compile).
 pub const MODELS_CRATE: [&str; 14] = [
@@ -103,19 +136,26 @@ pub fn generated_modules(runtime: bool) -> Vec<(String, String)> {
             "{must} does not compile"
         );
     }
+    for (name, text) in [
+        ("two_models.bg", TWO_MODELS.to_string()),
+        ("chain.bg", chain(130)),
+    ] {
+        out.push((name.to_string(), generate_text(name, &text, options)));
+    }
+    out
+}
+
+/// The module generated from `text` (named `name`); panics with the diagnostics if it does not compile.
+pub fn generate_text(name: &str, text: &str, options: rust::Options) -> String {
     let mut sources = SourceMap::new();
-    let id = sources.add("two_models.bg", TWO_MODELS);
+    let id = sources.add(name, text);
     match codegen::compile(&mut sources, id, &mut MemoryLoader::new()) {
-        Ok(compiled) => out.push((
-            "two_models.bg".into(),
-            rust::generate_with(&compiled, "two_models.bg", options),
-        )),
+        Ok(compiled) => rust::generate_with(&compiled, name, options),
         Err(diags) => panic!(
             "{}",
             bgc::diagnostic::render::to_text(&sources, &diags, false)
         ),
     }
-    out
 }
 
 /// A fresh directory for one test.

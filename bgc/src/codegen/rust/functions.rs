@@ -3,7 +3,7 @@
 //! inputs, parameters and time it calls (`let cos_theta = libm::cos(theta);`, computed once: the same call gives the
 //! same bits), then computes its statements, each under the equation it computes.
 
-use super::super::emit::{Block, StateSpace};
+use super::super::emit::{Block, MAX_LETS, StateSpace};
 use super::super::layout::Body;
 use super::super::names::{Namer, comment};
 use super::{Arg, Function, Uses, Writer, output_names};
@@ -519,17 +519,12 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             match terms.as_slice() {
                 [] => d.lines.push("    0.0".into()),
                 [(element, e)] => self.statement(&mut d, &format!("{element}: "), e, "", ""),
-                many => {
+                many if many.len() <= MAX_LETS => {
                     let mut parts = Vec::with_capacity(many.len());
                     for (element, e) in many {
                         let local = d.namer.ident(element);
-                        self.statement(
-                            &mut d,
-                            &format!("{element}: "),
-                            e,
-                            &format!("let {local} = "),
-                            ";",
-                        );
+                        let head = format!("let {local} = ");
+                        self.statement(&mut d, &format!("{element}: "), e, &head, ";");
                         d.locals.push(local.clone());
                         parts.push(RustCode::Atom(local));
                     }
@@ -540,6 +535,20 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
                         iter.map(|p| (crate::symbolic::RustOp::Add, p)).collect(),
                     );
                     self.statement_code(&mut d, Vec::new(), &sum, "", "");
+                }
+                // One `let` per element would nest too many scopes for rustc (see `MAX_LETS`): a running total
+                // instead, added in the same order.
+                many => {
+                    let total = d.namer.ident("total");
+                    for (k, (element, e)) in many.iter().enumerate() {
+                        let head = if k == 0 {
+                            format!("let mut {total} = ")
+                        } else {
+                            format!("{total} += ")
+                        };
+                        self.statement(&mut d, &format!("{element}: "), e, &head, ";");
+                    }
+                    d.lines.push(format!("    {total}"));
                 }
             }
             self.function(Function {

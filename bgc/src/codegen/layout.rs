@@ -223,7 +223,7 @@ impl<'n> Body<'n> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::codegen::format::{TestRng, assert_rustfmt_stable};
+    use crate::codegen::test_support::{TestRng, assert_rustfmt_stable};
     use crate::symbolic::RustOp;
 
     fn atom(s: &str) -> RustCode {

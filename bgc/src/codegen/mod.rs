@@ -20,6 +20,8 @@ mod format;
 mod layout;
 mod names;
 pub mod rust;
+#[cfg(test)]
+mod test_support;
 
 pub use adapter::{AdaptError, to_symbolic};
 

@@ -27,7 +27,8 @@
 //! The text is what `rustfmt --edition 2024` makes of it and no line is longer than 100 columns: statements too
 //! long for a line bind parts of their expression to `let`s first ([`super::layout`]), comments and documentation
 //! are wrapped ([`super::format`]), lists and signatures take `rustfmt`'s layout. Each statement of a body has the
-//! equation it computes in a comment above it (and above the `let`s it needs).
+//! equation it computes in a comment above it (and above the `let`s it needs). Two things can make a line longer:
+//! the header, which holds the source path as given, and a single name or number wider than a line.
 //!
 //! # Lints
 //! The code passes `clippy -D warnings`. An unused argument is named `_x`. Only two lints are allowed, and only on
@@ -35,6 +36,7 @@
 //! `clippy::approx_constant` where a number of the model (three or more significant digits) could be taken for a
 //! rounded `π`, `e`, ...: the number is what the model file says. A comment at the top of such a file says so.
 
+mod calls;
 mod functions;
 mod model;
 mod params;
@@ -336,7 +338,14 @@ impl<'a> Writer<'a> {
         self.params();
         self.functions();
         self.model();
-        let helpers = rust_helpers_used(&self.out);
+        // The helpers the code calls (comments and documentation, the model's text, left out).
+        let code: String = self
+            .out
+            .lines()
+            .filter(|l| !l.trim_start().starts_with("//"))
+            .collect::<Vec<_>>()
+            .join("\n");
+        let helpers = rust_helpers_used(&code);
         let mut out = String::from("use nalgebra::{SMatrix, SVector};\n");
         if !helpers.is_empty() {
             out.push('\n');

@@ -121,8 +121,8 @@ pub fn generate_with(file: &CompiledFile, source_name: &str, options: Options) -
             0,
             "//",
             "Allowed lints: `non_snake_case` where local names are the model's (`J_m`), \
-             `clippy::approx_constant` where a number of the model could be taken for a rounded constant \
-             (the number is the model's).",
+             `clippy::approx_constant` where a number of the model, as written or folded (`2*pi`), looks \
+             like one of `core::f64::consts` (the number is the model's).",
             Wrap::Prose,
             MAX_WIDTH,
         ) {

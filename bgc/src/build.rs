@@ -4,6 +4,7 @@
 //! ```toml
 //! [dependencies]
 //! bgc-runtime = { path = "../runtime" }
+//! libm = "0.2"
 //! nalgebra = "0.34"
 //!
 //! [build-dependencies]
@@ -22,6 +23,23 @@
 //! // src/lib.rs: the module of `back_support.bg` is `$OUT_DIR/back_support.rs`.
 //! pub mod back_support {
 //!     include!(concat!(env!("OUT_DIR"), "/back_support.rs"));
+//! }
+//! ```
+//!
+//! The generated functions call `libm` for the elementary functions (`sin`, `exp`, ...), so that they need only
+//! `core`. For a `#![no_std]` crate, leave out the runtime's trait implementations with [`Config::runtime`]:
+//!
+//! ```toml
+//! [dependencies]
+//! libm = "0.2"
+//! nalgebra = { version = "0.34", default-features = false }
+//! ```
+//!
+//! ```no_run
+//! // build.rs of a `#![no_std]` crate
+//! fn main() -> Result<(), bgc::build::Error> {
+//!     bgc::build::Config::new().runtime(false).compile(&["back_support.bg"])?;
+//!     Ok(())
 //! }
 //! ```
 //!
@@ -82,6 +100,7 @@ pub struct Generated {
 pub struct Config {
     out_dir: Option<PathBuf>,
     cargo_output: bool,
+    options: codegen::rust::Options,
 }
 
 impl Default for Config {
@@ -96,7 +115,16 @@ impl Config {
         Config {
             out_dir: None,
             cargo_output: true,
+            options: codegen::rust::Options::default(),
         }
+    }
+
+    /// Whether the generated modules implement `bgc_runtime`'s `ContinuousModel` and `Parametric` for `Model` and
+    /// use its `ParamError` (default: true, and the crate depends on `bgc-runtime`). Without them a module needs
+    /// only `core`, `nalgebra` (without its `std` feature) and `libm`, and builds in a `#![no_std]` crate.
+    pub fn runtime(&mut self, on: bool) -> &mut Config {
+        self.options.runtime = on;
+        self
     }
 
     /// Writes the generated files to `dir` (created if missing) instead of `OUT_DIR`.
@@ -204,7 +232,8 @@ impl Config {
                 println!("cargo:warning={}", one_line(&sources, d));
             }
         }
-        let code = codegen::rust::generate(&compiled, &source.display().to_string());
+        let code =
+            codegen::rust::generate_with(&compiled, &source.display().to_string(), self.options);
         let written = write_if_changed(output, &code)?;
         Ok(Generated {
             source: source.to_path_buf(),

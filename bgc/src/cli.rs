@@ -177,7 +177,13 @@ enum Command {
         atol: f64,
     },
     /// Print the Rust module that `bgc::build` generates for FILE (the same text, byte for byte).
-    Rust { file: PathBuf },
+    Rust {
+        file: PathBuf,
+        /// Leave out the `bgc_runtime` trait implementations (and use a module-local `ParamError`), as
+        /// `bgc::build::Config::runtime(false)` does: the module then needs only core, nalgebra and libm.
+        #[arg(long)]
+        no_runtime: bool,
+    },
     /// Print .bg files in the canonical layout (in place), or with --check report the files that differ.
     Fmt {
         #[arg(required = true)]
@@ -209,7 +215,7 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
     };
     let status = match cli.command {
         Command::Check { files, format } => commands::check(&files, format, color),
-        Command::Rust { file } => commands::rust(&file, color),
+        Command::Rust { file, no_runtime } => commands::rust(&file, !no_runtime, color),
         Command::Fmt { files, check } => commands::fmt(&files, check, color),
         Command::Causality {
             file,

@@ -24,8 +24,9 @@
 //! `s = sign(a - b)`, i.e. the derivative of the active argument and the mean of both where `a = b`.
 //!
 //! Evaluation and generated code share conventions: `sign(0) = 0`, `min`/`max` propagate NaN, `x^n` for integer
-//! constants is `powi`, `x^0.5` is `sqrt`; sums and products are computed in the order they print, so
-//! [`Expr::eval`] and the code printed by [`to_rust`] give the same bits.
+//! constants is binary powering, `x^0.5` is `sqrt`, the elementary functions are the `libm` crate's; sums and
+//! products are computed in the order they print, so [`Expr::eval`] and the code printed by [`to_rust`] give the
+//! same bits on every platform.
 //!
 //! # Representation
 //! Nodes are shared behind `Arc` with a cached structural hash, rather than interned in an arena. Expressions here
@@ -40,7 +41,7 @@
 //! - [`Expr::substitute`], [`Expr::diff`], [`Expr::jacobian`], [`Expr::eval`], [`Expr::free_symbols`],
 //!   [`Expr::expand`], [`Expr::linear_form`];
 //! - [`solve_linear`] for small linear systems;
-//! - printers [`to_text`] (also `Display`), [`to_latex`], [`to_rust`];
+//! - printers [`to_text`] (also `Display`), [`to_latex`], [`to_rust`] (and [`to_rust_code`], its tree);
 //! - [`from_ir`] from the IR's expressions.
 
 mod build;
@@ -62,6 +63,9 @@ pub use expr::{Expr, Node, Symbol, SymbolKind};
 pub use from_ir::from_ir;
 pub use linear::{LinearForm, MAX_EXPANDED_POWER, MAX_EXPANDED_TERMS};
 pub use print::latex::{latex_symbol, to_latex, to_latex_with};
-pub use print::rust::{RUST_HELPERS, RUST_MAX_FN, RUST_MIN_FN, RUST_SIGN_FN, to_rust};
+pub use print::rust::{
+    RUST_HELPERS, RUST_MAX_FN, RUST_MIN_FN, RUST_POWI_FN, RUST_SIGN_FN, RustCode, RustOp,
+    rust_helpers_used, to_rust, to_rust_code,
+};
 pub use print::text::{to_text, to_text_with};
 pub use solve::{LinearSolution, MAX_SOLVE_SIZE, solve_linear};

@@ -294,3 +294,30 @@ fn rust_command_prints_what_the_build_script_generates() {
     );
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// `bgc rust --no-runtime FILE` prints what `Config::runtime(false)` writes: no `bgc_runtime` in it.
+#[test]
+fn rust_command_without_the_runtime() {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/rehab_leg.bg");
+    let model = model.canonicalize().unwrap_or(model);
+    let name = model.display().to_string();
+    let run = bgc(&fixtures_dir(), &["rust", "--no-runtime", &name]);
+    assert_eq!(run.status, 0, "{}", run.transcript());
+    let out = scratch("rust-no-runtime");
+    let generated = bgc::build::Config::new()
+        .out_dir(&out)
+        .cargo_output(false)
+        .runtime(false)
+        .compile(&[&model])
+        .unwrap_or_else(|e| panic!("{e}"));
+    let written = std::fs::read_to_string(&generated[0].output).unwrap_or_default();
+    assert_eq!(run.stdout, written);
+    assert!(!written.contains("bgc_runtime"), "{written}");
+    assert!(written.contains("pub enum ParamError {"));
+    let with = bgc(&fixtures_dir(), &["rust", &name]);
+    assert!(
+        with.stdout
+            .contains("impl bgc_runtime::model::Parametric for Model {")
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}

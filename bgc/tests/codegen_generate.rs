@@ -1,15 +1,22 @@
 //! The text of generated modules: one module per model when a file has several, identifiers made valid,
 //! deterministic output, and the readable form with the equation above each line.
 
+mod codegen_support;
+
 use bgc::codegen::{self, rust};
 use bgc::lower::MemoryLoader;
 use bgc::span::SourceMap;
+use rust::Options;
 
 fn generate(text: &str) -> String {
+    generate_with(text, Options::default())
+}
+
+fn generate_with(text: &str, options: Options) -> String {
     let mut sources = SourceMap::new();
     let root = sources.add("test.bg", text);
     match codegen::compile(&mut sources, root, &mut MemoryLoader::new()) {
-        Ok(file) => rust::generate(&file, "test.bg"),
+        Ok(file) => rust::generate_with(&file, "test.bg", options),
         Err(diags) => panic!(
             "{}",
             bgc::diagnostic::render::to_text(&sources, &diags, false)
@@ -92,4 +99,164 @@ fn the_header_names_the_version_source_and_hash() {
             rust::BGC_VERSION
         )
     );
+}
+
+#[test]
+fn without_the_runtime_the_module_has_its_own_param_error_and_no_runtime_impls() {
+    let with = generate(TWO_MODELS);
+    assert!(with.contains("    pub use bgc_runtime::model::ParamError;\n"));
+    assert!(with.contains(
+        "impl bgc_runtime::model::ContinuousModel<N_STATES, N_INPUTS, N_OUTPUTS> for Model {"
+    ));
+    assert!(with.contains("impl bgc_runtime::model::Parametric for Model {"));
+    let without = generate_with(TWO_MODELS, Options { runtime: false });
+    assert!(!without.contains("bgc_runtime"), "{without}");
+    assert_eq!(without.matches("    pub enum ParamError {").count(), 2);
+    assert!(without.contains("    impl core::fmt::Display for ParamError {"));
+    // The model functions (from `rhs_into` to the energy) are the same text either way.
+    let functions = |code: &str| {
+        code.split("/// Writes the state derivative")
+            .skip(1)
+            .map(|rest| {
+                rest.split("/// Model `")
+                    .next()
+                    .unwrap_or_default()
+                    .to_string()
+            })
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(functions(&with).len(), 2);
+    assert_eq!(functions(&with), functions(&without));
+}
+
+/// A rigid pendulum as a rotational inertia under the gravity torque `-m g l sin(theta)`.
+const PENDULUM: &str = r#"
+model pendulum {
+    domain rotational;
+    param m = 1 [kg];
+    param l = 0.5 [m];
+    param g = 9.81 [m/s^2];
+    param b = 0.01 [N m s/rad];
+    var theta [rad] = int(f(pivot));
+    I bob = m * l^2;
+    MSe weight = -m * g * l * sin(theta);
+    R friction = b;
+    1 pivot;
+    bond weight -> pivot -> bob, friction;
+}
+"#;
+
+#[test]
+fn elementary_functions_are_libm_calls_bound_once() {
+    let code = generate(PENDULUM);
+    // No std method, only libm: sin(theta) computed once at the top of each body that needs it.
+    for method in [".sin()", ".cos()", ".powi(", ".powf(", ".sqrt()"] {
+        assert!(!code.contains(method), "{method} in\n{code}");
+    }
+    assert!(
+        code.contains("    let sin_theta = libm::sin(theta);\n"),
+        "{code}"
+    );
+    assert_eq!(
+        code.matches("libm::sin(theta)").count(),
+        code.matches("let sin_theta").count()
+    );
+    // The gravity torque uses it, with the equation above; its derivative uses the cosine.
+    assert!(
+        code.contains(
+            "    // e_weight = -g*l*m*sin(theta)\n    let e_weight = -p.g * p.l * p.m * sin_theta;\n"
+        ),
+        "{code}"
+    );
+    assert!(
+        code.contains(
+            "    // ∂(d/dt p_bob)/∂theta = -g*l*m*cos(theta)\n    jac[(0, 1)] = -p.g * p.l * p.m * cos_theta;\n"
+        ),
+        "{code}"
+    );
+}
+
+#[test]
+fn unused_arguments_are_named_with_an_underscore() {
+    let code = generate(PENDULUM);
+    // No input and no time: `_u`, `_t`; the output depends on theta only, not on the parameters' p_bob.
+    assert!(
+        code.contains(
+            "pub fn rhs_into(p: &Params, _t: f64, x: &State, _u: &Inputs, dx: &mut State) {"
+        ),
+        "{code}"
+    );
+    assert!(
+        code.contains(
+            "pub fn jac_u_into(_p: &Params, _t: f64, _x: &State, _u: &Inputs, jac: &mut JacU) {"
+        ),
+        "{code}"
+    );
+    assert!(!code.contains("#[allow(unused"), "{code}");
+}
+
+#[test]
+fn long_expressions_become_let_lines_under_their_equation() {
+    // The corpus pendulum's Jacobian has entries of several hundred characters.
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/corpus/pendulum.bg");
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let code = generate(&text);
+    let lines: Vec<&str> = code.lines().collect();
+    assert!(lines.iter().all(|l| l.chars().count() <= 100));
+    let is_temporary = |l: &str| {
+        l.strip_prefix("let t")
+            .and_then(|rest| rest.split(' ').next())
+            .is_some_and(|n| !n.is_empty() && n.chars().all(|c| c.is_ascii_digit()))
+    };
+    // Every temporary comes after an equation comment and before the statement that uses it.
+    let mut in_block = false;
+    let mut temporaries = 0;
+    for (k, l) in lines.iter().enumerate() {
+        let l = l.trim();
+        if l.starts_with("// ") {
+            in_block = true;
+        } else if is_temporary(l) {
+            assert!(
+                in_block,
+                "line {}: a temporary outside a commented block",
+                k + 1
+            );
+            temporaries += 1;
+        } else if l.ends_with(';') && !l.starts_with("let ") {
+            in_block = false;
+        }
+    }
+    assert!(temporaries > 10, "{code}");
+    // The equation of the longest entry is in the comment, wrapped over several lines.
+    let start = lines
+        .iter()
+        .position(|l| l.trim_start().starts_with("// ∂(d/dt p_mass_x)/∂theta = "))
+        .unwrap_or_else(|| panic!("{code}"));
+    assert!(lines[start + 1].trim_start().starts_with("//     "));
+}
+
+#[test]
+fn energy_is_a_sum_of_named_terms_or_a_running_total_for_many_terms() {
+    let energy = |code: &str| {
+        let start = code.find("pub fn stored_energy").unwrap_or_default();
+        let end = code[start..]
+            .find("\n}\n")
+            .map_or(code.len(), |e| start + e);
+        code[start..end].to_string()
+    };
+    // Ten masses: 19 storages, one `let` each, then their sum.
+    let small = energy(&generate(&codegen_support::chain(10)));
+    assert!(
+        small.contains(
+            "    // mass0: 0.5*p_mass0^2/m0\n    let mass0 = 0.5 * bgc_powi(p_mass0, 2) / p.m0;\n"
+        ),
+        "{small}"
+    );
+    // (The 19-term sum takes two lines: its first part is bound to a temporary.)
+    assert!(small.contains(" = mass0 + spring0 + mass1 + "), "{small}");
+    // 130 masses: 259 storages, more than a function's `let`s: a running total in the same order.
+    let large = energy(&generate(&codegen_support::chain(130)));
+    assert!(large.contains("    // mass0: 0.5*p_mass0^2/m0\n    let mut total = 0.5 * bgc_powi(p_mass0, 2) / p.m0;\n"), "{large}");
+    assert_eq!(large.matches("    total += ").count(), 258);
+    assert!(large.ends_with("    total"), "{large}");
 }

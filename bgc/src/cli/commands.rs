@@ -257,8 +257,9 @@ pub fn draw(
     Status::Ok
 }
 
-/// `bgc rust FILE`: the generated Rust module on standard output.
-pub fn rust(path: &Path, color: bool) -> Status {
+/// `bgc rust [--no-runtime] FILE`: the generated Rust module on standard output (`runtime`: with the
+/// `bgc_runtime` trait implementations).
+pub fn rust(path: &Path, runtime: bool, color: bool) -> Status {
     let mut sources = SourceMap::new();
     let (id, decode_diag) = match read_source(&mut sources, path) {
         Ok(x) => x,
@@ -275,7 +276,10 @@ pub fn rust(path: &Path, color: bool) -> Status {
         Ok(compiled) => {
             // Named as `bgc::build` names it, so that both print the same text.
             let name = path.display().to_string();
-            stdout(&bgc::codegen::rust::generate(&compiled, &name));
+            let options = bgc::codegen::rust::Options { runtime };
+            stdout(&bgc::codegen::rust::generate_with(
+                &compiled, &name, options,
+            ));
             Status::Ok
         }
         Err(diags) => {

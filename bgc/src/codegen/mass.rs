@@ -2,8 +2,9 @@
 //!
 //! For the flow states `f_B` of an I-field the equations give the generalised forces `F` and the inertia matrix
 //! `M(q)` (`M ḟ_B = F`). The generated `rhs_into` writes `F` into those rows like any other rate, then solves
-//! `M ḟ_B = F` in place with a Cholesky factorisation (an inertia matrix is symmetric positive definite; one that
-//! is not, at some configuration, leaves NaN in those rows rather than a panic). The Jacobians follow from
+//! `M ḟ_B = F` in place by Gaussian elimination with partial pivoting ([`SOLVE_FN`], emitted into the module so
+//! that it needs no more than `core`, `nalgebra` and `libm`; a singular matrix leaves NaN in those rows rather than
+//! a panic). The Jacobians follow from
 //! differentiating `M ḟ_B = F`:
 //!
 //! ```text
@@ -15,10 +16,9 @@
 
 use super::adapter::to_symbolic;
 use super::names::comment;
-use super::rust::Writer;
+use super::rust::{Draft, Writer};
 use crate::equations::Equations;
-use crate::symbolic::{Expr, Symbol, to_text};
-use std::fmt::Write;
+use crate::symbolic::{Expr, Symbol};
 
 /// One I-field's block for the generator.
 #[derive(Clone, Debug)]
@@ -71,117 +71,180 @@ pub(crate) fn plan(eqs: &Equations, states: &[Symbol]) -> Result<Vec<MassPlan>, 
     Ok(out)
 }
 
+/// The linear solve of the mass-matrix rows: Gaussian elimination with partial pivoting on fixed-size values (no
+/// allocation, no `std`, no panic: indices stay below the fixed sizes); a singular matrix gives NaN.
+pub(crate) const SOLVE_FN: &str = "
+/// Solves `m z = b` by Gaussian elimination with partial pivoting; all NaN when `m` is singular.
+fn bgc_solve<const N: usize, const C: usize>(
+    mut m: SMatrix<f64, N, N>,
+    mut b: SMatrix<f64, N, C>,
+) -> SMatrix<f64, N, C> {
+    for col in 0..N {
+        let mut pivot = col;
+        for r in col + 1..N {
+            if libm::fabs(m[(r, col)]) > libm::fabs(m[(pivot, col)]) {
+                pivot = r;
+            }
+        }
+        let largest = libm::fabs(m[(pivot, col)]);
+        if largest == 0.0 || largest.is_nan() {
+            b.fill(f64::NAN);
+            return b;
+        }
+        if pivot != col {
+            for c in 0..N {
+                let held = m[(col, c)];
+                m[(col, c)] = m[(pivot, c)];
+                m[(pivot, c)] = held;
+            }
+            for c in 0..C {
+                let held = b[(col, c)];
+                b[(col, c)] = b[(pivot, c)];
+                b[(pivot, c)] = held;
+            }
+        }
+        for r in col + 1..N {
+            let f = m[(r, col)] / m[(col, col)];
+            for c in col..N {
+                m[(r, c)] -= f * m[(col, c)];
+            }
+            for c in 0..C {
+                b[(r, c)] -= f * b[(col, c)];
+            }
+        }
+    }
+    for r in (0..N).rev() {
+        for c in 0..C {
+            let mut acc = b[(r, c)];
+            for k in r + 1..N {
+                acc -= m[(r, k)] * b[(k, c)];
+            }
+            b[(r, c)] = acc / m[(r, r)];
+        }
+    }
+    b
+}
+";
+
 impl Writer<'_> {
-    /// `fn mass_<field>(p, x) -> SMatrix`: the inertia matrix of each I-field.
+    /// `pub fn mass_<field>(p, x) -> SMatrix`: the inertia matrix of each I-field.
     pub(super) fn mass_fns(&mut self) {
         for b in self.plan.mass.clone() {
             let n = b.rows.len();
-            let _ = writeln!(
-                self.out,
-                "\n/// `M(q)` of the I-field `{}`: the inertia matrix of the rows of its flow states.\n{}\nfn mass_{}(p: &Params, x: &State) -> SMatrix<f64, {n}, {n}> {{",
-                comment(&b.element),
-                super::rust::FN_ALLOW,
-                b.ident
-            );
-            let entries: Vec<&Expr> = b.matrix.iter().flatten().collect();
-            self.bindings(&entries);
-            let _ = writeln!(
-                self.out,
+            let entries: Vec<&Expr> = b.matrix.iter().flatten().filter(|e| !e.is_zero()).collect();
+            let mut d = self.draft(&entries);
+            d.lines.push(format!(
                 "    let mut m = SMatrix::<f64, {n}, {n}>::zeros();"
-            );
+            ));
             for (i, row) in b.matrix.iter().enumerate() {
                 for (j, e) in row.iter().enumerate() {
-                    if e.is_zero() {
-                        continue;
+                    if !e.is_zero() {
+                        let label = format!("M[{}, {}] = ", i + 1, j + 1);
+                        self.statement(&mut d, &label, e, &format!("m[({i}, {j})] = "), ";");
                     }
-                    let _ = writeln!(
-                        self.out,
-                        "    // M[{}, {}] = {}\n    m[({i}, {j})] = {};",
-                        i + 1,
-                        j + 1,
-                        comment(&to_text(e)),
-                        self.rust(e)
-                    );
                 }
             }
-            self.line("    m\n}");
+            d.lines.push("    m".into());
+            let uses = d.uses;
+            self.emit_function(
+                &format!(
+                    "`M(q)` of the I-field `{}`: the inertia matrix of the rows of its flow states.",
+                    comment(&b.element)
+                ),
+                &format!("mass_{}", b.ident),
+                vec![("p", "&Params", uses.p), ("x", "&State", uses.x)],
+                &format!(" -> SMatrix<f64, {n}, {n}>"),
+                d,
+            );
         }
     }
 
     /// The lines of `rhs_into` that turn the forces in the mass rows of `dx` into rates.
-    pub(super) fn mass_solve_in_rhs(&mut self) {
-        for b in self.plan.mass.clone() {
+    pub(super) fn mass_solve_in_rhs(&self, d: &mut Draft) {
+        for b in &self.plan.mass {
             let n = b.rows.len();
-            let rows: Vec<String> = b.rows.iter().map(|r| format!("dx[{r}]")).collect();
-            let _ = writeln!(
-                self.out,
-                "    // M_{0}(q) d/dt [{1}] = the forces above, solved by Cholesky (M is symmetric positive definite;\n    // where it is not, the rates are NaN).\n    let force = SVector::<f64, {n}>::new({2});\n    let rate = match mass_{3}(p, x).cholesky() {{\n        Some(m) => m.solve(&force),\n        None => SVector::<f64, {n}>::repeat(f64::NAN),\n    }};",
-                comment(&b.element),
-                self.state_list(&b.rows),
-                rows.join(", "),
-                b.ident
-            );
+            d.lines.extend(self.comment_lines(&format!(
+                "M_{}(q) d/dt [{}] = the forces above.",
+                b.element,
+                self.state_list(&b.rows)
+            )));
+            d.lines.push(format!(
+                "    let mut force = SMatrix::<f64, {n}, 1>::zeros();"
+            ));
             for (k, r) in b.rows.iter().enumerate() {
-                let _ = writeln!(self.out, "    dx[{r}] = rate[{k}];");
+                d.lines.push(format!("    force[{k}] = dx[{r}];"));
             }
+            d.lines.push(format!(
+                "    let rate = bgc_solve(mass_{}(p, x), force);",
+                b.ident
+            ));
+            for (k, r) in b.rows.iter().enumerate() {
+                d.lines.push(format!("    dx[{r}] = rate[{k}];"));
+            }
+            d.uses.p = true;
+            d.uses.x = true;
         }
     }
 
     /// The lines of `jac_x_into` (`with_dm`) or `jac_u_into` that turn the rows of `∂F` in `jac` into those of the
-    /// rates.
-    pub(super) fn mass_solve_in_jacobian(&mut self, with_dm: bool, cols: &str) {
-        for b in self.plan.mass.clone() {
+    /// rates: `M ∂ḟ = ∂F − (∂M/∂x_k) ḟ`.
+    pub(super) fn mass_solve_in_jacobian(&self, d: &mut Draft, with_dm: bool, cols: &str) {
+        for b in &self.plan.mass {
             let n = b.rows.len();
-            let _ = writeln!(
-                self.out,
-                "    // The rows of d/dt [{}]: M (∂ḟ) = ∂F{}, solved with M.\n    let mut rows = SMatrix::<f64, {n}, {cols}>::zeros();",
+            let correction = if with_dm {
+                " − (∂M/∂x_k) ḟ"
+            } else {
+                ""
+            };
+            d.lines.extend(self.comment_lines(&format!(
+                "The rows of d/dt [{}]: M (∂ḟ) = ∂F{correction}, solved with M.",
                 self.state_list(&b.rows),
-                if with_dm {
-                    " − (∂M/∂x_k) ḟ"
-                } else {
-                    ""
-                },
-            );
+            )));
+            d.lines.push(format!(
+                "    let mut rows = SMatrix::<f64, {n}, {cols}>::zeros();"
+            ));
             for (k, r) in b.rows.iter().enumerate() {
-                let _ = writeln!(self.out, "    rows.set_row({k}, &jac.row({r}));");
+                d.lines.push(format!(
+                    "    for c in 0..{cols} {{\n        rows[({k}, c)] = jac[({r}, c)];\n    }}"
+                ));
             }
             if with_dm && !b.derivatives.is_empty() {
-                self.line("    let mut dx = State::zeros();\n    rhs_into(p, t, x, u, &mut dx);");
-                let rates: Vec<String> = b.rows.iter().map(|r| format!("dx[{r}]")).collect();
-                let _ = writeln!(
-                    self.out,
-                    "    let rate = SVector::<f64, {n}>::new({});",
-                    rates.join(", ")
-                );
-                for (k, d) in &b.derivatives {
-                    let state = self.plan.states.get(*k).map(|s| s.name().to_string());
-                    let _ = writeln!(
-                        self.out,
-                        "    // ∂M/∂{}\n    let mut dm = SMatrix::<f64, {n}, {n}>::zeros();",
-                        state.unwrap_or_default()
-                    );
-                    for (i, row) in d.iter().enumerate() {
+                d.lines.push("    let mut dx = State::zeros();".into());
+                d.lines.push("    rhs_into(p, t, x, u, &mut dx);".into());
+                d.uses.t = true;
+                d.uses.u = true;
+                for (k, dm) in &b.derivatives {
+                    let state = self
+                        .plan
+                        .states
+                        .get(*k)
+                        .map(|s| s.name().to_string())
+                        .unwrap_or_default();
+                    for (i, row) in dm.iter().enumerate() {
                         for (j, e) in row.iter().enumerate() {
                             if e.is_zero() {
                                 continue;
                             }
-                            let _ = writeln!(self.out, "    dm[({i}, {j})] = {};", self.rust(e));
+                            let label = format!("∂M[{}, {}]/∂{state} = ", i + 1, j + 1);
+                            self.statement(d, &label, e, "let dm = ", ";");
+                            let rate = b.rows.get(j).copied().unwrap_or_default();
+                            d.lines
+                                .push(format!("    rows[({i}, {k})] -= dm * dx[{rate}];"));
                         }
-                    }
-                    self.line("    let correction = dm * rate;");
-                    for i in 0..n {
-                        let _ = writeln!(self.out, "    rows[({i}, {k})] -= correction[{i}];");
                     }
                 }
             }
-            let _ = writeln!(
-                self.out,
-                "    let solved = match mass_{}(p, x).cholesky() {{\n        Some(m) => m.solve(&rows),\n        None => SMatrix::<f64, {n}, {cols}>::repeat(f64::NAN),\n    }};",
+            d.lines.push(format!(
+                "    let solved = bgc_solve(mass_{}(p, x), rows);",
                 b.ident
-            );
+            ));
             for (k, r) in b.rows.iter().enumerate() {
-                let _ = writeln!(self.out, "    jac.set_row({r}, &solved.row({k}));");
+                d.lines.push(format!(
+                    "    for c in 0..{cols} {{\n        jac[({r}, c)] = solved[({k}, c)];\n    }}"
+                ));
             }
+            d.uses.p = true;
+            d.uses.x = true;
         }
     }
 

@@ -3,7 +3,9 @@
 //! [`compile`] runs the pipeline on a file (lowering with its imports, causality, equations) and refuses it when
 //! any stage reports an error; [`rust::generate`] turns the result into the source of a Rust module. The module
 //! is plain Rust over `nalgebra` fixed-size types that implements `bgc_runtime::model::ContinuousModel` and
-//! `Parametric`; its functions allocate nothing and never panic. [`crate::build`] wraps both for build scripts.
+//! `Parametric` (unless [`rust::Options::runtime`] is off); its functions allocate nothing, never panic and need
+//! only `core`, `nalgebra` and `libm`. Its text is what `rustfmt` makes of it: `layout` breaks long statements into
+//! `let` lines, `format` lays out comments, lists and signatures. [`crate::build`] wraps both for build scripts.
 //!
 //! Diagnostics of this stage:
 //!
@@ -14,9 +16,13 @@
 
 mod adapter;
 mod emit;
+mod format;
+mod layout;
 mod mass;
 mod names;
 pub mod rust;
+#[cfg(test)]
+mod test_support;
 
 pub use adapter::{AdaptError, to_symbolic};
 

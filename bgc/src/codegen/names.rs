@@ -8,7 +8,8 @@
 
 use std::collections::HashSet;
 
-/// The identifiers the generated functions use for themselves.
+/// The identifiers the generated functions use for themselves, and the constants of the module (a `let` cannot
+/// shadow a constant).
 pub const RESERVED: &[&str] = &[
     "p",
     "t",
@@ -25,6 +26,9 @@ pub const RESERVED: &[&str] = &[
     "params",
     "index",
     "value",
+    "values",
+    "name",
+    "next",
     "out",
     "terms",
     "bgc_sign",
@@ -37,6 +41,20 @@ pub const RESERVED: &[&str] = &[
     "rows",
     "solved",
     "correction",
+    "bgc_powi",
+    "libm",
+    "core",
+    "N_STATES",
+    "N_ENERGY_STATES",
+    "N_INPUTS",
+    "N_OUTPUTS",
+    "N_PARAMS",
+    "N_COORDS",
+    "STATE_NAMES",
+    "INPUT_NAMES",
+    "OUTPUT_NAMES",
+    "PARAM_NAMES",
+    "COORD_NAMES",
 ];
 
 const KEYWORDS: &[&str] = &[

@@ -3,12 +3,18 @@
 //! Evaluation follows IEEE arithmetic with the same formulas and operation order as the generated Rust (see
 //! `print/rust.rs`): sums in print order, products as `(coefficient * numerator factors) / (denominator factors)`,
 //! so a model evaluated here and the compiled model agree to the last bit. In particular:
-//! - `x^n` for an integer constant `n` is `powi`, `x^0.5` is `sqrt`, other powers `powf`;
+//! - the elementary functions are those of the `libm` crate, which generated code calls too (rather than the
+//!   platform's C library behind `f64::sin`, whose last bit may differ between platforms);
+//! - `x^n` for an integer constant `n` is `bgc_powi` (binary powering), `x^0.5` is `libm::sqrt`, other powers
+//!   `libm::pow`;
 //! - `sign(x)` is 1 for `x > 0`, -1 for `x < 0`, 0 for `x = ±0` (unlike `f64::signum`, which gives 1 for +0) and NaN
 //!   for NaN;
 //! - `min`/`max` return NaN when either argument is NaN (IEEE 754-2019 `minimum`/`maximum`), unlike `f64::min`,
 //!   which would hide a NaN produced upstream (and would let the simplified form of an expression differ from the
 //!   original where the original's NaN was masked).
+//!
+//! `sign`, `min`, `max` and the integer power are the helpers generated code defines (`print/rust_helpers.rs`),
+//! compiled here from the same file.
 //!
 //! NaN and infinities propagate as IEEE values; checking them is the caller's business.
 
@@ -18,67 +24,56 @@ use super::print::sum_print_order;
 use crate::ir::Func;
 use std::collections::{BTreeMap, BTreeSet};
 
+// `bgc_sign`, `bgc_min`, `bgc_max`, `bgc_powi`: the very code generated modules define.
+include!("print/rust_helpers.rs");
+
 /// Applies `func` to numeric arguments. A missing argument reads as NaN (the constructors guarantee the arity).
 pub(super) fn apply_func(func: Func, args: &[f64]) -> f64 {
     let a = args.first().copied().unwrap_or(f64::NAN);
     let b = args.get(1).copied().unwrap_or(f64::NAN);
     match func {
-        Func::Sin => a.sin(),
-        Func::Cos => a.cos(),
-        Func::Tan => a.tan(),
-        Func::Asin => a.asin(),
-        Func::Acos => a.acos(),
-        Func::Atan => a.atan(),
-        Func::Atan2 => a.atan2(b),
-        Func::Exp => a.exp(),
-        Func::Ln => a.ln(),
-        Func::Log10 => a.log10(),
-        Func::Sqrt => a.sqrt(),
-        Func::Abs => a.abs(),
+        Func::Sin => libm::sin(a),
+        Func::Cos => libm::cos(a),
+        Func::Tan => libm::tan(a),
+        Func::Asin => libm::asin(a),
+        Func::Acos => libm::acos(a),
+        Func::Atan => libm::atan(a),
+        Func::Atan2 => libm::atan2(a, b),
+        Func::Exp => libm::exp(a),
+        Func::Ln => libm::log(a),
+        Func::Log10 => libm::log10(a),
+        Func::Sqrt => libm::sqrt(a),
+        Func::Abs => libm::fabs(a),
         Func::Sign => sign(a),
         Func::Min => min(a, b),
         Func::Max => max(a, b),
-        Func::Tanh => a.tanh(),
-        Func::Sinh => a.sinh(),
-        Func::Cosh => a.cosh(),
+        Func::Tanh => libm::tanh(a),
+        Func::Sinh => libm::sinh(a),
+        Func::Cosh => libm::cosh(a),
     }
 }
 
 /// `sign` with `sign(±0) = 0` and `sign(NaN) = NaN`.
 pub fn sign(x: f64) -> f64 {
-    if x > 0.0 {
-        1.0
-    } else if x < 0.0 {
-        -1.0
-    } else {
-        x * 0.0
-    }
+    bgc_sign(x)
 }
 
 /// The smaller argument, NaN if either is NaN (unlike `f64::min`, which returns the other argument).
 pub fn min(a: f64, b: f64) -> f64 {
-    if a.is_nan() || b.is_nan() {
-        f64::NAN
-    } else {
-        a.min(b)
-    }
+    bgc_min(a, b)
 }
 
 /// The larger argument, NaN if either is NaN (unlike `f64::max`).
 pub fn max(a: f64, b: f64) -> f64 {
-    if a.is_nan() || b.is_nan() {
-        f64::NAN
-    } else {
-        a.max(b)
-    }
+    bgc_max(a, b)
 }
 
 /// `b^e` as the generated code computes it.
 pub(super) fn pow_f64(b: f64, e: f64) -> f64 {
     match as_i32(e) {
-        Some(n) => b.powi(n),
-        None if e == 0.5 => b.sqrt(),
-        None => b.powf(e),
+        Some(n) => bgc_powi(b, n),
+        None if e == 0.5 => libm::sqrt(b),
+        None => libm::pow(b, e),
     }
 }
 

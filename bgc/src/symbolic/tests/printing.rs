@@ -1,6 +1,9 @@
 //! Printer snapshots for text, LaTeX and Rust, and the exact forms the code generators rely on.
 
-use super::super::{Expr, Symbol, SymbolKind, latex_symbol, to_latex, to_rust, to_text};
+use super::super::{
+    Expr, RUST_HELPERS, RustCode, RustOp, Symbol, SymbolKind, latex_symbol, rust_helpers_used,
+    to_latex, to_rust, to_rust_code, to_text,
+};
 use super::{c, p, s};
 
 /// A gallery of expressions covering every printing rule.
@@ -107,27 +110,54 @@ fn latex_symbol_names() {
 #[test]
 fn rust_forms_the_code_generators_rely_on() {
     let x = s("x");
-    assert_eq!(to_rust(&x.powi(2), &rust_name), "x[0].powi(2)");
-    assert_eq!(to_rust(&x.sqrt(), &rust_name), "x[0].sqrt()");
+    assert_eq!(to_rust(&x.powi(2), &rust_name), "bgc_powi(x[0], 2)");
+    assert_eq!(to_rust(&x.powi(-3), &rust_name), "1.0 / bgc_powi(x[0], 3)");
+    assert_eq!(to_rust(&x.sqrt(), &rust_name), "libm::sqrt(x[0])");
     assert_eq!(
         to_rust(&Expr::atan2(&p("a"), &x), &rust_name),
-        "f64::atan2(p.a, x[0])"
+        "libm::atan2(p.a, x[0])"
     );
     assert_eq!(to_rust(&x.sign(), &rust_name), "bgc_sign(x[0])");
+    assert_eq!(to_rust(&x.ln(), &rust_name), "libm::log(x[0])");
+    assert_eq!(to_rust(&x.abs(), &rust_name), "libm::fabs(x[0])");
     assert_eq!(to_rust(&c(0.1), &rust_name), "0.1");
-    assert_eq!(to_rust(&c(2.0).pow(&x), &rust_name), "2.0_f64.powf(x[0])");
-    assert_eq!(to_rust(&c(1e-7).pow(&x), &rust_name), "1e-7_f64.powf(x[0])");
+    assert_eq!(to_rust(&c(2.0).pow(&x), &rust_name), "libm::pow(2.0, x[0])");
+    assert_eq!(
+        to_rust(&c(1e-7).pow(&x), &rust_name),
+        "libm::pow(1e-7, x[0])"
+    );
     assert_eq!(
         to_rust(&c(-2.0).pow(&x), &rust_name),
-        "(-2.0_f64).powf(x[0])"
+        "libm::pow(-2.0, x[0])"
     );
     assert_eq!(
         to_rust(&c(f64::NAN).pow(&x), &rust_name),
-        "f64::NAN.powf(x[0])"
+        "libm::pow(f64::NAN, x[0])"
     );
-    // Rust accepts these literal forms and reads back the same values.
-    assert_eq!((-2.0_f64).powf(3.0), -8.0);
-    assert_eq!(1e-7_f64.sqrt(), 1e-7f64.sqrt());
+    // A negated product carries the minus on its first operand, as Rust parses `-a * b`.
+    let code = to_rust_code(&-(p("k") * &x), &rust_name);
+    assert_eq!(
+        code,
+        RustCode::Chain(
+            Box::new(RustCode::Neg(Box::new(RustCode::Atom("p.k".into())))),
+            vec![(RustOp::Mul, RustCode::Atom("x[0]".into()))]
+        )
+    );
+    assert_eq!(code.to_string(), "-p.k * x[0]");
+}
+
+#[test]
+fn only_the_helpers_a_piece_of_code_calls_are_picked() {
+    assert_eq!(rust_helpers_used("x + 1.0"), "");
+    let picked = rust_helpers_used("bgc_powi(x, 2) + bgc_sign(y)");
+    assert!(picked.starts_with("/// `sign(x)`"), "{picked}");
+    assert!(picked.contains("fn bgc_sign(") && picked.contains("fn bgc_powi("));
+    assert!(!picked.contains("fn bgc_min(") && !picked.contains("fn bgc_max("));
+    // Generated modules indent them by four spaces inside a `pub mod`: they must fit in 96 columns.
+    assert!(RUST_HELPERS.lines().all(|l| l.chars().count() <= 96));
+    // All four, in file order, give the file back.
+    let all = rust_helpers_used("bgc_sign( bgc_min( bgc_max( bgc_powi(");
+    assert_eq!(all.trim_end(), RUST_HELPERS.trim_end());
 }
 
 #[test]
@@ -162,9 +192,10 @@ mod generated {
     }
 
     pub fn value(x: &[f64; 2], p: &Params) -> f64 {
-        2.0_f64.powf(x[1]) - p.k * x[0] / p.m
-            + x[0].exp().cos().powi(3) / (x[1].abs().powf(1.5) * (x[0] + x[1]))
-            + f64::atan2(x[1], x[0]) * (x[0].powi(2) + 1.0).sqrt()
+        libm::pow(2.0, x[1]) - p.k * x[0] / p.m
+            + bgc_powi(libm::cos(libm::exp(x[0])), 3)
+                / (libm::pow(libm::fabs(x[1]), 1.5) * (x[0] + x[1]))
+            + libm::atan2(x[1], x[0]) * libm::sqrt(bgc_powi(x[0], 2) + 1.0)
             + bgc_sign(x[1]) * bgc_min(x[0], p.k)
             - bgc_max(x[1], 0.0)
     }
@@ -172,11 +203,15 @@ mod generated {
     pub fn helpers(v: f64) -> [f64; 3] {
         [bgc_sign(v), bgc_min(v, 0.0), bgc_max(0.0, v)]
     }
+
+    pub fn powi(x: f64, n: i32) -> f64 {
+        bgc_powi(x, n)
+    }
 }
 
-const END_TO_END_RUST: &str = "2.0_f64.powf(x[1]) - p.k * x[0] / p.m + x[0].exp().cos().powi(3) / (x[1].abs().powf(1.5) \
-    * (x[0] + x[1])) + f64::atan2(x[1], x[0]) * (x[0].powi(2) + 1.0).sqrt() + bgc_sign(x[1]) * bgc_min(x[0], p.k) \
-    - bgc_max(x[1], 0.0)";
+const END_TO_END_RUST: &str = "libm::pow(2.0, x[1]) - p.k * x[0] / p.m + bgc_powi(libm::cos(libm::exp(x[0])), 3) \
+    / (libm::pow(libm::fabs(x[1]), 1.5) * (x[0] + x[1])) + libm::atan2(x[1], x[0]) * libm::sqrt(bgc_powi(x[0], 2) + 1.0) \
+    + bgc_sign(x[1]) * bgc_min(x[0], p.k) - bgc_max(x[1], 0.0)";
 
 fn end_to_end_expr() -> Expr {
     let (x, y, k, m) = (s("x"), s("y"), p("k"), p("m"));
@@ -220,4 +255,27 @@ fn rust_helpers_follow_bgc_conventions() {
     assert_eq!(generated::helpers(-3.0), [-1.0, -3.0, 0.0]);
     assert_eq!(generated::helpers(2.0), [1.0, 0.0, 2.0]);
     assert!(generated::helpers(f64::NAN).iter().all(|v| v.is_nan()));
+}
+
+#[test]
+fn integer_powers_by_binary_powering() {
+    use generated::powi;
+    // Exact cases: every intermediate product is representable.
+    assert_eq!(powi(3.0, 5), 243.0);
+    assert_eq!(powi(-2.0, 3), -8.0);
+    assert_eq!(powi(2.0, -3), 0.125);
+    assert_eq!(powi(1.5, 2), 2.25);
+    assert_eq!(powi(7.0, 0), 1.0);
+    assert_eq!(powi(0.0, -1), f64::INFINITY);
+    // The most negative exponent neither overflows nor panics: 2^-(2^31) underflows to 0.
+    assert_eq!(powi(2.0, i32::MIN), 0.0);
+    assert!(powi(f64::NAN, 2).is_nan());
+    // Inexact cases: within a few rounding errors of the correctly rounded power.
+    for (x, n) in [(1.1_f64, 7), (0.3, 11), (-1.7, 5), (2.5, -6)] {
+        let want = x.powf(f64::from(n));
+        assert!(
+            (powi(x, n) - want).abs() <= 4.0 * f64::EPSILON * want.abs(),
+            "{x}^{n}"
+        );
+    }
 }

@@ -1,0 +1,556 @@
+//! The numeric functions of a generated module: `rhs`, `outputs`, the Jacobians, the state spaces and the energy
+//! and power functions. Each body binds the states and inputs it uses and the elementary functions of states,
+//! inputs, parameters and time it calls (`let cos_theta = libm::cos(theta);`, computed once: the same call gives the
+//! same bits), then computes its statements, each under the equation it computes.
+
+use super::super::emit::{Block, MAX_LETS, StateSpace};
+use super::super::layout::Body;
+use super::super::names::{Namer, comment};
+use super::calls::{call_name, early_calls, with_bound_calls};
+use super::{Arg, Function, Uses, Writer, output_names};
+use crate::equations::EnergyKind;
+use crate::symbolic::{Expr, RustCode, Symbol, SymbolKind};
+use std::collections::{BTreeMap, BTreeSet};
+
+/// The lines and facts of a function body being written.
+pub(in crate::codegen) struct Draft {
+    namer: Namer,
+    pub(in crate::codegen) lines: Vec<String>,
+    locals: Vec<String>,
+    pub(in crate::codegen) uses: Uses,
+    /// The number of the next temporary.
+    next_temp: usize,
+    /// Calls bound at the top of the body: the call's text and the name bound to it.
+    calls: BTreeMap<String, String>,
+}
+
+impl Writer<'_> {
+    /// A body that binds the states and inputs `exprs` use, and what it uses.
+    pub(in crate::codegen) fn draft(&self, exprs: &[&Expr]) -> Draft {
+        let mut used: BTreeSet<Symbol> = BTreeSet::new();
+        for e in exprs {
+            used.extend(e.free_symbols());
+        }
+        let mut d = Draft {
+            namer: self.namer.clone(),
+            lines: Vec::new(),
+            locals: Vec::new(),
+            uses: Uses {
+                p: used.iter().any(|s| s.kind() == SymbolKind::Param),
+                t: used.iter().any(|s| s.kind() == SymbolKind::Time),
+                x: false,
+                u: false,
+            },
+            next_temp: 1,
+            calls: BTreeMap::new(),
+        };
+        for (vector, symbols) in [("x", &self.plan.states), ("u", &self.plan.inputs)] {
+            for (i, s) in symbols.iter().enumerate() {
+                if used.contains(s) {
+                    let name = self.name(s);
+                    d.lines.push(format!("    let {name} = {vector}[{i}];"));
+                    d.locals.push(name);
+                    if vector == "x" {
+                        d.uses.x = true;
+                    } else {
+                        d.uses.u = true;
+                    }
+                }
+            }
+        }
+        // The names available from the start: states and inputs bound above, parameters, time.
+        let early: BTreeSet<String> = used
+            .iter()
+            .filter(|s| s.kind() != SymbolKind::Intermediate)
+            .map(|s| self.name(s))
+            .collect();
+        let mut calls = BTreeMap::new();
+        for e in exprs {
+            early_calls(&self.code(e), &early, &mut calls);
+        }
+        for (text, call) in calls {
+            let name = d.namer.ident(&call_name(&call));
+            d.lines.push(format!("    let {name} = {text};"));
+            d.locals.push(name.clone());
+            d.calls.insert(text, name);
+        }
+        d
+    }
+
+    /// Appends the statement `head code tail` of `d` under the comment `{label}{e}` (`d/dt x = ...`).
+    pub(in crate::codegen) fn statement(
+        &self,
+        d: &mut Draft,
+        label: &str,
+        e: &Expr,
+        head: &str,
+        tail: &str,
+    ) {
+        let code = with_bound_calls(self.code(e), &d.calls);
+        self.statement_code(d, self.equation(4, label, e), &code, head, tail);
+    }
+
+    fn statement_code(
+        &self,
+        d: &mut Draft,
+        comment_lines: Vec<String>,
+        code: &RustCode,
+        head: &str,
+        tail: &str,
+    ) {
+        let mut body = Body::new(&mut d.namer, 4, self.width).first_temp(d.next_temp);
+        body.lines(comment_lines);
+        body.statement(head, code, tail);
+        d.next_temp = body.next_temp();
+        d.lines.extend(body.finish().lines().map(str::to_string));
+    }
+
+    fn body_text(lines: &[String]) -> String {
+        lines.iter().map(|l| format!("{l}\n")).collect()
+    }
+
+    /// The model arguments `p, t, x, u` as `d` uses them.
+    fn model_args(uses: Uses) -> Vec<Arg> {
+        vec![
+            Arg::new("p", "&Params", uses.p),
+            Arg::new("t", "f64", uses.t),
+            Arg::new("x", "&State", uses.x),
+            Arg::new("u", "&Inputs", uses.u),
+        ]
+    }
+
+    /// `name` writing the block `b` into `target` (`dx` or `y`): the `let`s of the intermediates, then each entry.
+    fn block_fn(
+        &mut self,
+        name: &str,
+        doc: &str,
+        b: &Block,
+        target: (&'static str, &'static str),
+        lhs: &[String],
+    ) {
+        let mut all: Vec<&Expr> = b.lets.iter().map(|l| &l.1).collect();
+        all.extend(b.results.iter());
+        let mut d = self.draft(&all);
+        for (s, v) in &b.lets {
+            let local = self.name(s);
+            self.statement(
+                &mut d,
+                &format!("{} = ", s.name()),
+                v,
+                &format!("let {local} = "),
+                ";",
+            );
+            d.locals.push(local);
+        }
+        for (i, r) in b.results.iter().enumerate() {
+            let lhs = lhs.get(i).cloned().unwrap_or_default();
+            self.statement(
+                &mut d,
+                &format!("{lhs} = "),
+                r,
+                &format!("{}[{i}] = ", target.0),
+                ";",
+            );
+        }
+        if target.0 == "dx" {
+            self.mass_solve_in_rhs(&mut d);
+        }
+        let mut args = Self::model_args(d.uses);
+        args.push(Arg::new(target.0, target.1, !b.results.is_empty()));
+        self.function(Function {
+            doc: doc.to_string(),
+            name: name.to_string(),
+            args,
+            ret: String::new(),
+            body: Self::body_text(&d.lines),
+            locals: d.locals,
+        });
+    }
+
+    /// Emits a function with the body of `d`; `args` are `(name, type, used)`.
+    pub(in crate::codegen) fn emit_function(
+        &mut self,
+        doc: &str,
+        name: &str,
+        args: Vec<(&'static str, &'static str, bool)>,
+        ret: &str,
+        d: Draft,
+    ) {
+        self.function(Function {
+            doc: doc.to_string(),
+            name: name.to_string(),
+            args: args
+                .into_iter()
+                .map(|(n, t, used)| Arg::new(n, t, used))
+                .collect(),
+            ret: ret.to_string(),
+            body: Self::body_text(&d.lines),
+            locals: d.locals,
+        });
+    }
+
+    /// Comment lines `    // text` inside a function body.
+    pub(in crate::codegen) fn comment_lines(&self, text: &str) -> Vec<String> {
+        super::super::format::comment(4, "//", text, super::super::format::Wrap::Prose, self.width)
+    }
+
+    pub(super) fn functions(&mut self) {
+        self.mass_fns();
+        self.rhs();
+        self.outputs();
+        self.jacobians();
+        self.state_spaces();
+        self.energy();
+    }
+
+    fn rhs(&mut self) {
+        let mass_rows: Vec<usize> = self
+            .plan
+            .mass
+            .iter()
+            .flat_map(|b| b.rows.iter().copied())
+            .collect();
+        let lhs: Vec<String> = self
+            .plan
+            .states
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                if mass_rows.contains(&i) {
+                    format!("the force of d/dt {}", s.name())
+                } else {
+                    format!("d/dt {}", s.name())
+                }
+            })
+            .collect();
+        let b = self.plan.rhs.clone();
+        self.block_fn(
+            "rhs_into",
+            "Writes the state derivative `ẋ = f(t, x, u)` into `dx`.",
+            &b,
+            ("dx", "&mut State"),
+            &lhs,
+        );
+        self.out.push_str(
+            "
+/// The state derivative `ẋ = f(t, x, u)`.
+pub fn rhs(p: &Params, t: f64, x: &State, u: &Inputs) -> State {
+    let mut dx = State::zeros();
+    rhs_into(p, t, x, u, &mut dx);
+    dx
+}
+",
+        );
+    }
+
+    fn outputs(&mut self) {
+        let lhs = output_names(&self.m.equations);
+        let b = self.plan.outputs.clone();
+        self.block_fn(
+            "outputs_into",
+            "Writes the outputs `y = h(t, x, u)` into `y`.",
+            &b,
+            ("y", "&mut Outputs"),
+            &lhs,
+        );
+        self.out.push_str(
+            "
+/// The outputs `y = h(t, x, u)`.
+pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
+    let mut y = Outputs::zeros();
+    outputs_into(p, t, x, u, &mut y);
+    y
+}
+",
+        );
+    }
+
+    /// A function that fills a matrix: zeros, then every non-zero entry under a comment naming it.
+    fn matrix_fn(
+        &mut self,
+        (name, doc, ty): (&str, &str, &'static str),
+        m: &[Vec<Expr>],
+        rows: &[String],
+        cols: &[String],
+        row_prefix: &str,
+    ) {
+        let mut nonzero: Vec<&Expr> = m.iter().flatten().filter(|e| !e.is_zero()).collect();
+        if name == "jac_x_into" {
+            // The mass-matrix correction uses ∂M/∂x as well.
+            let plan = self.plan;
+            nonzero.extend(
+                plan.mass
+                    .iter()
+                    .flat_map(|b| b.derivatives.iter().flat_map(|(_, d)| d.iter().flatten())),
+            );
+        }
+        let mut d = self.draft(&nonzero);
+        d.lines.push("    jac.fill(0.0);".into());
+        for (r, row) in m.iter().enumerate() {
+            for (c, e) in row.iter().enumerate() {
+                if e.is_zero() {
+                    continue;
+                }
+                let lhs = format!(
+                    "∂({row_prefix}{})/∂{} = ",
+                    rows.get(r).cloned().unwrap_or_default(),
+                    cols.get(c).cloned().unwrap_or_default()
+                );
+                self.statement(&mut d, &lhs, e, &format!("jac[({r}, {c})] = "), ";");
+            }
+        }
+        match name {
+            "jac_x_into" => self.mass_solve_in_jacobian(&mut d, true, "N_STATES"),
+            "jac_u_into" => self.mass_solve_in_jacobian(&mut d, false, "N_INPUTS"),
+            _ => {}
+        }
+        let mut args = Self::model_args(d.uses);
+        args.push(Arg::new("jac", ty, true));
+        self.function(Function {
+            doc: doc.to_string(),
+            name: name.to_string(),
+            args,
+            ret: String::new(),
+            body: Self::body_text(&d.lines),
+            locals: d.locals,
+        });
+    }
+
+    fn jacobians(&mut self) {
+        let xs: Vec<String> = self
+            .plan
+            .states
+            .iter()
+            .map(|s| s.name().to_string())
+            .collect();
+        let us: Vec<String> = self
+            .plan
+            .inputs
+            .iter()
+            .map(|s| s.name().to_string())
+            .collect();
+        let ys: Vec<String> = output_names(&self.m.equations);
+        let plan = self.plan;
+        self.matrix_fn(
+            ("jac_x_into", "Writes `∂f/∂x` into `jac`.", "&mut JacX"),
+            &plan.dfdx,
+            &xs,
+            &xs,
+            "d/dt ",
+        );
+        self.matrix_fn(
+            ("jac_u_into", "Writes `∂f/∂u` into `jac`.", "&mut JacU"),
+            &plan.dfdu,
+            &xs,
+            &us,
+            "d/dt ",
+        );
+        self.matrix_fn(
+            (
+                "output_jac_x_into",
+                "Writes `∂h/∂x` into `jac`.",
+                "&mut OutJacX",
+            ),
+            &plan.dhdx,
+            &ys,
+            &xs,
+            "",
+        );
+        self.matrix_fn(
+            (
+                "output_jac_u_into",
+                "Writes `∂h/∂u` into `jac`.",
+                "&mut OutJacU",
+            ),
+            &plan.dhdu,
+            &ys,
+            &us,
+            "",
+        );
+    }
+
+    fn state_space_fn(&mut self, name: &str, size: &str, ss: &StateSpace, doc: &str) {
+        let ty = if name == "state_space" {
+            "EnergyStateSpace"
+        } else {
+            "DeclaredStateSpace"
+        };
+        self.out.push('\n');
+        self.doc(
+            0,
+            &format!("`A, B, C, D` of `ẋ = A x + B u`, `y = C x + D u` {doc}."),
+        );
+        self.out.push_str(&format!(
+            "pub type {ty} = (\n    SMatrix<f64, {size}, {size}>,\n    SMatrix<f64, {size}, N_INPUTS>,\n    \
+             SMatrix<f64, N_OUTPUTS, {size}>,\n    SMatrix<f64, N_OUTPUTS, N_INPUTS>,\n);\n"
+        ));
+        let matrices = [
+            ("a", &ss.a, size, size),
+            ("b", &ss.b, size, "N_INPUTS"),
+            ("c", &ss.c, "N_OUTPUTS", size),
+            ("d", &ss.d, "N_OUTPUTS", "N_INPUTS"),
+        ];
+        let all: Vec<&Expr> = matrices.iter().flat_map(|m| m.1.iter().flatten()).collect();
+        // Entries are free of states, inputs and time: the draft binds nothing.
+        let mut d = self.draft(&all);
+        for (var, m, rows, cols) in matrices {
+            let mutable = if m.iter().flatten().any(|e| !e.is_zero()) {
+                "mut "
+            } else {
+                ""
+            };
+            d.lines.push(format!(
+                "    let {mutable}{var} = SMatrix::<f64, {rows}, {cols}>::zeros();"
+            ));
+        }
+        let ys: Vec<String> = output_names(&self.m.equations);
+        let us: Vec<String> = self.m.equations.inputs.clone();
+        for (var, m, rows, cols) in [
+            ("a", &ss.a, &ss.states, &ss.states),
+            ("b", &ss.b, &ss.states, &us),
+            ("c", &ss.c, &ys, &ss.states),
+            ("d", &ss.d, &ys, &us),
+        ] {
+            for (r, row) in m.iter().enumerate() {
+                for (col, e) in row.iter().enumerate() {
+                    if e.is_zero() {
+                        continue;
+                    }
+                    let lhs = format!(
+                        "{}[{}, {}] = ",
+                        var.to_uppercase(),
+                        rows.get(r).cloned().unwrap_or_default(),
+                        cols.get(col).cloned().unwrap_or_default()
+                    );
+                    self.statement(&mut d, &lhs, e, &format!("{var}[({r}, {col})] = "), ";");
+                }
+            }
+        }
+        d.lines.push("    (a, b, c, d)".into());
+        self.function(Function {
+            doc: format!("The linear state space {doc}, at the parameters `p`."),
+            name: name.to_string(),
+            args: vec![Arg::new("p", "&Params", d.uses.p)],
+            ret: format!(" -> {ty}"),
+            body: Self::body_text(&d.lines),
+            locals: d.locals,
+        });
+    }
+
+    pub(super) fn state_spaces(&mut self) {
+        match &self.plan.energy_ss {
+            Ok(ss) => self.state_space_fn(
+                "state_space",
+                "N_ENERGY_STATES",
+                &ss.clone(),
+                "in the energy states (the first `N_ENERGY_STATES` states)",
+            ),
+            Err(why) => {
+                self.out.push('\n');
+                self.note(0, &format!("No `state_space`: {}.", comment(why)));
+            }
+        }
+        match &self.plan.declared_ss {
+            Some(Ok(ss)) => {
+                let names: Vec<String> = ss.states.clone();
+                self.out.push('\n');
+                self.doc(
+                    0,
+                    "The number of declared coordinates (`coords` of the model).",
+                );
+                self.out
+                    .push_str(&format!("pub const N_COORDS: usize = {};\n", names.len()));
+                self.name_array("COORD_NAMES", "N_COORDS", "declared coordinates", &names);
+                self.state_space_fn(
+                    "state_space_declared",
+                    "N_COORDS",
+                    &ss.clone(),
+                    "in the declared coordinates `COORD_NAMES`",
+                );
+            }
+            Some(Err(why)) => {
+                self.out.push('\n');
+                self.note(0, &format!("No `state_space_declared`: {}.", comment(why)));
+            }
+            None => {}
+        }
+    }
+
+    /// `stored_energy`, `dissipated_power` and `supplied_power`: one `let` per element, then their sum.
+    fn energy(&mut self) {
+        for (kind, terms) in self.plan.energy.clone() {
+            let (name, doc) = match kind {
+                EnergyKind::Stored => (
+                    "stored_energy",
+                    "The energy stored in the inertias and compliances (J).",
+                ),
+                EnergyKind::Dissipated => (
+                    "dissipated_power",
+                    "The power dissipated in the resistors (W).",
+                ),
+                EnergyKind::Supplied => {
+                    ("supplied_power", "The power delivered by the sources (W).")
+                }
+            };
+            let terms = match terms {
+                Ok(t) => t,
+                Err(missing) => {
+                    self.out.push('\n');
+                    self.note(
+                        0,
+                        &format!(
+                            "No `{name}`: no closed form for `{}`.",
+                            comment(&missing.join("`, `"))
+                        ),
+                    );
+                    continue;
+                }
+            };
+            let exprs: Vec<&Expr> = terms.iter().map(|t| &t.1).collect();
+            let mut d = self.draft(&exprs);
+            match terms.as_slice() {
+                [] => d.lines.push("    0.0".into()),
+                [(element, e)] => self.statement(&mut d, &format!("{element}: "), e, "", ""),
+                many if many.len() <= MAX_LETS => {
+                    let mut parts = Vec::with_capacity(many.len());
+                    for (element, e) in many {
+                        let local = d.namer.ident(element);
+                        let head = format!("let {local} = ");
+                        self.statement(&mut d, &format!("{element}: "), e, &head, ";");
+                        d.locals.push(local.clone());
+                        parts.push(RustCode::Atom(local));
+                    }
+                    let mut iter = parts.into_iter();
+                    let first = iter.next().unwrap_or(RustCode::Atom("0.0".into()));
+                    let sum = RustCode::Chain(
+                        Box::new(first),
+                        iter.map(|p| (crate::symbolic::RustOp::Add, p)).collect(),
+                    );
+                    self.statement_code(&mut d, Vec::new(), &sum, "", "");
+                }
+                // One `let` per element would nest too many scopes for rustc (see `MAX_LETS`): a running total
+                // instead, added in the same order.
+                many => {
+                    let total = d.namer.ident("total");
+                    for (k, (element, e)) in many.iter().enumerate() {
+                        let head = if k == 0 {
+                            format!("let mut {total} = ")
+                        } else {
+                            format!("{total} += ")
+                        };
+                        self.statement(&mut d, &format!("{element}: "), e, &head, ";");
+                    }
+                    d.lines.push(format!("    {total}"));
+                }
+            }
+            self.function(Function {
+                doc: doc.to_string(),
+                name: name.to_string(),
+                args: Self::model_args(d.uses),
+                ret: " -> f64".into(),
+                body: Self::body_text(&d.lines),
+                locals: d.locals,
+            });
+        }
+    }
+}

@@ -1,0 +1,444 @@
+//! The sizes, names and types of a generated module, its `ParamError` and its `Params`.
+
+use super::super::format::{self, Wrap};
+use super::super::layout::Body;
+use super::super::names::{Namer, comment, string_literal};
+use super::{Writer, output_names, rust_f64};
+use crate::ir;
+use crate::symbolic::{Expr, Symbol, from_ir, to_rust_code, to_text};
+use crate::syntax::ast::ElementKind;
+use std::collections::HashMap;
+use std::fmt::Write;
+
+/// The rule a parameter-only element value must satisfy.
+#[derive(Clone, Copy)]
+enum Rule {
+    Positive(&'static str),
+    NonNegative,
+    NonZero,
+}
+
+/// The error type of a module without the runtime, with the variants and messages of
+/// `bgc_runtime::model::ParamError`, as `rustfmt` lays it out.
+const OWN_PARAM_ERROR: &str = "
+/// Why parameter values are refused.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParamError {
+    /// No parameter has index `index`.
+    NoSuchParam { index: usize },
+    /// Parameter `name` cannot take `value`, for `reason`.
+    NonPhysical {
+        name: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+}
+
+impl core::fmt::Display for ParamError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            ParamError::NoSuchParam { index } => write!(f, \"no parameter with index {index}\"),
+            ParamError::NonPhysical {
+                name,
+                value,
+                reason,
+            } => write!(f, \"parameter `{name}` = {value} is not physical: {reason}\"),
+        }
+    }
+}
+
+impl core::error::Error for ParamError {}
+";
+
+impl Writer<'_> {
+    pub(super) fn name_array(&mut self, konst: &str, size: &str, what: &str, names: &[String]) {
+        let list: Vec<String> = names.iter().map(|n| string_literal(n)).collect();
+        self.out.push('\n');
+        self.doc(0, &format!("The names of the {what}, in vector order."));
+        let head = format!("pub const {konst}: [&str; {size}] = ");
+        self.out
+            .push_str(&format::array(&head, &list, ";", 0, self.width));
+        self.out.push('\n');
+    }
+
+    pub(super) fn sizes(&mut self) {
+        let eqs = &self.m.equations;
+        let consts = [
+            (
+                "N_STATES",
+                "The number of states: the energy variables of the storages (`p` of inertias, `q` of \
+                 compliances), then the integrated flows (`var`s).",
+                eqs.states.len(),
+            ),
+            (
+                "N_ENERGY_STATES",
+                "The number of energy states (the first `N_ENERGY_STATES` entries of the state vector).",
+                eqs.energy_states,
+            ),
+            ("N_INPUTS", "The number of inputs.", eqs.inputs.len()),
+            ("N_OUTPUTS", "The number of outputs.", eqs.outputs.len()),
+            (
+                "N_PARAMS",
+                "The number of free parameters (the fields of `Params`).",
+                self.free.len(),
+            ),
+        ];
+        self.out.push('\n');
+        for (name, doc, value) in consts {
+            self.doc(0, doc);
+            let _ = writeln!(self.out, "pub const {name}: usize = {value};");
+        }
+        let states: Vec<String> = eqs.states.iter().map(|s| s.name.clone()).collect();
+        let inputs = eqs.inputs.clone();
+        let outputs = output_names(eqs);
+        let params: Vec<String> = self
+            .free
+            .iter()
+            .filter_map(|&k| eqs.params.get(k).map(|p| p.0.clone()))
+            .collect();
+        self.name_array("STATE_NAMES", "N_STATES", "states", &states);
+        self.name_array("INPUT_NAMES", "N_INPUTS", "inputs", &inputs);
+        self.name_array("OUTPUT_NAMES", "N_OUTPUTS", "outputs", &outputs);
+        self.name_array("PARAM_NAMES", "N_PARAMS", "parameters", &params);
+        self.out.push_str(
+            "
+/// The state vector.
+pub type State = SVector<f64, N_STATES>;
+/// The input vector.
+pub type Inputs = SVector<f64, N_INPUTS>;
+/// The output vector.
+pub type Outputs = SVector<f64, N_OUTPUTS>;
+/// `∂f/∂x`.
+pub type JacX = SMatrix<f64, N_STATES, N_STATES>;
+/// `∂f/∂u`.
+pub type JacU = SMatrix<f64, N_STATES, N_INPUTS>;
+/// `∂h/∂x`.
+pub type OutJacX = SMatrix<f64, N_OUTPUTS, N_STATES>;
+/// `∂h/∂u`.
+pub type OutJacU = SMatrix<f64, N_OUTPUTS, N_INPUTS>;
+",
+        );
+    }
+
+    pub(super) fn params(&mut self) {
+        if self.options.runtime {
+            self.out.push('\n');
+            self.doc(
+                0,
+                "Why parameter values are refused: the runtime's error, which its traits return.",
+            );
+            self.out
+                .push_str("pub use bgc_runtime::model::ParamError;\n");
+        } else {
+            self.out.push_str(OWN_PARAM_ERROR);
+        }
+        let model = &self.m.model;
+        let free: Vec<&ir::Param> = self
+            .free
+            .iter()
+            .filter_map(|&k| model.params.get(k))
+            .collect();
+        self.out.push('\n');
+        self.doc(
+            0,
+            &format!(
+                "The parameters of `{}`, in SI units. A parameter the file defines from others is a method: it \
+                 follows the fields it uses.",
+                comment(&model.name)
+            ),
+        );
+        // `Default` derived when every default is +0 (clippy's `derivable_impls`), written out otherwise.
+        let derive_default = free.iter().all(|p| p.default.to_bits() == 0);
+        let _ = writeln!(
+            self.out,
+            "#[derive(Clone, Copy, Debug, {}PartialEq)]",
+            if derive_default { "Default, " } else { "" }
+        );
+        if self.fields.iter().any(|f| !format::is_snake_case(f)) {
+            self.out.push_str("#[allow(non_snake_case)]\n");
+        }
+        if free.is_empty() {
+            self.out.push_str("pub struct Params {}\n");
+        } else {
+            self.out.push_str("pub struct Params {\n");
+            for (p, field) in free.iter().zip(self.fields.clone()) {
+                let desc = p.description.as_deref().unwrap_or("(no description)");
+                self.doc(4, desc);
+                if !p.doc.is_empty() {
+                    self.doc(4, "");
+                    self.doc_lines(4, &p.doc);
+                }
+                self.doc(4, "");
+                self.doc(
+                    4,
+                    &format!(
+                        "Declared unit `[{}]`; the value is in SI units. Default: {}.",
+                        comment(&p.unit_text),
+                        rust_f64(p.default)
+                    ),
+                );
+                let _ = writeln!(self.out, "    pub {field}: f64,");
+            }
+            self.out.push_str("}\n");
+        }
+        if !derive_default {
+            let values: Vec<(String, String)> = free
+                .iter()
+                .zip(self.fields.clone())
+                .map(|(p, f)| (f, rust_f64(p.default)))
+                .collect();
+            let literal = format::struct_literal("Params", &values, "", 8, self.width);
+            let allow = if format::may_look_like_a_constant(&literal) {
+                "    #[allow(clippy::approx_constant)]\n"
+            } else {
+                ""
+            };
+            let _ = write!(
+                self.out,
+                "\nimpl Default for Params {{\n    /// The defaults of the `.bg` file.\n{allow}    fn default() -> Self {{\n{literal}\n    }}\n}}\n"
+            );
+        }
+        self.out.push_str("\nimpl Params {\n");
+        self.derived_methods();
+        self.validate();
+        self.get_set();
+        self.out.push_str("}\n");
+    }
+
+    /// One method per derived parameter, in terms of the fields and the methods before it.
+    fn derived_methods(&mut self) {
+        let model = &self.m.model;
+        let eqs = &self.m.equations;
+        for (k, p) in model.params.iter().enumerate() {
+            let Some(Some(e)) = eqs.derived.get(k) else {
+                continue;
+            };
+            let Ok(value) = super::super::adapter::to_symbolic(eqs, e) else {
+                continue;
+            };
+            let code = to_rust_code(&value, &|s| self.param_access(s.name()));
+            let name = self.all_fields.get(k).cloned().unwrap_or_default();
+            let desc = p.description.as_deref().unwrap_or("A derived parameter.");
+            self.doc(4, desc);
+            self.doc(4, "");
+            self.doc(
+                4,
+                &format!(
+                    "Declared unit `[{}]`, in SI units: `{}`.",
+                    comment(&p.unit_text),
+                    to_text(&value)
+                ),
+            );
+            let mut namer = Namer::with_reserved();
+            let mut body = Body::new(&mut namer, 8, self.width);
+            body.statement("", &code, "");
+            let text = body.finish();
+            let mut lints = Vec::new();
+            if !format::is_snake_case(&name) {
+                lints.push("non_snake_case");
+            }
+            if format::may_look_like_a_constant(&text) {
+                lints.push("clippy::approx_constant");
+            }
+            if !lints.is_empty() {
+                let _ = writeln!(self.out, "    #[allow({})]", lints.join(", "));
+            }
+            let _ = write!(
+                self.out,
+                "    pub fn {name}(&self) -> f64 {{\n{text}    }}\n\n"
+            );
+        }
+    }
+
+    /// How code inside `impl Params` reads parameter `name`: `self.field`, or `self.method()` when derived.
+    fn param_access(&self, name: &str) -> String {
+        let eqs = &self.m.equations;
+        let Some(k) = eqs.params.iter().position(|p| p.0 == name) else {
+            return "f64::NAN".into();
+        };
+        let field = self.all_fields.get(k).cloned().unwrap_or_default();
+        if eqs.derived.get(k).is_some_and(Option::is_some) {
+            format!("self.{field}()")
+        } else {
+            format!("self.{field}")
+        }
+    }
+
+    /// `get` and `set` by index.
+    fn get_set(&mut self) {
+        self.out.push('\n');
+        self.doc(
+            4,
+            "The parameter with index `index` (in `PARAM_NAMES` order).",
+        );
+        if self.fields.is_empty() {
+            self.out.push_str(
+                "    pub fn get(&self, _index: usize) -> Option<f64> {\n        None\n    }\n",
+            );
+        } else {
+            self.out.push_str(
+                "    pub fn get(&self, index: usize) -> Option<f64> {\n        match index {\n",
+            );
+            for (k, field) in self.fields.iter().enumerate() {
+                let _ = writeln!(self.out, "            {k} => Some(self.{field}),");
+            }
+            self.out
+                .push_str("            _ => None,\n        }\n    }\n");
+        }
+        self.out.push('\n');
+        self.doc(
+            4,
+            "Sets the parameter with index `index`; a value that makes the parameters non-physical is refused \
+             and leaves them unchanged.",
+        );
+        if self.fields.is_empty() {
+            self.out.push_str(
+                "    pub fn set(&mut self, index: usize, _value: f64) -> Result<(), ParamError> {\n        \
+                 Err(ParamError::NoSuchParam { index })\n    }\n",
+            );
+            return;
+        }
+        self.out.push_str(
+            "    pub fn set(&mut self, index: usize, value: f64) -> Result<(), ParamError> {\n        \
+             let mut next = *self;\n        match index {\n",
+        );
+        for (k, field) in self.fields.iter().enumerate() {
+            let _ = writeln!(self.out, "            {k} => next.{field} = value,");
+        }
+        self.out.push_str(
+            "            _ => return Err(ParamError::NoSuchParam { index }),\n        }\n        \
+             next.validate()?;\n        *self = next;\n        Ok(())\n    }\n",
+        );
+    }
+
+    /// `validate`: every parameter finite; each inertia and compliance positive, each resistance non-negative and
+    /// each transformer or gyrator modulus non-zero, where the element's value depends on parameters only.
+    fn validate(&mut self) {
+        let model = &self.m.model;
+        let mut namer = Namer::with_reserved();
+        let mut body = Body::new(&mut namer, 8, self.width);
+        let values: Vec<String> = self.fields.iter().map(|f| format!("self.{f}")).collect();
+        body.lines(
+            format::array(
+                "        let values: [f64; N_PARAMS] = ",
+                &values,
+                ";",
+                8,
+                self.width,
+            )
+            .lines()
+            .map(str::to_string),
+        );
+        body.lines(
+            "        for (name, value) in PARAM_NAMES.into_iter().zip(values) {
+            if !value.is_finite() {
+                return Err(ParamError::NonPhysical {
+                    name,
+                    value,
+                    reason: \"not a finite number\",
+                });
+            }
+        }"
+            .lines()
+            .map(str::to_string),
+        );
+        let field_of: HashMap<String, String> = model
+            .params
+            .iter()
+            .map(|p| (p.name.clone(), self.param_access(&p.name)))
+            .collect();
+        for node in model.graph.node_weights() {
+            let (expr, rule) = match (&node.kind, &node.relation) {
+                (ElementKind::I, ir::Relation::Linear(e)) => (e, Rule::Positive("inertia")),
+                (ElementKind::C, ir::Relation::Linear(e)) => (e, Rule::Positive("compliance")),
+                (ElementKind::R, ir::Relation::Linear(e)) => (e, Rule::NonNegative),
+                (ElementKind::TF | ElementKind::GY, ir::Relation::Modulus(e)) => (e, Rule::NonZero),
+                _ => continue,
+            };
+            let leaf = |l: &ir::Expr| match l {
+                ir::Expr::Param(i) => model
+                    .params
+                    .get(*i)
+                    .map(|p| Expr::symbol(Symbol::param(p.name.as_str()))),
+                _ => None,
+            };
+            let Ok(value) = from_ir(expr, &leaf) else {
+                continue;
+            };
+            let Some(first) = value.free_symbols().into_iter().next() else {
+                continue;
+            };
+            let Some(first_field) = field_of.get(first.name()) else {
+                continue;
+            };
+            let code = to_rust_code(&value, &|s| {
+                field_of
+                    .get(s.name())
+                    .cloned()
+                    .unwrap_or_else(|| "f64::NAN".into())
+            });
+            let text = to_text(&value);
+            let (cond, reason) = match rule {
+                Rule::Positive(what) => (
+                    "!v.is_finite() || v <= 0.0",
+                    format!(
+                        "the {what} of `{}` ({text}) must be positive and finite",
+                        node.name
+                    ),
+                ),
+                Rule::NonNegative => (
+                    "!v.is_finite() || v < 0.0",
+                    format!(
+                        "the resistance of `{}` ({text}) must be non-negative and finite",
+                        node.name
+                    ),
+                ),
+                Rule::NonZero => (
+                    "!v.is_finite() || v == 0.0",
+                    format!(
+                        "the modulus of `{}` ({text}) must be non-zero and finite",
+                        node.name
+                    ),
+                ),
+            };
+            body.lines(format::comment(
+                8,
+                "//",
+                &format!("{}: {text}", node.name),
+                Wrap::Equation,
+                self.width,
+            ));
+            body.statement("let v = ", &code, ";");
+            let reason_head = "                reason: ";
+            let reason = format::string_literal(&reason, reason_head.len(), 1, 16, self.width);
+            body.lines(
+                format!(
+                    "        if {cond} {{
+            return Err(ParamError::NonPhysical {{
+                name: {},
+                value: {first_field},
+{reason_head}{reason},
+            }});
+        }}",
+                    string_literal(first.name()),
+                )
+                .lines()
+                .map(str::to_string),
+            );
+        }
+        body.line("Ok(())");
+        let text = body.finish();
+        self.doc(
+            4,
+            "Checks that the parameters are physical: all finite, inertias and compliances positive, resistances \
+             non-negative, transformer and gyrator moduli non-zero.",
+        );
+        if format::may_look_like_a_constant(&text) {
+            self.out.push_str("    #[allow(clippy::approx_constant)]\n");
+        }
+        self.out
+            .push_str("    pub fn validate(&self) -> Result<(), ParamError> {\n");
+        self.out.push_str(&text);
+        self.out.push_str("    }\n");
+    }
+}

@@ -19,6 +19,7 @@ pub mod discretize;
 pub mod expm;
 pub mod lyapunov;
 pub mod pbh;
+mod refine;
 pub mod riccati;
 pub mod schur;
 pub mod sign;

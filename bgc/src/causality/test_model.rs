@@ -1,6 +1,12 @@
 //! A small builder of IR models for tests, independent of the parser and lowering. It also writes a source text
 //! (one line per declaration) so that every node and bond has a real span to check diagnostics against.
+//!
+//! Small graphs are written compactly: [`Builder::from_spec`] takes the nodes as `"kind name"` pairs and the
+//! bonds as chains of names, and creates both in the order written (the order decides node and bond indices and
+//! the order in which causality is assigned, so a test's graph is exactly what it reads).
 
+use super::{Causality, analyse};
+use crate::diagnostic::Diagnostic;
 use crate::ir::{Bond, Domain, Expr, Hint, Law, Model, Node, PortVar, Relation, SpanTable};
 use crate::span::{FileId, SourceMap, Span};
 use crate::syntax::ast::ElementKind;
@@ -27,6 +33,17 @@ impl Builder {
             },
             text: format!("model {name} {{\n"),
         }
+    }
+
+    /// A model `name` with the nodes `nodes` (see [`Builder::nodes`]) and then the bonds along `chains` (see
+    /// [`Builder::chains`]).
+    pub fn from_spec(name: &str, nodes: &str, chains: &str) -> Builder {
+        let mut b = Builder::new(name);
+        for (kind, node) in node_specs(nodes) {
+            b.node(kind, node);
+        }
+        b.chains(chains);
+        b
     }
 
     fn line(&mut self, s: &str) -> Span {
@@ -56,6 +73,24 @@ impl Builder {
             _ => 1,
         };
         self.add(kind, name, relation, ports)
+    }
+
+    /// Nodes with default relations from comma-separated `"kind name"` pairs, kinds as the language writes them
+    /// (`"Se u, 1 j, I m"`); their indices in the order written.
+    pub fn nodes<const N: usize>(&mut self, spec: &str) -> [NodeIndex; N] {
+        let nodes: Vec<NodeIndex> = node_specs(spec)
+            .map(|(kind, name)| self.node(kind, name))
+            .collect();
+        nodes
+            .try_into()
+            .unwrap_or_else(|v: Vec<_>| panic!("{} nodes in {spec:?}, {N} expected", v.len()))
+    }
+
+    /// The node called `name`.
+    pub fn id(&self, name: &str) -> NodeIndex {
+        self.model
+            .node_by_name(name)
+            .unwrap_or_else(|| panic!("no node {name}"))
     }
 
     /// A node with a given relation and port count.
@@ -163,6 +198,22 @@ impl Builder {
         }
     }
 
+    /// Bonds along chains of node names, the chains separated by `;`: `"u j m; j c"` bonds `u -> j`, `j -> m`,
+    /// `j -> c`, in this order.
+    pub fn chains(&mut self, spec: &str) {
+        for chain in spec.split(';').filter(|c| !c.trim().is_empty()) {
+            let nodes: Vec<NodeIndex> = chain.split_whitespace().map(|n| self.id(n)).collect();
+            self.chain(&nodes);
+        }
+    }
+
+    /// The finished model with its causality and findings.
+    pub fn analyse(self) -> (Model, Causality, Vec<Diagnostic>) {
+        let (m, _) = self.finish();
+        let (c, d) = analyse(&m);
+        (m, c, d)
+    }
+
     pub fn finish(mut self) -> (Model, SourceMap) {
         self.text.push_str("}\n");
         self.model.spans.model = Span::new(FileId(0), 0, self.text.len());
@@ -170,4 +221,17 @@ impl Builder {
         sources.add(format!("{}.bg", self.model.name), self.text);
         (self.model, sources)
     }
+}
+
+/// The `(kind, name)` pairs of a node list `"Se u, 1 j, I m"`.
+fn node_specs(spec: &str) -> impl Iterator<Item = (ElementKind, &str)> {
+    spec.split(',').map(|item| {
+        let (kind, name) = item
+            .trim()
+            .split_once(' ')
+            .unwrap_or_else(|| panic!("{item:?} is not `kind name`"));
+        let kind =
+            ElementKind::from_keyword(kind).unwrap_or_else(|| panic!("no element kind {kind}"));
+        (kind, name.trim())
+    })
 }

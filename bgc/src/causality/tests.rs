@@ -37,17 +37,12 @@ fn codes(d: &[Diagnostic]) -> Vec<&'static str> {
 fn oscillator_is_causally_complete() {
     // Se -> 1 -> I, C, R. Se sets the effort into the 1-junction; I (integral) takes its effort from the
     // junction, which is then the junction's one effort-setting bond; C (integral) and R set their efforts.
-    let mut b = Builder::new("oscillator");
-    let se = b.node(K::Se, "push");
-    let j = b.node(K::One, "v");
-    let i = b.node(K::I, "mass");
-    let c = b.node(K::C, "spring");
-    let r = b.node(K::R, "damper");
-    b.chain(&[se, j, i]);
-    b.bond(j, c);
-    b.bond(j, r);
-    let (m, _) = b.finish();
-    let (ca, d) = analyse(&m);
+    let (m, ca, d) = Builder::from_spec(
+        "oscillator",
+        "Se push, 1 v, I mass, C spring, R damper",
+        "push v mass; v spring; v damper",
+    )
+    .analyse();
     assert!(d.is_empty(), "{d:?}");
     assert!(ca.consistent);
     assert_eq!(setter(&m, &ca, "push", "v"), "push");
@@ -63,15 +58,8 @@ fn oscillator_is_causally_complete() {
 #[test]
 fn two_inertias_on_one_junction() {
     // The first inertia takes integral causality and so sets the junction's flow; the second gets it imposed.
-    let mut b = Builder::new("two");
-    let se = b.node(K::Se, "tau");
-    let j = b.node(K::One, "j");
-    let i1 = b.node(K::I, "J_m");
-    let i2 = b.node(K::I, "J_g");
-    b.chain(&[se, j, i1]);
-    b.bond(j, i2);
-    let (m, _) = b.finish();
-    let (ca, d) = analyse(&m);
+    let (m, ca, d) =
+        Builder::from_spec("two", "Se tau, 1 j, I J_m, I J_g", "tau j J_m; j J_g").analyse();
     assert_eq!(form(&m, &ca, "J_m"), StorageForm::Integral);
     assert_eq!(form(&m, &ca, "J_g"), StorageForm::Derivative);
     assert_eq!(codes(&d), ["BG0510"]);
@@ -84,21 +72,12 @@ fn gyrator_inverts_causality() {
     // DC motor: Se -> 1e {L, R} -> GY -> 1m {J, b}. L integral makes 1e set L's effort, so the GY bond is
     // effort-in to 1e from the GY; a gyrator that sets one effort sets both, so 1m receives its effort from
     // the GY and J can be integral. Two states.
-    let mut b = Builder::new("motor");
-    let se = b.node(K::Se, "v");
-    let je = b.node(K::One, "je");
-    let l = b.node(K::I, "L");
-    let r = b.node(K::R, "Ra");
-    let gy = b.node(K::GY, "kt");
-    let jm = b.node(K::One, "jm");
-    let rotor = b.node(K::I, "J");
-    let fr = b.node(K::R, "b");
-    b.chain(&[se, je, l]);
-    b.bond(je, r);
-    b.chain(&[je, gy, jm, rotor]);
-    b.bond(jm, fr);
-    let (m, _) = b.finish();
-    let (ca, d) = analyse(&m);
+    let (m, ca, d) = Builder::from_spec(
+        "motor",
+        "Se v, 1 je, I L, R Ra, GY kt, 1 jm, I J, R b",
+        "v je L; je Ra; je kt jm J; jm b",
+    )
+    .analyse();
     assert!(d.is_empty(), "{d:?}");
     assert_eq!(setter(&m, &ca, "je", "kt"), "kt");
     assert_eq!(setter(&m, &ca, "kt", "jm"), "kt");
@@ -110,15 +89,12 @@ fn transformer_passes_effort_through() {
     // Se -> 1a -> TF -> 1b -> I: the source brings 1a's effort in, so 1a's one effort-setting bond is the TF
     // bond; the TF then sets the effort on its output bond (effort in, effort out) and the inertia on 1b can be
     // integral.
-    let mut b = Builder::new("tf");
-    let se = b.node(K::Se, "tau");
-    let ja = b.node(K::One, "ja");
-    let tf = b.node(K::TF, "gear");
-    let jb = b.node(K::One, "jb");
-    let i = b.node(K::I, "load");
-    b.chain(&[se, ja, tf, jb, i]);
-    let (m, _) = b.finish();
-    let (ca, d) = analyse(&m);
+    let (m, ca, d) = Builder::from_spec(
+        "tf",
+        "Se tau, 1 ja, TF gear, 1 jb, I load",
+        "tau ja gear jb load",
+    )
+    .analyse();
     assert!(d.is_empty(), "{d:?}");
     assert_eq!(setter(&m, &ca, "ja", "gear"), "ja");
     assert_eq!(setter(&m, &ca, "gear", "jb"), "gear");
@@ -128,17 +104,12 @@ fn transformer_passes_effort_through() {
 #[test]
 fn modulated_elements_propagate_like_plain_ones() {
     // The same graph with MSe and MTF gives the same causality.
-    let mut b = Builder::new("mtf");
-    let se = b.node(K::MSe, "tau");
-    let ja = b.node(K::One, "ja");
-    let ia = b.node(K::I, "ia");
-    let tf = b.node(K::MTF, "lever");
-    let jb = b.node(K::One, "jb");
-    let ib = b.node(K::I, "ib");
-    b.chain(&[se, ja, ia]);
-    b.chain(&[ja, tf, jb, ib]);
-    let (m, _) = b.finish();
-    let (ca, d) = analyse(&m);
+    let (m, ca, d) = Builder::from_spec(
+        "mtf",
+        "MSe tau, 1 ja, I ia, MTF lever, 1 jb, I ib",
+        "tau ja ia; ja lever jb ib",
+    )
+    .analyse();
     // ia integral sets ja's flow, the MTF passes it to jb, so ib is in derivative causality.
     assert_eq!(form(&m, &ca, "ia"), StorageForm::Integral);
     assert_eq!(form(&m, &ca, "ib"), StorageForm::Derivative);
@@ -148,15 +119,8 @@ fn modulated_elements_propagate_like_plain_ones() {
 #[test]
 fn parallel_resistors_on_an_effort_source_are_forced() {
     // Se -> 0 -> R1, R2: the 0-junction passes the source's effort to both resistors: conductance, no choice.
-    let mut b = Builder::new("parallel");
-    let se = b.node(K::Se, "u");
-    let j = b.node(K::Zero, "n");
-    let r1 = b.node(K::R, "R1");
-    let r2 = b.node(K::R, "R2");
-    b.chain(&[se, j, r1]);
-    b.bond(j, r2);
-    let (m, _) = b.finish();
-    let (ca, d) = analyse(&m);
+    let (m, ca, d) =
+        Builder::from_spec("parallel", "Se u, 0 n, R R1, R R2", "u n R1; n R2").analyse();
     assert!(d.is_empty(), "{d:?}");
     assert_eq!(setter(&m, &ca, "n", "R1"), "n");
     assert_eq!(setter(&m, &ca, "n", "R2"), "n");
@@ -171,8 +135,7 @@ fn nonlinear_resistor_law_preference() {
     let r2 = b.node(K::R, "R2");
     b.bond(j, r1);
     b.bond(j, r2);
-    let (m, _) = b.finish();
-    let (ca, d) = analyse(&m);
+    let (m, ca, d) = b.analyse();
     assert_eq!(setter(&m, &ca, "n", "R1"), "n");
     assert_eq!(setter(&m, &ca, "n", "R2"), "R2");
     assert!(ca.arbitrary.is_empty());
@@ -186,8 +149,7 @@ fn nonlinear_resistor_law_preference() {
     let j = b.node(K::One, "s");
     let r = b.r_law("diode", PortVar::Flow);
     b.chain(&[sf, j, r]);
-    let (m, _) = b.finish();
-    let (ca, d) = analyse(&m);
+    let (m, ca, d) = b.analyse();
     assert_eq!(setter(&m, &ca, "s", "diode"), "diode");
     assert_eq!(
         ca.inverted_laws,
@@ -200,10 +162,7 @@ fn nonlinear_resistor_law_preference() {
 fn fields_take_causality_per_port() {
     // An I-field with M(q) on two 1-junctions, each driven by an effort source: integral on both ports.
     let mut b = Builder::new("leg");
-    let s1 = b.node(K::Se, "tau1");
-    let s2 = b.node(K::Se, "tau2");
-    let j1 = b.node(K::One, "hip");
-    let j2 = b.node(K::One, "knee");
+    let [s1, s2, j1, j2] = b.nodes("Se tau1, Se tau2, 1 hip, 1 knee");
     let mass = Relation::MassMatrix {
         n: 2,
         entries: vec![Expr::Const(1.0); 4],
@@ -224,8 +183,7 @@ fn fields_take_causality_per_port() {
     let rf = b.add(K::RF, "bearing", Relation::Laws(laws), 2);
     b.bond_full(j1, None, rf, Some(0), None);
     b.bond_full(j2, None, rf, Some(1), None);
-    let (m, _) = b.finish();
-    let (ca, d) = analyse(&m);
+    let (m, ca, d) = b.analyse();
     assert!(d.is_empty(), "{d:?}");
     assert_eq!(ca.storage.len(), 2);
     assert!(

@@ -6,13 +6,15 @@
 //! factors with negative exponents (made positive); `x^0.5` prints as a square root.
 //!
 //! Each printer takes a closure mapping a symbol to its printed name, so the caller decides whether `J_m` prints as
-//! `J_m`, `p.J_m` or `x[0]`.
+//! `J_m`, `p.J_m` or `x[0]`. The walk itself (which node prints how, and a sum's terms) is [`Layout`]; a printer
+//! that implements it supplies only its own forms of numbers, products, powers, calls and parentheses.
 
 pub mod latex;
 pub mod rust;
 pub mod text;
 
-use super::expr::{Expr, Node};
+use super::expr::{Expr, Node, Symbol};
+use crate::ir::Func;
 
 /// Binding strength of what a printer produced, weakest first: callers parenthesise a part whose strength is below
 /// what its position needs.
@@ -83,5 +85,67 @@ pub(super) fn number_text(c: f64) -> String {
         format!("{c:.0}")
     } else {
         format!("{c:?}")
+    }
+}
+
+/// The walk of an expression that the printers share; each printed part comes with its binding strength so that
+/// its user can parenthesise it. A printer supplies the forms of its own language.
+pub(super) trait Layout {
+    /// A constant (a negative one binds as a unary minus).
+    fn number(&self, c: f64) -> String;
+    /// A symbol's printed name.
+    fn symbol(&self, s: &Symbol) -> String;
+    /// `s` in the printer's parentheses.
+    fn parenthesised(&self, s: String) -> String;
+    /// A product, or a power with a visibly negative exponent ([`split_fraction`] gives its parts); it binds as
+    /// a product.
+    fn product(&self, e: &Expr) -> String;
+    /// `base^exp` for an exponent that is not visibly negative, with its binding strength.
+    fn power(&self, base: &Expr, exp: &Expr) -> (String, u8);
+    /// A function call; it binds as an atom.
+    fn call(&self, f: Func, args: &[Expr]) -> String;
+
+    /// The text of `e` and its binding strength.
+    fn print(&self, e: &Expr) -> (String, u8) {
+        match e.node() {
+            Node::Const(c) => (self.number(*c), if *c < 0.0 { UNARY } else { ATOM }),
+            Node::Sym(s) => (self.symbol(s), ATOM),
+            Node::Add(terms) => (self.sum(terms), SUM),
+            Node::Mul(_) => match negated(e) {
+                Some(pos) => (format!("-{}", self.product(&pos)), PRODUCT),
+                None => (self.product(e), PRODUCT),
+            },
+            Node::Pow(b, x) => match reciprocal(e) {
+                Some(_) => (self.product(e), PRODUCT),
+                None => self.power(b, x),
+            },
+            Node::Call(f, args) => (self.call(*f, args), ATOM),
+        }
+    }
+
+    /// `e` parenthesised when it binds less tightly than `need`.
+    fn wrapped(&self, e: &Expr, need: u8) -> String {
+        let (s, p) = self.print(e);
+        if p < need { self.parenthesised(s) } else { s }
+    }
+
+    /// The terms in [`sum_print_order`], joined by ` + ` and, for a term that prints with a leading minus,
+    /// ` - ` and the term made positive.
+    fn sum(&self, terms: &[Expr]) -> String {
+        let mut out = String::new();
+        for (i, t) in sum_print_order(terms).into_iter().enumerate() {
+            match (i, negated(t)) {
+                (0, _) => out.push_str(&self.print(t).0),
+                (_, Some(pos)) => {
+                    out.push_str(" - ");
+                    out.push_str(&self.wrapped(&pos, PRODUCT));
+                }
+                (_, None) => {
+                    out.push_str(" + ");
+                    out.push_str(&self.print(t).0);
+                }
+            }
+        }
+        out
     }
 }

@@ -46,34 +46,10 @@ pub const KEYWORDS: &[&str] = &[
     "IF",
 ];
 
-/// Keywords that begin a statement or an item; recovery stops before one that starts a line.
-const STATEMENT_KEYWORDS: &[&str] = &[
-    "model",
-    "component",
-    "import",
-    "param",
-    "input",
-    "output",
-    "var",
-    "bond",
-    "port",
-    "domain",
-    "coords",
-    "Se",
-    "Sf",
-    "MSe",
-    "MSf",
-    "C",
-    "I",
-    "R",
-    "TF",
-    "GY",
-    "MTF",
-    "MGY",
-    "CF",
-    "RF",
-    "IF",
-];
+/// The keywords that never begin a statement: `stroke` (a bond's causality hint, inside the bond statement) and the
+/// reserved `hint`. Every other keyword begins a statement or an item, and recovery stops before one that starts a
+/// line.
+const CLAUSE_KEYWORDS: &[&str] = &["hint", "stroke"];
 
 pub fn is_keyword(s: &str) -> bool {
     KEYWORDS.contains(&s)
@@ -235,7 +211,8 @@ impl<'a> Parser<'a> {
     }
 
     pub(super) fn is_statement_keyword(&self, t: Token) -> bool {
-        t.kind == Tok::Ident && STATEMENT_KEYWORDS.contains(&self.tok_text(t))
+        let text = self.tok_text(t);
+        t.kind == Tok::Ident && is_keyword(text) && !CLAUSE_KEYWORDS.contains(&text)
     }
 
     // ----- diagnostics -----

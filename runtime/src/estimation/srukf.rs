@@ -22,13 +22,13 @@ use super::dense::{
     solve_lower, solve_upper_transposed,
 };
 use super::fault::{
-    CovarianceRepair, EstimationError, FaultPolicy, UpdateOutcome, check_additive_noise,
-    check_estimate, repair_covariance,
+    CovarianceRepair, EstimationError, UpdateOutcome, check_additive_noise, check_estimate,
+    repair_covariance,
 };
-use super::sigma::{MeanFn, ResidualFn, SigmaPoints, cross_covariance};
+use super::sigma::{ResidualFn, SigmaPoints, cross_covariance};
 use super::unscented::{
-    SpaceFns, check_input, check_state_mean, evaluate_points, model_measurement, model_process,
-    rejected_measurement,
+    FilterSettings, check_state_mean, model_measurement, model_process, rejected_measurement,
+    settings_methods, sigma_images,
 };
 use crate::model::DiscreteModel;
 use nalgebra::{SMatrix, SVector};
@@ -38,14 +38,11 @@ const FILTER: &str = "square-root UKF";
 /// A square-root UKF with `NX` states, `NU` inputs, `NY` measurements and `NS = 2 NX + 1` sigma points.
 #[derive(Clone, Debug)]
 pub struct SquareRootUkf<const NX: usize, const NU: usize, const NY: usize, const NS: usize> {
-    points: SigmaPoints<NX, NS>,
+    settings: FilterSettings<NX, NX, NY, NS>,
     x: SVector<f64, NX>,
     s: SMatrix<f64, NX, NX>,
     sqrt_q: SMatrix<f64, NX, NX>,
     sqrt_r: SMatrix<f64, NY, NY>,
-    x_fns: SpaceFns<NX, NS>,
-    y_fns: SpaceFns<NY, NS>,
-    policy: FaultPolicy,
     innovation: SVector<f64, NY>,
     sqrt_innovation_cov: SMatrix<f64, NY, NY>,
 }
@@ -68,57 +65,33 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
             kind: "definite",
         };
         Ok(SquareRootUkf {
-            points,
+            settings: FilterSettings::new(points, FILTER),
             x: x0,
             s: cholesky_lower(&p0).ok_or(not_pd("P0"))?,
             sqrt_q: cholesky_psd(&q).ok_or(not_pd("Q"))?,
             sqrt_r: cholesky_psd(&r).ok_or(not_pd("R"))?,
-            x_fns: SpaceFns::default(),
-            y_fns: SpaceFns::default(),
-            policy: FaultPolicy::default(),
             innovation: SVector::zeros(),
             sqrt_innovation_cov: SMatrix::zeros(),
         })
     }
 
-    /// Replaces the state mean and residual functions.
-    pub fn with_state_functions(mut self, mean: MeanFn<NX, NS>, residual: ResidualFn<NX>) -> Self {
-        self.x_fns = SpaceFns { mean, residual };
-        self
-    }
-
-    /// Replaces the measurement mean and residual functions.
-    pub fn with_measurement_functions(
-        mut self,
-        mean: MeanFn<NY, NS>,
-        residual: ResidualFn<NY>,
-    ) -> Self {
-        self.y_fns = SpaceFns { mean, residual };
-        self
-    }
-
-    /// Replaces the fault policy.
-    pub fn set_fault_policy(&mut self, policy: FaultPolicy) -> Result<(), EstimationError> {
-        policy.validate()?;
-        self.policy = policy;
-        Ok(())
-    }
+    settings_methods!();
 
     /// The time update through `f(x, u)`.
     pub fn predict<F>(
         &mut self,
         u: &SVector<f64, NU>,
-        mut f: F,
+        f: F,
     ) -> Result<Option<CovarianceRepair>, EstimationError>
     where
         F: FnMut(&SVector<f64, NX>, &SVector<f64, NU>) -> SVector<f64, NX>,
     {
-        check_input(u)?;
-        let chi = self.points.generate_from_factor(&self.x, &self.s);
-        let prop = evaluate_points("process function", |i| f(&chi.column(i).into_owned(), u))?;
-        let x = (self.x_fns.mean)(&prop, self.points.mean_weights());
+        let draw = || Ok(self.settings.points.generate_from_factor(&self.x, &self.s));
+        let (_, prop) = sigma_images("process function", u, draw, f)?;
+        let x = (self.settings.x_fns.mean)(&prop, self.settings.points.mean_weights());
         check_state_mean(&x)?;
-        let (s, repair) = self.factor_of_spread(&prop, &x, &self.sqrt_q, self.x_fns.residual)?;
+        let x_residual = self.settings.x_fns.residual;
+        let (s, repair) = self.factor_of_spread(&prop, &x, &self.sqrt_q, x_residual)?;
         self.x = x;
         self.s = s;
         Ok(repair)
@@ -129,7 +102,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         &mut self,
         y: &SVector<f64, NY>,
         u: &SVector<f64, NU>,
-        mut h: H,
+        h: H,
     ) -> Result<UpdateOutcome, EstimationError>
     where
         H: FnMut(&SVector<f64, NX>, &SVector<f64, NU>) -> SVector<f64, NY>,
@@ -137,15 +110,13 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         if let Some(rejected) = rejected_measurement(y) {
             return Ok(rejected);
         }
-        check_input(u)?;
-        let chi = self.points.generate_from_factor(&self.x, &self.s);
-        let ys = evaluate_points("measurement function", |i| {
-            h(&chi.column(i).into_owned(), u)
-        })?;
-        let y_hat = (self.y_fns.mean)(&ys, self.points.mean_weights());
+        let draw = || Ok(self.settings.points.generate_from_factor(&self.x, &self.s));
+        let (chi, ys) = sigma_images("measurement function", u, draw, h)?;
+        let settings = &self.settings;
+        let y_hat = (settings.y_fns.mean)(&ys, settings.points.mean_weights());
         let singular = EstimationError::SingularInnovation { filter: FILTER };
         let (sy, _) = self
-            .factor_of_spread(&ys, &y_hat, &self.sqrt_r, self.y_fns.residual)
+            .factor_of_spread(&ys, &y_hat, &self.sqrt_r, settings.y_fns.residual)
             .map_err(|_| singular.clone())?;
         if (0..NY).any(|i| sy[(i, i)] <= 0.0) {
             return Err(singular);
@@ -155,16 +126,16 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
             &self.x,
             &ys,
             &y_hat,
-            self.points.covariance_weights(),
-            self.x_fns.residual,
-            self.y_fns.residual,
+            settings.points.covariance_weights(),
+            settings.x_fns.residual,
+            settings.y_fns.residual,
         );
-        let e = (self.y_fns.residual)(y, &y_hat);
+        let e = (settings.y_fns.residual)(y, &y_hat);
         let whitened = solve_lower(&sy, &e).ok_or(singular.clone())?;
         let nis = whitened.norm_squared();
         self.innovation = e;
         self.sqrt_innovation_cov = sy;
-        if let Some(reason) = self.policy.gate(nis) {
+        if let Some(reason) = settings.policy.gate(nis) {
             return Ok(UpdateOutcome::Rejected { reason });
         }
         // K = P_xy (S_y S_yᵀ)⁻¹  ⇔  Kᵀ = S_y⁻ᵀ S_y⁻¹ P_xyᵀ.
@@ -226,7 +197,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         sqrt_noise: &SMatrix<f64, M, M>,
         residual: ResidualFn<M>,
     ) -> Result<(SMatrix<f64, M, M>, Option<CovarianceRepair>), EstimationError> {
-        let wc = self.points.covariance_weights();
+        let wc = self.settings.points.covariance_weights();
         let mut l = *sqrt_noise;
         for i in 1..NS {
             let mut col = residual(&pts.column(i).into_owned(), mean) * wc[i].sqrt();
@@ -252,7 +223,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         &self,
         p: &mut SMatrix<f64, M, M>,
     ) -> Result<(SMatrix<f64, M, M>, Option<CovarianceRepair>), EstimationError> {
-        let repair = repair_covariance(p, self.policy.eigen_floor, FILTER)?;
+        let repair = repair_covariance(p, self.settings.policy.eigen_floor, FILTER)?;
         let l = cholesky_lower(p).or_else(|| cholesky_psd(p)).ok_or(
             EstimationError::NotPositiveDefinite {
                 name: "square-root UKF covariance",

@@ -23,15 +23,14 @@
 //! Every step works on copies and commits at the end: a step that returns an error leaves the filter
 //! unchanged. Steps do not allocate.
 
-use super::dense::symmetrise;
 use super::fault::{
     CovarianceRepair, EstimationError, FaultPolicy, UpdateOutcome, check_additive_noise,
     check_estimate,
 };
-use super::sigma::{MeanFn, ResidualFn, SigmaPoints};
+use super::sigma::{ResidualFn, SigmaPoints};
 use super::unscented::{
-    SpaceFns, check_input, evaluate_points, innovation_moments, kalman_correct, model_measurement,
-    model_process, predicted_moments, rejected_measurement,
+    FilterSettings, model_measurement, model_process, rejected_measurement, settings_methods,
+    sigma_images,
 };
 use crate::model::DiscreteModel;
 use nalgebra::{SMatrix, SVector};
@@ -42,14 +41,11 @@ const FILTER: &str = "UKF";
 #[derive(Clone, Debug)]
 pub struct UnscentedKalmanFilter<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
 {
-    points: SigmaPoints<NX, NS>,
+    settings: FilterSettings<NX, NX, NY, NS>,
     x: SVector<f64, NX>,
     p: SMatrix<f64, NX, NX>,
     q: SMatrix<f64, NX, NX>,
     r: SMatrix<f64, NY, NY>,
-    x_fns: SpaceFns<NX, NS>,
-    y_fns: SpaceFns<NY, NS>,
-    policy: FaultPolicy,
     innovation: SVector<f64, NY>,
     innovation_cov: SMatrix<f64, NY, NY>,
     gain: SMatrix<f64, NX, NY>,
@@ -71,42 +67,18 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         check_additive_noise(&q, &r)?;
         check_estimate(("x0", "P0"), &x0, &p0)?;
         Ok(UnscentedKalmanFilter {
-            points,
+            settings: FilterSettings::new(points, FILTER),
             x: x0,
             p: p0,
             q,
             r,
-            x_fns: SpaceFns::default(),
-            y_fns: SpaceFns::default(),
-            policy: FaultPolicy::default(),
             innovation: SVector::zeros(),
             innovation_cov: r,
             gain: SMatrix::zeros(),
         })
     }
 
-    /// Replaces the state mean and residual functions (for angle states).
-    pub fn with_state_functions(mut self, mean: MeanFn<NX, NS>, residual: ResidualFn<NX>) -> Self {
-        self.x_fns = SpaceFns { mean, residual };
-        self
-    }
-
-    /// Replaces the measurement mean and residual functions (for angle measurements).
-    pub fn with_measurement_functions(
-        mut self,
-        mean: MeanFn<NY, NS>,
-        residual: ResidualFn<NY>,
-    ) -> Self {
-        self.y_fns = SpaceFns { mean, residual };
-        self
-    }
-
-    /// Replaces the fault policy (NIS gate, eigenvalue floor).
-    pub fn set_fault_policy(&mut self, policy: FaultPolicy) -> Result<(), EstimationError> {
-        policy.validate()?;
-        self.policy = policy;
-        Ok(())
-    }
+    settings_methods!();
 
     /// Replaces the noise covariances.
     pub fn set_noise(
@@ -136,22 +108,14 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
     pub fn predict<F>(
         &mut self,
         u: &SVector<f64, NU>,
-        mut f: F,
+        f: F,
     ) -> Result<Option<CovarianceRepair>, EstimationError>
     where
         F: FnMut(&SVector<f64, NX>, &SVector<f64, NU>) -> SVector<f64, NX>,
     {
-        check_input(u)?;
-        let chi = self.points.generate(&self.x, &self.p)?;
-        let prop = evaluate_points("process function", |i| f(&chi.column(i).into_owned(), u))?;
-        let (x, p, repair) = predicted_moments(
-            &prop,
-            &self.points,
-            &self.x_fns,
-            Some(&self.q),
-            &self.policy,
-            FILTER,
-        )?;
+        let draw = || self.settings.points.generate(&self.x, &self.p);
+        let (_, prop) = sigma_images("process function", u, draw, f)?;
+        let (x, p, repair) = self.settings.predicted(&prop, Some(&self.q))?;
         self.x = x;
         self.p = p;
         Ok(repair)
@@ -162,7 +126,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         &mut self,
         y: &SVector<f64, NY>,
         u: &SVector<f64, NU>,
-        mut h: H,
+        h: H,
     ) -> Result<UpdateOutcome, EstimationError>
     where
         H: FnMut(&SVector<f64, NX>, &SVector<f64, NU>) -> SVector<f64, NY>,
@@ -170,29 +134,17 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         if let Some(rejected) = rejected_measurement(y) {
             return Ok(rejected);
         }
-        check_input(u)?;
-        let chi = self.points.generate(&self.x, &self.p)?;
-        let ys = evaluate_points("measurement function", |i| {
-            h(&chi.column(i).into_owned(), u)
-        })?;
-        let (y_hat, mut s, pxy) = innovation_moments(
-            &chi,
-            &self.x,
-            self.x_fns.residual,
-            &ys,
-            &self.y_fns,
-            Some(&self.r),
-            &self.points,
-        );
-        symmetrise(&mut s);
-        let e = (self.y_fns.residual)(y, &y_hat);
-        let outcome = kalman_correct(&mut self.x, &mut self.p, &e, &s, &pxy, &self.policy, FILTER)?;
-        self.innovation = e;
-        self.innovation_cov = s;
-        if let Some(k) = outcome.1 {
+        let draw = || self.settings.points.generate(&self.x, &self.p);
+        let (chi, ys) = sigma_images("measurement function", u, draw, h)?;
+        let correction =
+            self.settings
+                .correct(&mut self.x, &mut self.p, &chi, &ys, y, Some(&self.r))?;
+        self.innovation = correction.innovation;
+        self.innovation_cov = correction.innovation_cov;
+        if let Some(k) = correction.gain {
             self.gain = k;
         }
-        Ok(outcome.0)
+        Ok(correction.outcome)
     }
 
     /// [`Self::predict`] with a [`DiscreteModel`]'s `step` as the process function.
@@ -246,16 +198,16 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
 
     /// The fault policy in use.
     pub fn fault_policy(&self) -> &FaultPolicy {
-        &self.policy
+        &self.settings.policy
     }
 
     /// The measurement residual function.
     pub(crate) fn measurement_residual(&self) -> ResidualFn<NY> {
-        self.y_fns.residual
+        self.settings.y_fns.residual
     }
 
     /// The sigma-point weights in use.
     pub fn sigma_points(&self) -> &SigmaPoints<NX, NS> {
-        &self.points
+        &self.settings.points
     }
 }

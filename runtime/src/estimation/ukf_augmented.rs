@@ -15,15 +15,12 @@
 //! `NA` and `NS` are const parameters because stable Rust cannot compute them; wrong values are compile
 //! errors.
 
-use super::dense::symmetrise;
 use super::fault::{
-    CovarianceRepair, EstimationError, FaultPolicy, UpdateOutcome, check_estimate,
-    check_positive_definite,
+    CovarianceRepair, EstimationError, UpdateOutcome, check_estimate, check_positive_definite,
 };
-use super::sigma::{MeanFn, ResidualFn, SigmaPoints};
+use super::sigma::SigmaPoints;
 use super::unscented::{
-    SpaceFns, check_input, evaluate_points, innovation_moments, kalman_correct, predicted_moments,
-    rejected_measurement,
+    FilterSettings, check_input, evaluate_points, rejected_measurement, settings_methods,
 };
 use nalgebra::{SMatrix, SVector};
 
@@ -40,7 +37,7 @@ pub struct AugmentedUkf<
     const NA: usize,
     const NS: usize,
 > {
-    points: SigmaPoints<NA, NS>,
+    settings: FilterSettings<NA, NX, NY, NS>,
     x: SVector<f64, NX>,
     p: SMatrix<f64, NX, NX>,
     q: SMatrix<f64, NV, NV>,
@@ -50,9 +47,6 @@ pub struct AugmentedUkf<
     /// Measurement-noise parts of the last predict's points.
     meas_noise: SMatrix<f64, NN, NS>,
     fresh: bool,
-    x_fns: SpaceFns<NX, NS>,
-    y_fns: SpaceFns<NY, NS>,
-    policy: FaultPolicy,
     innovation: SVector<f64, NY>,
     innovation_cov: SMatrix<f64, NY, NY>,
 }
@@ -84,7 +78,7 @@ impl<
         check_positive_definite("R", &r)?;
         check_estimate(("x0", "P0"), &x0, &p0)?;
         Ok(AugmentedUkf {
-            points,
+            settings: FilterSettings::new(points, FILTER),
             x: x0,
             p: p0,
             q,
@@ -92,36 +86,12 @@ impl<
             propagated: SMatrix::zeros(),
             meas_noise: SMatrix::zeros(),
             fresh: false,
-            x_fns: SpaceFns::default(),
-            y_fns: SpaceFns::default(),
-            policy: FaultPolicy::default(),
             innovation: SVector::zeros(),
             innovation_cov: SMatrix::zeros(),
         })
     }
 
-    /// Replaces the state mean and residual functions.
-    pub fn with_state_functions(mut self, mean: MeanFn<NX, NS>, residual: ResidualFn<NX>) -> Self {
-        self.x_fns = SpaceFns { mean, residual };
-        self
-    }
-
-    /// Replaces the measurement mean and residual functions.
-    pub fn with_measurement_functions(
-        mut self,
-        mean: MeanFn<NY, NS>,
-        residual: ResidualFn<NY>,
-    ) -> Self {
-        self.y_fns = SpaceFns { mean, residual };
-        self
-    }
-
-    /// Replaces the fault policy.
-    pub fn set_fault_policy(&mut self, policy: FaultPolicy) -> Result<(), EstimationError> {
-        policy.validate()?;
-        self.policy = policy;
-        Ok(())
-    }
+    settings_methods!();
 
     fn augmented_points(&self) -> Result<SMatrix<f64, NA, NS>, EstimationError> {
         let mut xa = SVector::<f64, NA>::zeros();
@@ -131,7 +101,7 @@ impl<
         pa.fixed_view_mut::<NV, NV>(NX, NX).copy_from(&self.q);
         pa.fixed_view_mut::<NN, NN>(NX + NV, NX + NV)
             .copy_from(&self.r);
-        self.points.generate(&xa, &pa)
+        self.settings.points.generate(&xa, &pa)
     }
 
     /// The time update through `f(x, u, v)`.
@@ -152,8 +122,7 @@ impl<
             f(&xs, u, &vs)
         })?;
         let noise: SMatrix<f64, NN, NS> = chi.fixed_rows::<NN>(NX + NV).into_owned();
-        let (x, p, repair) =
-            predicted_moments(&prop, &self.points, &self.x_fns, None, &self.policy, FILTER)?;
+        let (x, p, repair) = self.settings.predicted(&prop, None)?;
         self.x = x;
         self.p = p;
         self.propagated = prop;
@@ -191,23 +160,13 @@ impl<
             let ni: SVector<f64, NN> = ns.column(i).into_owned();
             h(&xi, u, &ni)
         })?;
-        let (y_hat, mut s, pxy) = innovation_moments(
-            &xs,
-            &self.x,
-            self.x_fns.residual,
-            &ys,
-            &self.y_fns,
-            None,
-            &self.points,
-        );
-        symmetrise(&mut s);
-        let e = (self.y_fns.residual)(y, &y_hat);
-        let (outcome, _) =
-            kalman_correct(&mut self.x, &mut self.p, &e, &s, &pxy, &self.policy, FILTER)?;
-        self.innovation = e;
-        self.innovation_cov = s;
+        let correction = self
+            .settings
+            .correct(&mut self.x, &mut self.p, &xs, &ys, y, None)?;
+        self.innovation = correction.innovation;
+        self.innovation_cov = correction.innovation_cov;
         self.fresh = false;
-        Ok(outcome)
+        Ok(correction.outcome)
     }
 
     /// The state estimate.

@@ -7,12 +7,16 @@
 //! - [`predicted_moments`]: `x̂⁻ = mean(χ*)`, `P⁻ = Σ W⁽ᶜ⁾ (χ*ᵢ − x̂⁻)(χ*ᵢ − x̂⁻)ᵀ (+ Q)`, repaired;
 //! - [`innovation_moments`]: `ŷ = mean(Y)`, `S = Σ W⁽ᶜ⁾ (Yᵢ − ŷ)(Yᵢ − ŷ)ᵀ (+ R)`,
 //!   `P_xy = Σ W⁽ᶜ⁾ (χᵢ − x̂)(Yᵢ − ŷ)ᵀ`;
-//! - [`kalman_correct`]: NIS and gate, `K = P_xy S⁻¹`, `x̂ += K e`, `P −= K S Kᵀ`, repaired.
+//! - [`kalman_correct`]: NIS and gate, `K = P_xy S⁻¹`, `x̂ += K e`, `P −= K S Kᵀ`, repaired;
+//! - [`FilterSettings`]: what the filters are configured with (sigma points, mean and residual functions, fault
+//!   policy), with the predict moments and the whole correction of a covariance-form filter as methods, and
+//!   [`settings_methods`], the public methods that replace those settings;
+//! - [`sigma_images`]: the input check, the sigma points and their images under a model function.
 //!
 //! None of them allocates or panics; each returns its results by value so that the caller commits only when
 //! the whole step succeeded.
 
-use super::dense::{cholesky_lower, cholesky_solve, first_non_finite};
+use super::dense::{cholesky_lower, cholesky_solve, first_non_finite, symmetrise};
 use super::fault::{
     CovarianceRepair, EstimationError, FaultPolicy, RejectReason, UpdateOutcome, repair_covariance,
 };
@@ -71,6 +75,20 @@ pub(crate) fn evaluate_points<const N: usize, const NS: usize>(
         }),
         None => Ok(out),
     }
+}
+
+/// The sigma points `χ` (from `draw`, called once `u` has passed [`check_input`]) and their images
+/// `g(χᵢ, u)`, evaluated as in [`evaluate_points`] under the name `function`.
+pub(crate) fn sigma_images<const N: usize, const M: usize, const NU: usize, const NS: usize>(
+    function: &'static str,
+    u: &SVector<f64, NU>,
+    draw: impl FnOnce() -> Result<SMatrix<f64, N, NS>, EstimationError>,
+    mut g: impl FnMut(&SVector<f64, N>, &SVector<f64, NU>) -> SVector<f64, M>,
+) -> Result<(SMatrix<f64, N, NS>, SMatrix<f64, M, NS>), EstimationError> {
+    check_input(u)?;
+    let chi = draw()?;
+    let images = evaluate_points(function, |i| g(&chi.column(i).into_owned(), u))?;
+    Ok((chi, images))
 }
 
 /// `Err` when the state mean function gave a non-finite mean.
@@ -196,3 +214,127 @@ pub(crate) fn model_measurement<const NX: usize, const NU: usize, const NY: usiz
         out
     }
 }
+
+/// The configuration an unscented filter carries besides its estimate and noise: the sigma points (over `NP`
+/// dimensions: the state, or the augmented state), the mean and residual functions of the state (`NX`) and
+/// measurement (`NY`) spaces, the fault policy, and the filter's name for its errors.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct FilterSettings<const NP: usize, const NX: usize, const NY: usize, const NS: usize>
+{
+    pub points: SigmaPoints<NP, NS>,
+    pub x_fns: SpaceFns<NX, NS>,
+    pub y_fns: SpaceFns<NY, NS>,
+    pub policy: FaultPolicy,
+    pub filter: &'static str,
+}
+
+/// What [`FilterSettings::correct`] found: the outcome, the gain when the measurement was accepted, and the
+/// innovation `e = y − ŷ` and its covariance `S` (kept by the filters even for a gated measurement).
+pub(crate) struct Correction<const NX: usize, const NY: usize> {
+    pub outcome: UpdateOutcome,
+    pub gain: Option<SMatrix<f64, NX, NY>>,
+    pub innovation: SVector<f64, NY>,
+    pub innovation_cov: SMatrix<f64, NY, NY>,
+}
+
+impl<const NP: usize, const NX: usize, const NY: usize, const NS: usize>
+    FilterSettings<NP, NX, NY, NS>
+{
+    /// The points `points` with plain means and residuals and the default fault policy.
+    pub fn new(points: SigmaPoints<NP, NS>, filter: &'static str) -> Self {
+        FilterSettings {
+            points,
+            x_fns: SpaceFns::default(),
+            y_fns: SpaceFns::default(),
+            policy: FaultPolicy::default(),
+            filter,
+        }
+    }
+
+    /// [`predicted_moments`] of the propagated points `prop` with these settings.
+    pub fn predicted(
+        &self,
+        prop: &SMatrix<f64, NX, NS>,
+        q: Option<&SMatrix<f64, NX, NX>>,
+    ) -> Result<Prediction<NX>, EstimationError> {
+        predicted_moments(
+            prop,
+            &self.points,
+            &self.x_fns,
+            q,
+            &self.policy,
+            self.filter,
+        )
+    }
+
+    /// The measurement correction of a covariance-form filter at the estimate `(x, p)`: [`innovation_moments`]
+    /// of the points `chi` and their measurements `ys` (plus `r` if the noise is additive), `S` symmetrised,
+    /// `e = residual(y, ŷ)`, then [`kalman_correct`], which changes `x` and `p` only on acceptance.
+    pub fn correct(
+        &self,
+        x: &mut SVector<f64, NX>,
+        p: &mut SMatrix<f64, NX, NX>,
+        chi: &SMatrix<f64, NX, NS>,
+        ys: &SMatrix<f64, NY, NS>,
+        y: &SVector<f64, NY>,
+        r: Option<&SMatrix<f64, NY, NY>>,
+    ) -> Result<Correction<NX, NY>, EstimationError> {
+        let (y_hat, mut s, pxy) = innovation_moments(
+            chi,
+            x,
+            self.x_fns.residual,
+            ys,
+            &self.y_fns,
+            r,
+            &self.points,
+        );
+        symmetrise(&mut s);
+        let e = (self.y_fns.residual)(y, &y_hat);
+        let (outcome, gain) = kalman_correct(x, p, &e, &s, &pxy, &self.policy, self.filter)?;
+        Ok(Correction {
+            outcome,
+            gain,
+            innovation: e,
+            innovation_cov: s,
+        })
+    }
+}
+
+/// The public methods by which every unscented filter replaces its [`FilterSettings`] (the field `settings`):
+/// the state and measurement mean and residual functions (for angles: a circular mean and a wrapped residual;
+/// the update adds `K e` to the state, so a wrapping state mean function should also wrap its output) and the
+/// fault policy. Expanded inside an `impl` block whose const parameters include `NX`, `NY` and `NS`.
+macro_rules! settings_methods {
+    () => {
+        /// Replaces the state mean and residual functions (for angle states).
+        pub fn with_state_functions(
+            mut self,
+            mean: $crate::estimation::sigma::MeanFn<NX, NS>,
+            residual: $crate::estimation::sigma::ResidualFn<NX>,
+        ) -> Self {
+            self.settings.x_fns = $crate::estimation::unscented::SpaceFns { mean, residual };
+            self
+        }
+
+        /// Replaces the measurement mean and residual functions (for angle measurements).
+        pub fn with_measurement_functions(
+            mut self,
+            mean: $crate::estimation::sigma::MeanFn<NY, NS>,
+            residual: $crate::estimation::sigma::ResidualFn<NY>,
+        ) -> Self {
+            self.settings.y_fns = $crate::estimation::unscented::SpaceFns { mean, residual };
+            self
+        }
+
+        /// Replaces the fault policy (NIS gate, eigenvalue floor).
+        pub fn set_fault_policy(
+            &mut self,
+            policy: $crate::estimation::fault::FaultPolicy,
+        ) -> Result<(), $crate::estimation::fault::EstimationError> {
+            policy.validate()?;
+            self.settings.policy = policy;
+            Ok(())
+        }
+    };
+}
+pub(crate) use settings_methods;

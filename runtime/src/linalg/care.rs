@@ -16,6 +16,7 @@ use nalgebra::DMatrix;
 
 use super::lyapunov::{lyap, symmetrize};
 use super::pbh::Domain;
+use super::refine::{Evaluated, refine, relative_residual};
 use super::riccati::{
     Problem, Riccati, RiccatiError, Scaled, finite_solution, stabilising_solution,
 };
@@ -74,61 +75,45 @@ pub fn care_with_cross(
     let Some(x0) = qr.r().solve_upper_triangular(&qtb) else {
         return Err(p.diagnose(Domain::Continuous, f64::INFINITY, sign_iterations));
     };
-    let mut xs = symmetrize(&x0);
+    let xs = symmetrize(&x0);
     finite_solution(&xs, sign_iterations)?;
 
-    // Newton–Kleinman refinement in the scaled coordinates; keep the best iterate.
-    let mut res = residual(&s.a, &s.g, &s.q, &xs);
-    let mut rel = relative(&res, &s.a, &s.g, &s.q, &xs);
-    let mut steps = 0;
-    while steps < MAX_NEWTON_STEPS && rel > 1e-15 {
-        let closed = &s.a - &s.g * &xs;
-        let Ok(delta) = lyap(&closed.transpose(), &res) else {
-            break;
-        };
-        let candidate = symmetrize(&(&xs + delta));
-        let cand_res = residual(&s.a, &s.g, &s.q, &candidate);
-        let cand_rel = relative(&cand_res, &s.a, &s.g, &s.q, &candidate);
-        if cand_rel.is_nan() || cand_rel >= rel {
-            break;
-        }
-        steps += 1;
-        xs = candidate;
-        res = cand_res;
-        rel = cand_rel;
-    }
+    // Newton–Kleinman refinement in the scaled coordinates: (Ã − GX)ᵀ Δ + Δ (Ã − GX) + Res(X) = 0.
+    let evaluate = |x: &DMatrix<f64>| Some(Evaluation::new(&s.a, &s.g, &s.q, x));
+    let eval = Evaluation::new(&s.a, &s.g, &s.q, &xs);
+    let newton = |x: &DMatrix<f64>, eval: &Evaluation| {
+        lyap(&(&s.a - &s.g * x).transpose(), &eval.residual).ok()
+    };
+    let (xs, steps) = refine(xs, eval, MAX_NEWTON_STEPS, newton, evaluate);
 
     let x = s.unscale(&xs);
     finite_solution(&x, sign_iterations + steps)?;
     let g = p.g();
-    let rel_orig = relative(&residual(&p.a, &g, &p.q, &x), &p.a, &g, &p.q, &x);
+    let rel_orig = Evaluation::new(&p.a, &g, &p.q, &x).relative;
     p.check_residual(Domain::Continuous, rel_orig, sign_iterations + steps)?;
     let k = &p.r_inv * (p.b.transpose() * &x + &p.n_t);
     stabilising_solution(Domain::Continuous, a, b, x, k, rel_orig, steps)
 }
 
-/// `AᵀX + XA − XGX + Q`.
-fn residual(
-    a: &DMatrix<f64>,
-    g: &DMatrix<f64>,
-    q: &DMatrix<f64>,
-    x: &DMatrix<f64>,
-) -> DMatrix<f64> {
-    symmetrize(&(a.transpose() * x + x * a - x * g * x + q))
+/// The CARE residual `AᵀX + XA − XGX + Q` at `X` and its size relative to the terms.
+struct Evaluation {
+    residual: DMatrix<f64>,
+    relative: f64,
 }
 
-fn relative(
-    res: &DMatrix<f64>,
-    a: &DMatrix<f64>,
-    g: &DMatrix<f64>,
-    q: &DMatrix<f64>,
-    x: &DMatrix<f64>,
-) -> f64 {
-    let xa = x * a;
-    let denom = 2.0 * xa.norm() + (x * g * x).norm() + q.norm();
-    if denom > 0.0 {
-        res.norm() / denom
-    } else {
-        res.norm()
+impl Evaluation {
+    fn new(a: &DMatrix<f64>, g: &DMatrix<f64>, q: &DMatrix<f64>, x: &DMatrix<f64>) -> Evaluation {
+        let xa = x * a;
+        let xgx = x * g * x;
+        let residual = symmetrize(&(a.transpose() * x + &xa - &xgx + q));
+        // ‖AᵀX‖ = ‖XA‖ for symmetric X.
+        let relative = relative_residual(&residual, 2.0 * xa.norm() + xgx.norm() + q.norm());
+        Evaluation { residual, relative }
+    }
+}
+
+impl Evaluated for Evaluation {
+    fn relative(&self) -> f64 {
+        self.relative
     }
 }

@@ -20,6 +20,7 @@ use nalgebra::DMatrix;
 
 use super::lyapunov::{dlyap, symmetrize};
 use super::pbh::Domain;
+use super::refine::{Evaluated, refine, relative_residual};
 use super::riccati::{
     Problem, Riccati, RiccatiError, Scaled, finite_solution, stabilising_solution,
 };
@@ -80,30 +81,18 @@ pub fn dare_with_cross(
     if !converged {
         return Err(p.diagnose(Domain::Discrete, f64::INFINITY, doubling));
     }
-    let mut xs = hk;
+    let xs = hk;
     finite_solution(&xs, doubling)?;
 
-    // Hewer refinement in the scaled coordinates; keep the best iterate.
-    let Some(mut eval) = Evaluation::new(&s.a, &s.b, &s.q, &s.r, &xs) else {
+    // Hewer refinement in the scaled coordinates: (Ã − BK)ᵀ Δ (Ã − BK) − Δ + Res(X) = 0.
+    let evaluate = |x: &DMatrix<f64>| Evaluation::new(&s.a, &s.b, &s.q, &s.r, x);
+    let Some(eval) = evaluate(&xs) else {
         return Err(p.diagnose(Domain::Discrete, f64::INFINITY, doubling));
     };
-    let mut steps = 0;
-    while steps < MAX_HEWER_STEPS && eval.relative > 1e-15 {
-        let closed = &s.a - &s.b * &eval.gain;
-        let Ok(delta) = dlyap(&closed.transpose(), &eval.residual) else {
-            break;
-        };
-        let candidate = symmetrize(&(&xs + delta));
-        let Some(next) = Evaluation::new(&s.a, &s.b, &s.q, &s.r, &candidate) else {
-            break;
-        };
-        if next.relative.is_nan() || next.relative >= eval.relative {
-            break;
-        }
-        steps += 1;
-        xs = candidate;
-        eval = next;
-    }
+    let hewer = |_: &DMatrix<f64>, eval: &Evaluation| {
+        dlyap(&(&s.a - &s.b * &eval.gain).transpose(), &eval.residual).ok()
+    };
+    let (xs, steps) = refine(xs, eval, MAX_HEWER_STEPS, hewer, evaluate);
 
     let x = s.unscale(&xs);
     finite_solution(&x, doubling + steps)?;
@@ -140,16 +129,20 @@ impl Evaluation {
         let atxa = a.transpose() * x * a;
         let correction = symmetrize(&((btx * a).transpose() * &gain));
         let residual = symmetrize(&(&atxa - x - &correction + q));
-        let denom = atxa.norm() + x.norm() + correction.norm() + q.norm();
-        let relative = if denom > 0.0 {
-            residual.norm() / denom
-        } else {
-            residual.norm()
-        };
+        let relative = relative_residual(
+            &residual,
+            atxa.norm() + x.norm() + correction.norm() + q.norm(),
+        );
         Some(Evaluation {
             residual,
             relative,
             gain,
         })
+    }
+}
+
+impl Evaluated for Evaluation {
+    fn relative(&self) -> f64 {
+        self.relative
     }
 }

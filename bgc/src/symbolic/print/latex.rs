@@ -5,10 +5,8 @@
 //! subscript (a Greek name becomes the letter, other text is kept with `_` escaped): `J_m` → `J_{m}`,
 //! `theta_sint` → `\theta_{sint}`, `omega` → `\omega`, `x_theta` → `x_{\theta}`, `Kt` → `\mathrm{Kt}`.
 
-use super::super::expr::{Expr, Node, Symbol};
-use super::{
-    ATOM, PRODUCT, SUM, UNARY, negated, number_text, reciprocal, split_fraction, sum_print_order,
-};
+use super::super::expr::{Expr, Symbol};
+use super::{ATOM, Layout, POWER, UNARY, number_text, split_fraction};
 use crate::ir::Func;
 
 const GREEK: [&str; 40] = [
@@ -123,50 +121,6 @@ struct LatexPrinter<'a> {
 }
 
 impl LatexPrinter<'_> {
-    fn print(&self, e: &Expr) -> (String, u8) {
-        match e.node() {
-            Node::Const(c) => (latex_number(*c), if *c < 0.0 { UNARY } else { ATOM }),
-            Node::Sym(s) => ((self.names)(s), ATOM),
-            Node::Add(terms) => (self.sum(terms), SUM),
-            Node::Mul(_) => match negated(e) {
-                Some(pos) => (format!("-{}", self.product(&pos)), PRODUCT),
-                None => (self.product(e), PRODUCT),
-            },
-            Node::Pow(b, x) => match reciprocal(e) {
-                Some(_) => (self.product(e), PRODUCT),
-                None => self.power(b, x),
-            },
-            Node::Call(f, args) => (self.call(*f, args), ATOM),
-        }
-    }
-
-    fn wrapped(&self, e: &Expr, need: u8) -> String {
-        let (s, p) = self.print(e);
-        if p < need {
-            format!("\\left({s}\\right)")
-        } else {
-            s
-        }
-    }
-
-    fn sum(&self, terms: &[Expr]) -> String {
-        let mut out = String::new();
-        for (i, t) in sum_print_order(terms).into_iter().enumerate() {
-            match (i, negated(t)) {
-                (0, _) => out.push_str(&self.print(t).0),
-                (_, Some(pos)) => {
-                    out.push_str(" - ");
-                    out.push_str(&self.wrapped(&pos, PRODUCT));
-                }
-                (_, None) => {
-                    out.push_str(" + ");
-                    out.push_str(&self.print(t).0);
-                }
-            }
-        }
-        out
-    }
-
     /// Factors side by side, with `\cdot` where a factor starts with a digit (so `2 \cdot 3^{x}`, not `2 3^{x}`).
     fn juxtapose(&self, parts: Vec<String>) -> String {
         let mut out = String::new();
@@ -197,6 +151,20 @@ impl LatexPrinter<'_> {
             self.juxtapose(parts)
         }
     }
+}
+
+impl Layout for LatexPrinter<'_> {
+    fn number(&self, c: f64) -> String {
+        latex_number(c)
+    }
+
+    fn symbol(&self, s: &Symbol) -> String {
+        (self.names)(s)
+    }
+
+    fn parenthesised(&self, s: String) -> String {
+        format!("\\left({s}\\right)")
+    }
 
     fn product(&self, e: &Expr) -> String {
         let fr = split_fraction(e);
@@ -216,7 +184,7 @@ impl LatexPrinter<'_> {
             return (format!("\\sqrt{{{}}}", self.print(base).0), ATOM);
         }
         let b = self.wrapped(base, ATOM);
-        (format!("{b}^{{{}}}", self.print(exp).0), super::POWER)
+        (format!("{b}^{{{}}}", self.print(exp).0), POWER)
     }
 
     fn call(&self, f: Func, args: &[Expr]) -> String {

@@ -4,11 +4,9 @@
 //! back to an equal expression. Constants print so they parse back to the same `f64` (integers without `.0`;
 //! non-finite values print as `inf`, `-inf`, `NaN`, which are not bgc syntax).
 
-use super::super::expr::{Expr, Node, Symbol};
-use super::{
-    ATOM, POWER, PRODUCT, SUM, UNARY, negated, number_text, reciprocal, split_fraction,
-    sum_print_order,
-};
+use super::super::expr::{Expr, Symbol};
+use super::{ATOM, Layout, POWER, UNARY, number_text, split_fraction};
+use crate::ir::Func;
 use std::fmt;
 
 /// `e` as text, symbols by their names.
@@ -31,50 +29,17 @@ struct TextPrinter<'a> {
     names: &'a dyn Fn(&Symbol) -> String,
 }
 
-impl TextPrinter<'_> {
-    /// The text and its binding strength.
-    fn print(&self, e: &Expr) -> (String, u8) {
-        match e.node() {
-            Node::Const(c) => (number_text(*c), if *c < 0.0 { UNARY } else { ATOM }),
-            Node::Sym(s) => ((self.names)(s), ATOM),
-            Node::Add(terms) => (self.sum(terms), SUM),
-            Node::Mul(_) => match negated(e) {
-                Some(pos) => (format!("-{}", self.product(&pos)), PRODUCT),
-                None => (self.product(e), PRODUCT),
-            },
-            Node::Pow(b, x) => match reciprocal(e) {
-                Some(_) => (self.product(e), PRODUCT),
-                None => self.power(b, x),
-            },
-            Node::Call(f, args) => {
-                let args: Vec<String> = args.iter().map(|a| self.print(a).0).collect();
-                (format!("{}({})", f.name(), args.join(", ")), ATOM)
-            }
-        }
+impl Layout for TextPrinter<'_> {
+    fn number(&self, c: f64) -> String {
+        number_text(c)
     }
 
-    /// `e` parenthesised when it binds less tightly than `need`.
-    fn wrapped(&self, e: &Expr, need: u8) -> String {
-        let (s, p) = self.print(e);
-        if p < need { format!("({s})") } else { s }
+    fn symbol(&self, s: &Symbol) -> String {
+        (self.names)(s)
     }
 
-    fn sum(&self, terms: &[Expr]) -> String {
-        let mut out = String::new();
-        for (i, t) in sum_print_order(terms).into_iter().enumerate() {
-            match (i, negated(t)) {
-                (0, _) => out.push_str(&self.print(t).0),
-                (_, Some(pos)) => {
-                    out.push_str(" - ");
-                    out.push_str(&self.wrapped(&pos, PRODUCT));
-                }
-                (_, None) => {
-                    out.push_str(" + ");
-                    out.push_str(&self.print(t).0);
-                }
-            }
-        }
-        out
+    fn parenthesised(&self, s: String) -> String {
+        format!("({s})")
     }
 
     fn product(&self, e: &Expr) -> String {
@@ -106,5 +71,10 @@ impl TextPrinter<'_> {
         let b = self.wrapped(base, ATOM);
         let x = self.wrapped(exp, POWER);
         (format!("{b}^{x}"), POWER)
+    }
+
+    fn call(&self, f: Func, args: &[Expr]) -> String {
+        let args: Vec<String> = args.iter().map(|a| self.print(a).0).collect();
+        format!("{}({})", f.name(), args.join(", "))
     }
 }

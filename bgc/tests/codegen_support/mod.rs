@@ -3,6 +3,8 @@
 //! forms large models take).
 #![allow(dead_code)]
 
+pub mod rustc;
+
 use bgc::codegen::{self, rust};
 use bgc::lower::MemoryLoader;
 use bgc::span::SourceMap;

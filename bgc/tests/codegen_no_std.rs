@@ -7,10 +7,8 @@
 
 mod codegen_support;
 
-use codegen_support::rustc::{compile_no_std, rustc, stand_ins};
+use codegen_support::rustc::{compile_no_std, stand_ins};
 use codegen_support::{generated_modules, scratch};
-use std::path::Path;
-use std::process::Command;
 
 /// The part of `nalgebra`'s API generated code uses, without `std`.
 #[test]

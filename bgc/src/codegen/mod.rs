@@ -18,6 +18,7 @@ mod adapter;
 mod emit;
 mod format;
 mod layout;
+mod loops;
 mod mass;
 mod names;
 pub mod rust;

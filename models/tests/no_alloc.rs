@@ -91,5 +91,5 @@ fn generated_functions_do_not_allocate() {
         bgc_models::corpus::series_rlc,
         bgc_models::corpus::two_tank,
     );
-    assert_eq!(n, 15);
+    assert_eq!(n, 16);
 }

@@ -1,6 +1,9 @@
 //! What the generated functions compute, as symbolic-engine expressions: the explicit rates and outputs, the
 //! readable blocks (intermediates, then rates or outputs) that the function bodies print, the Jacobians, the state
-//! spaces and the energy terms.
+//! spaces, the energy terms, the I-fields' mass matrices ([`super::mass`]) and the nonlinear algebraic loops
+//! ([`super::loops`]). With loops, the rates, outputs and energy terms hold the tear variables (intermediates
+//! `loop_<variable>`, bound from the loops' solution in each function), `dfdx` and the other Jacobians are partial
+//! derivatives at fixed tears, and the printer adds the loops' contribution.
 //!
 //! A block uses the readable form of the equations stage (one `let` per named bond variable, then the rates) when
 //! every intermediate it needs is defined before use and is not a derivative; otherwise (an algebraic loop, a

@@ -104,7 +104,8 @@ pub(crate) const NEWTON_FN: &str = "
 /// The residuals `r`, their scales `s` and `∂r/∂z` of one block of the algebraic loops.
 pub type LoopEval<const B: usize> = (SVector<f64, B>, SVector<f64, B>, SMatrix<f64, B, B>);
 
-/// Solves the block of `B` tears starting at `first` in `z` by damped Newton's method, from the values in `z`.
+/// Solves the block of `B` tears starting at `first` in `z` by damped Newton's method, from the
+/// values in `z`.
 fn bgc_newton<const B: usize>(
     z: &mut Tears,
     first: usize,
@@ -190,7 +191,7 @@ fn bgc_newton<const B: usize>(
                 *z = trial;
                 (r, s, jz) = at;
             }
-            // At the rounding floor no step decreases the residual: a converged iterate stays as it is.
+            // At the rounding floor no step decreases the residual: a converged iterate stays.
             None if converged => return Ok(()),
             None => return Err(fail(LoopFailure::NoDescent, k, &r)),
         }
@@ -238,7 +239,8 @@ impl core::fmt::Display for LoopError {
         let tear = TEAR_NAMES.get(self.tear).copied().unwrap_or(\"?\");
         write!(
             f,
-            \"the algebraic loop for `{tear}` was not solved ({:?} after {} iterations, residual {:e})\",
+            \"the algebraic loop for `{tear}` was not solved ({:?} after {} iterations, \\
+             residual {:e})\",
             self.kind, self.iterations, self.residual
         )
     }
@@ -360,8 +362,8 @@ impl Writer<'_> {
         self.out.push_str("}\n");
         self.out.push_str(
             "
-/// The tears for the model functions: `solve_loops`, or all NaN when it fails (so that what depends on them is
-/// NaN, never silently wrong).
+/// The tears for the model functions: `solve_loops`, or all NaN when it fails (so that what
+/// depends on them is NaN, never silently wrong).
 fn loop_values(p: &Params, t: f64, x: &State, u: &Inputs) -> Tears {
     match solve_loops(p, t, x, u) {
         Ok(z) => z,

@@ -12,6 +12,9 @@
 //! - for a linear model `state_space(&Params) -> (A, B, C, D)` in the energy states and, when the model declares
 //!   coordinates, `state_space_declared`;
 //! - `stored_energy`, `dissipated_power`, `supplied_power` when every term has a closed form;
+//! - for a model with nonlinear algebraic loops, `N_TEARS`, `TEAR_NAMES`, `Tears`, `LoopFailure`, `LoopError` and
+//!   `solve_loops(p, t, x, u) -> Result<Tears, LoopError>` (damped Newton's method per block, see
+//!   [`super::loops`]); the functions above solve the loops first and give NaN where `solve_loops` fails;
 //! - `Model` (the parameters, validated) and, with [`Options::runtime`], its implementations of
 //!   `bgc_runtime::model::ContinuousModel` and `Parametric`.
 //!

@@ -14,6 +14,7 @@ const MODELS: &[&str] = &[
 /// The compiler's corpus (`bgc/tests/corpus`), each with a module in `src/corpus.rs`.
 const CORPUS: &[&str] = &[
     "dc_motor_load",
+    "diode_rc",
     "gear_train",
     "hydraulic_cylinder",
     "msd_chain",

@@ -13,6 +13,7 @@ macro_rules! corpus {
 
 corpus!(
     dc_motor_load,
+    diode_rc,
     gear_train,
     hydraulic_cylinder,
     msd_chain,

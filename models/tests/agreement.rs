@@ -4,7 +4,7 @@
 mod support;
 
 use bgc_models::corpus;
-use support::{check_agreement, check_state_space};
+use support::{check_agreement, check_agreement_in, check_state_space};
 
 macro_rules! agreement {
     ($($test:ident: $module:path => $file:expr),* $(,)?) => {
@@ -37,6 +37,19 @@ agreement! {
     resistive_network: corpus::resistive_network => "bgc/tests/corpus/resistive_network.bg",
     series_rlc: corpus::series_rlc => "bgc/tests/corpus/series_rlc.bg",
     two_tank: corpus::two_tank => "bgc/tests/corpus/two_tank.bg",
+}
+
+/// The diode's nonlinear loop, solved by the generated Newton iteration. The charge is drawn from ±1 mC so that the
+/// capacitor voltage `q/C` stays within a few volts (at ±1 C it would be ±1000 V, where `exp(v/V_t)` overflows and
+/// neither side has a solution).
+#[test]
+fn diode_rc() {
+    use corpus::diode_rc as m;
+    check_agreement_in::<m::Model, { m::N_STATES }, { m::N_INPUTS }, { m::N_OUTPUTS }>(
+        "bgc/tests/corpus/diode_rc.bg",
+        m::Model::default(),
+        1e-3,
+    );
 }
 
 macro_rules! state_space {

@@ -91,3 +91,29 @@ fn back_support_unforced_energy_decays_by_dissipation() {
         );
     }
 }
+
+/// The diode's loop current comes from the generated Newton solve in every energy function: the stored energy still
+/// changes at the supplied minus the dissipated power, and the diode never supplies power (`v_d i ≥ 0`). The charge
+/// stays within ±1 mC (±1 V on the capacitor), where the loop has a solution.
+#[test]
+fn diode_rc_power_balance_through_the_loop() {
+    use corpus::diode_rc as m;
+    let p = m::Params::default();
+    let mut rng = Rng::new(13);
+    for _ in 0..50 {
+        let x = m::State::from_fn(|_, _| rng.uniform(-1e-3, 1e-3));
+        let u = m::Inputs::from_fn(|_, _| rng.uniform(-2.0, 2.0));
+        let dx = m::rhs(&p, 0.0, &x, &u);
+        let (rate, scale) = energy_rate(&|x| m::stored_energy(&p, 0.0, x, &u), &x, &dx);
+        let supplied = m::supplied_power(&p, 0.0, &x, &u);
+        let dissipated = m::dissipated_power(&p, 0.0, &x, &u);
+        let balance = supplied - dissipated;
+        assert!(
+            (rate - balance).abs() <= 1e-6 * scale.max(balance.abs()).max(1e-9),
+            "dE/dt = {rate}, supplied - dissipated = {balance}"
+        );
+        let y = m::outputs(&p, 0.0, &x, &u);
+        let diode_power = y[0] * y[1];
+        assert!(diode_power >= 0.0, "diode power {diode_power}");
+    }
+}

@@ -79,6 +79,7 @@ fn generated_functions_do_not_allocate() {
         bgc_models::rehab_leg,
         bgc_models::walking_leg,
         bgc_models::corpus::dc_motor_load,
+        bgc_models::corpus::diode_rc,
         bgc_models::corpus::gear_train,
         bgc_models::corpus::hydraulic_cylinder,
         bgc_models::corpus::msd_chain,
@@ -90,5 +91,5 @@ fn generated_functions_do_not_allocate() {
         bgc_models::corpus::series_rlc,
         bgc_models::corpus::two_tank,
     );
-    assert_eq!(n, 15);
+    assert_eq!(n, 16);
 }

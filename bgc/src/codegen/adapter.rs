@@ -4,8 +4,9 @@
 //! [`crate::symbolic::to_rust`], so every expression crosses over here. The conversion is structural (sums,
 //! products, powers and calls rebuilt with the engine's simplifying constructors), so the value is unchanged up to
 //! the engine's canonical reordering. Leaves become named [`Symbol`]s: parameters, inputs, states, intermediates
-//! (bond variables of the readable form) and time. Derivatives of inputs or states and tear variables have no
-//! meaning in generated code and are refused. When the two expression types are unified this module goes away.
+//! (bond variables of the readable form), the tear variables of nonlinear algebraic loops (intermediates named
+//! `loop_<variable>`, which the generated functions bind from the loops' solution, see [`super::loops`]) and time.
+//! Derivatives of inputs or states have no meaning in generated code and are refused. When the two expression types are unified this module goes away.
 
 use crate::equations::Equations;
 use crate::equations::sym::{Ex, Sym};
@@ -14,9 +15,7 @@ use crate::symbolic::{Expr, Symbol};
 /// An expression that cannot be generated.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum AdaptError {
-    #[error(
-        "`{symbol}` (a derivative or an algebraic-loop unknown) has no value in generated code"
-    )]
+    #[error("`{symbol}` (a derivative) has no value in generated code")]
     Unsupported { symbol: String },
     #[error("`{func}` is called with the wrong number of arguments")]
     Arity { func: &'static str },
@@ -28,9 +27,10 @@ pub fn symbol(eqs: &Equations, s: Sym) -> Result<Symbol, AdaptError> {
         Sym::Param(_) => Ok(Symbol::param(eqs.sym_name(s))),
         Sym::Input(_) => Ok(Symbol::input(eqs.sym_name(s))),
         Sym::State(_) => Ok(Symbol::state(eqs.sym_name(s))),
-        Sym::Var(_) => Ok(Symbol::intermediate(eqs.sym_name(s))),
+        // A tear (`loop_<variable>`) is a local of the generated functions, bound from the loops' solution.
+        Sym::Var(_) | Sym::Tear(_) => Ok(Symbol::intermediate(eqs.sym_name(s))),
         Sym::Time => Ok(Symbol::time()),
-        Sym::InputDot(_) | Sym::StateDot(_) | Sym::Tear(_) => Err(AdaptError::Unsupported {
+        Sym::InputDot(_) | Sym::StateDot(_) => Err(AdaptError::Unsupported {
             symbol: eqs.sym_name(s),
         }),
     }

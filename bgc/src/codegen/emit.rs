@@ -1,6 +1,9 @@
 //! What the generated functions compute, as symbolic-engine expressions: the explicit rates and outputs, the
 //! readable blocks (intermediates, then rates or outputs) that the function bodies print, the Jacobians, the state
-//! spaces and the energy terms.
+//! spaces, the energy terms, the I-fields' mass matrices ([`super::mass`]) and the nonlinear algebraic loops
+//! ([`super::loops`]). With loops, the rates, outputs and energy terms hold the tear variables (intermediates
+//! `loop_<variable>`, bound from the loops' solution in each function), `dfdx` and the other Jacobians are partial
+//! derivatives at fixed tears, and the printer adds the loops' contribution.
 //!
 //! A block uses the readable form of the equations stage (one `let` per named bond variable, then the rates) when
 //! every intermediate it needs is defined before use and is not a derivative; otherwise (an algebraic loop, a
@@ -54,6 +57,8 @@ pub(crate) struct Plan {
     /// Stored energy, dissipated and supplied power: the terms `(element, value)`, or the elements without a closed
     /// form.
     pub energy: Vec<(EnergyKind, EnergyTerms)>,
+    /// The nonlinear algebraic loops (`None` without any): rates, outputs and energy terms hold their tears.
+    pub loops: Option<super::loops::LoopPlan>,
     /// The I-fields' mass-matrix blocks (their rows of `rhs`, `dfdx` and `dfdu` hold the forces `F`).
     pub mass: Vec<super::mass::MassPlan>,
 }
@@ -73,19 +78,6 @@ fn convert_matrix(eqs: &Equations, m: &[Vec<Ex>]) -> Result<Vec<Vec<Expr>>, Adap
 
 /// The plan of a complete model.
 pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
-    // The rates of a model with a nonlinear algebraic loop hold its tear variables, which only an iterative solve
-    // defines; generated code has none.
-    if !eqs.tear_blocks.is_empty() {
-        let tears: Vec<&str> = eqs
-            .tear_blocks
-            .iter()
-            .flat_map(|b| b.names.iter().map(String::as_str))
-            .collect();
-        return Err(format!(
-            "its nonlinear algebraic loop (solve for `{}`) needs an iterative solver, which generated code does not include; `bgc simulate` solves it by Newton's method",
-            tears.join("`, `")
-        ));
-    }
     let mut f_ex = Vec::with_capacity(eqs.f.len());
     for (i, f) in eqs.f.iter().enumerate() {
         let name = eqs.states.get(i).map(|s| s.name.as_str()).unwrap_or("?");
@@ -152,7 +144,20 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
         ));
     }
     let mass = super::mass::plan(eqs, &states)?;
+    let loops = super::loops::plan(eqs, &f, &h, &states, &inputs)?;
+    if let Some(l) = &loops {
+        let in_mass = mass
+            .iter()
+            .flat_map(|b| b.matrix.iter().flatten())
+            .any(|e| e.free_symbols().iter().any(|s| l.tears.contains(s)));
+        if in_mass {
+            return Err(
+                "an inertia matrix depends on the tear of a nonlinear algebraic loop".into(),
+            );
+        }
+    }
     Ok(Plan {
+        loops,
         mass,
         dfdx: Expr::jacobian(&f, &states),
         dfdu: Expr::jacobian(&f, &inputs),

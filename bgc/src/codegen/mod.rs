@@ -6,6 +6,8 @@
 //! `Parametric` (unless [`rust::Options::runtime`] is off); its functions allocate nothing, never panic and need
 //! only `core`, `nalgebra` and `libm`. Its text is what `rustfmt` makes of it: `layout` breaks long statements into
 //! `let` lines, `format` lays out comments, lists and signatures. [`crate::build`] wraps both for build scripts.
+//! Nonlinear algebraic loops are solved inside the generated functions by Newton's method (`loops`); I-fields'
+//! mass matrices by Gaussian elimination (`mass`).
 //!
 //! Diagnostics of this stage:
 //!
@@ -18,6 +20,7 @@ mod adapter;
 mod emit;
 mod format;
 mod layout;
+mod loops;
 mod mass;
 mod names;
 pub mod rust;

@@ -13,8 +13,8 @@
 //! 4. A nonlinear algebraic loop stays implicit (`tear.rs`): its tear variable `z` (`Sym::Tear`, printed
 //!    `loop_<variable>`) is an unknown of the equations, defined by a residual equation `0 = r(z, x, u, p, t)` in
 //!    [`Equations::tear_blocks`]. Rates, outputs and energy terms hold `z`; `bgc simulate` solves the blocks by
-//!    Newton's method ([`newton`]) at every evaluation, [`linearise`] uses the implicit function theorem, and code
-//!    generation refuses such a model.
+//!    Newton's method ([`newton`]) at every evaluation (so do [`Equations::rates_at`] and `outputs_at`),
+//!    [`linearise`] uses the implicit function theorem, and generated code solves them in its functions.
 //! 5. Readable forms keep intermediates (one per bond variable that is computed and not a mere copy of another).
 //!
 //! # Calling it

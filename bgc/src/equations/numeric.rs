@@ -96,7 +96,8 @@ impl Equations {
         t: f64,
     ) -> Result<Vec<f64>, LinearError> {
         self.check_point(params, x, u)?;
-        let value = |s: Sym| point(s, params, x, u, t);
+        let tears = self.tears_at(params, x, u, t)?;
+        let value = |s: Sym| point_with_tears(s, params, x, u, t, &tears);
         let mut dx = Vec::with_capacity(x.len());
         for (i, f) in self.f.iter().enumerate() {
             let what = || format!("the rate of `{}`", self.sym_name(Sym::State(i)));
@@ -124,7 +125,8 @@ impl Equations {
         t: f64,
     ) -> Result<Vec<f64>, LinearError> {
         self.check_point(params, x, u)?;
-        let value = |s: Sym| point(s, params, x, u, t);
+        let tears = self.tears_at(params, x, u, t)?;
+        let value = |s: Sym| point_with_tears(s, params, x, u, t, &tears);
         self.outputs
             .iter()
             .map(|o| {
@@ -136,6 +138,44 @@ impl Equations {
                 value_of(self, e, &what, &value)
             })
             .collect()
+    }
+}
+
+impl Equations {
+    /// The tear variables of the nonlinear algebraic loops at a point, solved by Newton's method (none without
+    /// loops).
+    fn tears_at(
+        &self,
+        params: &[f64],
+        x: &[f64],
+        u: &[f64],
+        t: f64,
+    ) -> Result<Vec<(Sym, f64)>, LinearError> {
+        if self.tear_blocks.is_empty() {
+            return Ok(Vec::new());
+        }
+        super::tear::solve_all(self, &|s| point(s, params, x, u, t)).map_err(|e| {
+            LinearError::LoopNotSolved {
+                tears: e.tear_list(),
+                reason: e.failure.kind.describe(),
+                residual: e.failure.residual,
+            }
+        })
+    }
+}
+
+/// [`point`], and the tears' values.
+fn point_with_tears(
+    s: Sym,
+    params: &[f64],
+    x: &[f64],
+    u: &[f64],
+    t: f64,
+    tears: &[(Sym, f64)],
+) -> Option<f64> {
+    match s {
+        Sym::Tear(_) => tears.iter().find(|(z, _)| *z == s).map(|(_, v)| *v),
+        other => point(other, params, x, u, t),
     }
 }
 

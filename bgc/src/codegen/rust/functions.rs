@@ -24,6 +24,13 @@ pub(in crate::codegen) struct Draft {
     calls: BTreeMap<String, String>,
 }
 
+impl Draft {
+    /// Records a local name the body binds.
+    pub(in crate::codegen) fn push_local(&mut self, name: String) {
+        self.locals.push(name);
+    }
+}
+
 impl Writer<'_> {
     /// A body that binds the states and inputs `exprs` use, and what it uses.
     pub(in crate::codegen) fn draft(&self, exprs: &[&Expr]) -> Draft {
@@ -131,6 +138,7 @@ impl Writer<'_> {
         let mut all: Vec<&Expr> = b.lets.iter().map(|l| &l.1).collect();
         all.extend(b.results.iter());
         let mut d = self.draft(&all);
+        self.solve_tears(&mut d, &all);
         for (s, v) in &b.lets {
             let local = self.name(s);
             self.statement(
@@ -195,6 +203,7 @@ impl Writer<'_> {
     }
 
     pub(super) fn functions(&mut self) {
+        self.loop_fns();
         self.mass_fns();
         self.rhs();
         self.outputs();
@@ -284,7 +293,18 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
                     .flat_map(|b| b.derivatives.iter().flat_map(|(_, d)| d.iter().flatten())),
             );
         }
+        let plan = self.plan;
+        let (g_z, r_v, size) = match (name, &plan.loops) {
+            ("jac_x_into", Some(l)) => (&l.dfdz[..], &l.drdx[..], ("N_STATES", "N_STATES")),
+            ("jac_u_into", Some(l)) => (&l.dfdz[..], &l.drdu[..], ("N_STATES", "N_INPUTS")),
+            ("output_jac_x_into", Some(l)) => (&l.dhdz[..], &l.drdx[..], ("N_OUTPUTS", "N_STATES")),
+            ("output_jac_u_into", Some(l)) => (&l.dhdz[..], &l.drdu[..], ("N_OUTPUTS", "N_INPUTS")),
+            _ => (&[][..], &[][..], ("", "")),
+        };
+        let correction = self.loop_correction_exprs(g_z, r_v);
+        nonzero.extend(correction.iter());
         let mut d = self.draft(&nonzero);
+        self.solve_tears(&mut d, &nonzero);
         d.lines.push("    jac.fill(0.0);".into());
         for (r, row) in m.iter().enumerate() {
             for (c, e) in row.iter().enumerate() {
@@ -299,6 +319,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
                 self.statement(&mut d, &lhs, e, &format!("jac[({r}, {c})] = "), ";");
             }
         }
+        self.loop_correction(&mut d, g_z, r_v, size);
         match name {
             "jac_x_into" => self.mass_solve_in_jacobian(&mut d, true, "N_STATES"),
             "jac_u_into" => self.mass_solve_in_jacobian(&mut d, false, "N_INPUTS"),
@@ -508,6 +529,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             };
             let exprs: Vec<&Expr> = terms.iter().map(|t| &t.1).collect();
             let mut d = self.draft(&exprs);
+            self.solve_tears(&mut d, &exprs);
             match terms.as_slice() {
                 [] => d.lines.push("    0.0".into()),
                 [(element, e)] => self.statement(&mut d, &format!("{element}: "), e, "", ""),

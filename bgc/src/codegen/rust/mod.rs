@@ -12,6 +12,9 @@
 //! - for a linear model `state_space(&Params) -> (A, B, C, D)` in the energy states and, when the model declares
 //!   coordinates, `state_space_declared`;
 //! - `stored_energy`, `dissipated_power`, `supplied_power` when every term has a closed form;
+//! - for a model with nonlinear algebraic loops, `N_TEARS`, `TEAR_NAMES`, `Tears`, `LoopFailure`, `LoopError` and
+//!   `solve_loops(p, t, x, u) -> Result<Tears, LoopError>` (damped Newton's method per block, see
+//!   [`super::loops`]); the functions above solve the loops first and give NaN where `solve_loops` fails;
 //! - `Model` (the parameters, validated) and, with [`Options::runtime`], its implementations of
 //!   `bgc_runtime::model::ContinuousModel` and `Parametric`.
 //!
@@ -199,16 +202,16 @@ struct Function {
 
 /// Which of the model function's arguments a body uses.
 #[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Uses {
-    pub(super) p: bool,
-    pub(super) t: bool,
-    pub(super) x: bool,
-    pub(super) u: bool,
+pub(in crate::codegen) struct Uses {
+    pub(in crate::codegen) p: bool,
+    pub(in crate::codegen) t: bool,
+    pub(in crate::codegen) x: bool,
+    pub(in crate::codegen) u: bool,
 }
 
-pub(super) struct Writer<'a> {
+pub(in crate::codegen) struct Writer<'a> {
     m: &'a CompiledModel,
-    pub(super) plan: &'a Plan,
+    pub(in crate::codegen) plan: &'a Plan,
     options: Options,
     /// Rust text of each symbol inside a model function (`p.J_m`, `p_rotor`, `t`).
     names: HashMap<Symbol, String>,
@@ -222,7 +225,7 @@ pub(super) struct Writer<'a> {
     all_fields: Vec<String>,
     /// The columns of a line.
     width: usize,
-    pub(super) out: String,
+    pub(in crate::codegen) out: String,
 }
 
 impl<'a> Writer<'a> {
@@ -252,6 +255,9 @@ impl<'a> Writer<'a> {
         for i in &eqs.intermediates {
             names.insert(Symbol::intermediate(i.name.as_str()), namer.ident(&i.name));
         }
+        for s in plan.loops.iter().flat_map(|l| &l.tears) {
+            names.insert(s.clone(), namer.ident(s.name()));
+        }
         names.insert(Symbol::time(), "t".into());
         Writer {
             m,
@@ -268,7 +274,7 @@ impl<'a> Writer<'a> {
     }
 
     /// The name of `s` inside a model function.
-    fn name(&self, s: &Symbol) -> String {
+    pub(in crate::codegen) fn name(&self, s: &Symbol) -> String {
         self.names.get(s).cloned().unwrap_or_else(|| {
             format!(
                 "compile_error!({})",
@@ -282,7 +288,7 @@ impl<'a> Writer<'a> {
     }
 
     /// Wrapped documentation lines `{indent}/// text`.
-    fn doc(&mut self, indent: usize, text: &str) {
+    pub(in crate::codegen) fn doc(&mut self, indent: usize, text: &str) {
         for line in format::comment(indent, "///", text, Wrap::Prose, self.width) {
             self.out.push_str(&line);
             self.out.push('\n');
@@ -371,8 +377,11 @@ impl<'a> Writer<'a> {
             out.push_str(helpers.trim_end());
             out.push('\n');
         }
-        if !self.plan.mass.is_empty() {
+        if !self.plan.mass.is_empty() || self.plan.loops.is_some() {
             out.push_str(super::mass::SOLVE_FN);
+        }
+        if self.plan.loops.is_some() {
+            out.push_str(super::loops::NEWTON_FN);
         }
         out.push_str(&self.out);
         out

@@ -51,7 +51,13 @@ impl core::error::Error for ParamError {}
 ";
 
 impl Writer<'_> {
-    pub(super) fn name_array(&mut self, konst: &str, size: &str, what: &str, names: &[String]) {
+    pub(in crate::codegen) fn name_array(
+        &mut self,
+        konst: &str,
+        size: &str,
+        what: &str,
+        names: &[String],
+    ) {
         let list: Vec<String> = names.iter().map(|n| string_literal(n)).collect();
         self.out.push('\n');
         self.doc(0, &format!("The names of the {what}, in vector order."));

@@ -1,0 +1,490 @@
+//! The nonlinear algebraic loops of a model in generated code.
+//!
+//! The equations keep such a loop implicit ([`crate::equations::TearBlock`]): its tear variables `z` solve
+//! `0 = r(z, x, u, p, t)`, block after block, and the rates, outputs and energy terms hold `z`. The generated
+//! module gets:
+//! - `N_TEARS`, `TEAR_NAMES` and `Tears` (an `SVector<f64, N_TEARS>`), the error type `LoopError`;
+//! - `solve_loops(p, t, x, u) -> Result<Tears, LoopError>`: each block in turn by damped Newton's method on
+//!   fixed-size values ([`NEWTON_FN`]), from `z = 0`, with the analytic `∂r/∂z` (symbolic derivatives of the
+//!   residuals). It mirrors [`crate::equations::newton`]: the step solves `∂r/∂z Δ = −r`, the damping halves `λ`
+//!   until the Armijo test on `Σ (r_i/w_i)²` passes, and the block has converged when `|r_i| ≤ 10⁻¹² s_i` for every
+//!   residual, `s_i` being the sum of the magnitudes of its terms ([`crate::equations::residual_scale`]), after at
+//!   least one step; at most 100 iterations;
+//! - every function that needs the tears (`rhs_into`, `outputs_into`, the Jacobians, the energy functions) starts
+//!   with `let z = loop_values(p, t, x, u);`, which is `solve_loops` with all NaN when it fails: the values are then
+//!   NaN, never silently wrong. Callers that need to know why call `solve_loops`.
+//!
+//! The Jacobians follow from the implicit function theorem: with `r(z(x, u), x, u) = 0`,
+//! `dz/dx = −(∂r/∂z)⁻¹ ∂r/∂x` and `dz/du = −(∂r/∂z)⁻¹ ∂r/∂u`, so `∂f/∂x` gets `∂f/∂z dz/dx` added (the same for
+//! `u` and for the outputs). `∂r/∂z` of all blocks together is block-triangular and is solved by `bgc_solve`.
+
+use super::adapter::to_symbolic;
+use super::rust::{Draft, Writer};
+use crate::equations::{Equations, residual_scale};
+use crate::symbolic::{Expr, Symbol};
+use std::fmt::Write;
+
+/// One block of the loops for the generator.
+#[derive(Clone, Debug)]
+pub(crate) struct LoopBlockPlan {
+    /// The index of its first tear in `Tears`.
+    pub first: usize,
+    pub residuals: Vec<Expr>,
+    pub scales: Vec<Expr>,
+    /// `∂r_i/∂z_j` over this block's tears.
+    pub jacobian: Vec<Vec<Expr>>,
+}
+
+/// The loops of a model for the generator.
+#[derive(Clone, Debug)]
+pub(crate) struct LoopPlan {
+    pub tears: Vec<Symbol>,
+    pub blocks: Vec<LoopBlockPlan>,
+    /// `∂r/∂z`, `∂r/∂x`, `∂r/∂u` of all residuals (in block order) with respect to all tears, states, inputs.
+    pub drdz: Vec<Vec<Expr>>,
+    pub drdx: Vec<Vec<Expr>>,
+    pub drdu: Vec<Vec<Expr>>,
+    /// `∂f/∂z` and `∂h/∂z`.
+    pub dfdz: Vec<Vec<Expr>>,
+    pub dhdz: Vec<Vec<Expr>>,
+}
+
+/// The loops of `eqs` (`None` without any), for the rates `f` and outputs `h`.
+pub(crate) fn plan(
+    eqs: &Equations,
+    f: &[Expr],
+    h: &[Expr],
+    states: &[Symbol],
+    inputs: &[Symbol],
+) -> Result<Option<LoopPlan>, String> {
+    if eqs.tear_blocks.is_empty() {
+        return Ok(None);
+    }
+    let convert = |e: &crate::equations::sym::Ex| to_symbolic(eqs, e).map_err(|e| e.to_string());
+    let mut tears = Vec::new();
+    let mut blocks = Vec::new();
+    let mut residuals = Vec::new();
+    for b in &eqs.tear_blocks {
+        let first = tears.len();
+        let own: Vec<Symbol> = b
+            .names
+            .iter()
+            .map(|n| Symbol::intermediate(n.as_str()))
+            .collect();
+        let rs: Vec<Expr> = b.residuals.iter().map(convert).collect::<Result<_, _>>()?;
+        let scales: Vec<Expr> = b
+            .residuals
+            .iter()
+            .zip(&b.tears)
+            .map(|(r, &z)| convert(&residual_scale(r, z)))
+            .collect::<Result<_, _>>()?;
+        blocks.push(LoopBlockPlan {
+            first,
+            jacobian: Expr::jacobian(&rs, &own),
+            residuals: rs.clone(),
+            scales,
+        });
+        tears.extend(own);
+        residuals.extend(rs);
+    }
+    Ok(Some(LoopPlan {
+        drdz: Expr::jacobian(&residuals, &tears),
+        drdx: Expr::jacobian(&residuals, states),
+        drdu: Expr::jacobian(&residuals, inputs),
+        dfdz: Expr::jacobian(f, &tears),
+        dhdz: Expr::jacobian(h, &tears),
+        tears,
+        blocks,
+    }))
+}
+
+/// Damped Newton's method for one block, on fixed-size values (see the module docs). Emitted into the module with
+/// [`ITEMS`]; needs `bgc_solve` ([`super::mass::SOLVE_FN`]).
+pub(crate) const NEWTON_FN: &str = "
+/// The residuals `r`, their scales `s` and `∂r/∂z` of one block of the algebraic loops.
+pub type LoopEval<const B: usize> = (SVector<f64, B>, SVector<f64, B>, SMatrix<f64, B, B>);
+
+/// Solves the block of `B` tears starting at `first` in `z` by damped Newton's method, from the
+/// values in `z`.
+fn bgc_newton<const B: usize>(
+    z: &mut Tears,
+    first: usize,
+    block: usize,
+    eval: impl Fn(&Tears) -> LoopEval<B>,
+) -> Result<(), LoopError> {
+    let (mut r, mut s, mut jz) = eval(z);
+    let fail = |kind: LoopFailure, iterations: usize, r: &SVector<f64, B>| {
+        let mut worst = 0;
+        for i in 0..B {
+            if !r[i].is_finite() || libm::fabs(r[i]) > libm::fabs(r[worst]) {
+                worst = i;
+                if !r[i].is_finite() {
+                    break;
+                }
+            }
+        }
+        LoopError {
+            block,
+            tear: first + worst,
+            kind,
+            iterations,
+            residual: if B == 0 { 0.0 } else { libm::fabs(r[worst]) },
+        }
+    };
+    for k in 0..=LOOP_MAX_ITERATIONS {
+        let mut finite = true;
+        let mut converged = true;
+        let mut all_zero = true;
+        for i in 0..B {
+            finite &= r[i].is_finite() && s[i].is_finite();
+            converged &= libm::fabs(r[i]) <= LOOP_RTOL * s[i];
+            all_zero &= r[i] == 0.0;
+        }
+        if !finite {
+            return Err(fail(LoopFailure::NonFinite, k, &r));
+        }
+        if converged && (k > 0 || all_zero) {
+            return Ok(());
+        }
+        if k == LOOP_MAX_ITERATIONS {
+            break;
+        }
+        let mut minus_r = SMatrix::<f64, B, 1>::zeros();
+        for i in 0..B {
+            for j in 0..B {
+                if !jz[(i, j)].is_finite() {
+                    return Err(fail(LoopFailure::NonFinite, k, &r));
+                }
+            }
+            minus_r[i] = -r[i];
+        }
+        let step = bgc_solve(jz, minus_r);
+        let mut weights = SVector::<f64, B>::zeros();
+        let mut merit = 0.0;
+        for i in 0..B {
+            if !step[i].is_finite() {
+                return Err(fail(LoopFailure::Singular, k, &r));
+            }
+            weights[i] = if s[i] > 0.0 { s[i] } else { 1.0 };
+            merit += (r[i] / weights[i]) * (r[i] / weights[i]);
+        }
+        let mut lambda = 1.0;
+        let mut accepted = None;
+        let mut trial = *z;
+        for _ in 0..40 {
+            for i in 0..B {
+                trial[first + i] = z[first + i] + lambda * step[i];
+            }
+            let at = eval(&trial);
+            let mut merit_trial = 0.0;
+            for i in 0..B {
+                merit_trial += (at.0[i] / weights[i]) * (at.0[i] / weights[i]);
+            }
+            if merit_trial.is_finite() && merit_trial <= (1.0 - 1e-4 * lambda) * merit {
+                accepted = Some(at);
+                break;
+            }
+            lambda /= 2.0;
+        }
+        match accepted {
+            Some(at) => {
+                *z = trial;
+                (r, s, jz) = at;
+            }
+            // At the rounding floor no step decreases the residual: a converged iterate stays.
+            None if converged => return Ok(()),
+            None => return Err(fail(LoopFailure::NoDescent, k, &r)),
+        }
+    }
+    Err(fail(LoopFailure::IterationLimit, LOOP_MAX_ITERATIONS, &r))
+}
+";
+
+/// The error types and constants of the loops (after `N_TEARS` and `Tears`).
+const ITEMS: &str = "
+/// The residual tolerance of the loops, relative to the magnitudes of each residual's terms.
+pub const LOOP_RTOL: f64 = 1e-12;
+
+/// The most Newton iterations per block of the loops.
+pub const LOOP_MAX_ITERATIONS: usize = 100;
+
+/// Why Newton's method stopped without solving a block of the algebraic loops.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LoopFailure {
+    /// No damped step decreases the residual (the equations may have no solution here).
+    NoDescent,
+    /// `LOOP_MAX_ITERATIONS` iterations did not converge.
+    IterationLimit,
+    /// `∂r/∂z` is singular at the iterate.
+    Singular,
+    /// The residuals or their derivatives are not finite at the iterate.
+    NonFinite,
+}
+
+/// A block of the algebraic loops that was not solved.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LoopError {
+    /// The block (in solving order).
+    pub block: usize,
+    /// The tear (index into `TEAR_NAMES`) with the largest residual.
+    pub tear: usize,
+    pub kind: LoopFailure,
+    pub iterations: usize,
+    /// `|r|` of that tear at the last iterate (NaN when not finite).
+    pub residual: f64,
+}
+
+impl core::fmt::Display for LoopError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let tear = TEAR_NAMES.get(self.tear).copied().unwrap_or(\"?\");
+        write!(
+            f,
+            \"the algebraic loop for `{tear}` was not solved ({:?} after {} iterations, \\
+             residual {:e})\",
+            self.kind, self.iterations, self.residual
+        )
+    }
+}
+";
+
+impl Writer<'_> {
+    /// The items of the loops: sizes, error types, one residual function per block, `solve_loops`, `loop_values`.
+    pub(super) fn loop_fns(&mut self) {
+        let Some(lp) = self.plan.loops.clone() else {
+            return;
+        };
+        let names: Vec<String> = lp.tears.iter().map(|s| s.name().to_string()).collect();
+        self.out.push('\n');
+        self.doc(
+            0,
+            "The number of tear variables of the nonlinear algebraic loops.",
+        );
+        let _ = writeln!(self.out, "pub const N_TEARS: usize = {};", names.len());
+        self.name_array("TEAR_NAMES", "N_TEARS", "tear variables", &names);
+        self.out.push('\n');
+        self.doc(0, "The values of the tear variables.");
+        self.out
+            .push_str("pub type Tears = SVector<f64, N_TEARS>;\n");
+        self.out.push_str(ITEMS);
+        for (k, b) in lp.blocks.iter().enumerate() {
+            let n = b.residuals.len();
+            let mut all: Vec<&Expr> = b.residuals.iter().chain(&b.scales).collect();
+            all.extend(b.jacobian.iter().flatten().filter(|e| !e.is_zero()));
+            let mut d = self.draft(&all);
+            self.tear_lets(&mut d, &all);
+            d.lines
+                .push(format!("    let mut r = SVector::<f64, {n}>::zeros();"));
+            d.lines
+                .push(format!("    let mut s = SVector::<f64, {n}>::zeros();"));
+            let mutable = if b.jacobian.iter().flatten().any(|e| !e.is_zero()) {
+                "mut "
+            } else {
+                ""
+            };
+            d.lines.push(format!(
+                "    let {mutable}jz = SMatrix::<f64, {n}, {n}>::zeros();"
+            ));
+            for (i, r) in b.residuals.iter().enumerate() {
+                let tear = names.get(b.first + i).cloned().unwrap_or_default();
+                self.statement(
+                    &mut d,
+                    &format!("r[{tear}] = "),
+                    r,
+                    &format!("r[{i}] = "),
+                    ";",
+                );
+                let scale = b
+                    .scales
+                    .get(i)
+                    .cloned()
+                    .unwrap_or_else(|| Expr::constant(1.0));
+                self.statement(
+                    &mut d,
+                    &format!("s[{tear}] = "),
+                    &scale,
+                    &format!("s[{i}] = "),
+                    ";",
+                );
+            }
+            for (i, row) in b.jacobian.iter().enumerate() {
+                for (j, e) in row.iter().enumerate() {
+                    if e.is_zero() {
+                        continue;
+                    }
+                    let label = format!(
+                        "∂r[{}]/∂{} = ",
+                        names.get(b.first + i).cloned().unwrap_or_default(),
+                        names.get(b.first + j).cloned().unwrap_or_default()
+                    );
+                    self.statement(&mut d, &label, e, &format!("jz[({i}, {j})] = "), ";");
+                }
+            }
+            d.lines.push("    (r, s, jz)".into());
+            let uses = d.uses;
+            let block_names = names
+                .get(b.first..b.first + n)
+                .unwrap_or_default()
+                .join("`, `");
+            self.emit_function(
+                &format!(
+                    "Block {k} of the algebraic loops (`{block_names}`): the residuals `0 = r(z, x, u, p, t)`, their scales and `∂r/∂z`, at the tears `z`."
+                ),
+                &format!("bgc_loop_block_{k}"),
+                vec![
+                    ("p", "&Params", uses.p),
+                    ("t", "f64", uses.t),
+                    ("x", "&State", uses.x),
+                    ("u", "&Inputs", uses.u),
+                    ("z", "&Tears", true),
+                ],
+                &format!(" -> LoopEval<{n}>"),
+                d,
+            );
+        }
+        let mut body = String::from("    let mut z = Tears::zeros();\n");
+        for (k, b) in lp.blocks.iter().enumerate() {
+            let _ = writeln!(
+                body,
+                "    bgc_newton(&mut z, {}, {k}, |at| bgc_loop_block_{k}(p, t, x, u, at))?;",
+                b.first
+            );
+        }
+        body.push_str("    Ok(z)\n");
+        self.out.push('\n');
+        self.doc(
+            0,
+            "Solves the nonlinear algebraic loops at `(t, x, u)`: each block in turn by damped Newton's method from zero, to `|r| ≤ LOOP_RTOL` times the magnitudes of each residual's terms. The error names the block that was not solved.",
+        );
+        self.out.push_str(
+            "pub fn solve_loops(p: &Params, t: f64, x: &State, u: &Inputs) -> Result<Tears, LoopError> {\n",
+        );
+        self.out.push_str(&body);
+        self.out.push_str("}\n");
+        self.out.push_str(
+            "
+/// The tears for the model functions: `solve_loops`, or all NaN when it fails (so that what
+/// depends on them is NaN, never silently wrong).
+fn loop_values(p: &Params, t: f64, x: &State, u: &Inputs) -> Tears {
+    match solve_loops(p, t, x, u) {
+        Ok(z) => z,
+        Err(_) => {
+            let mut z = Tears::zeros();
+            z.fill(f64::NAN);
+            z
+        }
+    }
+}
+",
+        );
+    }
+
+    /// `let loop_v = z[i];` for the tears `exprs` use.
+    fn tear_lets(&self, d: &mut Draft, exprs: &[&Expr]) {
+        let Some(lp) = &self.plan.loops else {
+            return;
+        };
+        for (i, s) in lp.tears.iter().enumerate() {
+            if exprs.iter().any(|e| e.free_symbols().contains(s)) {
+                let name = self.name(s);
+                d.lines.push(format!("    let {name} = z[{i}];"));
+                d.push_local(name);
+            }
+        }
+    }
+
+    /// True when any of `exprs` holds a tear.
+    pub(super) fn uses_tears(&self, exprs: &[&Expr]) -> bool {
+        self.plan.loops.as_ref().is_some_and(|lp| {
+            exprs
+                .iter()
+                .any(|e| e.free_symbols().iter().any(|s| lp.tears.contains(s)))
+        })
+    }
+
+    /// When `exprs` hold tears: `let z = loop_values(p, t, x, u);` and the tears' `let`s.
+    pub(super) fn solve_tears(&self, d: &mut Draft, exprs: &[&Expr]) {
+        if !self.uses_tears(exprs) {
+            return;
+        }
+        d.lines.push("    let z = loop_values(p, t, x, u);".into());
+        d.uses.p = true;
+        d.uses.t = true;
+        d.uses.x = true;
+        d.uses.u = true;
+        self.tear_lets(d, exprs);
+    }
+
+    /// The expressions the loop correction of a Jacobian needs: `∂g/∂z` and `∂r/∂v` (`v` = x or u), with `∂r/∂z`.
+    pub(super) fn loop_correction_exprs(&self, g_z: &[Vec<Expr>], r_v: &[Vec<Expr>]) -> Vec<Expr> {
+        let Some(lp) = &self.plan.loops else {
+            return Vec::new();
+        };
+        if !needs_correction(g_z, r_v) {
+            return Vec::new();
+        }
+        lp.drdz
+            .iter()
+            .chain(r_v)
+            .chain(g_z)
+            .flatten()
+            .filter(|e| !e.is_zero())
+            .cloned()
+            .collect()
+    }
+
+    /// The lines that add `∂g/∂z dz/dv` to `jac` (`rows × cols`), `dz/dv = −(∂r/∂z)⁻¹ ∂r/∂v`.
+    pub(super) fn loop_correction(
+        &self,
+        d: &mut Draft,
+        g_z: &[Vec<Expr>],
+        r_v: &[Vec<Expr>],
+        (rows, cols): (&str, &str),
+    ) {
+        let Some(lp) = &self.plan.loops else {
+            return;
+        };
+        if !needs_correction(g_z, r_v) {
+            return;
+        }
+        d.lines.extend(self.comment_lines(
+            "Through the algebraic loops (implicit function theorem): dz = −(∂r/∂z)⁻¹ ∂r, jac += (∂/∂z) dz.",
+        ));
+        d.lines
+            .push("    let mut rz = SMatrix::<f64, N_TEARS, N_TEARS>::zeros();".into());
+        d.lines.push(format!(
+            "    let mut rv = SMatrix::<f64, N_TEARS, {cols}>::zeros();"
+        ));
+        d.lines.push(format!(
+            "    let mut gz = SMatrix::<f64, {rows}, N_TEARS>::zeros();"
+        ));
+        let cell = |m: &[Vec<Expr>], var: &str, sign: bool, d: &mut Draft| {
+            for (i, row) in m.iter().enumerate() {
+                for (j, e) in row.iter().enumerate() {
+                    if e.is_zero() {
+                        continue;
+                    }
+                    let value = if sign { -e } else { e.clone() };
+                    self.statement(
+                        d,
+                        &format!("{var}[{i}, {j}] = "),
+                        &value,
+                        &format!("{var}[({i}, {j})] = "),
+                        ";",
+                    );
+                }
+            }
+        };
+        cell(&lp.drdz, "rz", false, d);
+        cell(r_v, "rv", true, d);
+        cell(g_z, "gz", false, d);
+        d.lines.push("    let dz = bgc_solve(rz, rv);".into());
+        d.lines.push(format!(
+            "    for row in 0..{rows} {{\n        for col in 0..{cols} {{\n            for k in 0..N_TEARS {{\n                jac[(row, col)] += gz[(row, k)] * dz[(k, col)];\n            }}\n        }}\n    }}"
+        ));
+    }
+}
+
+/// The correction is zero when `∂g/∂z` or `∂r/∂v` is.
+fn needs_correction(g_z: &[Vec<Expr>], r_v: &[Vec<Expr>]) -> bool {
+    g_z.iter().flatten().any(|e| !e.is_zero()) && r_v.iter().flatten().any(|e| !e.is_zero())
+}

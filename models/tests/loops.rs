@@ -1,0 +1,82 @@
+//! The generated Newton solve of a nonlinear algebraic loop (corpus/diode_rc.bg): its solution satisfies the
+//! diode's law written out by hand, and where no solution can be computed the generated functions say so (an
+//! `Err` from `solve_loops`, NaN from `rhs`, `outputs` and the Jacobians) instead of returning a wrong number.
+
+mod support;
+
+use bgc_models::corpus::diode_rc as m;
+use nalgebra::SVector;
+
+/// The loop, by hand: the current `i` through the source, the series resistor, the diode and the capacitor obeys
+/// `u = R_s i + v_d + q/C` with the diode `i = I_s (exp(v_d/V_t) − 1)`.
+fn diode_residual(p: &m::Params, q: f64, u: f64, i: f64) -> (f64, f64) {
+    let v_d = u - q / p.C_v - p.R_s * i;
+    let law = p.I_s * ((v_d / p.V_t).exp() - 1.0);
+    (law - i, v_d)
+}
+
+#[test]
+fn the_solved_current_satisfies_the_diode_law() {
+    let p = m::Params::default();
+    // Forward bias (2 V across the series resistor and the diode), reverse bias and no bias.
+    for (q, u) in [(0.0, 2.0), (1e-3, -1.0), (0.0, 0.0)] {
+        let x = SVector::from([q]);
+        let uu = SVector::from([u]);
+        let z = m::solve_loops(&p, 0.0, &x, &uu).unwrap_or_else(|e| panic!("{e}"));
+        let i = z[0];
+        assert_eq!(m::TEAR_NAMES, ["loop_f_diode"]);
+        let (r, v_d) = diode_residual(&p, q, u, i);
+        assert!(
+            r.abs() <= 1e-12 * (i.abs() + p.I_s),
+            "q {q}, u {u}: i {i}, residual {r}"
+        );
+        // The rate of the charge is that current, the outputs the current and the diode's voltage.
+        assert_eq!(m::rhs(&p, 0.0, &x, &uu)[0], i);
+        let y = m::outputs(&p, 0.0, &x, &uu);
+        assert_eq!(y[0], i);
+        assert!(
+            (y[1] - v_d).abs() <= 1e-12 * v_d.abs().max(1e-9),
+            "{} vs {v_d}",
+            y[1]
+        );
+    }
+    // Forward bias: most of the 2 V drop is across R_s = 100 Ω, the diode takes about V_t ln(i/I_s) ≈ 0.5 V.
+    let z = m::solve_loops(&p, 0.0, &SVector::from([0.0]), &SVector::from([2.0]));
+    let i = z.map(|z| z[0]).unwrap_or(f64::NAN);
+    assert!(i > 0.013 && i < 0.016, "{i}");
+    // Reverse bias: the saturation current.
+    let z = m::solve_loops(&p, 0.0, &SVector::from([1e-3]), &SVector::from([-1.0]));
+    let i = z.map(|z| z[0]).unwrap_or(f64::NAN);
+    assert!((i + p.I_s).abs() < 1e-12 * p.I_s, "{i}");
+}
+
+#[test]
+fn an_unsolvable_loop_is_an_error_and_nan() {
+    let p = m::Params::default();
+    // q = −1 C on 1 mF is −1000 V: from zero current the diode sees exp(1000/0.05), which overflows.
+    let x = SVector::from([-1.0]);
+    let u = SVector::from([0.0]);
+    let err = match m::solve_loops(&p, 0.0, &x, &u) {
+        Ok(z) => panic!("solved to {z:?}"),
+        Err(e) => e,
+    };
+    assert_eq!(err.kind, m::LoopFailure::NonFinite);
+    assert_eq!((err.block, err.tear, err.iterations), (0, 0, 0));
+    assert!(err.to_string().contains("`loop_f_diode`"), "{err}");
+    assert!(m::rhs(&p, 0.0, &x, &u)[0].is_nan());
+    let y = m::outputs(&p, 0.0, &x, &u);
+    assert!(y[0].is_nan() && y[1].is_nan(), "{y:?}");
+    let mut jac = m::JacX::zeros();
+    m::jac_x_into(&p, 0.0, &x, &u, &mut jac);
+    assert!(jac[(0, 0)].is_nan());
+    // The compiler's own solve fails there too.
+    let eqs = support_equations();
+    let values: Vec<f64> = (0..m::N_PARAMS)
+        .map(|i| p.get(i).unwrap_or(f64::NAN))
+        .collect();
+    assert!(eqs.rates_at(&values, &[-1.0], &[0.0], 0.0).is_err());
+}
+
+fn support_equations() -> bgc::equations::Equations {
+    support::equations_of("bgc/tests/corpus/diode_rc.bg")
+}

@@ -69,6 +69,9 @@ use nalgebra::{SMatrix, SVector};
 
 const FILTER: &str = "dual UKF parameter filter";
 
+/// What a failed evaluation in the parameter filter of [`DualUkf::step`] names.
+const MODEL_AT_POINT: &str = "model at a parameter sigma point";
+
 /// The model a dual UKF runs: `x[k+1] = f(x, u, w)` and `y = h(x, u, w)`.
 pub trait DualModel<const NX: usize, const NU: usize, const NY: usize, const NP: usize> {
     /// `f(x, u, w)`.
@@ -423,35 +426,27 @@ impl<
 
         // Parameter filter: Eq. 27 time update, then the measurement update through the model.
         let mut w = w_prior;
-        let mut pw = self.pw / self.forgetting;
-        repair_covariance(&mut pw, self.param_policy.eigen_floor, FILTER)?;
-        let wpts = self.param_points.generate(&w, &pw)?;
-        let ds = evaluate_points("model at a parameter sigma point", |i| {
-            let wi: SVector<f64, NP> = wpts.column(i).into_owned();
-            let xi = model.propagate(&x_prev, u, &wi);
-            model.observe(&xi, u, &wi)
-        })?;
-        let y_residual = st.measurement_residual();
+        let mut pw = self.pw;
         let d_fns = SpaceFns {
             mean: self.param_measurement_mean,
-            residual: y_residual,
+            residual: st.measurement_residual(),
         };
         let observation_noise = match self.param_noise {
             ParameterObservationNoise::MeasurementNoise => *st.measurement_noise(),
             ParameterObservationNoise::StateInnovation => *st.innovation_covariance(),
         };
-        let (d_hat, sd, pwd) = innovation_moments(
-            &wpts,
-            &w,
-            subtract::<NP>,
-            &ds,
+        let (parameters, e) = self.parameter_update(
+            &mut w,
+            &mut pw,
+            y,
             &d_fns,
-            Some(&observation_noise),
-            &self.param_points,
-        );
-        let e = y_residual(y, &d_hat);
-        let (parameters, _) =
-            kalman_correct(&mut w, &mut pw, &e, &sd, &pwd, &self.param_policy, FILTER)?;
+            &observation_noise,
+            MODEL_AT_POINT,
+            |wi| {
+                let xi = model.propagate(&x_prev, u, wi);
+                model.observe(&xi, u, wi)
+            },
+        )?;
 
         model.commit(&w)?;
         self.state = st;
@@ -503,26 +498,16 @@ impl<
             Some(obs) => match rejected_measurement(&obs.d) {
                 Some(rejected) => Some(rejected),
                 None => {
-                    pw /= self.forgetting;
-                    repair_covariance(&mut pw, self.param_policy.eigen_floor, FILTER)?;
                     let x_post = *st.state();
-                    let wpts = self.param_points.generate(&w, &pw)?;
-                    let ds = evaluate_points("parameter observation function", |i| {
-                        output(&x_post, u, &wpts.column(i).into_owned())
-                    })?;
-                    let (d_hat, mut sd, pwd) = innovation_moments(
-                        &wpts,
-                        &w,
-                        subtract::<NP>,
-                        &ds,
+                    let (outcome, e) = self.parameter_update(
+                        &mut w,
+                        &mut pw,
+                        &obs.d,
                         &SpaceFns::default(),
-                        Some(&obs.noise),
-                        &self.param_points,
-                    );
-                    symmetrise(&mut sd);
-                    let e = obs.d - d_hat;
-                    let (outcome, _) =
-                        kalman_correct(&mut w, &mut pw, &e, &sd, &pwd, &self.param_policy, FILTER)?;
+                        &obs.noise,
+                        "parameter observation function",
+                        |wi| output(&x_post, u, wi),
+                    )?;
                     if outcome.is_accepted() {
                         parameter_innovation = e;
                     }
@@ -539,6 +524,39 @@ impl<
             parameters,
             parameter_innovation,
         })
+    }
+
+    /// The parameter filter's step on an observation `d` (`what` names the observation function in errors): forgetting (Eq. 27, `P_w / λ`, repaired), sigma points
+    /// of `w`, the observation predicted at each (`observe(w_i)`), and the Kalman correction of `(w, P_w)` with
+    /// the observation noise `noise`. Returns the outcome and the innovation `e = d − d̂` (through `fns.residual`).
+    #[allow(clippy::too_many_arguments)]
+    fn parameter_update<const ND: usize>(
+        &self,
+        w: &mut SVector<f64, NP>,
+        pw: &mut SMatrix<f64, NP, NP>,
+        d: &SVector<f64, ND>,
+        fns: &SpaceFns<ND, NSP>,
+        noise: &SMatrix<f64, ND, ND>,
+        what: &'static str,
+        mut observe: impl FnMut(&SVector<f64, NP>) -> SVector<f64, ND>,
+    ) -> Result<(UpdateOutcome, SVector<f64, ND>), EstimationError> {
+        *pw /= self.forgetting;
+        repair_covariance(pw, self.param_policy.eigen_floor, FILTER)?;
+        let wpts = self.param_points.generate(w, pw)?;
+        let ds = evaluate_points(what, |i| observe(&wpts.column(i).into_owned()))?;
+        let (d_hat, mut sd, pwd) = innovation_moments(
+            &wpts,
+            w,
+            subtract::<NP>,
+            &ds,
+            fns,
+            Some(noise),
+            &self.param_points,
+        );
+        symmetrise(&mut sd);
+        let e = (fns.residual)(d, &d_hat);
+        let (outcome, _) = kalman_correct(w, pw, &e, &sd, &pwd, &self.param_policy, FILTER)?;
+        Ok((outcome, e))
     }
 
     /// [`Self::step`] on a [`DiscreteModel`] + [`Parametric`] model, estimating its parameters `indices`

@@ -263,7 +263,7 @@ pub struct Param {
     pub doc: Vec<String>,
     /// For a parameter whose default (or instance override) refers to other parameters: that expression, in SI
     /// units. Such a parameter is derived: its value follows the parameters it refers to (see
-    /// [`Model::param_values`]).
+    /// `Equations::param_values`).
     pub derived: Option<Expr>,
 }
 
@@ -342,26 +342,6 @@ impl Expr {
             }
             _ => return None,
         })
-    }
-}
-
-impl Model {
-    /// The parameter values with some given (`given[i] = Some(v)`, indexed like [`Model::params`]) and the rest
-    /// at their defaults, derived parameters recomputed from the values before them. A given value always wins,
-    /// also for a derived parameter.
-    pub fn param_values(&self, given: &[Option<f64>]) -> Vec<f64> {
-        let mut values: Vec<f64> = Vec::with_capacity(self.params.len());
-        for (i, p) in self.params.iter().enumerate() {
-            let v = match (given.get(i).copied().flatten(), &p.derived) {
-                (Some(v), _) => v,
-                (None, Some(e)) => e
-                    .eval_const(&|j| values.get(j).copied())
-                    .unwrap_or(p.default),
-                (None, None) => p.default,
-            };
-            values.push(v);
-        }
-        values
     }
 }
 

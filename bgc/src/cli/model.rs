@@ -107,7 +107,7 @@ pub fn statespace(
 
 fn state_space(d: &Derived, args: &StateSpaceArgs<'_>) -> Result<Value, String> {
     let eqs = &d.eqs;
-    let params = param_values(&d.loaded.model, args.params)?;
+    let params = param_values(&d.loaded.model, &d.eqs, args.params)?;
     match args.coords {
         Coords::Energy => energy_coords(eqs, &params, args),
         Coords::Declared => {

@@ -62,14 +62,18 @@ pub fn assign(
 }
 
 /// The parameter values: the defaults with the overrides, checked to be physical (see [`check_physical`]).
-pub fn param_values(model: &Model, given: &[Assignment]) -> Result<Vec<f64>, String> {
+pub fn param_values(
+    model: &Model,
+    eqs: &bgc::equations::Equations,
+    given: &[Assignment],
+) -> Result<Vec<f64>, String> {
     let names: Vec<String> = model.params.iter().map(|p| p.name.clone()).collect();
     // The given values, marked by being set; the others follow from the defaults and the derived parameters.
     let mut values: Vec<f64> = vec![f64::NAN; names.len()];
     assign("parameter", &names, &mut values, given)?;
     let given_values: Vec<Option<f64>> =
         values.iter().map(|v| (!v.is_nan()).then_some(*v)).collect();
-    let values = model.param_values(&given_values);
+    let values = eqs.param_values(&given_values);
     check_physical(model, &values)?;
     Ok(values)
 }

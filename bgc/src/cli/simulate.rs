@@ -48,7 +48,7 @@ fn csv(
     eqs: &bgc::equations::Equations,
     args: &SimulateArgs<'_>,
 ) -> Result<String, String> {
-    let params = param_values(model, args.params)?;
+    let params = param_values(model, eqs, args.params)?;
     // Inputs not given are zero.
     let mut signals = vec![Signal::Num(0.0); eqs.inputs.len()];
     for a in args.inputs {

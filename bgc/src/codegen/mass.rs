@@ -55,11 +55,7 @@ pub(crate) fn plan(eqs: &Equations, states: &[Symbol]) -> Result<Vec<MassPlan>, 
                 derivatives.push((k, d));
             }
         }
-        let ident: String = b
-            .element
-            .chars()
-            .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
-            .collect();
+        let ident = super::names::sanitize(&b.element);
         out.push(MassPlan {
             element: b.element.clone(),
             ident,

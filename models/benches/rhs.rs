@@ -22,21 +22,7 @@ fn rhs(c: &mut Criterion) {
             black_box(&dx);
         })
     });
-    let hand = eq3::Eq3::new(&eq3::Eq3Params {
-        j_m: p.J_m,
-        j_g: p.J_g,
-        b_f: p.b_f,
-        r_g: p.r_g,
-        b_g: p.b_g,
-        k_g: p.k_g,
-        d_g: p.d_g,
-        j_sint: p.J_sint,
-        k_s: p.k_s,
-        d_s: p.d_s,
-        j_sext: p.J_sext,
-        k_eh: p.k_eh,
-        d_eh: p.d_eh,
-    });
+    let hand = eq3::Eq3::new(&eq3::Eq3Params::of(&p));
     let x7 = SVector::<f64, 7>::from_fn(|i, _| 1e-3 * (i as f64 + 1.0));
     let mut dx7 = SVector::<f64, 7>::zeros();
     group.bench_function("hand_written_eq3", |b| {

@@ -131,21 +131,7 @@ mod eq3;
 fn back_support_declared_is_the_papers_eq3() {
     use bgc_models::back_support as m;
     let p = m::Params::default();
-    let hand = eq3::Eq3::new(&eq3::Eq3Params {
-        j_m: p.J_m,
-        j_g: p.J_g,
-        b_f: p.b_f,
-        r_g: p.r_g,
-        b_g: p.b_g,
-        k_g: p.k_g,
-        d_g: p.d_g,
-        j_sint: p.J_sint,
-        k_s: p.k_s,
-        d_s: p.d_s,
-        j_sext: p.J_sext,
-        k_eh: p.k_eh,
-        d_eh: p.d_eh,
-    });
+    let hand = eq3::Eq3::new(&eq3::Eq3Params::of(&p));
     let (a, b, _, _) = m::state_space_declared(&p);
     for r in 0..7 {
         for c in 0..7 {
@@ -171,21 +157,7 @@ fn back_support_declared_is_the_papers_eq3() {
 fn back_support_rhs_follows_eq3() {
     use bgc_models::back_support as m;
     let p = m::Params::default();
-    let hand = eq3::Eq3::new(&eq3::Eq3Params {
-        j_m: p.J_m,
-        j_g: p.J_g,
-        b_f: p.b_f,
-        r_g: p.r_g,
-        b_g: p.b_g,
-        k_g: p.k_g,
-        d_g: p.d_g,
-        j_sint: p.J_sint,
-        k_s: p.k_s,
-        d_s: p.d_s,
-        j_sext: p.J_sext,
-        k_eh: p.k_eh,
-        d_eh: p.d_eh,
-    });
+    let hand = eq3::Eq3::new(&eq3::Eq3Params::of(&p));
     let mut rng = support::Rng::new(3);
     for _ in 0..100 {
         let z = nalgebra::SVector::<f64, 7>::from_fn(|_, _| rng.uniform(-1.0, 1.0));

@@ -30,6 +30,27 @@ pub struct Eq3Params {
     pub d_eh: f64,
 }
 
+impl Eq3Params {
+    /// The same values as the generated model's parameters.
+    pub fn of(p: &bgc_models::back_support::Params) -> Eq3Params {
+        Eq3Params {
+            j_m: p.J_m,
+            j_g: p.J_g,
+            b_f: p.b_f,
+            r_g: p.r_g,
+            b_g: p.b_g,
+            k_g: p.k_g,
+            d_g: p.d_g,
+            j_sint: p.J_sint,
+            k_s: p.k_s,
+            d_s: p.d_s,
+            j_sext: p.J_sext,
+            k_eh: p.k_eh,
+            d_eh: p.d_eh,
+        }
+    }
+}
+
 /// `ẋ = A x + B u` with `A` and `B` formed once.
 pub struct Eq3 {
     pub a: SMatrix<f64, 7, 7>,

@@ -28,6 +28,18 @@ struct Line {
     points: Vec<(f64, f64)>,
 }
 
+/// A white SVG canvas of `size` pixels at `path`, split into `grid` (rows, columns) panels.
+fn canvas(
+    path: &Path,
+    size: (u32, u32),
+    grid: (usize, usize),
+) -> PlotResult<(Area<'_>, Vec<Area<'_>>)> {
+    let root = SVGBackend::new(path, size).into_drawing_area();
+    root.fill(&WHITE)?;
+    let areas = root.split_evenly(grid);
+    Ok((root, areas))
+}
+
 fn line(name: &str, color: RGBColor, width: u32, points: Vec<(f64, f64)>) -> Line {
     Line {
         name: name.to_string(),
@@ -138,9 +150,7 @@ fn series<T>(samples: &[&T], f: impl Fn(&T) -> (f64, f64)) -> Vec<(f64, f64)> {
 }
 
 fn fig11(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
-    let root = SVGBackend::new(path, (1200, 800)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let areas = root.split_evenly((2, 2));
+    let (root, areas) = canvas(path, (1200, 800), (2, 2))?;
     let s = filter_in(r, window(cfg));
     for (col, (j, name)) in JOINTS.iter().enumerate() {
         let j = *j;
@@ -190,9 +200,7 @@ fn after_warmup<'a>(r: &'a WalkingRun, cfg: &WalkingConfig) -> Vec<&'a FilterSam
 }
 
 fn fig12(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
-    let root = SVGBackend::new(path, (1200, 800)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let areas = root.split_evenly((2, 2));
+    let (root, areas) = canvas(path, (1200, 800), (2, 2))?;
     let s = filter_in(r, window(cfg));
     let all = after_warmup(r, cfg);
     for (col, (j, name)) in JOINTS.iter().enumerate() {
@@ -223,9 +231,7 @@ fn fig12(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
 }
 
 fn fig13(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
-    let root = SVGBackend::new(path, (1200, 800)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let areas = root.split_evenly((2, 2));
+    let (root, areas) = canvas(path, (1200, 800), (2, 2))?;
     let s = filter_in(r, window(cfg));
     for (col, (j, name)) in JOINTS.iter().enumerate() {
         let j = *j;
@@ -267,9 +273,7 @@ fn fig13(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
 }
 
 fn fig14(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
-    let root = SVGBackend::new(path, (1200, 800)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let areas = root.split_evenly((2, 2));
+    let (root, areas) = canvas(path, (1200, 800), (2, 2))?;
     let all = after_warmup(r, cfg);
     for (col, (j, name)) in JOINTS.iter().enumerate() {
         let j = *j;
@@ -298,9 +302,7 @@ fn fig14(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
 }
 
 fn fig16(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
-    let root = SVGBackend::new(path, (1200, 800)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let areas = root.split_evenly((2, 2));
+    let (root, areas) = canvas(path, (1200, 800), (2, 2))?;
     let s = control_in(r, window(cfg));
     for (col, (j, name)) in JOINTS.iter().enumerate() {
         let j = *j;
@@ -346,9 +348,7 @@ fn fig16(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
 }
 
 fn fig17(r: &WalkingRun, path: &Path) -> PlotResult<()> {
-    let root = SVGBackend::new(path, (1200, 900)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let areas = root.split_evenly((3, 1));
+    let (root, areas) = canvas(path, (1200, 900), (3, 1))?;
     let s: Vec<&FilterSample> = r.filter.iter().collect();
     let names = ["m1 (foot)", "m2 (shank)", "m3 (thigh, + torso in stance)"];
     for (i, name) in names.iter().enumerate() {
@@ -390,9 +390,7 @@ fn state_number(label: &str) -> f64 {
 }
 
 fn supervisor(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
-    let root = SVGBackend::new(path, (1200, 1000)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let areas = root.split_evenly((3, 1));
+    let (root, areas) = canvas(path, (1200, 1000), (3, 1))?;
     let s = control_in(r, window(cfg));
     let index = |f: fn(&ControlSample) -> Option<f64>| -> Vec<(f64, f64)> {
         // An unloaded foot has no P: the line breaks there.
@@ -445,9 +443,7 @@ fn supervisor(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()
 }
 
 fn torques(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
-    let root = SVGBackend::new(path, (1200, 800)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let areas = root.split_evenly((2, 1));
+    let (root, areas) = canvas(path, (1200, 800), (2, 1))?;
     let s = control_in(r, window(cfg));
     for (row, (j, name)) in JOINTS.iter().enumerate() {
         let j = *j;

@@ -479,28 +479,9 @@ fn a_diode_loop_is_solved_by_newton_at_every_step() {
     }
 }
 
-const NO_SOLUTION: &str = "/// A resistor with the law f = k e^2 (it conducts one way only) in series with R_s and a capacitor: the loop
-/// current i = k (u - q/C - R_s i)^2 has no real solution when u - q/C < -1/(4 R_s k).
-model valve_loop {
-    domain electrical;
-    param R_s = 1 [Ohm];
-    param k = 1 [A/V^2];
-    param C_v = 1 [F];
-    input u [V];
-
-    Se source = u;
-    1 loop_current;
-    R series = R_s;
-    R valve { f = k * e^2; }
-    C cap = C_v;
-
-    bond source -> loop_current -> series, valve, cap;
-}
-";
-
 #[test]
 fn a_loop_without_a_solution_stops_the_run_with_its_residual() {
-    let path = temp_model("valve_loop", NO_SOLUTION);
+    let path = repo("bgc/tests/fixtures/loops/valve_loop.bg");
     // u = -10 from the start: i^2 + 19 i + 100 = 0 has no real root; the smallest |r| over real i is
     // 100 - 19^2/4 = 9.75 (at i = -9.5), which is where the damped iteration stops.
     let (code, out, err) = bgc(&["simulate", &path, "--t-end", "1", "--input", "u=-10"]);
@@ -528,5 +509,4 @@ fn a_loop_without_a_solution_stops_the_run_with_its_residual() {
     // With u = 0.5 the loop has its solution (the smaller root) and the run completes.
     let (code, _, err) = bgc(&["simulate", &path, "--t-end", "1", "--input", "u=0.5"]);
     assert_eq!(code, 0, "{err}");
-    let _ = std::fs::remove_file(&path);
 }

@@ -157,19 +157,7 @@ fn symbolic_state_spaces_refuse_the_loop() {
 fn a_loop_without_a_solution_at_the_operating_point_is_an_error() {
     // A one-way conductance f = k e^2 in series with R_s and C: i = k (u - q/C - R_s i)^2 has no real root when
     // u - q/C < -1/(4 R_s k); with R_s = k = C = 1, q = 0 and u = -10, i^2 + 19 i + 100 = 0.
-    let text = "model valve_loop {
-    domain electrical;
-    param R_s = 1 [Ohm];
-    param k = 1 [A/V^2];
-    param C_v = 1 [F];
-    input u [V];
-    Se source = u;
-    1 loop_current;
-    R series = R_s;
-    R valve { f = k * e^2; }
-    C cap = C_v;
-    bond source -> loop_current -> series, valve, cap;
-}";
+    let text = include_str!("fixtures/loops/valve_loop.bg");
     let mut sources = SourceMap::new();
     let root = sources.add("valve_loop.bg", text);
     let (models, _) = lower(&mut sources, root, &mut MemoryLoader::new());

@@ -1,6 +1,6 @@
 //! `bgc equations` and `bgc statespace`, run as a user would.
 
-mod cli_support;
+use crate::cli_support;
 
 use cli_support::{assert_close, bgc, corpus, matrix, names, ok_json, repo};
 use serde_json::Value;

@@ -1,6 +1,6 @@
 //! `bgc simulate`, run as a user would: solutions against analytic ones, energy balances, errors.
 
-mod cli_support;
+use crate::cli_support;
 
 use cli_support::{Csv, bgc, corpus, repo, simulate};
 

@@ -1,7 +1,7 @@
 //! The text of generated modules: one module per model when a file has several, identifiers made valid,
 //! deterministic output, and the readable form with the equation above each line.
 
-mod codegen_support;
+use crate::codegen_support;
 
 use bgc::codegen::{self, rust};
 use bgc::lower::MemoryLoader;

@@ -5,7 +5,7 @@
 //! one fails to compile (the last test shows it). The real `nalgebra` without default features and `libm` are
 //! checked by the `bgc-no-std-check` crate of the workspace (`cargo build -p bgc-no-std-check`).
 
-mod codegen_support;
+use crate::codegen_support;
 
 use codegen_support::rustc::{compile_no_std, stand_ins};
 use codegen_support::{generated_modules, scratch};

@@ -3,7 +3,7 @@
 //! `models/` and of the compiler's corpus that compiles, and a file with two models and long names, with and
 //! without the runtime's trait implementations.
 
-mod codegen_support;
+use crate::codegen_support;
 
 use codegen_support::{generated_modules, scratch};
 use std::process::Command;

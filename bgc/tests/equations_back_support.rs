@@ -4,7 +4,7 @@
 //! `b_g/r_g θ̇_m`, but Eq. 3 has `b_g/r_g²` (inside `(b_f r_g² + b_g + d_g)/((J_m+J_g) r_g²)`): with the gear
 //! friction on the gearbox-output junction (Fig. 6) the bond graph gives `b_g/r_g²`, so the tests follow Eq. 3.
 
-mod equations_support;
+use crate::equations_support;
 
 use bgc::causality::analyse;
 use bgc::equations::{

@@ -3,8 +3,6 @@
 //! back-support model against the paper are in `equations_back_support.rs` (on a hand-built graph) and here (on the
 //! model file).
 
-mod equations_support;
-
 use bgc::causality::analyse;
 use bgc::diagnostic::Diagnostic;
 use bgc::equations::{Equations, derive, to_latex, to_text};

@@ -1,6 +1,6 @@
 //! Storages in derivative causality and algebraic loops: state counts and equations against hand derivations.
 
-mod equations_support;
+use crate::equations_support;
 
 use bgc::causality::analyse;
 use bgc::equations::sym::{self, Sym};

@@ -1,6 +1,6 @@
 //! Linear models against hand derivations: the mass-spring-damper and the series RLC circuit.
 
-mod equations_support;
+use crate::equations_support;
 
 use bgc::causality::analyse;
 use bgc::equations::{StateSelection, derive, linear_state_space, numeric_state_space, to_text};

@@ -1,7 +1,7 @@
 //! Nonlinear laws, Jacobians and linearisation, energy balance, declared coordinates and their errors, JSON —
 //! on models written in the language.
 
-mod equations_support;
+use crate::equations_support;
 
 use bgc::causality::analyse;
 use bgc::diagnostic::Diagnostic;

@@ -1,6 +1,6 @@
 //! Large and malformed inputs: no panic, no stack overflow; a clear diagnostic instead.
 
-mod equations_support;
+use crate::equations_support;
 
 use bgc::causality::analyse;
 use bgc::equations::{StateSelection, derive, numeric_state_space};

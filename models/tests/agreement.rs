@@ -1,7 +1,7 @@
 //! Every generated model (the exoskeleton models and the compiler's corpus) against the compiler's own evaluation
 //! of its equations, finite differences and, where the model is linear, the compiler's numeric state space.
 
-mod support;
+use crate::support;
 
 use bgc_models::corpus;
 use support::{check_agreement, check_agreement_in, check_state_space};
@@ -123,8 +123,7 @@ fn back_support_declared_entries_by_hand() {
     assert!(rel(a[(3, 2)], -(p.k_g + p.k_s) / p.J_sint), "{}", a[(3, 2)]);
 }
 
-#[path = "support/eq3.rs"]
-mod eq3;
+use crate::eq3;
 
 /// The generated `state_space_declared` is the hand-written Eq. (3) (see `support/eq3.rs`), entry for entry.
 #[test]

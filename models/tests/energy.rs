@@ -2,7 +2,7 @@
 //! `Σ ∂E/∂x_i · ẋ_i` (gradient by central differences of the generated `stored_energy`, rates from the generated
 //! `rhs`), equals the power the sources supply minus the power the resistors dissipate.
 
-mod support;
+use crate::support;
 
 use bgc_models::corpus;
 use support::Rng;

@@ -2,7 +2,7 @@
 //! diode's law written out by hand, and where no solution can be computed the generated functions say so (an
 //! `Err` from `solve_loops`, NaN from `rhs`, `outputs` and the Jacobians) instead of returning a wrong number.
 
-mod support;
+use crate::support;
 
 use bgc_models::corpus::diode_rc as m;
 use nalgebra::SVector;

@@ -1,17 +1,32 @@
 //! The generated rhs, outputs and Jacobians allocate nothing: a counting global allocator sees no allocation while
 //! they run (for the models and every corpus model).
+//!
+//! The count is per thread: the other tests of this binary run on other threads at the same time, and their
+//! allocations must not be counted here.
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 struct Counting;
 
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+/// Allocations made so far on this thread.
+fn allocations() -> usize {
+    ALLOCATIONS.with(Cell::get)
+}
+
+/// Counts one allocation on this thread; `try_with` so that allocations during thread teardown cannot fail.
+fn count_one() {
+    let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+}
 
 // SAFETY: forwards to the system allocator unchanged; only counts.
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        count_one();
         // SAFETY: same contract as the caller's.
         unsafe { System.alloc(layout) }
     }
@@ -22,7 +37,7 @@ unsafe impl GlobalAlloc for Counting {
     }
 
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        count_one();
         // SAFETY: same contract as the caller's.
         unsafe { System.realloc(ptr, layout, new_size) }
     }
@@ -46,7 +61,7 @@ macro_rules! exercise {
                 let mut ju = m::JacU::zeros();
                 let mut cx = m::OutJacX::zeros();
                 let mut du = m::OutJacU::zeros();
-                let before = ALLOCATIONS.load(Ordering::SeqCst);
+                let before = allocations();
                 m::rhs_into(&p, 0.3, &x, &u, &mut dx);
                 let dx2 = m::rhs(&p, 0.3, &x, &u);
                 m::outputs_into(&p, 0.3, &x, &u, &mut y);
@@ -54,7 +69,7 @@ macro_rules! exercise {
                 m::jac_u_into(&p, 0.3, &x, &u, &mut ju);
                 m::output_jac_x_into(&p, 0.3, &x, &u, &mut cx);
                 m::output_jac_u_into(&p, 0.3, &x, &u, &mut du);
-                let after = ALLOCATIONS.load(Ordering::SeqCst);
+                let after = allocations();
                 assert_eq!(after - before, 0, "{} allocated", stringify!($module));
                 // The results are used (and finite at this point), so nothing above was optimised away.
                 assert!(dx.iter().chain(dx2.iter()).chain(jx.iter()).all(|v| v.is_finite()));
@@ -69,9 +84,9 @@ macro_rules! exercise {
 #[test]
 fn generated_functions_do_not_allocate() {
     // Prove the counter works.
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = allocations();
     let v = vec![1.0_f64; 16];
-    assert!(ALLOCATIONS.load(Ordering::SeqCst) > before);
+    assert!(allocations() > before);
     drop(v);
     let n = exercise!(
         bgc_models::back_support,

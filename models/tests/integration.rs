@@ -1,0 +1,12 @@
+//! The integration tests of this crate, in one test binary: one module per concern.
+
+#[path = "support/eq3.rs"]
+mod eq3;
+mod support;
+
+mod agreement;
+mod energy;
+mod loops;
+mod no_alloc;
+mod params;
+mod runtime;

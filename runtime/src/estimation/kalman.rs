@@ -51,14 +51,14 @@ pub struct LinearDiscreteModel<const NX: usize, const NU: usize, const NY: usize
 impl<const NX: usize, const NU: usize, const NY: usize> LinearDiscreteModel<NX, NU, NY> {
     /// The fixed-size model of a discrete-time [`StateSpace`] (sizes and sample time checked).
     pub fn from_state_space(ss: &StateSpace) -> Result<Self, EstimationError> {
-        if ss.dt.is_none() {
+        if ss.dt().is_none() {
             return Err(EstimationError::NotDiscrete);
         }
         let m = LinearDiscreteModel {
-            a: fixed_from_dynamic("A", &ss.a)?,
-            b: fixed_from_dynamic("B", &ss.b)?,
-            c: fixed_from_dynamic("C", &ss.c)?,
-            d: fixed_from_dynamic("D", &ss.d)?,
+            a: fixed_from_dynamic("A", ss.a())?,
+            b: fixed_from_dynamic("B", ss.b())?,
+            c: fixed_from_dynamic("C", ss.c())?,
+            d: fixed_from_dynamic("D", ss.d())?,
         };
         m.validate()?;
         Ok(m)
@@ -401,8 +401,8 @@ mod tests {
                 ..
             })
         ));
-        let mut cont = ss.clone();
-        cont.dt = None;
+        let (a, b, c, d, _) = ss.into_parts();
+        let cont = StateSpace::new(a, b, c, d).unwrap();
         assert_eq!(
             LinearDiscreteModel::<2, 1, 1>::from_state_space(&cont),
             Err(EstimationError::NotDiscrete)

@@ -79,3 +79,19 @@ fn a_grid_too_long_to_allocate_is_refused() {
     }
     assert_eq!(logspace(1.0, 100.0, 3).unwrap(), vec![1.0, 10.0, 100.0]);
 }
+
+proptest::proptest! {
+    /// Any finite phases, however large: one output per input, and consecutive unwrapped phases differ by at
+    /// most 180° plus the rounding of the offset.
+    #[test]
+    fn unwrapping_any_finite_phases_leaves_no_jump_above_180(
+        phase in proptest::collection::vec(-1e12f64..1e12, 1..50),
+    ) {
+        let out = unwrap_degrees(&phase);
+        proptest::prop_assert_eq!(out.len(), phase.len());
+        for pair in out.windows(2) {
+            let slack = 1e-3 * (1.0 + pair[0].abs().max(pair[1].abs()) * 1e-12);
+            proptest::prop_assert!((pair[1] - pair[0]).abs() <= 180.0 + slack, "{:?}", pair);
+        }
+    }
+}

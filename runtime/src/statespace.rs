@@ -3,14 +3,40 @@
 use nalgebra::DMatrix;
 
 /// `ẋ = A x + B u`, `y = C x + D u` (or `x[k+1] = A x[k] + B u[k]` when `dt` is `Some`).
+///
+/// The matrices are private and only [`StateSpace::new`] and [`StateSpace::new_discrete`] build a model, so
+/// every `StateSpace` has consistent sizes (`A` n×n, `B` n×m, `C` p×n, `D` p×m), finite entries and, when
+/// discrete, a positive finite sample time. Functions that take a `StateSpace` rely on that and need not
+/// check it again.
+///
+/// ```compile_fail
+/// // A model cannot be assembled from its fields (here a 2x2 `A` with a 1x1 `B`).
+/// use nalgebra::DMatrix;
+/// let _ = bgc_runtime::statespace::StateSpace {
+///     a: DMatrix::zeros(2, 2),
+///     b: DMatrix::zeros(1, 1),
+///     c: DMatrix::zeros(1, 2),
+///     d: DMatrix::zeros(1, 1),
+///     dt: None,
+/// };
+/// ```
+///
+/// ```
+/// use bgc_runtime::statespace::{StateSpace, StateSpaceError};
+/// use nalgebra::{DMatrix, dmatrix};
+/// let bad = StateSpace::new(DMatrix::zeros(2, 2), DMatrix::zeros(1, 1), DMatrix::zeros(1, 2), dmatrix![0.0]);
+/// assert!(matches!(bad, Err(StateSpaceError::Shape { name: "B", .. })));
+/// let nan = StateSpace::new(dmatrix![f64::NAN], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0]);
+/// assert!(matches!(nan, Err(StateSpaceError::NonFinite { name: "A", .. })));
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct StateSpace {
-    pub a: DMatrix<f64>,
-    pub b: DMatrix<f64>,
-    pub c: DMatrix<f64>,
-    pub d: DMatrix<f64>,
+    a: DMatrix<f64>,
+    b: DMatrix<f64>,
+    c: DMatrix<f64>,
+    d: DMatrix<f64>,
     /// The sample time of a discrete-time model; `None` for continuous time.
-    pub dt: Option<f64>,
+    dt: Option<f64>,
 }
 
 /// Why a state-space model could not be built.
@@ -75,6 +101,56 @@ impl StateSpace {
         let mut ss = Self::new(a, b, c, d)?;
         ss.dt = Some(dt);
         Ok(ss)
+    }
+
+    /// The state matrix `A` (n×n).
+    pub fn a(&self) -> &DMatrix<f64> {
+        &self.a
+    }
+
+    /// The input matrix `B` (n×m).
+    pub fn b(&self) -> &DMatrix<f64> {
+        &self.b
+    }
+
+    /// The output matrix `C` (p×n).
+    pub fn c(&self) -> &DMatrix<f64> {
+        &self.c
+    }
+
+    /// The feedthrough matrix `D` (p×m).
+    pub fn d(&self) -> &DMatrix<f64> {
+        &self.d
+    }
+
+    /// The sample time of a discrete-time model; `None` for continuous time.
+    pub fn dt(&self) -> Option<f64> {
+        self.dt
+    }
+
+    /// The matrices `(A, B, C, D)` and the sample time, moved out of the model.
+    #[allow(clippy::type_complexity)]
+    pub fn into_parts(
+        self,
+    ) -> (
+        DMatrix<f64>,
+        DMatrix<f64>,
+        DMatrix<f64>,
+        DMatrix<f64>,
+        Option<f64>,
+    ) {
+        (self.a, self.b, self.c, self.d, self.dt)
+    }
+
+    /// The same model with its output negated (`−C`, `−D`); sizes and finiteness are unchanged.
+    pub fn with_negated_output(&self) -> StateSpace {
+        StateSpace {
+            a: self.a.clone(),
+            b: self.b.clone(),
+            c: -&self.c,
+            d: -&self.d,
+            dt: self.dt,
+        }
     }
 
     pub fn n_states(&self) -> usize {

@@ -55,7 +55,7 @@ fn negative_feedback_with_feedthrough() {
     let expected = (S + 2.0) / (S * 1.5 + 2.0);
     assert!((at(&g, W) - expected).norm() < 1e-15);
     // The closed-loop pole is at −4/3.
-    assert!((g.a[(0, 0)] + 4.0 / 3.0).abs() < 1e-15);
+    assert!((g.a()[(0, 0)] + 4.0 / 3.0).abs() < 1e-15);
 }
 
 #[test]
@@ -114,7 +114,7 @@ fn observer_loop_obeys_the_separation_principle() {
     let (plant, k, l) = double_integrator();
     let ctrl = observer_controller(&plant, &k, &l).unwrap();
     let closed = feedback(&plant, &ctrl, FeedbackSign::Positive).unwrap();
-    let mut poles: Vec<C64> = closed.a.complex_eigenvalues().iter().copied().collect();
+    let mut poles: Vec<C64> = closed.a().complex_eigenvalues().iter().copied().collect();
     poles.sort_by(|a, b| a.re.total_cmp(&b.re).then(a.im.total_cmp(&b.im)));
     let im = (1.0f64 - 0.75 * 0.75).sqrt();
     let expected = [

@@ -173,7 +173,7 @@ fn back_support_sampled_dlqr_matches_high_precision_reference() {
     let (a, b, q, r) = back_support_8();
     let sys = StateSpace::new(a, b, DMatrix::identity(8, 8), DMatrix::zeros(8, 1)).unwrap();
     let d = c2d_zoh(&sys, 1e-3).unwrap();
-    let sol = dlqr(&d.a, &d.b, &q, &r).unwrap();
+    let sol = dlqr(d.a(), d.b(), &q, &r).unwrap();
     let k_hp = [
         1.9993771442634825673,
         0.037033961782676446712,
@@ -248,19 +248,19 @@ fn back_support_zoh_matches_50_digit_expm() {
         ((7, 2), -0.00018725228638582357944),
     ];
     for ((i, j), v) in reference {
-        let rel = (d.a[(i, j)] - v).abs() / v.abs();
+        let rel = (d.a()[(i, j)] - v).abs() / v.abs();
         assert!(
             rel < 1e-12,
             "Ad[{i},{j}] = {} vs {v} (rel {rel:e})",
-            d.a[(i, j)]
+            d.a()[(i, j)]
         );
     }
     for (i, v) in [(1, 2.8896063552327976485), (7, -3.541103242284202674e-10)] {
-        let rel = (d.b[(i, 0)] - v).abs() / v.abs();
+        let rel = (d.b()[(i, 0)] - v).abs() / v.abs();
         assert!(
             rel < 1e-12,
             "Bd[{i}] = {} vs {v} (rel {rel:e})",
-            d.b[(i, 0)]
+            d.b()[(i, 0)]
         );
     }
 }

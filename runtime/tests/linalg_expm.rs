@@ -174,10 +174,10 @@ fn c2d_zoh_matches_scipy() {
         ],
     );
     let bd_ref = DMatrix::from_row_slice(2, 1, &[0.00124067513657828, 0.04942085299780529]);
-    assert!((&d.a - ad_ref).amax() < 1e-15);
-    assert!((&d.b - bd_ref).amax() < 1e-15);
-    assert_eq!(d.c, sys.c);
-    assert_eq!(d.dt, Some(0.05));
+    assert!((d.a() - ad_ref).amax() < 1e-15);
+    assert!((d.b() - bd_ref).amax() < 1e-15);
+    assert_eq!(d.c(), sys.c());
+    assert_eq!(d.dt(), Some(0.05));
     assert!(matches!(
         c2d_zoh(&sys, -1.0),
         Err(DiscretizeError::Input(MatrixError::BadScalar { .. }))

@@ -157,19 +157,19 @@ pub fn design(
     sample_time: f64,
 ) -> Result<ObserverDesign, BackSupportError> {
     let ss = model.measurement_model()?;
-    let observable = unobservable_modes(&ss.a, &ss.c)?.is_empty();
+    let observable = unobservable_modes(ss.a(), ss.c())?.is_empty();
     let continuous = lqe(
-        &ss.a,
-        &ss.b,
-        &ss.c,
+        ss.a(),
+        ss.b(),
+        ss.c(),
         &(noise.input_variances() * sample_time),
         &(noise.measurement_variances() * sample_time),
     )?;
     let d = c2d_zoh(&ss, sample_time)?;
     let q_in = noise.input_variances();
-    let q_d = &d.b * &q_in * d.b.transpose();
+    let q_d = d.b() * &q_in * d.b().transpose();
     let r_d = noise.measurement_variances();
-    let discrete = dlqe(&d.a, &d.b, &ss.c, &q_in, &r_d)?;
+    let discrete = dlqe(d.a(), d.b(), ss.c(), &q_in, &r_d)?;
     let predicted_human_torque_variance =
         (&model.c_b * &discrete.z * model.c_b.transpose())[(0, 0)];
     let predicted_motor_velocity_variance = discrete.z[(1, 1)];
@@ -178,8 +178,8 @@ pub fn design(
         sample_time,
         observable,
         continuous,
-        a_d: d.a,
-        b_d: d.b,
+        a_d: d.a().clone(),
+        b_d: d.b().clone(),
         q_d: (&q_d + q_d.transpose()) * 0.5,
         r_d,
         discrete,

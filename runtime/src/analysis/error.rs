@@ -15,6 +15,12 @@ pub enum AnalysisError {
         "frequency response at {omega} rad/s is ill-conditioned (relative residual {residual:e})"
     )]
     IllConditioned { omega: f64, residual: f64 },
+    /// The response at this frequency exceeds the range of `f64` (the model's entries are finite but their
+    /// products overflow).
+    #[error(
+        "the frequency response at {omega} rad/s overflows f64: the model's entries are too large for its products to be represented"
+    )]
+    Overflow { omega: f64 },
     /// A frequency was negative, zero where not allowed, or non-finite.
     #[error("frequency {omega} is not a valid evaluation frequency: {reason}")]
     BadFrequency { omega: f64, reason: &'static str },

@@ -17,6 +17,10 @@ pub type C64 = Complex<f64>;
 /// Relative residual above which a resolvent solve is refused.
 const RESIDUAL_LIMIT: f64 = 1e-8;
 
+/// The most points [`logspace`] builds (80 MB of frequencies), so that a mistyped length is an error rather
+/// than an allocation failure that aborts the process.
+pub const MAX_GRID_POINTS: usize = 10_000_000;
+
 /// The point of the complex plane at which frequency `omega` (rad/s) is evaluated: `jω`, or `e^{jωT}`.
 pub fn evaluation_point(sys: &StateSpace, omega: f64) -> Result<C64, AnalysisError> {
     if !omega.is_finite() || omega < 0.0 {
@@ -25,7 +29,7 @@ pub fn evaluation_point(sys: &StateSpace, omega: f64) -> Result<C64, AnalysisErr
             reason: "frequencies must be finite and non-negative",
         });
     }
-    match sys.dt {
+    match sys.dt() {
         None => Ok(C64::new(0.0, omega)),
         Some(dt) => {
             let nyquist = std::f64::consts::PI / dt;
@@ -40,15 +44,15 @@ pub fn evaluation_point(sys: &StateSpace, omega: f64) -> Result<C64, AnalysisErr
 /// `C (pI − A)⁻¹ B + D` at a point `p` of the complex plane; `omega` only names the point in errors.
 pub fn transfer_at(sys: &StateSpace, p: C64, omega: f64) -> Result<DMatrix<C64>, AnalysisError> {
     let n = sys.n_states();
-    let d = sys.d.map(|v| C64::new(v, 0.0));
+    let d = sys.d().map(|v| C64::new(v, 0.0));
     if n == 0 {
         return Ok(d);
     }
-    let mut resolvent = sys.a.map(|v| C64::new(-v, 0.0));
+    let mut resolvent = sys.a().map(|v| C64::new(-v, 0.0));
     for i in 0..n {
         resolvent[(i, i)] += p;
     }
-    let b = sys.b.map(|v| C64::new(v, 0.0));
+    let b = sys.b().map(|v| C64::new(v, 0.0));
     let x = resolvent
         .clone()
         .lu()
@@ -59,6 +63,10 @@ pub fn transfer_at(sys: &StateSpace, p: C64, omega: f64) -> Result<DMatrix<C64>,
     }
     let residual = (&resolvent * &x - &b).norm();
     let scale = resolvent.norm() * x.norm() + b.norm();
+    if !(residual.is_finite() && scale.is_finite()) {
+        // The entries are finite but their products are not: no residual, and no response, can be trusted.
+        return Err(AnalysisError::Overflow { omega });
+    }
     let relative = if scale > 0.0 { residual / scale } else { 0.0 };
     if relative > RESIDUAL_LIMIT {
         return Err(AnalysisError::IllConditioned {
@@ -66,8 +74,12 @@ pub fn transfer_at(sys: &StateSpace, p: C64, omega: f64) -> Result<DMatrix<C64>,
             residual: relative,
         });
     }
-    let c = sys.c.map(|v| C64::new(v, 0.0));
-    Ok(c * x + d)
+    let c = sys.c().map(|v| C64::new(v, 0.0));
+    let g = c * x + d;
+    if g.iter().any(|v| !(v.re.is_finite() && v.im.is_finite())) {
+        return Err(AnalysisError::Overflow { omega });
+    }
+    Ok(g)
 }
 
 /// The frequency response matrix (outputs × inputs) at each frequency of `omegas` (rad/s).
@@ -92,7 +104,7 @@ pub fn siso_response(sys: &StateSpace, omega: f64) -> Result<C64, AnalysisError>
 ///
 /// A pole at `s = 0` (or `z = 1`) gives [`AnalysisError::InfiniteDcGain`].
 pub fn dc_gain(sys: &StateSpace) -> Result<DMatrix<f64>, AnalysisError> {
-    let p = match sys.dt {
+    let p = match sys.dt() {
         None => C64::new(0.0, 0.0),
         Some(_) => C64::new(1.0, 0.0),
     };
@@ -118,6 +130,9 @@ pub fn logspace(low: f64, high: f64, points: usize) -> Result<Vec<f64>, Analysis
     }
     if points < 2 {
         return Err(bad("a grid needs at least two points"));
+    }
+    if points > MAX_GRID_POINTS {
+        return Err(bad("a grid may have at most 10,000,000 points"));
     }
     let (l0, l1) = (low.log10(), high.log10());
     let step = (l1 - l0) / (points - 1) as f64;
@@ -168,23 +183,27 @@ pub fn bode(
 }
 
 /// Removes jumps of more than 180° between consecutive phases by adding multiples of 360°.
+///
+/// The multiple is computed in one step (`round(jump / 360)`), so any finite input takes one pass; a
+/// non-finite phase is copied as it is and does not change the offset of the phases after it.
 pub fn unwrap_degrees(phase: &[f64]) -> Vec<f64> {
     let mut out = Vec::with_capacity(phase.len());
     let mut offset = 0.0;
-    for (i, &p) in phase.iter().enumerate() {
-        if i > 0 {
-            let prev = phase[i - 1] + offset;
-            let mut candidate = p + offset;
-            while candidate - prev > 180.0 {
-                candidate -= 360.0;
-                offset -= 360.0;
-            }
-            while candidate - prev < -180.0 {
-                candidate += 360.0;
-                offset += 360.0;
-            }
+    let mut prev: Option<f64> = None;
+    for &p in phase {
+        if !p.is_finite() {
+            out.push(p);
+            continue;
         }
-        out.push(p + offset);
+        if let Some(prev) = prev {
+            let jump = p + offset - prev;
+            // Round half towards zero so that a jump of exactly ±180° is kept, as the loop it replaces did.
+            let turns = (jump.abs() / 360.0 - 0.5).ceil().max(0.0).copysign(jump);
+            offset -= 360.0 * turns;
+        }
+        let unwrapped = p + offset;
+        out.push(unwrapped);
+        prev = Some(unwrapped);
     }
     out
 }

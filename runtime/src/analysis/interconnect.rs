@@ -39,13 +39,13 @@ pub fn series(g1: &StateSpace, g2: &StateSpace) -> Result<StateSpace, AnalysisEr
     )?;
     let (n1, n2) = (g1.n_states(), g2.n_states());
     let mut a = DMatrix::zeros(n1 + n2, n1 + n2);
-    a.view_mut((0, 0), (n1, n1)).copy_from(&g1.a);
-    a.view_mut((n1, 0), (n2, n1)).copy_from(&(&g2.b * &g1.c));
-    a.view_mut((n1, n1), (n2, n2)).copy_from(&g2.a);
-    let b = stack_rows(&g1.b, &(&g2.b * &g1.d));
-    let c = stack_cols(&(&g2.d * &g1.c), &g2.c);
-    let d = &g2.d * &g1.d;
-    build(a, b, c, d, g1.dt)
+    a.view_mut((0, 0), (n1, n1)).copy_from(g1.a());
+    a.view_mut((n1, 0), (n2, n1)).copy_from(&(g2.b() * g1.c()));
+    a.view_mut((n1, n1), (n2, n2)).copy_from(g2.a());
+    let b = stack_rows(g1.b(), &(g2.b() * g1.d()));
+    let c = stack_cols(&(g2.d() * g1.c()), g2.c());
+    let d = g2.d() * g1.d();
+    build(a, b, c, d, g1.dt())
 }
 
 /// `g1` and `g2` driven by the same input, outputs added: `y = g1(u) + g2(u)`.
@@ -63,11 +63,11 @@ pub fn parallel(g1: &StateSpace, g2: &StateSpace) -> Result<StateSpace, Analysis
         g1.n_outputs(),
         g2.n_outputs(),
     )?;
-    let a = block_diag(&g1.a, &g2.a);
-    let b = stack_rows(&g1.b, &g2.b);
-    let c = stack_cols(&g1.c, &g2.c);
-    let d = &g1.d + &g2.d;
-    build(a, b, c, d, g1.dt)
+    let a = block_diag(g1.a(), g2.a());
+    let b = stack_rows(g1.b(), g2.b());
+    let c = stack_cols(g1.c(), g2.c());
+    let d = g1.d() + g2.d();
+    build(a, b, c, d, g1.dt())
 }
 
 /// `g1` with `g2` in its feedback path: `y = g1(u1)`, `u1 = u + sign · g2(y)`.
@@ -94,7 +94,7 @@ pub fn feedback(
     )?;
     let s = sign.value();
     let m1 = g1.n_inputs();
-    let loop_matrix = DMatrix::identity(m1, m1) - (&g2.d * &g1.d) * s;
+    let loop_matrix = DMatrix::identity(m1, m1) - (g2.d() * g1.d()) * s;
     let e = loop_matrix
         .try_inverse()
         .ok_or(AnalysisError::IllPosedFeedback)?;
@@ -102,23 +102,23 @@ pub fn feedback(
         return Err(AnalysisError::IllPosedFeedback);
     }
     // u1 = E (u + s D2 C1 x1 + s C2 x2)
-    let u_x1 = &e * &g2.d * &g1.c * s;
-    let u_x2 = &e * &g2.c * s;
+    let u_x1 = &e * g2.d() * g1.c() * s;
+    let u_x2 = &e * g2.c() * s;
     let (n1, n2) = (g1.n_states(), g2.n_states());
     let mut a = DMatrix::zeros(n1 + n2, n1 + n2);
     a.view_mut((0, 0), (n1, n1))
-        .copy_from(&(&g1.a + &g1.b * &u_x1));
-    a.view_mut((0, n1), (n1, n2)).copy_from(&(&g1.b * &u_x2));
+        .copy_from(&(g1.a() + g1.b() * &u_x1));
+    a.view_mut((0, n1), (n1, n2)).copy_from(&(g1.b() * &u_x2));
     // y1 = C1 x1 + D1 u1 drives the feedback model.
-    let y_x1 = &g1.c + &g1.d * &u_x1;
-    let y_x2 = &g1.d * &u_x2;
-    a.view_mut((n1, 0), (n2, n1)).copy_from(&(&g2.b * &y_x1));
+    let y_x1 = g1.c() + g1.d() * &u_x1;
+    let y_x2 = g1.d() * &u_x2;
+    a.view_mut((n1, 0), (n2, n1)).copy_from(&(g2.b() * &y_x1));
     a.view_mut((n1, n1), (n2, n2))
-        .copy_from(&(&g2.a + &g2.b * &y_x2));
-    let b = stack_rows(&(&g1.b * &e), &(&g2.b * &g1.d * &e));
+        .copy_from(&(g2.a() + g2.b() * &y_x2));
+    let b = stack_rows(&(g1.b() * &e), &(g2.b() * g1.d() * &e));
     let c = stack_cols(&y_x1, &y_x2);
-    let d = &g1.d * &e;
-    build(a, b, c, d, g1.dt)
+    let d = g1.d() * &e;
+    build(a, b, c, d, g1.dt())
 }
 
 /// Block-diagonal stacking: the inputs and outputs of all models side by side, no coupling.
@@ -136,11 +136,11 @@ pub fn append(models: &[&StateSpace]) -> Result<StateSpace, AnalysisError> {
     for g in &models[1..] {
         same_timebase("append", &acc, g)?;
         acc = build(
-            block_diag(&acc.a, &g.a),
-            block_diag(&acc.b, &g.b),
-            block_diag(&acc.c, &g.c),
-            block_diag(&acc.d, &g.d),
-            acc.dt,
+            block_diag(acc.a(), g.a()),
+            block_diag(acc.b(), g.b()),
+            block_diag(acc.c(), g.c()),
+            block_diag(acc.d(), g.d()),
+            acc.dt(),
         )?;
     }
     Ok(acc)
@@ -148,13 +148,7 @@ pub fn append(models: &[&StateSpace]) -> Result<StateSpace, AnalysisError> {
 
 /// `−g`: the same model with its output negated.
 pub fn negate(g: &StateSpace) -> StateSpace {
-    StateSpace {
-        a: g.a.clone(),
-        b: g.b.clone(),
-        c: -&g.c,
-        d: -&g.d,
-        dt: g.dt,
-    }
+    g.with_negated_output()
 }
 
 /// A static gain `y = K u` as a model without states, on the given time base.
@@ -205,13 +199,14 @@ pub fn observer_controller(
         observer_gain.ncols(),
         p,
     )?;
-    let a = &plant.a - &plant.b * gain - observer_gain * &plant.c + observer_gain * &plant.d * gain;
+    let a =
+        plant.a() - plant.b() * gain - observer_gain * plant.c() + observer_gain * plant.d() * gain;
     build(
         a,
         observer_gain.clone(),
         -gain,
         DMatrix::zeros(m, p),
-        plant.dt,
+        plant.dt(),
     )
 }
 
@@ -252,7 +247,7 @@ fn same_timebase(
     g1: &StateSpace,
     g2: &StateSpace,
 ) -> Result<(), AnalysisError> {
-    let same = match (g1.dt, g2.dt) {
+    let same = match (g1.dt(), g2.dt()) {
         (None, None) => true,
         (Some(a), Some(b)) => (a - b).abs() <= 1e-12 * a.abs().max(b.abs()),
         _ => false,
@@ -262,8 +257,8 @@ fn same_timebase(
     } else {
         Err(AnalysisError::TimebaseMismatch {
             operation,
-            left: g1.dt,
-            right: g2.dt,
+            left: g1.dt(),
+            right: g2.dt(),
         })
     }
 }

@@ -74,6 +74,10 @@ pub fn stability_margins(loop_tf: &StateSpace) -> Result<StabilityMargins, Analy
         .iter()
         .map(|&w| sample(loop_tf, w))
         .collect::<Result<_, _>>()?;
+    if samples.iter().all(Option::is_none) {
+        // Not one point of the grid could be evaluated: report why instead of a loop without crossings.
+        siso_response(loop_tf, grid[0])?;
+    }
 
     let mut phase_crossings = Vec::new();
     if let Ok(l0) = dc_gain(loop_tf)
@@ -161,13 +165,14 @@ pub fn stability_margins(loop_tf: &StateSpace) -> Result<StabilityMargins, Analy
     })
 }
 
-/// The loop response at `w`, or `None` on a pole of the loop (such points break brackets).
+/// The loop response at `w`, or `None` on (or, for an overflowing response, next to) a pole of the loop
+/// (such points break brackets).
 fn sample(sys: &StateSpace, w: f64) -> Result<Option<C64>, AnalysisError> {
     match siso_response(sys, w) {
         Ok(l) => Ok(Some(l)),
-        Err(AnalysisError::PoleOnContour { .. }) | Err(AnalysisError::IllConditioned { .. }) => {
-            Ok(None)
-        }
+        Err(AnalysisError::PoleOnContour { .. })
+        | Err(AnalysisError::IllConditioned { .. })
+        | Err(AnalysisError::Overflow { .. }) => Ok(None),
         Err(e) => Err(e),
     }
 }
@@ -223,7 +228,7 @@ pub fn search_grid(sys: &StateSpace) -> Result<Vec<f64>, AnalysisError> {
     };
     let low = slow * 1e-3;
     let mut high = fast * 1e3;
-    match sys.dt {
+    match sys.dt() {
         Some(dt) => high = std::f64::consts::PI / dt,
         None => {
             // Widen until the loop gain has fallen well below 1 (or stopped falling: a biproper loop).
@@ -259,13 +264,13 @@ fn pole_frequencies(sys: &StateSpace) -> Vec<f64> {
     if sys.n_states() == 0 {
         return Vec::new();
     }
-    let Some(schur) = sys.a.clone().try_schur(f64::EPSILON, 10_000) else {
+    let Some(schur) = sys.a().clone().try_schur(f64::EPSILON, 10_000) else {
         return Vec::new();
     };
     schur
         .complex_eigenvalues()
         .iter()
-        .filter_map(|z| match sys.dt {
+        .filter_map(|z| match sys.dt() {
             None => Some(z.norm()),
             Some(dt) => {
                 let s = z.ln() / dt;

@@ -70,16 +70,20 @@ impl AngleKalmanFilter {
         Ok(AngleKalmanFilter { kf })
     }
 
-    /// One sample: predict with the gyro rate, correct with the accelerometer angle. A non-finite gyro rate
-    /// is an error (nothing changes); a non-finite accelerometer angle is rejected and the prediction kept.
+    /// One sample: predict with the gyro rate, correct with the accelerometer angle. A non-finite gyro rate,
+    /// or one so large that the step overflows, is an error and nothing changes (the prediction is not kept
+    /// either); a non-finite accelerometer angle is rejected and the prediction kept.
     pub fn step(
         &mut self,
         gyro_rate: f64,
         accel_angle: f64,
     ) -> Result<UpdateOutcome, EstimationError> {
         let u = Vector1::new(gyro_rate);
-        self.kf.predict(&u)?;
-        self.kf.update(&Vector1::new(accel_angle), &u)
+        let mut next = self.kf.clone();
+        next.predict(&u)?;
+        let outcome = next.update(&Vector1::new(accel_angle), &u)?;
+        self.kf = next;
+        Ok(outcome)
     }
 
     /// The angle estimate.

@@ -62,6 +62,19 @@ pub fn cholesky_lower<const N: usize>(p: &SMatrix<f64, N, N>) -> Option<SMatrix<
     Some(l)
 }
 
+/// Lower Cholesky factor of `p` whose pivots must each exceed `floor` (the rounding error with which the
+/// diagonal of `p` is known), or `None`: a pivot at or below its floor means that `p` is singular to within
+/// the accuracy of its entries, even when rounding left it a tiny positive value.
+pub fn cholesky_above_floor<const N: usize>(
+    p: &SMatrix<f64, N, N>,
+    floor: &SVector<f64, N>,
+) -> Option<SMatrix<f64, N, N>> {
+    let l = cholesky_lower(p)?;
+    (0..N)
+        .all(|j| l[(j, j)] * l[(j, j)] > floor[j])
+        .then_some(l)
+}
+
 /// Lower factor `L` with `L Lᵀ = P` of a symmetric positive *semi*-definite matrix. A pivot below
 /// `tol · max(1, max diag)` is treated as zero (its column is set to zero); a clearly negative pivot or a
 /// non-finite entry gives `None`.

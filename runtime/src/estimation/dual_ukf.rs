@@ -61,7 +61,7 @@ use super::fault::{
 use super::sigma::{MeanFn, SigmaPoints, subtract, weighted_mean};
 use super::ukf::UnscentedKalmanFilter;
 use super::unscented::{
-    SpaceFns, check_input, evaluate_points, innovation_moments, kalman_correct,
+    Innovation, SpaceFns, check_input, evaluate_points, innovation_moments, kalman_correct,
     rejected_measurement,
 };
 use crate::model::{DiscreteModel, ParamError, Parametric};
@@ -544,7 +544,7 @@ impl<
         repair_covariance(pw, self.param_policy.eigen_floor, FILTER)?;
         let wpts = self.param_points.generate(w, pw)?;
         let ds = evaluate_points(what, |i| observe(&wpts.column(i).into_owned()))?;
-        let (d_hat, mut sd, pwd) = innovation_moments(
+        let (d_hat, mut sd, pwd, floor) = innovation_moments(
             &wpts,
             w,
             subtract::<NP>,
@@ -555,7 +555,20 @@ impl<
         );
         symmetrise(&mut sd);
         let e = (fns.residual)(d, &d_hat);
-        let (outcome, _) = kalman_correct(w, pw, &e, &sd, &pwd, &self.param_policy, FILTER)?;
+        let innovation = Innovation {
+            e: &e,
+            s: &sd,
+            floor: &floor,
+        };
+        let (outcome, _) = kalman_correct(
+            w,
+            pw,
+            innovation,
+            &pwd,
+            &self.param_points,
+            &self.param_policy,
+            FILTER,
+        )?;
         Ok((outcome, e))
     }
 

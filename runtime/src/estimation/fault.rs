@@ -56,6 +56,29 @@ pub enum EstimationError {
     /// The innovation covariance `S` is not positive definite, so the gain `P_xy S⁻¹` does not exist.
     #[error("innovation covariance of the {filter} is singular or not positive definite")]
     SingularInnovation { filter: &'static str },
+    /// A quantity computed from finite data left the range of `f64` (an input, measurement or state too large
+    /// for the arithmetic of the step); the step was not taken.
+    #[error(
+        "{quantity} of the {filter} overflows f64: an input, measurement or state is too large for the step"
+    )]
+    Overflow {
+        filter: &'static str,
+        quantity: &'static str,
+    },
+    /// The sigma-point weights sum to one from terms far larger than one, so their cancellation amplifies
+    /// rounding; here it would leave a covariance entry with fewer than half of its digits.
+    #[error(
+        "{quantity} of the {filter}, entry {index}: estimated relative rounding error {relative_error:.1e} exceeds \
+         sqrt(eps) = 1.5e-8, because the sigma-point mean weights (sum of magnitudes {amplification:.1e}) cancel; \
+         increase alpha or kappa"
+    )]
+    PrecisionLoss {
+        filter: &'static str,
+        quantity: &'static str,
+        index: usize,
+        relative_error: f64,
+        amplification: f64,
+    },
     /// The covariance has non-finite entries and cannot be repaired.
     #[error("covariance of the {filter} has non-finite entries")]
     NonFiniteCovariance { filter: &'static str },

@@ -13,6 +13,12 @@
 //!
 //! When a sensor's reading is NaN or infinite, [`WeightedFusion::fuse`] leaves it out and renormalises Eq. 27
 //! over the remaining sensors (the minimum-variance weights of that subset) and reports how many were left out.
+//!
+//! Eq. 27 is evaluated as `W_j = (σ²_min / σ_j²) / Σᵢ (σ²_min / σᵢ²)`, which is the same number but has every
+//! ratio in `(0, 1]` and the sum in `[1, N]`: the reciprocals `1/σ²` of tiny variances would overflow, and
+//! the sum `Σ Z_j / σ_j²` of large readings would too. The fused value `Σ W_j Z_j` is a convex combination, so
+//! it lies between the readings and cannot overflow. Variances must be normal positive numbers (subnormal
+//! ones, below `f64::MIN_POSITIVE` ≈ 2.2e-308, keep too few digits to weigh with).
 
 use super::fault::EstimationError;
 use nalgebra::SVector;
@@ -22,8 +28,9 @@ pub fn minimum_variance_weights<const N: usize>(
     variances: &SVector<f64, N>,
 ) -> Result<SVector<f64, N>, EstimationError> {
     check_variances(variances)?;
-    let inv_sum: f64 = variances.iter().map(|v| 1.0 / v).sum();
-    Ok(variances.map(|v| 1.0 / (v * inv_sum)))
+    let smallest = variances.min();
+    let ratio_sum: f64 = variances.iter().map(|v| smallest / v).sum();
+    Ok(variances.map(|v| (smallest / v) / ratio_sum))
 }
 
 /// The variance `Σ W_j² σ_j²` of a weighted fusion (Eq. 25).
@@ -43,11 +50,11 @@ fn check_variances<const N: usize>(variances: &SVector<f64, N>) -> Result<(), Es
         return Err(EstimationError::NoFiniteMeasurement { sensors: 0 });
     }
     for &v in variances.iter() {
-        if !(v > 0.0 && v.is_finite()) {
+        if !(v >= f64::MIN_POSITIVE && v.is_finite()) {
             return Err(EstimationError::InvalidSetting {
                 name: "sensor variance",
                 value: v,
-                reason: "a sensor variance must be positive and finite",
+                reason: "a sensor variance must be a positive, finite, normal number (at least 2.2e-308)",
             });
         }
     }
@@ -91,23 +98,28 @@ impl<const N: usize> WeightedFusion<N> {
 
     /// Fuses one reading per sensor; non-finite readings are left out. An error when none is finite.
     pub fn fuse(&self, readings: &SVector<f64, N>) -> Result<Fused, EstimationError> {
-        let mut inv_sum = 0.0;
-        let mut weighted = 0.0;
-        let mut excluded = 0;
-        for (z, v) in readings.iter().zip(self.variances.iter()) {
-            if z.is_finite() {
-                inv_sum += 1.0 / v;
-                weighted += z / v;
-            } else {
-                excluded += 1;
-            }
-        }
-        if excluded == N {
+        let used = || {
+            readings
+                .iter()
+                .zip(self.variances.iter())
+                .filter(|(z, _)| z.is_finite())
+        };
+        let excluded = N - used().count();
+        let Some(smallest) = used().map(|(_, &v)| v).reduce(f64::min) else {
             return Err(EstimationError::NoFiniteMeasurement { sensors: N });
+        };
+        let ratio_sum: f64 = used().map(|(_, v)| smallest / v).sum();
+        let value: f64 = used().map(|(z, v)| (smallest / v) / ratio_sum * z).sum();
+        if !value.is_finite() {
+            // Only possible for readings within rounding of f64::MAX.
+            return Err(EstimationError::Overflow {
+                filter: "weighted fusion",
+                quantity: "fused value",
+            });
         }
         Ok(Fused {
-            value: weighted / inv_sum,
-            variance: 1.0 / inv_sum,
+            value,
+            variance: smallest / ratio_sum,
             excluded,
         })
     }
@@ -126,13 +138,15 @@ impl ErrorVariance {
         Self::default()
     }
 
-    /// Adds a sample; a pair with a non-finite value is skipped and `false` returned.
+    /// Adds a sample; a pair with a non-finite value, or whose squared error would overflow the sum, is
+    /// skipped and `false` returned.
     pub fn push(&mut self, measured: f64, reference: f64) -> bool {
         let e = measured - reference;
-        if !e.is_finite() {
+        let sum_sq = self.sum_sq + e * e;
+        if !sum_sq.is_finite() {
             return false;
         }
-        self.sum_sq += e * e;
+        self.sum_sq = sum_sq;
         self.count += 1;
         true
     }

@@ -90,6 +90,31 @@ impl<const NX: usize, const NY: usize, const NL: usize> FilterHealth<NX, NY, NL>
         };
         let ls = cholesky_lower(s).ok_or(singular.clone())?;
         let nis = e.dot(&cholesky_solve(&ls, e).ok_or(singular)?);
+        // Accumulate into a copy (no allocation: every field is fixed-size) and keep it only if every sum is
+        // still finite, so that one huge innovation cannot turn the statistics into inf or NaN.
+        let mut next = self.clone();
+        next.accumulate_innovation(e, nis);
+        if !next.sums_finite() {
+            return Err(EstimationError::NonFiniteValue {
+                what: "innovation statistics (an innovation too large to square and sum)",
+            });
+        }
+        *self = next;
+        Ok(())
+    }
+
+    fn sums_finite(&self) -> bool {
+        let finite = |m: &[f64]| m.iter().all(|v| v.is_finite());
+        finite(self.sum_e.as_slice())
+            && finite(self.sum_e2.as_slice())
+            && finite(self.lag_prod.as_slice())
+            && finite(self.lag_lead_sum.as_slice())
+            && finite(self.lag_trail_sum.as_slice())
+            && self.sum_nis.is_finite()
+            && finite(self.sum_err.as_slice())
+    }
+
+    fn accumulate_innovation(&mut self, e: &SVector<f64, NY>, nis: f64) {
         let k = self.n_innov;
         for l in 1..=NL.min(k) {
             let col = (k - l) % NL;
@@ -108,7 +133,6 @@ impl<const NX: usize, const NY: usize, const NL: usize> FilterHealth<NX, NY, NL>
         self.sum_e2 += e.component_mul(e);
         self.sum_nis += nis;
         self.n_innov += 1;
-        Ok(())
     }
 
     /// Records a state error `x_true − x̂` with the filter's covariance `p`; non-finite values are refused.
@@ -122,7 +146,13 @@ impl<const NX: usize, const NY: usize, const NL: usize> FilterHealth<NX, NY, NL>
                 what: "state error or covariance",
             });
         }
-        self.sum_err += err;
+        let sum_err = self.sum_err + err;
+        if sum_err.iter().any(|v| !v.is_finite()) {
+            return Err(EstimationError::NonFiniteValue {
+                what: "state error statistics (a state error too large to sum)",
+            });
+        }
+        self.sum_err = sum_err;
         for i in 0..NX {
             if err[i].abs() > p[(i, i)].max(0.0).sqrt() {
                 self.outside[i] += 1.0;

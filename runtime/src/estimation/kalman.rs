@@ -28,7 +28,9 @@
 //! Faults follow [`super::fault`]: non-finite or gated measurements are rejected, a singular `S` is an error,
 //! the covariance is symmetrised after every step and repaired if it loses definiteness.
 
-use super::dense::{cholesky_lower, cholesky_solve, first_non_finite, symmetrise};
+use super::dense::{
+    cholesky_above_floor, cholesky_lower, cholesky_solve, first_non_finite, symmetrise,
+};
 use super::fault::{
     CovarianceRepair, EstimationError, FaultPolicy, UpdateOutcome, check_additive_noise,
     check_estimate, check_finite, check_positive_definite, check_positive_semidefinite,
@@ -51,14 +53,14 @@ pub struct LinearDiscreteModel<const NX: usize, const NU: usize, const NY: usize
 impl<const NX: usize, const NU: usize, const NY: usize> LinearDiscreteModel<NX, NU, NY> {
     /// The fixed-size model of a discrete-time [`StateSpace`] (sizes and sample time checked).
     pub fn from_state_space(ss: &StateSpace) -> Result<Self, EstimationError> {
-        if ss.dt.is_none() {
+        if ss.dt().is_none() {
             return Err(EstimationError::NotDiscrete);
         }
         let m = LinearDiscreteModel {
-            a: fixed_from_dynamic("A", &ss.a)?,
-            b: fixed_from_dynamic("B", &ss.b)?,
-            c: fixed_from_dynamic("C", &ss.c)?,
-            d: fixed_from_dynamic("D", &ss.d)?,
+            a: fixed_from_dynamic("A", ss.a())?,
+            b: fixed_from_dynamic("B", ss.b())?,
+            c: fixed_from_dynamic("C", ss.c())?,
+            d: fixed_from_dynamic("D", ss.d())?,
         };
         m.validate()?;
         Ok(m)
@@ -170,6 +172,12 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         }
         let m = &self.model;
         let x = m.a * self.x + m.b * u;
+        if first_non_finite(&x).is_some() {
+            return Err(EstimationError::Overflow {
+                filter: FILTER,
+                quantity: "predicted state",
+            });
+        }
         let mut p = m.a * self.p * m.a.transpose() + self.q;
         let repair = repair_covariance(&mut p, self.policy.eigen_floor, FILTER)?;
         self.x = x;
@@ -196,8 +204,18 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         let mut s = m.c * self.p * m.c.transpose() + self.r;
         symmetrise(&mut s);
         let singular = EstimationError::SingularInnovation { filter: FILTER };
-        let ls = cholesky_lower(&s).ok_or(singular.clone())?;
+        let ls = cholesky_above_floor(&s, &self.innovation_floor()).ok_or(singular.clone())?;
+        let overflow = |quantity| EstimationError::Overflow {
+            filter: FILTER,
+            quantity,
+        };
+        if first_non_finite(&e).is_some() {
+            return Err(overflow("innovation"));
+        }
         let nis = e.dot(&cholesky_solve(&ls, &e).ok_or(singular.clone())?);
+        if !nis.is_finite() {
+            return Err(overflow("normalised innovation squared"));
+        }
         self.innovation = e;
         self.innovation_cov = s;
         if let Some(reason) = self.policy.gate(nis) {
@@ -212,12 +230,25 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         };
         let i_kc = SMatrix::<f64, NX, NX>::identity() - k * m.c;
         let x = self.x + k * e;
+        if first_non_finite(&x).is_some() {
+            return Err(overflow("corrected state"));
+        }
         let mut p = i_kc * self.p * i_kc.transpose() + k * self.r * k.transpose();
         let repair = repair_covariance(&mut p, self.policy.eigen_floor, FILTER)?;
         self.x = x;
         self.p = p;
         self.gain = k;
         Ok(UpdateOutcome::Accepted { nis, repair })
+    }
+
+    /// The rounding error with which `diag(C P Cᵀ + R)` is known, `NX ε (|C| |P| |C|ᵀ)ⱼⱼ + ε Rⱼⱼ`: a Cholesky
+    /// pivot of `S` at or below it means `S` is singular to working accuracy.
+    fn innovation_floor(&self) -> SVector<f64, NY> {
+        let c = self.model.c.abs();
+        let spread = c * self.p.abs() * c.transpose();
+        SVector::from_fn(|j, _| {
+            f64::EPSILON * (NX.max(1) as f64 * spread[(j, j)] + self.r[(j, j)].abs())
+        })
     }
 
     /// The state estimate.
@@ -401,8 +432,8 @@ mod tests {
                 ..
             })
         ));
-        let mut cont = ss.clone();
-        cont.dt = None;
+        let (a, b, c, d, _) = ss.into_parts();
+        let cont = StateSpace::new(a, b, c, d).unwrap();
         assert_eq!(
             LinearDiscreteModel::<2, 1, 1>::from_state_space(&cont),
             Err(EstimationError::NotDiscrete)

@@ -97,6 +97,16 @@ impl<const N: usize, const NS: usize> SigmaPoints<N, NS> {
         let mut wc = wm;
         wm[0] = lambda / spread;
         wc[0] = lambda / spread + (1.0 - alpha * alpha + beta);
+        let amplification: f64 = wm.iter().map(|w| w.abs()).sum();
+        let mean_rounding = NS as f64 * f64::EPSILON * amplification;
+        if mean_rounding >= 1.0 || mean_rounding.is_nan() {
+            return Err(EstimationError::InvalidSetting {
+                name: "alpha",
+                value: alpha,
+                reason: "the mean weights cancel so strongly (sum of |W| times NS eps >= 1) that the \
+                         sigma-point mean has no correct digit; increase alpha or kappa",
+            });
+        }
         Ok(SigmaPoints {
             alpha,
             beta,
@@ -115,6 +125,14 @@ impl<const N: usize, const NS: usize> SigmaPoints<N, NS> {
     /// The covariance weights `W⁽ᶜ⁾`.
     pub fn covariance_weights(&self) -> &SVector<f64, NS> {
         &self.wc
+    }
+
+    /// `Σ |W⁽ᵐ⁾ᵢ|`, the factor by which the weights' cancellation amplifies the rounding of a weighted mean
+    /// (1 for `α² (L + κ) ≥ L`, about `2/α²` for small `α` and `κ = 0`). The filters estimate from it the
+    /// rounding error of every covariance they form and refuse a step that would keep fewer than half of the
+    /// digits ([`EstimationError::PrecisionLoss`]); weights with `NS · ε · Σ|W| ≥ 1` are refused here.
+    pub fn rounding_amplification(&self) -> f64 {
+        self.wm.iter().map(|w| w.abs()).sum()
     }
 
     /// `λ = α²(L + κ) − L`.
@@ -179,6 +197,40 @@ pub(crate) fn unscented_transform<const N: usize, const NS: usize>(
         cov += r * r.transpose() * wc[i];
     }
     (m, cov)
+}
+
+/// The estimated rounding error of each diagonal entry of `Σ W⁽ᶜ⁾ rᵢ rᵢᵀ`, `rᵢ = residual(pointsᵢ, mean)`.
+///
+/// The weighted mean of entry `j` is known to `δⱼ = NS ε Σ |W⁽ᵐ⁾ᵢ| |Zⱼᵢ|` (the rounding bound of a dot
+/// product; the weights' cancellation is the factor `Σ |W⁽ᵐ⁾|`). An error `δ` common to all residuals changes
+/// the covariance by `−2 δ Σ W⁽ᶜ⁾ᵢ rⱼᵢ + δ² Σ W⁽ᶜ⁾ᵢ`, and the weighted sum itself is known to
+/// `NS ε Σ |W⁽ᶜ⁾ᵢ| rⱼᵢ²`; the estimate is the sum of their magnitudes.
+pub(crate) fn rounding_floor<const N: usize, const NS: usize>(
+    points: &SMatrix<f64, N, NS>,
+    mean: &SVector<f64, N>,
+    wm: &SVector<f64, NS>,
+    wc: &SVector<f64, NS>,
+    residual: ResidualFn<N>,
+) -> SVector<f64, N> {
+    let eps = NS as f64 * f64::EPSILON;
+    let wc_sum: f64 = wc.sum();
+    let mut floor = SVector::<f64, N>::zeros();
+    let (mut weighted_residual, mut sum_error) = (SVector::<f64, N>::zeros(), floor);
+    let mut delta = floor;
+    for i in 0..NS {
+        let r = residual(&points.column(i).into_owned(), mean);
+        for j in 0..N {
+            delta[j] += eps * (wm[i] * points[(j, i)]).abs();
+            weighted_residual[j] += wc[i] * r[j];
+            sum_error[j] += eps * (wc[i] * r[j] * r[j]).abs();
+        }
+    }
+    for j in 0..N {
+        floor[j] = 2.0 * (weighted_residual[j] * delta[j]).abs()
+            + (wc_sum * delta[j] * delta[j]).abs()
+            + sum_error[j];
+    }
+    floor
 }
 
 /// The cross covariance `Σ W⁽ᶜ⁾ (χᵢ − x)(Yᵢ − y)ᵀ`.

@@ -25,10 +25,10 @@ use super::fault::{
     CovarianceRepair, EstimationError, UpdateOutcome, check_additive_noise, check_estimate,
     repair_covariance,
 };
-use super::sigma::{ResidualFn, SigmaPoints, cross_covariance};
+use super::sigma::{ResidualFn, SigmaPoints, cross_covariance, rounding_floor};
 use super::unscented::{
-    FilterSettings, check_state_mean, model_measurement, model_process, rejected_measurement,
-    settings_methods, sigma_images,
+    FilterSettings, check_precision, check_state_mean, model_measurement, model_process,
+    rejected_measurement, settings_methods, sigma_images,
 };
 use crate::model::DiscreteModel;
 use nalgebra::{SMatrix, SVector};
@@ -92,6 +92,16 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         check_state_mean(&x)?;
         let x_residual = self.settings.x_fns.residual;
         let (s, repair) = self.factor_of_spread(&prop, &x, &self.sqrt_q, x_residual)?;
+        let points = &self.settings.points;
+        let floor = rounding_floor(
+            &prop,
+            &x,
+            points.mean_weights(),
+            points.covariance_weights(),
+            x_residual,
+        );
+        let p = s * s.transpose();
+        check_precision(&floor, &p, points, "predicted covariance", FILTER)?;
         self.x = x;
         self.s = s;
         Ok(repair)
@@ -115,12 +125,35 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         let settings = &self.settings;
         let y_hat = (settings.y_fns.mean)(&ys, settings.points.mean_weights());
         let singular = EstimationError::SingularInnovation { filter: FILTER };
-        let (sy, _) = self
+        // A factor that needed a repair came from an innovation covariance that was not positive definite.
+        let (sy, repair) = self
             .factor_of_spread(&ys, &y_hat, &self.sqrt_r, settings.y_fns.residual)
             .map_err(|_| singular.clone())?;
-        if (0..NY).any(|i| sy[(i, i)] <= 0.0) {
+        if repair.is_some() {
             return Err(singular);
         }
+        // A pivot of S_y S_yᵀ at or below the rounding of its diagonal: S is singular to working accuracy.
+        let points = &settings.points;
+        let mut floor = rounding_floor(
+            &ys,
+            &y_hat,
+            points.mean_weights(),
+            points.covariance_weights(),
+            settings.y_fns.residual,
+        );
+        let r = self.sqrt_r * self.sqrt_r.transpose();
+        for j in 0..NY {
+            floor[j] += f64::EPSILON * r[(j, j)];
+        }
+        let at_floor = |i: usize| {
+            let pivot = sy[(i, i)] * sy[(i, i)];
+            pivot <= floor[i] || pivot.is_nan() || floor[i].is_nan()
+        };
+        if (0..NY).any(at_floor) {
+            return Err(singular);
+        }
+        let s_y = sy * sy.transpose();
+        check_precision(&floor, &s_y, points, "innovation covariance", FILTER)?;
         let pxy = cross_covariance(
             &chi,
             &self.x,
@@ -133,6 +166,12 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         let e = (settings.y_fns.residual)(y, &y_hat);
         let whitened = solve_lower(&sy, &e).ok_or(singular.clone())?;
         let nis = whitened.norm_squared();
+        if !nis.is_finite() {
+            return Err(EstimationError::Overflow {
+                filter: FILTER,
+                quantity: "normalised innovation squared",
+            });
+        }
         self.innovation = e;
         self.sqrt_innovation_cov = sy;
         if let Some(reason) = settings.policy.gate(nis) {
@@ -163,7 +202,10 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
             repair
         };
         if first_non_finite(&x).is_some() {
-            return Err(EstimationError::NonFiniteCovariance { filter: FILTER });
+            return Err(EstimationError::Overflow {
+                filter: FILTER,
+                quantity: "corrected state",
+            });
         }
         self.x = x;
         self.s = s;

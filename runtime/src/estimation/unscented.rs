@@ -16,12 +16,12 @@
 //! None of them allocates or panics; each returns its results by value so that the caller commits only when
 //! the whole step succeeded.
 
-use super::dense::{cholesky_lower, cholesky_solve, first_non_finite, symmetrise};
+use super::dense::{cholesky_above_floor, cholesky_solve, first_non_finite, symmetrise};
 use super::fault::{
     CovarianceRepair, EstimationError, FaultPolicy, RejectReason, UpdateOutcome, repair_covariance,
 };
 use super::sigma::{
-    MeanFn, ResidualFn, SigmaPoints, cross_covariance, first_bad_column, subtract,
+    MeanFn, ResidualFn, SigmaPoints, cross_covariance, first_bad_column, rounding_floor, subtract,
     unscented_transform, weighted_mean,
 };
 use crate::model::DiscreteModel;
@@ -130,13 +130,61 @@ pub(crate) fn predicted_moments<const NP: usize, const NX: usize, const NS: usiz
     if let Some(q) = q {
         p += q;
     }
-    let repair = repair_covariance(&mut p, policy.eigen_floor, filter)?;
     check_state_mean(&x)?;
+    let floor = rounding_floor(
+        prop,
+        &x,
+        points.mean_weights(),
+        points.covariance_weights(),
+        fns.residual,
+    );
+    check_precision(&floor, &p, points, "predicted covariance", filter)?;
+    let repair = repair_covariance(&mut p, policy.eigen_floor, filter)?;
     Ok((x, p, repair))
 }
 
-/// The predicted measurement `ŷ`, its covariance `S` (plus the additive noise `r` if any; not symmetrised)
-/// and the cross covariance `P_xy` of the points `chi` (around `x`) and their measurements `ys`.
+/// Half of the digits of `f64`: a covariance entry whose estimated rounding error exceeds this fraction of
+/// the entry is refused.
+const PRECISION_LIMIT: f64 = 1.4901161193847656e-8;
+
+/// `Err(PrecisionLoss)` at the first diagonal entry of `cov` whose rounding estimate `floor` (from
+/// [`rounding_floor`]) exceeds [`PRECISION_LIMIT`] of the entry.
+pub(crate) fn check_precision<const NP: usize, const N: usize, const NS: usize>(
+    floor: &SVector<f64, N>,
+    cov: &SMatrix<f64, N, N>,
+    points: &SigmaPoints<NP, NS>,
+    quantity: &'static str,
+    filter: &'static str,
+) -> Result<(), EstimationError> {
+    for index in 0..N {
+        if floor[index] == 0.0 {
+            continue;
+        }
+        let relative_error = floor[index] / cov[(index, index)].abs();
+        if relative_error > PRECISION_LIMIT || relative_error.is_nan() {
+            return Err(EstimationError::PrecisionLoss {
+                filter,
+                quantity,
+                index,
+                relative_error,
+                amplification: points.rounding_amplification(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The moments of the measurement points: `ŷ`, `S`, `P_xy` and the rounding estimate of `diag S`.
+pub(crate) type InnovationMoments<const NX: usize, const NY: usize> = (
+    SVector<f64, NY>,
+    SMatrix<f64, NY, NY>,
+    SMatrix<f64, NX, NY>,
+    SVector<f64, NY>,
+);
+
+/// The predicted measurement `ŷ`, its covariance `S` (plus the additive noise `r` if any; not symmetrised),
+/// the cross covariance `P_xy` of the points `chi` (around `x`) and their measurements `ys`, and the rounding
+/// estimate of `diag S` ([`rounding_floor`], plus the rounding of adding `r`).
 pub(crate) fn innovation_moments<
     const NP: usize,
     const NX: usize,
@@ -150,31 +198,53 @@ pub(crate) fn innovation_moments<
     y_fns: &SpaceFns<NY, NS>,
     r: Option<&SMatrix<f64, NY, NY>>,
     points: &SigmaPoints<NP, NS>,
-) -> (SVector<f64, NY>, SMatrix<f64, NY, NY>, SMatrix<f64, NX, NY>) {
+) -> InnovationMoments<NX, NY> {
     let wc = points.covariance_weights();
     let (y_hat, mut s) =
         unscented_transform(ys, points.mean_weights(), wc, y_fns.mean, y_fns.residual);
+    let mut floor = rounding_floor(ys, &y_hat, points.mean_weights(), wc, y_fns.residual);
     if let Some(r) = r {
         s += r;
+        for j in 0..NY {
+            floor[j] += f64::EPSILON * (s[(j, j)].abs() + r[(j, j)].abs());
+        }
     }
     let pxy = cross_covariance(chi, x, ys, &y_hat, wc, x_residual, y_fns.residual);
-    (y_hat, s, pxy)
+    (y_hat, s, pxy, floor)
 }
 
-/// The Kalman correction shared by the unscented filters: NIS and gate, `K = P_xy S⁻¹`, `x += K e`,
-/// `P −= K S Kᵀ`, repair. `x` and `p` change only when the measurement is accepted and no error occurs.
-pub(crate) fn kalman_correct<const N: usize, const M: usize>(
+/// The innovation `e` and its covariance `S` with the rounding estimate `floor` of `diag S`, as the
+/// correction needs them.
+pub(crate) struct Innovation<'a, const M: usize> {
+    pub e: &'a SVector<f64, M>,
+    pub s: &'a SMatrix<f64, M, M>,
+    pub floor: &'a SVector<f64, M>,
+}
+
+/// The Kalman correction shared by the unscented filters: `S` checked (a Cholesky pivot at or below its
+/// rounding estimate means `S` is singular; a diagonal known to fewer than half of its digits is a precision
+/// loss), NIS and gate, `K = P_xy S⁻¹`, `x += K e`, `P −= K S Kᵀ`, repair. `x` and `p` change only when the
+/// measurement is accepted and no error occurs.
+pub(crate) fn kalman_correct<const NP: usize, const N: usize, const M: usize, const NS: usize>(
     x: &mut SVector<f64, N>,
     p: &mut SMatrix<f64, N, N>,
-    e: &SVector<f64, M>,
-    s: &SMatrix<f64, M, M>,
+    innovation: Innovation<'_, M>,
     pxy: &SMatrix<f64, N, M>,
+    points: &SigmaPoints<NP, NS>,
     policy: &FaultPolicy,
     filter: &'static str,
 ) -> Result<(UpdateOutcome, Option<SMatrix<f64, N, M>>), EstimationError> {
+    let Innovation { e, s, floor } = innovation;
     let singular = EstimationError::SingularInnovation { filter };
-    let ls = cholesky_lower(s).ok_or(singular.clone())?;
+    let ls = cholesky_above_floor(s, floor).ok_or(singular.clone())?;
+    check_precision(floor, s, points, "innovation covariance", filter)?;
     let nis = e.dot(&cholesky_solve(&ls, e).ok_or(singular.clone())?);
+    if !nis.is_finite() {
+        return Err(EstimationError::Overflow {
+            filter,
+            quantity: "normalised innovation squared",
+        });
+    }
     if let Some(reason) = policy.gate(nis) {
         return Ok((UpdateOutcome::Rejected { reason }, None));
     }
@@ -184,10 +254,13 @@ pub(crate) fn kalman_correct<const N: usize, const M: usize>(
         .transpose();
     let new_x = *x + k * e;
     let mut new_p = *p - k * s * k.transpose();
-    let repair = repair_covariance(&mut new_p, policy.eigen_floor, filter)?;
     if first_non_finite(&new_x).is_some() {
-        return Err(EstimationError::NonFiniteCovariance { filter });
+        return Err(EstimationError::Overflow {
+            filter,
+            quantity: "corrected state",
+        });
     }
+    let repair = repair_covariance(&mut new_p, policy.eigen_floor, filter)?;
     *x = new_x;
     *p = new_p;
     Ok((UpdateOutcome::Accepted { nis, repair }, Some(k)))
@@ -279,7 +352,7 @@ impl<const NP: usize, const NX: usize, const NY: usize, const NS: usize>
         y: &SVector<f64, NY>,
         r: Option<&SMatrix<f64, NY, NY>>,
     ) -> Result<Correction<NX, NY>, EstimationError> {
-        let (y_hat, mut s, pxy) = innovation_moments(
+        let (y_hat, mut s, pxy, floor) = innovation_moments(
             chi,
             x,
             self.x_fns.residual,
@@ -290,7 +363,20 @@ impl<const NP: usize, const NX: usize, const NY: usize, const NS: usize>
         );
         symmetrise(&mut s);
         let e = (self.y_fns.residual)(y, &y_hat);
-        let (outcome, gain) = kalman_correct(x, p, &e, &s, &pxy, &self.policy, self.filter)?;
+        let innovation = Innovation {
+            e: &e,
+            s: &s,
+            floor: &floor,
+        };
+        let (outcome, gain) = kalman_correct(
+            x,
+            p,
+            innovation,
+            &pxy,
+            &self.points,
+            &self.policy,
+            self.filter,
+        )?;
         Ok(Correction {
             outcome,
             gain,

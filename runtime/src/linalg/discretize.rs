@@ -28,24 +28,24 @@ pub enum DiscretizeError {
 
 /// The zero-order-hold equivalent of a continuous-time model with sample time `dt`.
 pub fn c2d_zoh(sys: &StateSpace, dt: f64) -> Result<StateSpace, DiscretizeError> {
-    if let Some(dt) = sys.dt {
+    if let Some(dt) = sys.dt() {
         return Err(DiscretizeError::AlreadyDiscrete { dt });
     }
     check::positive_scalar("sample time", dt)?;
-    let n = check::square("A", &sys.a)?;
-    let m = sys.b.ncols();
-    check::shape("B", &sys.b, n, m)?;
+    let n = check::square("A", sys.a())?;
+    let m = sys.b().ncols();
+    check::shape("B", sys.b(), n, m)?;
     let mut big = DMatrix::<f64>::zeros(n + m, n + m);
-    big.view_mut((0, 0), (n, n)).copy_from(&(&sys.a * dt));
-    big.view_mut((0, n), (n, m)).copy_from(&(&sys.b * dt));
+    big.view_mut((0, 0), (n, n)).copy_from(&(sys.a() * dt));
+    big.view_mut((0, n), (n, m)).copy_from(&(sys.b() * dt));
     let e = expm(&big)?;
     let ad = e.view((0, 0), (n, n)).clone_owned();
     let bd = e.view((0, n), (n, m)).clone_owned();
     Ok(StateSpace::new_discrete(
         ad,
         bd,
-        sys.c.clone(),
-        sys.d.clone(),
+        sys.c().clone(),
+        sys.d().clone(),
         dt,
     )?)
 }

@@ -2,8 +2,10 @@
 
 mod commands;
 mod io;
+mod matrix_text;
 mod model;
 mod params;
+mod quantities;
 mod simulate;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -128,7 +130,8 @@ enum Command {
         /// Only this model of the file.
         #[arg(long)]
         model: Option<String>,
-        /// A parameter value other than the default, in SI units (repeatable).
+        /// A parameter value other than the default (repeatable, each name once): a number in the unit the file
+        /// declares for it, or with its unit in brackets: `L_a=2.5` or `'L_a=2.5 [mH]'`.
         #[arg(long = "param", value_name = "NAME=VALUE", value_parser = params::parse_assignment)]
         params: Vec<params::Assignment>,
         /// The state coordinates.
@@ -139,10 +142,14 @@ enum Command {
         symbolic: bool,
         #[arg(long, value_enum, default_value_t = ReportFormat::Json)]
         format: ReportFormat,
-        /// The operating point of a nonlinear model: energy states and inputs by name, comma-separated; those not
-        /// given are 0.
+        /// The operating point of a nonlinear model: energy states and inputs by name, comma-separated, each once;
+        /// a number in the state's SI unit or the input's declared unit, or with its unit in brackets
+        /// (`theta=30 [deg]`); those not given are 0.
         #[arg(long, value_name = "NAME=VALUE,...", value_delimiter = ',', value_parser = params::parse_assignment)]
         at: Vec<params::Assignment>,
+        /// Print the effective parameter values (declared unit and SI) and the operating point on standard error.
+        #[arg(long, short)]
+        verbose: bool,
     },
     /// Simulate a model and print CSV: t, the states, the outputs, energy (stored), dissipated (in the resistors
     /// since t = 0) and supplied (by the sources since t = 0).
@@ -157,14 +164,17 @@ enum Command {
         /// The sampling interval of the rows; t-end/1000 when absent.
         #[arg(long, value_name = "DT", allow_hyphen_values = true)]
         dt_out: Option<f64>,
-        /// A parameter value other than the default, in SI units (repeatable).
+        /// A parameter value other than the default (repeatable, each name once): a number in the unit the file
+        /// declares for it, or with its unit in brackets: `L_a=2.5` or `'L_a=2.5 [mH]'`.
         #[arg(long = "param", value_name = "NAME=VALUE", value_parser = params::parse_assignment)]
         params: Vec<params::Assignment>,
-        /// An input signal as an expression of t: numbers, t, pi, + - * / ^, step(t0), ramp(t0), sin, cos, tan,
-        /// exp, sqrt, abs, min, max (repeatable). Inputs not given are 0.
+        /// An input signal as an expression of t in the input's declared unit (or followed by a unit in brackets,
+        /// `'theta=30*sin(t) [deg]'`): numbers, t, pi, + - * / ^, step(t0), ramp(t0), sin, cos, tan, exp, ln, sqrt,
+        /// abs, sign, min, max (repeatable, each name once). Inputs not given are held at 0, with a warning.
         #[arg(long = "input", value_name = "NAME=EXPR", value_parser = params::parse_assignment)]
         inputs: Vec<params::Assignment>,
-        /// An initial state value (a state name as in the CSV header; repeatable). States not given start at 0.
+        /// An initial state value (a state name as in the CSV header, without the unit; repeatable, each name once):
+        /// in the state's unit of the header, or with its unit in brackets. States not given start at 0.
         #[arg(long = "x0", value_name = "STATE=VALUE", value_parser = params::parse_assignment)]
         x0: Vec<params::Assignment>,
         #[arg(long, value_enum, default_value_t = Solver::Bdf)]
@@ -175,6 +185,9 @@ enum Command {
         /// Absolute tolerance (all states and the energy quadratures).
         #[arg(long, default_value_t = 1e-9, allow_hyphen_values = true)]
         atol: f64,
+        /// Print the effective parameter values (declared unit and SI) and initial state on standard error.
+        #[arg(long, short)]
+        verbose: bool,
     },
     /// Print the Rust module that `bgc::build` generates for FILE (the same text, byte for byte).
     Rust {
@@ -241,6 +254,7 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
             symbolic,
             format,
             at,
+            verbose,
         } => {
             let args = model::StateSpaceArgs {
                 params: &params,
@@ -248,6 +262,7 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
                 symbolic,
                 format,
                 at: &at,
+                verbose,
             };
             model::statespace(&file, model.as_deref(), &args, color)
         }
@@ -262,6 +277,7 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
             solver,
             rtol,
             atol,
+            verbose,
         } => {
             let args = simulate::SimulateArgs {
                 t_end,
@@ -272,6 +288,7 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
                 solver,
                 rtol,
                 atol,
+                verbose,
             };
             simulate::simulate(&file, model.as_deref(), &args, color)
         }

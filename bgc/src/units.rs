@@ -253,6 +253,55 @@ pub fn parse_unit(u: &UnitExpr) -> Result<Unit, UnitError> {
     Ok(out)
 }
 
+/// Parses a unit written as in a `.bg` file but without the brackets (`mH`, `N m/rad`, `rad/s^2`, `1`), as the
+/// command line takes it after a number: `--param 'L_a=2.5 [mH]'`.
+pub fn parse_unit_text(text: &str) -> Result<Unit, String> {
+    let (num, den) = match text.split_once('/') {
+        Some((n, d)) => (n, Some(d)),
+        None => (text, None),
+    };
+    let factors = |part: &str| -> Result<Vec<(String, i32)>, String> {
+        let mut out = Vec::new();
+        for f in part.split_whitespace() {
+            let (symbol, power) = match f.split_once('^') {
+                Some((b, p)) => match p.parse::<i32>() {
+                    Ok(v) if v != 0 && !p.starts_with('+') => (b, v),
+                    _ => return Err(format!("`{f}`: a unit's power is a non-zero whole number")),
+                },
+                None => (f, 1),
+            };
+            out.push((symbol.to_string(), power));
+        }
+        Ok(out)
+    };
+    let mut numerator = factors(num)?;
+    if numerator.len() == 1 && numerator[0] == ("1".to_string(), 1) && den.is_some() {
+        numerator.clear();
+    }
+    let denominator = match den {
+        Some(d) => {
+            let d = d.trim().trim_start_matches('(').trim_end_matches(')');
+            let list = factors(d)?;
+            if list.is_empty() || d.contains('/') {
+                return Err(format!(
+                    "`{text}`: one `/` followed by the denominator's units"
+                ));
+            }
+            list
+        }
+        None => Vec::new(),
+    };
+    if numerator.is_empty() && denominator.is_empty() {
+        return Err("an empty unit: write `1` for a dimensionless value".into());
+    }
+    parse_unit(&UnitExpr {
+        numerator,
+        denominator,
+        span: crate::span::Span::default(),
+    })
+    .map_err(|e| e.to_string())
+}
+
 /// The unit as it was written, `N m/rad`, for messages.
 pub fn unit_text(u: &UnitExpr) -> String {
     let part = |list: &[(String, i32)]| {
@@ -293,13 +342,12 @@ const DISPLAY_DERIVED: [(&str, Dim); 7] = [
     ("H", D_H),
 ];
 
-impl fmt::Display for Dim {
-    /// Readable SI form: `N m s`, `1/(N m)`, `kg m^2`, `V`, `1`.
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        // Pick the writing with the fewest symbols: base units alone, or one derived unit (to the power ±1) times
-        // base units. Ties keep the earlier candidate, base units first.
-        let mut best: (u32, Option<(&str, i8)>, Dim) = (self.weight(), None, *self);
-        for (name, d) in DISPLAY_DERIVED {
+impl Dim {
+    /// The writing with the fewest symbols: base units alone, or one derived unit (to the power ±1) times base
+    /// units, the derived unit chosen from `derived`. Ties keep the earlier candidate, base units first.
+    fn shortest(self, derived: &[(&'static str, Dim)]) -> (u32, Option<(&'static str, i8)>, Dim) {
+        let mut best: (u32, Option<(&str, i8)>, Dim) = (self.weight(), None, self);
+        for &(name, d) in derived {
             for p in [1i8, -1] {
                 let Some(rest) = d.powi(i32::from(p)).and_then(|dp| self.checked_div(dp)) else {
                     continue;
@@ -313,36 +361,70 @@ impl fmt::Display for Dim {
                 }
             }
         }
-        let (_, derived, rest) = best;
-        let mut num: Vec<String> = Vec::new();
-        let mut den: Vec<String> = Vec::new();
-        let mut push = |name: &str, p: i8| {
-            let target = if p > 0 { &mut num } else { &mut den };
-            let a = p.unsigned_abs();
-            if a == 1 {
-                target.push(name.to_string());
-            } else {
-                target.push(format!("{name}^{a}"));
-            }
+        best
+    }
+
+    /// The other way a datasheet writes an electromechanical unit: a unit with a current written with the volt is
+    /// also given with the newton (`V s` = `N m/A`, a motor's torque and back-EMF constant), and one written with
+    /// the newton also with the volt (`N/A` = `V s/m`), when that takes at most two symbols more.
+    pub fn datasheet_form(self) -> Option<String> {
+        if self.0[3] == 0 {
+            return None;
+        }
+        let (w, derived, _) = self.shortest(&DISPLAY_DERIVED);
+        let other: &[(&'static str, Dim)] = match derived {
+            Some(("N", _)) => &[("V", D_V)],
+            Some(("V", _)) | Some(("W", _)) => &[("N", D_N)],
+            _ => return None,
         };
-        if let Some((name, p)) = derived {
-            push(name, p);
-        }
-        // Mass first, as engineers write `kg m^2`.
-        for i in [1usize, 0, 2, 3, 4, 5, 6] {
-            if rest.0[i] != 0 {
-                push(BASE_SYMBOLS[i], rest.0[i]);
-            }
-        }
-        let n = if num.is_empty() {
-            "1".to_string()
+        let alt = self.shortest(other);
+        (alt.1.is_some() && alt.0 <= w + 2).then(|| write_dim(alt.1, alt.2))
+    }
+}
+
+/// `derived` (a unit and its power) times the base units of `rest`, as [`Dim`]'s display writes it.
+fn write_dim(derived: Option<(&str, i8)>, rest: Dim) -> String {
+    let mut num: Vec<String> = Vec::new();
+    let mut den: Vec<String> = Vec::new();
+    let mut push = |name: &str, p: i8| {
+        let target = if p > 0 { &mut num } else { &mut den };
+        let a = p.unsigned_abs();
+        if a == 1 {
+            target.push(name.to_string());
         } else {
-            num.join(" ")
-        };
-        match den.len() {
-            0 => write!(f, "{n}"),
-            1 => write!(f, "{n}/{}", den[0]),
-            _ => write!(f, "{n}/({})", den.join(" ")),
+            target.push(format!("{name}^{a}"));
+        }
+    };
+    if let Some((name, p)) = derived {
+        push(name, p);
+    }
+    // Mass first, as engineers write `kg m^2`.
+    for i in [1usize, 0, 2, 3, 4, 5, 6] {
+        if rest.0[i] != 0 {
+            push(BASE_SYMBOLS[i], rest.0[i]);
+        }
+    }
+    let n = if num.is_empty() {
+        "1".to_string()
+    } else {
+        num.join(" ")
+    };
+    match den.len() {
+        0 => n,
+        1 => format!("{n}/{}", den[0]),
+        _ => format!("{n}/({})", den.join(" ")),
+    }
+}
+
+impl fmt::Display for Dim {
+    /// Readable SI form: `N m s`, `1/(N m)`, `kg m^2`, `V`, `1`; an electromechanical unit also in its other
+    /// datasheet form, `V s (= N m/A)` (see [`Dim::datasheet_form`]).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (_, derived, rest) = self.shortest(&DISPLAY_DERIVED);
+        write!(f, "{}", write_dim(derived, rest))?;
+        match self.datasheet_form() {
+            Some(alt) => write!(f, " (= {alt})"),
+            None => Ok(()),
         }
     }
 }
@@ -546,6 +628,23 @@ mod tests {
     }
 
     #[test]
+    fn unit_text_of_the_command_line_parses_as_in_a_file() {
+        let mh = parse_unit_text("mH").unwrap_or(Unit::ONE);
+        assert!(mh.dim == D_H && close(mh.scale, 1e-3));
+        assert_eq!(parse_unit_text("N m/rad"), Ok(Unit::si(D_J)));
+        assert_eq!(parse_unit_text("1/s"), Ok(Unit::si(D_HZ)));
+        assert_eq!(parse_unit_text("1"), Ok(Unit::ONE));
+        let acc = parse_unit_text("m/s^2").map(|u| u.dim);
+        assert_eq!(acc, Ok(Dim::new(1, 0, -2, 0, 0, 0, 0)));
+        let rpm = parse_unit_text("rpm").unwrap_or(Unit::ONE);
+        assert!(close(rpm.scale, 0.10471975511965977));
+        assert!(parse_unit_text("").is_err());
+        assert!(parse_unit_text("furlong").is_err());
+        assert!(parse_unit_text("m^0").is_err());
+        assert!(parse_unit_text("m/s/s").is_err());
+    }
+
+    #[test]
     fn unknown_symbol_is_reported_by_name() {
         assert_eq!(
             unit(&[("N", 1), ("furlong", 1)], &[]),
@@ -591,7 +690,12 @@ mod tests {
         assert_eq!(Dim::new(1, 0, -2, 0, 0, 0, 0).to_string(), "m/s^2");
         assert_eq!(Dim::new(0, -1, 2, 0, 0, 0, 0).to_string(), "m/N");
         assert_eq!(Dim::new(-4, 1, -1, 0, 0, 0, 0).to_string(), "Pa s/m^3");
-        assert_eq!(Dim::new(1, 1, -2, -1, 0, 0, 0).to_string(), "N/A");
+        assert_eq!(Dim::new(1, 1, -2, -1, 0, 0, 0).to_string(), "N/A (= V s/m)");
+        // A motor constant: V s = Wb = N m/A.
+        assert_eq!(D_WB.to_string(), "V s (= N m/A)");
+        // Electrical units with no short mechanical writing stay as they are.
+        assert_eq!(D_A.to_string(), "A");
+        assert_eq!(Dim::new(2, 1, -3, -2, 0, 0, 0).to_string(), "Ohm");
     }
 
     #[test]

@@ -2,7 +2,7 @@
 
 use crate::cli_support;
 
-use cli_support::{Csv, bgc, corpus, repo, simulate};
+use cli_support::{Csv, bgc, corpus, repo, simulate, temp_model};
 
 #[test]
 fn undamped_oscillator_conserves_energy_over_ten_periods() {
@@ -245,13 +245,6 @@ fn back_support_counts_the_energy_of_a_trunk_velocity_step() {
         );
     }
     assert!(t.contains(&0.5), "a row at the jump");
-}
-
-/// Writes a model to a fresh file of the system's temporary directory and returns its path.
-fn temp_model(name: &str, text: &str) -> String {
-    let path = std::env::temp_dir().join(format!("bgc-{}-{name}.bg", std::process::id()));
-    std::fs::write(&path, text).expect("temporary model written");
-    path.display().to_string()
 }
 
 const DRIVEN_INERTIA: &str = "/// A flow source imposing the velocity of an inertia.

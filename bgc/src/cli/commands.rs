@@ -28,7 +28,9 @@ pub fn check(files: &[PathBuf], format: DiagFormat, color: bool) -> Status {
         let (models, mut diags) = bgc::lower::lower(&mut sources, id, &mut FsLoader);
         if !has_errors(&diags) {
             for m in &models {
-                diags.extend(bgc::causality::analyse(m).1);
+                let mut found = bgc::causality::analyse(m).1;
+                bgc::lower::add_instance_context(m, &mut found);
+                diags.extend(found);
             }
         }
         if !has_errors(&diags) {
@@ -103,7 +105,14 @@ fn fmt_one(path: &Path, check_only: bool, color: bool) -> std::io::Result<bool> 
         return Ok(true);
     }
     if check_only {
-        stdoutln(&format!("{}: not in the canonical layout", path.display()));
+        let name = path.display().to_string();
+        let diff = similar::TextDiff::from_lines(&text, &formatted)
+            .unified_diff()
+            .context_radius(3)
+            .header(&name, &format!("{name} (canonical layout)"))
+            .to_string();
+        stdout(&diff);
+        stderrln(&format!("{name}: not in the canonical layout"));
         return Ok(false);
     }
     std::fs::write(path, formatted)?;
@@ -205,7 +214,8 @@ pub fn causality(path: &Path, wanted: Option<&str>, format: ReportFormat, color:
         Ok(l) => l,
         Err(s) => return s,
     };
-    let (result, causal_diags) = bgc::causality::analyse(&loaded.model);
+    let (result, mut causal_diags) = bgc::causality::analyse(&loaded.model);
+    bgc::lower::add_instance_context(&loaded.model, &mut causal_diags);
     let mut diags = loaded.diags;
     diags.extend(causal_diags);
     match format {
@@ -239,7 +249,8 @@ pub fn draw(
         Err(s) => return s,
     };
     // A drawing is most useful exactly when causality has problems, so they are drawn (highlighted), not refused.
-    let (result, causal_diags) = bgc::causality::analyse(&loaded.model);
+    let (result, mut causal_diags) = bgc::causality::analyse(&loaded.model);
+    bgc::lower::add_instance_context(&loaded.model, &mut causal_diags);
     stderr(&render::to_text(&loaded.sources, &causal_diags, color));
     let text = match format {
         DrawFormat::Svg => bgc::draw::svg(&loaded.model, Some(&result)),

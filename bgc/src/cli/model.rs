@@ -2,7 +2,9 @@
 
 use super::commands::{Loaded, count_line, load_one};
 use super::io::{stderr, stderrln, stdout, stdoutln};
-use super::params::{Assignment, assign, param_values};
+use super::matrix_text;
+use super::params::{Assignment, param_values, values_or_zero};
+use super::quantities::{self, Declared};
 use super::{Coords, EquationsFormat, ReportFormat, Status};
 use bgc::diagnostic::{has_errors, render};
 use bgc::equations::sym::{self, Ex, Sym};
@@ -30,6 +32,7 @@ pub(super) fn derive_one(
     let (causality, mut diags) = bgc::causality::analyse(&loaded.model);
     let (eqs, eq_diags) = equations::derive(&loaded.model, &causality);
     diags.extend(eq_diags);
+    bgc::lower::add_instance_context(&loaded.model, &mut diags);
     let mut all = loaded.diags.clone();
     all.extend(diags);
     stderr(&render::to_text(&loaded.sources, &all, color));
@@ -77,6 +80,8 @@ pub struct StateSpaceArgs<'a> {
     pub symbolic: bool,
     pub format: ReportFormat,
     pub at: &'a [Assignment],
+    /// Print the effective parameter values and the operating point on standard error.
+    pub verbose: bool,
 }
 
 /// `bgc statespace FILE`
@@ -108,8 +113,16 @@ pub fn statespace(
 fn state_space(d: &Derived, args: &StateSpaceArgs<'_>) -> Result<Value, String> {
     let eqs = &d.eqs;
     let params = param_values(&d.loaded.model, &d.eqs, args.params)?;
+    if args.verbose {
+        stderr(&quantities::describe_params(
+            &d.loaded.model,
+            eqs,
+            &params,
+            args.params,
+        ));
+    }
     match args.coords {
-        Coords::Energy => energy_coords(eqs, &params, args),
+        Coords::Energy => energy_coords(&d.loaded.model, eqs, &params, args),
         Coords::Declared => {
             if !args.at.is_empty() {
                 return Err("--at applies to the energy coordinates only; the declared coordinates are defined for linear models".into());
@@ -130,7 +143,19 @@ fn state_space(d: &Derived, args: &StateSpaceArgs<'_>) -> Result<Value, String> 
                     &fixed_params(eqs, args.params, &params),
                 ))
             } else {
-                let ss = equations::declared_state_space(eqs, &params).map_err(declared)?;
+                // The exact elimination, evaluated at the parameters, keeps structural zeros exactly zero; the
+                // numeric path (null spaces by floating-point elimination) leaves rounding residue such as 5e-11
+                // in them, so it serves only when the symbolic form is refused.
+                let exact = equations::declared_state_space_symbolic(eqs)
+                    .ok()
+                    .and_then(|j| {
+                        let (x0, u0) = (vec![0.0; j.states.len()], vec![0.0; eqs.inputs.len()]);
+                        equations::evaluate_at(eqs, &j, &params, &x0, &u0, 0.0).ok()
+                    });
+                let ss = match exact {
+                    Some(ss) => ss,
+                    None => equations::declared_state_space(eqs, &params).map_err(declared)?,
+                };
                 Ok(numeric_json(&ss))
             }
         }
@@ -140,6 +165,7 @@ fn state_space(d: &Derived, args: &StateSpaceArgs<'_>) -> Result<Value, String> 
 /// The state space in the energy variables: exact for a linear model, the linearisation at `--at` otherwise. When
 /// the rates need an integrated flow (an angle in a modulated transformer), the integrated flows join the state.
 fn energy_coords(
+    model: &bgc::ir::Model,
     eqs: &Equations,
     params: &[f64],
     args: &StateSpaceArgs<'_>,
@@ -150,7 +176,7 @@ fn energy_coords(
     };
     let n = eqs.state_count(selection);
     let state_names: Vec<String> = (0..n).map(|i| eqs.sym_name(Sym::State(i))).collect();
-    let (x0, u0) = operating_point(eqs, &state_names, args.at)?;
+    let (x0, u0) = operating_point(model, eqs, &state_names, args.at, args.verbose)?;
     let linear = match equations::linear_state_space(eqs, selection) {
         Ok(j) => Ok(j),
         Err(
@@ -200,22 +226,42 @@ fn list(names: &[String]) -> String {
     }
 }
 
-/// The operating point from `--at`: state values and input values by name, 0 for those not given.
+/// The operating point from `--at`: state values and input values by name (each in its unit: see
+/// [`super::quantities`]), 0 for those not given.
 fn operating_point(
+    model: &bgc::ir::Model,
     eqs: &Equations,
     state_names: &[String],
     at: &[Assignment],
+    verbose: bool,
 ) -> Result<(Vec<f64>, Vec<f64>), String> {
-    let mut x0 = vec![0.0; state_names.len()];
-    let mut u0 = vec![0.0; eqs.inputs.len()];
-    let mut names: Vec<String> = state_names.to_vec();
-    names.extend(eqs.inputs.iter().cloned());
-    let mut values = vec![0.0; names.len()];
-    assign("state or input", &names, &mut values, at)?;
+    let all_states = quantities::states(model, eqs);
+    let mut declared: Vec<Declared> = state_names
+        .iter()
+        .map(|n| {
+            all_states
+                .iter()
+                .find(|d| d.name == *n)
+                .cloned()
+                .unwrap_or(Declared {
+                    name: n.clone(),
+                    unit: bgc::units::Unit::ONE,
+                    text: "1".into(),
+                })
+        })
+        .collect();
+    declared.extend(quantities::inputs(model));
+    let values = values_or_zero("state or input", "--at", &declared, at)?;
+    if verbose {
+        stderr(&quantities::describe_values(
+            "operating point",
+            &declared,
+            &values,
+            at,
+        ));
+    }
     let (xs, us) = values.split_at(state_names.len().min(values.len()));
-    x0.copy_from_slice(xs);
-    u0.copy_from_slice(us);
-    Ok((x0, u0))
+    Ok((xs.to_vec(), us.to_vec()))
 }
 
 /// The Jacobians with the operating point put in for the states, inputs and time.
@@ -262,18 +308,41 @@ fn fixed_params(eqs: &Equations, given: &[Assignment], values: &[f64]) -> Vec<Op
         .collect()
 }
 
+/// `e` in the free parameters: those given with `--param` as numbers, and each derived parameter replaced by its
+/// expression, so that an instance parameter set by an override (`dc_motor mot(R_a = R)`) reads as the user's `R`,
+/// not as `mot.R_a`.
+fn in_free_params(eqs: &Equations, e: &Ex, fixed: &[Option<f64>]) -> Ex {
+    // Derived parameters refer only to earlier ones, so the substitution ends; the bound guards a malformed table.
+    let mut e = e.clone();
+    for _ in 0..=eqs.params.len() {
+        let mut changed = false;
+        e = sym::subst(&e, &mut |s| match s {
+            Sym::Param(i) => match (fixed.get(i).copied().flatten(), eqs.derived.get(i)) {
+                (Some(v), _) => {
+                    changed = true;
+                    Some(Ex::Num(v))
+                }
+                (None, Some(Some(d))) => {
+                    changed = true;
+                    Some(d.clone())
+                }
+                _ => None,
+            },
+            _ => None,
+        });
+        if !changed {
+            break;
+        }
+    }
+    e
+}
+
 fn symbolic_json(eqs: &Equations, j: &Jacobians, fixed: &[Option<f64>]) -> Value {
     let render = |m: &[Vec<Ex>]| -> Vec<Vec<String>> {
         m.iter()
             .map(|row| {
                 row.iter()
-                    .map(|e| {
-                        let e = sym::subst(e, &mut |s| match s {
-                            Sym::Param(i) => fixed.get(i).copied().flatten().map(Ex::Num),
-                            _ => None,
-                        });
-                        equations::expr_text(eqs, &e)
-                    })
+                    .map(|e| equations::expr_text(eqs, &in_free_params(eqs, e, fixed)))
                     .collect()
             })
             .collect()
@@ -290,14 +359,20 @@ fn symbolic_json(eqs: &Equations, j: &Jacobians, fixed: &[Option<f64>]) -> Value
 }
 
 fn numeric_json(ss: &NumericStateSpace) -> Value {
+    // A zero is a zero: `-0.0` (the product of a zero coefficient and a negative one) would print as `-0.0`.
+    let positive_zero = |m: &[Vec<f64>]| -> Vec<Vec<f64>> {
+        m.iter()
+            .map(|r| r.iter().map(|x| if *x == 0.0 { 0.0 } else { *x }).collect())
+            .collect()
+    };
     json!({
         "states": ss.states,
         "inputs": ss.inputs,
         "outputs": ss.outputs,
-        "A": ss.a,
-        "B": ss.b,
-        "C": ss.c,
-        "D": ss.d,
+        "A": positive_zero(&ss.a),
+        "B": positive_zero(&ss.b),
+        "C": positive_zero(&ss.c),
+        "D": positive_zero(&ss.d),
     })
 }
 
@@ -355,19 +430,32 @@ fn text(v: &Value) -> String {
     );
     for m in ["A", "B", "C", "D"] {
         out.push_str(&format!("\n{m} =\n"));
-        for row in v.get(m).and_then(Value::as_array).into_iter().flatten() {
-            let cells: Vec<String> = row
-                .as_array()
-                .into_iter()
-                .flatten()
-                .map(|c| match c {
-                    Value::Number(n) => format!("{:>13.6e}", n.as_f64().unwrap_or(f64::NAN)),
-                    Value::String(s) => format!("[{s}]"),
-                    other => other.to_string(),
+        let rows: Vec<&Vec<Value>> = v
+            .get(m)
+            .and_then(Value::as_array)
+            .into_iter()
+            .flatten()
+            .filter_map(Value::as_array)
+            .collect();
+        let numbers: Option<Vec<Vec<f64>>> = rows
+            .iter()
+            .map(|r| r.iter().map(Value::as_f64).collect())
+            .collect();
+        let cells = match numbers {
+            Some(numbers) => matrix_text::format_matrix(&numbers),
+            None => rows
+                .iter()
+                .map(|r| {
+                    r.iter()
+                        .map(|c| match c {
+                            Value::String(s) => format!("[{s}]"),
+                            other => other.to_string(),
+                        })
+                        .collect()
                 })
-                .collect();
-            out.push_str(&format!("  {}\n", cells.join(" ")));
-        }
+                .collect(),
+        };
+        out.push_str(&matrix_text::layout(&cells));
     }
     out
 }

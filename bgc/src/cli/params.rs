@@ -1,7 +1,9 @@
 //! `NAME=VALUE` arguments: parameter overrides, initial states, operating points, and the physical check of the
 //! parameter values.
 
+use super::quantities::{self, Declared};
 use bgc::ir::{Expr, Model, Relation};
+use bgc::simulate::input::Signal;
 use bgc::syntax::ast::ElementKind;
 
 /// A `NAME=VALUE` pair as given (the value is checked by the command, so that a bad number is an input error).
@@ -22,27 +24,32 @@ pub fn parse_assignment(s: &str) -> Result<Assignment, String> {
     }
 }
 
-/// A finite number, or a message naming the argument.
-pub fn number(what: &str, a: &Assignment) -> Result<f64, String> {
-    match a.value.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        Ok(_) => Err(format!(
-            "{what} `{}` = {}: the value must be finite",
-            a.name, a.value
-        )),
-        Err(_) => Err(format!("{what} `{}` = `{}`: not a number", a.name, a.value)),
+/// An error when a name is given twice: the last value would win silently.
+pub fn reject_repeats(what: &str, option: &str, given: &[Assignment]) -> Result<(), String> {
+    for (k, a) in given.iter().enumerate() {
+        if let Some(b) = given[k + 1..].iter().find(|b| b.name == a.name) {
+            return Err(format!(
+                "{what} `{}` is given twice with {option} (`{}={}` and `{}={}`); give each name once",
+                a.name, a.name, a.value, b.name, b.value
+            ));
+        }
     }
+    Ok(())
 }
 
-/// Sets `values[i]` for each assignment whose name is `names[i]`; an unknown name is an error listing the known.
+/// For each assignment, its index among `declared` and its value in the declared unit (see
+/// [`quantities::value_in_declared`]); an unknown name is an error listing the known, a repeated one an error.
 pub fn assign(
     what: &str,
-    names: &[String],
-    values: &mut [f64],
+    option: &str,
+    declared: &[Declared],
     given: &[Assignment],
-) -> Result<(), String> {
+) -> Result<Vec<(usize, f64)>, String> {
+    reject_repeats(what, option, given)?;
+    let mut out = Vec::with_capacity(given.len());
     for a in given {
-        let Some(i) = names.iter().position(|n| *n == a.name) else {
+        let Some(i) = declared.iter().position(|d| d.name == a.name) else {
+            let names: Vec<&str> = declared.iter().map(|d| d.name.as_str()).collect();
             return Err(format!(
                 "unknown {what} `{}`; the model has {}",
                 a.name,
@@ -53,26 +60,38 @@ pub fn assign(
                 }
             ));
         };
-        let v = number(what, a)?;
-        if let Some(slot) = values.get_mut(i) {
-            *slot = v;
-        }
+        out.push((i, quantities::value_in_declared(what, &declared[i], a)?));
     }
-    Ok(())
+    Ok(out)
 }
 
-/// The parameter values: the defaults with the overrides, checked to be physical (see [`check_physical`]).
+/// The values of `declared` in their declared units: 0 where not given.
+pub fn values_or_zero(
+    what: &str,
+    option: &str,
+    declared: &[Declared],
+    given: &[Assignment],
+) -> Result<Vec<f64>, String> {
+    let mut values = vec![0.0; declared.len()];
+    for (i, v) in assign(what, option, declared, given)? {
+        values[i] = v;
+    }
+    Ok(values)
+}
+
+/// The parameter values in SI: the defaults with the overrides (a bare number in the parameter's declared unit),
+/// checked to be physical (see [`check_physical`]).
 pub fn param_values(
     model: &Model,
     eqs: &bgc::equations::Equations,
     given: &[Assignment],
 ) -> Result<Vec<f64>, String> {
-    let names: Vec<String> = model.params.iter().map(|p| p.name.clone()).collect();
-    // The given values, marked by being set; the others follow from the defaults and the derived parameters.
-    let mut values: Vec<f64> = vec![f64::NAN; names.len()];
-    assign("parameter", &names, &mut values, given)?;
-    let given_values: Vec<Option<f64>> =
-        values.iter().map(|v| (!v.is_nan()).then_some(*v)).collect();
+    let declared = quantities::params(model);
+    // The given values; the others follow from the defaults and the derived parameters.
+    let mut given_values: Vec<Option<f64>> = vec![None; declared.len()];
+    for (i, v) in assign("parameter", "--param", &declared, given)? {
+        given_values[i] = Some(v * declared[i].unit.scale);
+    }
     let values = eqs.param_values(&given_values);
     check_physical(model, &values)?;
     Ok(values)
@@ -109,4 +128,66 @@ pub fn check_physical(model: &Model, params: &[f64]) -> Result<(), String> {
 /// The value of an expression of constants and parameters; `None` when it uses anything else.
 fn eval_params(e: &Expr, params: &[f64]) -> Option<f64> {
     e.eval_const(&|i| params.get(i).copied())
+}
+
+/// The input signals of `bgc simulate` from `--input NAME=EXPR` (an expression of `t` in the input's declared unit,
+/// or followed by a unit in brackets: `'theta=30*sin(t) [deg]'`), with the names of the inputs not given, which are
+/// held at zero.
+pub fn input_signals(
+    model: &Model,
+    given: &[Assignment],
+) -> Result<(Vec<Signal>, Vec<String>), String> {
+    reject_repeats("input", "--input", given)?;
+    let declared = quantities::inputs(model);
+    let mut signals: Vec<Option<Signal>> = vec![None; declared.len()];
+    for a in given {
+        let Some(i) = declared.iter().position(|d| d.name == a.name) else {
+            let names: Vec<&str> = declared.iter().map(|d| d.name.as_str()).collect();
+            return Err(format!(
+                "unknown input `{}`; the model has {}",
+                a.name,
+                if names.is_empty() {
+                    "no inputs".to_string()
+                } else {
+                    names.join(", ")
+                }
+            ));
+        };
+        let (text, unit) =
+            quantities::split_unit(&a.value).map_err(|e| format!("input `{}` = {e}", a.name))?;
+        let s = Signal::parse(text).map_err(|e| format!("input `{}` = `{text}`: {e}", a.name))?;
+        let factor = quantities::factor_to_declared("input", &declared[i], unit)?;
+        signals[i] = Some(if factor == 1.0 {
+            s
+        } else {
+            Signal::Mul(Box::new(Signal::Num(factor)), Box::new(s))
+        });
+    }
+    let zero: Vec<String> = declared
+        .iter()
+        .zip(&signals)
+        .filter(|(_, s)| s.is_none())
+        .map(|(d, _)| d.name.clone())
+        .collect();
+    let signals = signals
+        .into_iter()
+        .map(|s| s.unwrap_or(Signal::Num(0.0)))
+        .collect();
+    Ok((signals, zero))
+}
+
+/// The line `bgc simulate` prints on standard error when inputs are not given.
+pub fn zero_inputs_warning(zero: &[String]) -> Option<String> {
+    let list: Vec<String> = zero.iter().map(|n| format!("`{n}`")).collect();
+    match list.len() {
+        0 => None,
+        1 => Some(format!(
+            "warning: input {} is not given and is held at 0 (set it with --input NAME=EXPR)",
+            list[0]
+        )),
+        _ => Some(format!(
+            "warning: inputs {} are not given and are held at 0 (set them with --input NAME=EXPR)",
+            list.join(", ")
+        )),
+    }
 }

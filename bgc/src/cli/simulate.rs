@@ -1,11 +1,11 @@
 //! `bgc simulate`: integrate a model's equations and print CSV.
 
-use super::io::{stderrln, stdout};
+use super::io::{stderr, stderrln, stdout};
 use super::model::derive_one;
-use super::params::{Assignment, assign, param_values};
+use super::params::{Assignment, input_signals, param_values, values_or_zero, zero_inputs_warning};
+use super::quantities;
 use super::{Solver, Status};
 use bgc::simulate::System;
-use bgc::simulate::input::Signal;
 use bgc::simulate::integrate::{Method, RunOptions, run};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -20,6 +20,8 @@ pub struct SimulateArgs<'a> {
     pub solver: Solver,
     pub rtol: f64,
     pub atol: f64,
+    /// Print the effective parameter values and initial state on standard error.
+    pub verbose: bool,
 }
 
 /// The number of sample intervals when `--dt-out` is not given.
@@ -49,32 +51,31 @@ fn csv(
     args: &SimulateArgs<'_>,
 ) -> Result<String, String> {
     let params = param_values(model, eqs, args.params)?;
-    // Inputs not given are zero.
-    let mut signals = vec![Signal::Num(0.0); eqs.inputs.len()];
-    for a in args.inputs {
-        let Some(i) = eqs.inputs.iter().position(|n| *n == a.name) else {
-            return Err(format!(
-                "unknown input `{}`; the model has {}",
-                a.name,
-                if eqs.inputs.is_empty() {
-                    "no inputs".to_string()
-                } else {
-                    eqs.inputs.join(", ")
-                }
-            ));
-        };
-        let s = Signal::parse(&a.value)
-            .map_err(|e| format!("input `{}` = `{}`: {e}", a.name, a.value))?;
-        if let Some(slot) = signals.get_mut(i) {
-            *slot = s;
-        }
+    let (signals, held_at_zero) = input_signals(model, args.inputs)?;
+    if let Some(w) = zero_inputs_warning(&held_at_zero) {
+        stderrln(&w);
     }
-    let (system, warnings) = System::new(eqs, params, signals).map_err(|e| e.to_string())?;
+    let (system, warnings) =
+        System::new(eqs, params.clone(), signals).map_err(|e| e.to_string())?;
     for w in warnings {
         stderrln(&format!("warning: {w}"));
     }
-    let mut x0 = vec![0.0; system.state_count()];
-    assign("state", &system.states, &mut x0, args.x0)?;
+    let states = quantities::states(model, eqs);
+    let x0 = values_or_zero("state", "--x0", &states, args.x0)?;
+    if args.verbose {
+        stderr(&quantities::describe_params(
+            model,
+            eqs,
+            &params,
+            args.params,
+        ));
+        stderr(&quantities::describe_values(
+            "initial state",
+            &states,
+            &x0,
+            args.x0,
+        ));
+    }
     let opts = RunOptions {
         t_end: args.t_end,
         dt_out: args.dt_out.unwrap_or(args.t_end / DEFAULT_INTERVALS),
@@ -90,11 +91,7 @@ fn csv(
     };
     let traj = run(&system, &x0, &opts).map_err(|e| e.to_string())?;
     let mut out = String::new();
-    out.push('t');
-    for c in &traj.columns {
-        out.push(',');
-        out.push_str(c);
-    }
+    out.push_str(&quantities::csv_header(model, eqs, &traj.columns));
     out.push('\n');
     for (t, row) in traj.times.iter().zip(&traj.rows) {
         let _ = write!(out, "{t}");

@@ -152,10 +152,16 @@ impl<'a> Builder<'a> {
                 None
             }
             None => {
-                let help = self.scopes[sid]
-                    .suggest(&last.name, |e| {
-                        matches!(e, Entity::Node(_) | Entity::Instance(_))
-                    })
+                let suggestion = self.scopes[sid].suggest(&last.name, |e| {
+                    matches!(e, Entity::Node(_) | Entity::Instance(_))
+                });
+                // The element the misspelling meant lost this bond: its bond count follows from this error.
+                if let Some(Entity::Node(meant)) =
+                    suggestion.as_ref().and_then(|c| self.scopes[sid].get(c))
+                {
+                    self.suspect_nodes.insert(meant);
+                }
+                let help = suggestion
                     .map(|c| format!("did you mean `{c}`?"))
                     .unwrap_or_else(|| {
                         format!("declare it, e.g. `1 {};` for a 1-junction", last.name)

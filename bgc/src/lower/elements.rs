@@ -10,6 +10,7 @@
 use super::builder::Builder;
 use super::consteval::{eval, params_of};
 use super::exprs::{Allow, Cx, Q, port_var, var_letter};
+use super::unit_hints::Place;
 use crate::diagnostic::Diagnostic;
 use crate::ir::{self, Domain, Law, PortVar, Relation};
 use crate::span::Span;
@@ -84,6 +85,7 @@ impl Builder<'_> {
                     let expected = format!("{text} ({what} in the {} domain)", d.name());
                     if self.expect_unit(q, want, v.span, &expected, &name) {
                         self.explain_units(&expr);
+                        self.suggest_domain(Place::OnePort(kind), &name, q.dim(), (d, d));
                     }
                 }
                 Some(Relation::Source(expr))
@@ -107,6 +109,7 @@ impl Builder<'_> {
                     let expected = format!("{text} ({what} in the {} domain)", d.name());
                     if self.expect_unit(q, want, v.span, &expected, &name) {
                         self.explain_units(&expr);
+                        self.suggest_domain(Place::OnePort(kind), &name, q.dim(), (d, d));
                     }
                 }
                 self.check_value(kind, &name, &expr, v.span);
@@ -141,6 +144,7 @@ impl Builder<'_> {
                         let text = format!("{want} ({what}, {} to {})", din.name(), dout.name());
                         if self.expect_unit(q, want, v.span, &text, &name) {
                             self.explain_units(&expr);
+                            self.suggest_domain(Place::TwoPort(kind), &name, q.dim(), (din, dout));
                         }
                     }
                 }

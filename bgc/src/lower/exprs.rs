@@ -12,7 +12,7 @@ use super::scope::{Entity, closest};
 use crate::diagnostic::Diagnostic;
 use crate::ir::{self, Func, PortVar};
 use crate::syntax::ast::{self, BinOp, ExprKind};
-use crate::units::Dim;
+use crate::units::{Dim, Unit};
 use petgraph::graph::NodeIndex;
 
 /// The dimension of an expression: known, or free (a pure number that adapts to its place).
@@ -162,13 +162,14 @@ impl Builder<'_> {
                     self.not_allowed(e, &format!("the input `{name}`"), cx);
                     return None;
                 }
-                let d = self
+                let unit = self
                     .model
                     .inputs
                     .get(id)
-                    .map(|p| p.unit.dim)
-                    .unwrap_or_default();
-                Some((ir::Expr::Input(id), self.declared(Entity::Input(id), d)))
+                    .map(|p| p.unit)
+                    .unwrap_or(Unit::ONE);
+                let q = self.declared(Entity::Input(id), unit.dim);
+                Some((to_si(ir::Expr::Input(id), unit), q))
             }
             Some(Entity::Output(id)) => {
                 let ok = matches!(cx.allow, Allow::States { outputs_before: Some(n) } if id < n);
@@ -176,26 +177,23 @@ impl Builder<'_> {
                     self.not_allowed(e, &format!("the output `{name}`"), cx);
                     return None;
                 }
-                let d = self
+                let unit = self
                     .model
                     .outputs
                     .get(id)
-                    .map(|p| p.unit.dim)
-                    .unwrap_or_default();
-                Some((ir::Expr::Output(id), self.declared(Entity::Output(id), d)))
+                    .map(|p| p.unit)
+                    .unwrap_or(Unit::ONE);
+                let q = self.declared(Entity::Output(id), unit.dim);
+                Some((to_si(ir::Expr::Output(id), unit), q))
             }
             Some(Entity::Var(id)) => {
                 if !matches!(cx.allow, Allow::States { .. }) {
                     self.not_allowed(e, &format!("the integrated flow `{name}`"), cx);
                     return None;
                 }
-                let d = self
-                    .model
-                    .vars
-                    .get(id)
-                    .map(|p| p.unit.dim)
-                    .unwrap_or_default();
-                Some((ir::Expr::Var(id), self.declared(Entity::Var(id), d)))
+                let unit = self.model.vars.get(id).map(|p| p.unit).unwrap_or(Unit::ONE);
+                let q = self.declared(Entity::Var(id), unit.dim);
+                Some((to_si(ir::Expr::Var(id), unit), q))
             }
             Some(other) => {
                 self.diags.push(
@@ -224,6 +222,15 @@ impl Builder<'_> {
                         )
                     })
                 });
+                // The parameter a misspelling meant is not "unused": that would only repeat this error.
+                match suggestion
+                    .as_ref()
+                    .and_then(|c| self.scopes.get(cx.scope).and_then(|s| s.get(c)))
+                {
+                    Some(Entity::Param(meant)) => self.mark_used(meant),
+                    Some(_) => {}
+                    None => self.unmatched_name = true,
+                }
                 d = match (suggestion, cx.allow) {
                     (Some(c), _) => d.with_help(format!("did you mean `{c}`?")),
                     (None, Allow::Constant) => d.with_help(
@@ -266,7 +273,21 @@ impl Builder<'_> {
         let ra = self.expr(a, cx);
         let rb = self.expr(b, cx);
         let ((ea, qa), (eb, qb)) = (ra?, rb?);
-        let q = match op {
+        let q = self.binary_dim(op, (qa, qb), &eb, a, b, e)?;
+        Some((ir::Expr::Binary(op, Box::new(ea), Box::new(eb)), q))
+    }
+
+    /// The dimension of `a op b` from those of its operands (`eb` is `b` resolved, for the exponent of a power).
+    fn binary_dim(
+        &mut self,
+        op: BinOp,
+        (qa, qb): (Q, Q),
+        eb: &ir::Expr,
+        a: &ast::Expr,
+        b: &ast::Expr,
+        e: &ast::Expr,
+    ) -> Option<Q> {
+        match op {
             BinOp::Add | BinOp::Sub => self.same_dims(qa, qb, a, b, e, "added"),
             // A number times a dimensionless quantity is still a number that takes its place's unit:
             // `0.001 * sign(f(x))` may be a torque.
@@ -276,9 +297,48 @@ impl Builder<'_> {
                 (Q::Free, Q::Dim(d)) => Dim::NONE.checked_div(d).map(Q::Dim),
                 _ => combine(qa, qb, Dim::checked_div),
             },
-            BinOp::Pow => self.power(qa, &eb, qb, a, b),
-        }?;
-        Some((ir::Expr::Binary(op, Box::new(ea), Box::new(eb)), q))
+            BinOp::Pow => self.power(qa, eb, qb, a, b),
+        }
+    }
+
+    /// The argument of a function that needs a dimensionless one (`sin`, `exp`, ...). A bare number that multiplies
+    /// or divides a quantity in seconds takes 1/s (or s) here, so `sin(3*t)`, `exp(-t/2)` and `cos(2*pi*5*t + 1)`
+    /// are dimensionless. Anything with a declared unit keeps it: `sin(L*t)` with `L` in m is in m s (BG0309).
+    fn dimensionless_arg(&mut self, e: &ast::Expr, cx: Cx) -> Option<(ir::Expr, Q)> {
+        let second = Q::Dim(Dim::new(0, 0, 1, 0, 0, 0, 0));
+        match &e.kind {
+            ExprKind::Neg(a) => {
+                let (a, q) = self.dimensionless_arg(a, cx)?;
+                Some((ir::Expr::Neg(Box::new(a)), q))
+            }
+            ExprKind::Binary(op @ (BinOp::Add | BinOp::Sub), a, b) => {
+                let ra = self.dimensionless_arg(a, cx);
+                let rb = self.dimensionless_arg(b, cx);
+                let ((ea, qa), (eb, qb)) = (ra?, rb?);
+                let q = self.same_dims(qa, qb, a, b, e, "added")?;
+                Some((ir::Expr::Binary(*op, Box::new(ea), Box::new(eb)), q))
+            }
+            ExprKind::Binary(op @ (BinOp::Mul | BinOp::Div), a, b) => {
+                let ra = self.expr(a, cx);
+                let rb = self.expr(b, cx);
+                let ((ea, qa), (eb, qb)) = (ra?, rb?);
+                let rate = match op {
+                    BinOp::Mul => {
+                        (qa == Q::Free && qb == second) || (qa == second && qb == Q::Free)
+                    }
+                    _ => qa == second && qb == Q::Free,
+                };
+                // The number took the unit that makes the product dimensionless: what is left is a pure number,
+                // free like the number itself (so `sin(3*t)` may be a torque as `0.5` may).
+                let q = if rate {
+                    Q::Free
+                } else {
+                    self.binary_dim(*op, (qa, qb), &eb, a, b, e)?
+                };
+                Some((ir::Expr::Binary(*op, Box::new(ea), Box::new(eb)), q))
+            }
+            _ => self.expr(e, cx),
+        }
     }
 
     fn same_dims(
@@ -407,7 +467,20 @@ impl Builder<'_> {
             self.arity(f, func.arity(), args.len(), e);
             return None;
         }
-        let resolved: Vec<Option<(ir::Expr, Q)>> = args.iter().map(|a| self.expr(a, cx)).collect();
+        let needs_dimensionless = !matches!(
+            func,
+            Func::Sqrt | Func::Abs | Func::Sign | Func::Min | Func::Max | Func::Atan2
+        );
+        let resolved: Vec<Option<(ir::Expr, Q)>> = args
+            .iter()
+            .map(|a| {
+                if needs_dimensionless {
+                    self.dimensionless_arg(a, cx)
+                } else {
+                    self.expr(a, cx)
+                }
+            })
+            .collect();
         let resolved: Vec<(ir::Expr, Q)> = resolved.into_iter().collect::<Option<_>>()?;
         let q0 = resolved[0].1;
         let q = match func {
@@ -471,6 +544,33 @@ impl Builder<'_> {
                 if want == 1 { "x" } else { "a, b" }
             )),
         );
+    }
+}
+
+/// An input, output or integrated flow holds its value in its declared unit (a `[rpm]` output is in rpm, in every
+/// printed and generated form); expressions compute in SI, so a reference to it is multiplied by the unit's scale.
+fn to_si(e: ir::Expr, unit: Unit) -> ir::Expr {
+    if unit.scale == 1.0 {
+        e
+    } else {
+        ir::Expr::Binary(
+            BinOp::Mul,
+            Box::new(ir::Expr::Const(unit.scale)),
+            Box::new(e),
+        )
+    }
+}
+
+/// An SI value `e` expressed in `unit` (the value an output or integrated flow declared in `unit` holds).
+pub(super) fn from_si(e: ir::Expr, unit: Unit) -> ir::Expr {
+    if unit.scale == 1.0 {
+        e
+    } else {
+        ir::Expr::Binary(
+            BinOp::Div,
+            Box::new(e),
+            Box::new(ir::Expr::Const(unit.scale)),
+        )
     }
 }
 

@@ -13,8 +13,10 @@ use std::path::{Component, Path, PathBuf};
 
 /// The standard library, embedded.
 pub const STD_SOURCE: &str = include_str!("../../std/std.bg");
-/// The import path that names the standard library, and the name it has in diagnostics.
+/// The import path that names the standard library.
 pub const STD_NAME: &str = "std.bg";
+/// The name the standard library has in diagnostics: its path in bgc's sources, where a user can read it.
+pub const STD_DISPLAY_NAME: &str = "bgc/std/std.bg";
 
 /// Every parsed file of one compilation, the root first.
 pub(crate) struct Program {
@@ -106,7 +108,7 @@ impl LoadState {
         self.done.insert(key, id);
         for imp in imports {
             let (child_key, child_name, text) = if imp.path == STD_NAME {
-                (PathBuf::from("<std>"), STD_NAME.to_string(), None)
+                (PathBuf::from("<std>"), STD_DISPLAY_NAME.to_string(), None)
             } else {
                 let dir = Path::new(&name).parent().unwrap_or(Path::new(""));
                 let path = normalize(&dir.join(&imp.path));

@@ -18,10 +18,12 @@ mod elements;
 mod exprs;
 mod flatten;
 mod imports;
+mod instances;
 mod references;
 mod scope;
 mod signals;
 mod structure;
+mod unit_hints;
 
 #[cfg(test)]
 mod fixture_tests;
@@ -39,6 +41,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 pub use imports::{STD_NAME, STD_SOURCE};
+pub use instances::add_instance_context;
 
 /// Where lowering gets the text of imported files. The path is the import joined to the directory of the importing
 /// file's name in the [`SourceMap`] (so relative to wherever the root file's name is relative to). The CLI reads the
@@ -101,6 +104,7 @@ pub fn lower(
         b.build_relations();
         b.build_signals();
         b.unused_params();
+        add_instance_context(&b.model, &mut b.diags);
         diags.append(&mut b.diags);
         instantiated.append(&mut b.instantiated);
         models.push(b.model);

@@ -3,9 +3,13 @@
 //!
 //! An output's declared unit must be the unit of its expression; a var's declared unit must be its integrand's unit
 //! times seconds (BG0303). A declaration whose unit could not be read is not checked again.
+//!
+//! Outputs and integrated flows hold their values in their declared units: `output w [rpm] = f(rotor);` is the
+//! rotor speed divided by the rpm's scale, so that the CSV of `bgc simulate`, the C and D of `bgc statespace` and the
+//! generated code all give rpm. References to them convert back to SI (see `exprs::to_si`).
 
 use super::builder::Builder;
-use super::exprs::{Allow, Cx, Q};
+use super::exprs::{Allow, Cx, Q, from_si};
 use super::scope::Entity;
 use crate::diagnostic::Diagnostic;
 use crate::units::Dim;
@@ -43,7 +47,8 @@ impl Builder<'_> {
                     .with_help("fix the declared unit or the expression"),
                 );
             }
-            self.model.outputs[id].value = expr;
+            let unit = self.model.outputs[id].unit;
+            self.model.outputs[id].value = from_si(expr, unit);
         }
         for (id, scope, decl) in std::mem::take(&mut self.pending_vars) {
             let cx = Cx {
@@ -83,7 +88,8 @@ impl Builder<'_> {
                     .with_help("the unit of `int(x)` is the unit of `x` times seconds"),
                 );
             }
-            self.model.vars[id].integrand = expr;
+            let unit = self.model.vars[id].unit;
+            self.model.vars[id].integrand = from_si(expr, unit);
         }
         if let Some((scope, decl)) = self.pending_coords.take() {
             let cx = Cx {
@@ -105,8 +111,11 @@ impl Builder<'_> {
         }
     }
 
-    /// BG0402 for every parameter nothing uses.
+    /// BG0402 for every parameter nothing uses (none while an unknown name without a close match is reported).
     pub fn unused_params(&mut self) {
+        if self.unmatched_name {
+            return;
+        }
         for (p, info) in self.model.params.iter().zip(&self.params) {
             if !info.used {
                 self.diags.push(

@@ -6,9 +6,9 @@
 //! - a TF, GY, MTF or MGY has exactly one bond in (its port 0) and one out (its port 1) (BG0304);
 //! - a junction has at least two bonds (BG0305);
 //! - each port of a field has exactly one bond (BG0307);
-//! - a source whose bond points into it, or a C, I or R whose bond points out of it, is a warning (BG0308): the
-//!   equations are still right (the half-arrow only fixes the sign convention of power), but a source that
-//!   absorbs power or a resistor that supplies it is almost always a reversed arrow.
+//! - a source whose bond points into it, or a C, I or R whose bond points out of it, is a warning (BG0308): a C, I
+//!   or R behaves the same either way (its own `e` and `f` are taken with power into it), but the bond's variables
+//!   change sign, and a source drawn this way absorbs the power it sets; either is almost always a reversed arrow.
 
 use super::builder::Builder;
 use super::flatten::kind_name;
@@ -196,6 +196,8 @@ impl Builder<'_> {
         }
     }
 
+    /// BG0308: a source whose bond points into it, or a C, I or R whose bond points out of it. The message says
+    /// which way the bond is drawn and which way is usual, and the help writes the bond turned round.
     fn power_direction(
         &mut self,
         kind: ElementKind,
@@ -204,27 +206,50 @@ impl Builder<'_> {
         outgoing: &[EdgeIndex],
     ) {
         use ElementKind as K;
-        let (bad, expected) = match kind {
-            K::Se | K::Sf | K::MSe | K::MSf => {
-                (incoming.first(), "a source's bond points away from it")
-            }
-            K::C | K::I | K::R => (
-                outgoing.first(),
-                "a storage or dissipative element's bond points into it",
-            ),
-            _ => (None, ""),
+        let source = matches!(kind, K::Se | K::Sf | K::MSe | K::MSf);
+        let bad = match kind {
+            _ if source => incoming.first(),
+            K::C | K::I | K::R => outgoing.first(),
+            _ => None,
         };
         let Some(&e) = bad else { return };
-        self.diags.push(
-            Diagnostic::warning(
-                "BG0308",
-                format!("the bond of `{name}` points the unusual way"),
+        let Some((from, to)) = self.model.graph.edge_endpoints(e) else {
+            return;
+        };
+        let from = self.model.graph[from].name.clone();
+        let to = self.model.graph[to].name.clone();
+        let kw = match kind {
+            K::I | K::R => format!("an `{}`", kind.keyword()),
+            _ => format!("a `{}`", kind.keyword()),
+        };
+        let (message, label, note) = if source {
+            (
+                format!("the bond of source `{name}` points into it"),
+                format!("this bond points from `{from}` into `{name}`"),
+                "a source's bond usually points away from it, so that the power it delivers counts positive; drawn \
+                 into it, the source absorbs `e·f` and `supplied` counts it with the opposite sign",
             )
-            .with_primary(self.bond_span(e), "power flows the other way here")
-            .with_note(format!(
-                "{expected}; reversing it changes the sign convention of the power on this bond"
-            ))
-            .with_help("turn the bond around unless the reversed sign is intended"),
+        } else {
+            (
+                format!("the bond of `{name}` ({kw}) points out of it"),
+                format!("this bond points from `{name}` out to `{to}`"),
+                "a C, I or R usually has its bond pointing into it, so that the power it stores or dissipates counts \
+                 positive along the bond; the element's own `e`, `f` and energy are the same either way, but the \
+                 bond's flow is minus the element's",
+            )
+        };
+        let turned = if source {
+            format!("bond {name} -> {from};")
+        } else {
+            format!("bond {to} -> {name};")
+        };
+        self.diags.push(
+            Diagnostic::warning("BG0308", message)
+                .with_primary(self.bond_span(e), label)
+                .with_note(note)
+                .with_help(format!(
+                    "write `{turned}` unless the reversed sign is intended"
+                )),
         );
     }
 }

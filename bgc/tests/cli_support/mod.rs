@@ -79,13 +79,14 @@ pub struct Csv {
 }
 
 impl Csv {
+    /// Parses the CSV; the header's names without their units (`q_spring [m]` is `q_spring`, see [`Csv::units`]).
     pub fn parse(text: &str) -> Csv {
         let mut lines = text.lines();
         let header = lines
             .next()
             .expect("header")
             .split(',')
-            .map(String::from)
+            .map(|h| h.split(" [").next().unwrap_or(h).to_string())
             .collect();
         let rows = lines
             .map(|l| l.split(',').map(|x| x.parse().expect("number")).collect())
@@ -103,10 +104,30 @@ impl Csv {
     }
 }
 
+/// The units of the header's columns, `t [s]` giving `s`.
+pub fn units(text: &str) -> Vec<String> {
+    let header = text.lines().next().unwrap_or("");
+    header
+        .split(',')
+        .map(|h| {
+            h.split_once(" [")
+                .map(|(_, u)| u.trim_end_matches(']').to_string())
+                .unwrap_or_default()
+        })
+        .collect()
+}
+
 pub fn simulate(args: &[&str]) -> Csv {
     let mut all = vec!["simulate"];
     all.extend_from_slice(args);
     let (code, out, err) = bgc(&all);
     assert_eq!(code, 0, "stderr: {err}");
     Csv::parse(&out)
+}
+
+/// Writes a model to a fresh file of the system's temporary directory and returns its path.
+pub fn temp_model(name: &str, text: &str) -> String {
+    let path = std::env::temp_dir().join(format!("bgc-{}-{name}.bg", std::process::id()));
+    std::fs::write(&path, text).expect("temporary model written");
+    path.display().to_string()
 }

@@ -1,7 +1,7 @@
 //! Messages that point at the cause: power directions, forgotten domains, datasheet units, follow-on findings,
 //! symbolic entries in the user's parameters, `fmt --check` diffs and the language reference's own examples.
 
-mod cli_support;
+use crate::cli_support;
 
 use cli_support::{bgc, ok_json, temp_model};
 

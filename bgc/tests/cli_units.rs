@@ -1,7 +1,7 @@
 //! Numbers that mean what the user wrote: declared units of outputs, inputs, vars and parameters, units on the
 //! command line, repeated names, inputs held at zero, and the state space's text form.
 
-mod cli_support;
+use crate::cli_support;
 
 use cli_support::{Csv, bgc, matrix, ok_json, repo, temp_model, units};
 

@@ -45,18 +45,23 @@
 //! - [`from_ir`] from the IR's expressions.
 
 mod build;
+mod cse;
+mod dag;
 mod diff;
 mod error;
 mod eval;
 mod expr;
 mod from_ir;
+mod intern;
 mod linear;
+mod order;
 mod print;
 mod solve;
 
 #[cfg(test)]
 mod tests;
 
+pub use cse::{cse, to_rust_cse, to_text_cse};
 pub use error::SymbolicError;
 pub use eval::{max, min, sign};
 pub use expr::{Expr, Node, Symbol, SymbolKind};

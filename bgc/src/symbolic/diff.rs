@@ -11,54 +11,137 @@
 //! - `min(a, b)' = (1 - s)/2 a' + (1 + s)/2 b'` and `max(a, b)' = (1 + s)/2 a' + (1 - s)/2 b'` with
 //!   `s = sign(a - b)`: the derivative of the active argument, and the mean of both where `a = b`.
 
+use super::dag::{Dag, Memo};
 use super::expr::{Expr, Node, Symbol};
 use crate::ir::Func;
+use std::collections::BTreeSet;
 use std::f64::consts::LN_10;
 
 impl Expr {
-    /// `d self / d x`, simplified.
+    /// `d self / d x`, simplified. Each distinct node is differentiated once.
     pub fn diff(&self, x: &Symbol) -> Expr {
-        if !self.depends_on(x) {
-            return Expr::zero();
-        }
-        match self.node() {
-            Node::Const(_) => Expr::zero(),
-            Node::Sym(s) => Expr::constant(if s == x { 1.0 } else { 0.0 }),
-            Node::Add(terms) => Expr::sum(terms.iter().map(|t| t.diff(x))),
-            Node::Mul(factors) => Expr::sum((0..factors.len()).map(|i| {
-                Expr::product(
-                    factors.iter().enumerate().map(
-                        |(j, f)| {
-                            if i == j { f.diff(x) } else { f.clone() }
-                        },
-                    ),
-                )
-            })),
-            Node::Pow(b, e) => {
-                if e.depends_on(x) {
-                    self * (e.diff(x) * b.ln() + e * b.diff(x) / b)
-                } else {
-                    e * b.pow(&(e - 1.0)) * b.diff(x)
-                }
-            }
-            Node::Call(func, args) => diff_call(*func, args, x),
-        }
+        diff_all(std::slice::from_ref(self), x)
+            .pop()
+            .unwrap_or_else(Expr::zero)
     }
 
-    /// The Jacobian `∂ exprsᵢ / ∂ varsⱼ`, row by row.
+    /// The Jacobian `∂ exprsᵢ / ∂ varsⱼ`, row by row. Each variable is one walk over all rows together, so a
+    /// subexpression the rows share is differentiated once.
     pub fn jacobian(exprs: &[Expr], vars: &[Symbol]) -> Vec<Vec<Expr>> {
-        exprs
-            .iter()
-            .map(|e| vars.iter().map(|v| e.diff(v)).collect())
+        let columns: Vec<Vec<Expr>> = vars.iter().map(|v| diff_all(exprs, v)).collect();
+        (0..exprs.len())
+            .map(|i| {
+                columns
+                    .iter()
+                    .map(|col| col.get(i).cloned().unwrap_or_else(Expr::zero))
+                    .collect()
+            })
             .collect()
+    }
+
+    /// The entries of the Jacobian `∂ exprsᵢ / ∂ varsⱼ` that are not structurally zero, as `(i, j, entry)` sorted
+    /// by row then column. Only the variables an expression reads are differentiated for: the cost follows the
+    /// non-zeros, not `exprs.len() * vars.len()`. An entry that simplifies to 0 although its variable occurs
+    /// (`x - x` cannot occur in canonical form, but `d(x*y)/dx` at `y = 0` is `y`, not 0) is kept only when it is
+    /// not the constant 0.
+    pub fn sparse_jacobian(exprs: &[Expr], vars: &[Symbol]) -> Vec<(usize, usize, Expr)> {
+        let reads = Expr::symbols_read(exprs);
+        let mut out = Vec::new();
+        for (j, v) in vars.iter().enumerate() {
+            let rows: Vec<usize> = (0..exprs.len())
+                .filter(|&i| reads.get(i).is_some_and(|r| r.contains(v)))
+                .collect();
+            let picked: Vec<Expr> = rows.iter().filter_map(|&i| exprs.get(i).cloned()).collect();
+            for (&i, d) in rows.iter().zip(diff_all(&picked, v)) {
+                if !d.is_zero() {
+                    out.push((i, j, d));
+                }
+            }
+        }
+        out.sort_by_key(|(i, j, _)| (*i, *j));
+        out
+    }
+
+    /// For each expression, the symbols it reads: one walk per expression over its distinct nodes.
+    pub fn symbols_read(exprs: &[Expr]) -> Vec<BTreeSet<Symbol>> {
+        exprs.iter().map(Expr::free_symbols).collect()
     }
 }
 
-fn diff_call(func: Func, args: &[Expr], x: &Symbol) -> Expr {
+/// `d e / d x` for each `e` of `exprs`, over one walk of their nodes: first which nodes depend on `x`, then the
+/// derivative of each of those from its children's.
+fn diff_all(exprs: &[Expr], x: &Symbol) -> Vec<Expr> {
+    let dag = Dag::new(exprs);
+    let mut depends = vec![false; dag.len()];
+    for (i, e) in dag.order.iter().enumerate() {
+        let mut d = e.as_symbol() == Some(x);
+        e.node().for_each_child(|c| {
+            d |= dag
+                .index(c)
+                .and_then(|k| depends.get(k))
+                .copied()
+                .unwrap_or(false);
+        });
+        if let Some(slot) = depends.get_mut(i) {
+            *slot = d;
+        }
+    }
+    let mut memo: Memo<Expr> = Memo::new(&dag);
+    for (i, e) in dag.order.iter().enumerate() {
+        if !depends.get(i).copied().unwrap_or(false) {
+            continue;
+        }
+        let dep = |u: &Expr| {
+            dag.index(u)
+                .and_then(|k| depends.get(k))
+                .copied()
+                .unwrap_or(false)
+        };
+        let d = |u: &Expr| memo.get(u).cloned().unwrap_or_else(Expr::zero);
+        let derivative = diff_node(e, x, &dep, &d);
+        memo.set(i, derivative);
+    }
+    exprs
+        .iter()
+        .map(|e| memo.get(e).cloned().unwrap_or_else(Expr::zero))
+        .collect()
+}
+
+/// The derivative of the node `e`, given which children depend on `x` and their derivatives.
+fn diff_node(
+    e: &Expr,
+    x: &Symbol,
+    depends: &dyn Fn(&Expr) -> bool,
+    d: &dyn Fn(&Expr) -> Expr,
+) -> Expr {
+    match e.node() {
+        Node::Const(_) => Expr::zero(),
+        Node::Sym(s) => Expr::constant(if s == x { 1.0 } else { 0.0 }),
+        Node::Add(terms) => Expr::sum(terms.iter().map(d)),
+        Node::Mul(factors) => Expr::sum((0..factors.len()).map(|i| {
+            Expr::product(
+                factors
+                    .iter()
+                    .enumerate()
+                    .map(|(j, f)| if i == j { d(f) } else { f.clone() }),
+            )
+        })),
+        Node::Pow(b, ex) => {
+            if depends(ex) {
+                e * (d(ex) * b.ln() + ex * d(b) / b)
+            } else {
+                ex * b.pow(&(ex - 1.0)) * d(b)
+            }
+        }
+        Node::Call(func, args) => diff_call(*func, args, d),
+    }
+}
+
+fn diff_call(func: Func, args: &[Expr], d: &dyn Fn(&Expr) -> Expr) -> Expr {
     let zero = Expr::zero();
     let u = args.first().unwrap_or(&zero);
     let v = args.get(1).unwrap_or(&zero);
-    let du = u.diff(x);
+    let du = d(u);
     match func {
         Func::Sin => u.cos() * du,
         Func::Cos => -(u.sin() * du),
@@ -66,7 +149,7 @@ fn diff_call(func: Func, args: &[Expr], x: &Symbol) -> Expr {
         Func::Asin => du * (1.0 - u.powi(2)).pow(&Expr::constant(-0.5)),
         Func::Acos => -(du * (1.0 - u.powi(2)).pow(&Expr::constant(-0.5))),
         Func::Atan => du / (1.0 + u.powi(2)),
-        Func::Atan2 => (v * du - u * v.diff(x)) / (u.powi(2) + v.powi(2)),
+        Func::Atan2 => (v * du - u * d(v)) / (u.powi(2) + v.powi(2)),
         Func::Exp => u.exp() * du,
         Func::Ln => du / u,
         Func::Log10 => du / (u * LN_10),
@@ -80,7 +163,7 @@ fn diff_call(func: Func, args: &[Expr], x: &Symbol) -> Expr {
             } else {
                 ((1.0 + &s) * 0.5, (1.0 - &s) * 0.5)
             };
-            wu * du + wv * v.diff(x)
+            wu * du + wv * d(v)
         }
         Func::Tanh => du * (1.0 - u.tanh().powi(2)),
         Func::Sinh => u.cosh() * du,

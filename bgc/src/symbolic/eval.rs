@@ -1,4 +1,4 @@
-//! Numeric evaluation, free symbols and substitution.
+//! Numeric evaluation, free symbols and substitution, each a walk of the distinct nodes (see `dag.rs`).
 //!
 //! Evaluation follows IEEE arithmetic with the same formulas and operation order as the generated Rust (see
 //! `print/rust.rs`): sums in print order, products as `(coefficient * numerator factors) / (denominator factors)`,
@@ -19,10 +19,12 @@
 //! NaN and infinities propagate as IEEE values; checking them is the caller's business.
 
 use super::SymbolicError;
+use super::dag::{Dag, Memo};
 use super::expr::{Expr, Node, Symbol};
+use super::intern::PassThroughState;
 use super::print::sum_print_order;
 use crate::ir::Func;
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::{BTreeMap, BTreeSet, HashSet};
 
 // `bgc_sign`, `bgc_min`, `bgc_max`, `bgc_powi`: the very code generated modules define.
 include!("print/rust_helpers.rs");
@@ -98,72 +100,53 @@ impl Expr {
         self.eval_dyn(&|s: &Symbol| env.get(s).copied())
     }
 
+    /// Each distinct node once, children first; `env` is asked once per distinct symbol.
     fn eval_dyn(&self, env: &dyn Fn(&Symbol) -> Option<f64>) -> Result<f64, SymbolicError> {
-        Ok(match self.node() {
-            Node::Const(c) => *c,
-            Node::Sym(s) => env(s).ok_or_else(|| SymbolicError::UnboundSymbol {
-                name: s.name().to_string(),
-                kind: s.kind(),
-            })?,
-            Node::Add(xs) => {
-                // In the printers' order, so that generated code rounds the same way.
-                let mut acc = 0.0;
-                for x in sum_print_order(xs) {
-                    acc += x.eval_dyn(env)?;
+        let dag = Dag::new([self]);
+        let mut values: Vec<f64> = Vec::with_capacity(dag.len());
+        for e in &dag.order {
+            let value = {
+                let val = |x: &Expr| {
+                    dag.index(x)
+                        .and_then(|i| values.get(i))
+                        .copied()
+                        .unwrap_or(f64::NAN)
+                };
+                match e.node() {
+                    Node::Const(c) => *c,
+                    Node::Sym(s) => env(s).ok_or_else(|| SymbolicError::UnboundSymbol {
+                        name: s.name().to_string(),
+                        kind: s.kind(),
+                    })?,
+                    // In the printers' order, so that generated code rounds the same way.
+                    Node::Add(xs) => sum_print_order(xs)
+                        .into_iter()
+                        .fold(0.0, |acc, x| acc + val(x)),
+                    Node::Mul(_) => fraction_value(e, &val),
+                    Node::Pow(..) if e.negative_power().is_some() => fraction_value(e, &val),
+                    Node::Pow(b, x) => pow_f64(val(b), val(x)),
+                    Node::Call(f, xs) => {
+                        let mut args = [f64::NAN; 2];
+                        for (slot, x) in args.iter_mut().zip(xs) {
+                            *slot = val(x);
+                        }
+                        apply_func(*f, &args[..xs.len().min(2)])
+                    }
                 }
-                acc
-            }
-            Node::Mul(_) => self.eval_fraction(env)?,
-            Node::Pow(..) if self.negative_power().is_some() => self.eval_fraction(env)?,
-            Node::Pow(b, e) => pow_f64(b.eval_dyn(env)?, e.eval_dyn(env)?),
-            Node::Call(f, xs) => {
-                let mut args = [f64::NAN; 2];
-                for (slot, x) in args.iter_mut().zip(xs) {
-                    *slot = x.eval_dyn(env)?;
-                }
-                apply_func(*f, &args[..xs.len().min(2)])
-            }
-        })
-    }
-
-    /// A product (or a power with a negative exponent) as the printers lay it out: `(coeff * num...) / (den...)`.
-    fn eval_fraction(&self, env: &dyn Fn(&Symbol) -> Option<f64>) -> Result<f64, SymbolicError> {
-        let (coeff, factors) = match self.node() {
-            Node::Mul(_) => self.coeff_and_factors(),
-            _ => (1.0, std::slice::from_ref(self)),
-        };
-        let mut num = coeff;
-        let mut den = 1.0;
-        for f in factors {
-            match f.negative_power() {
-                Some((b, e)) => den *= pow_f64(b.eval_dyn(env)?, -e.eval_dyn(env)?),
-                None => num *= f.eval_dyn(env)?,
-            }
+            };
+            values.push(value);
         }
-        Ok(num / den)
+        Ok(values.last().copied().unwrap_or(f64::NAN))
     }
 
     /// The symbols the expression depends on, in [`Symbol`] order.
     pub fn free_symbols(&self) -> BTreeSet<Symbol> {
-        let mut out = BTreeSet::new();
-        self.collect_symbols(&mut out);
-        out
-    }
-
-    fn collect_symbols(&self, out: &mut BTreeSet<Symbol>) {
-        match self.node() {
-            Node::Const(_) => {}
-            Node::Sym(s) => {
-                out.insert(s.clone());
-            }
-            Node::Add(xs) | Node::Mul(xs) | Node::Call(_, xs) => {
-                xs.iter().for_each(|x| x.collect_symbols(out));
-            }
-            Node::Pow(b, e) => {
-                b.collect_symbols(out);
-                e.collect_symbols(out);
-            }
-        }
+        Dag::new([self])
+            .order
+            .into_iter()
+            .filter_map(Expr::as_symbol)
+            .cloned()
+            .collect()
     }
 
     /// Whether `symbol` occurs in the expression.
@@ -171,16 +154,22 @@ impl Expr {
         self.depends_on_any(std::slice::from_ref(symbol))
     }
 
-    /// Whether any of `symbols` occurs in the expression.
+    /// Whether any of `symbols` occurs in the expression: a walk of the distinct nodes that stops at the first.
     pub fn depends_on_any(&self, symbols: &[Symbol]) -> bool {
-        match self.node() {
-            Node::Const(_) => false,
-            Node::Sym(s) => symbols.contains(s),
-            Node::Add(xs) | Node::Mul(xs) | Node::Call(_, xs) => {
-                xs.iter().any(|x| x.depends_on_any(symbols))
+        let mut seen: HashSet<usize, PassThroughState> = HashSet::default();
+        let mut pending = vec![self];
+        while let Some(e) = pending.pop() {
+            if !seen.insert(e.address()) {
+                continue;
             }
-            Node::Pow(b, e) => b.depends_on_any(symbols) || e.depends_on_any(symbols),
+            if let Some(s) = e.as_symbol()
+                && symbols.contains(s)
+            {
+                return true;
+            }
+            e.node().for_each_child(|c| pending.push(c));
         }
+        false
     }
 
     /// Replaces every symbol in `map` by its expression, all at once (a replacement is not substituted again), and
@@ -189,27 +178,68 @@ impl Expr {
         self.substitute_with(&|s: &Symbol| map.get(s).cloned())
     }
 
-    /// Replaces each symbol for which `f` returns an expression, all at once, and simplifies the result.
+    /// Replaces each symbol for which `f` returns an expression, all at once, and simplifies the result. Each
+    /// distinct node is rebuilt once; a node none of whose symbols is replaced is kept as it is.
     pub fn substitute_with(&self, f: &dyn Fn(&Symbol) -> Option<Expr>) -> Expr {
-        match self.node() {
-            Node::Const(_) => self.clone(),
-            Node::Sym(s) => f(s).unwrap_or_else(|| self.clone()),
-            _ => self.map_children(&|c| c.substitute_with(f)),
+        let dag = Dag::new([self]);
+        let mut memo = Memo::new(&dag);
+        for (i, e) in dag.order.iter().enumerate() {
+            let out = match e.node() {
+                Node::Const(_) => (*e).clone(),
+                Node::Sym(s) => f(s).unwrap_or_else(|| (*e).clone()),
+                _ => e.map_children(&|c| memo.get(c).cloned().unwrap_or_else(|| c.clone())),
+            };
+            memo.set(i, out);
         }
+        memo.get(self).cloned().unwrap_or_else(|| self.clone())
     }
 
-    /// Rebuilds the node from its children transformed by `f`, simplifying.
+    /// Rebuilds the node from its children transformed by `f`, simplifying; the node itself when `f` changes no
+    /// child (canonical form is rebuilt unchanged, so this only saves the work).
     pub(super) fn map_children(&self, f: &dyn Fn(&Expr) -> Expr) -> Expr {
-        match self.node() {
-            Node::Const(_) | Node::Sym(_) => self.clone(),
-            Node::Add(xs) => Expr::sum(xs.iter().map(f)),
-            Node::Mul(xs) => Expr::product(xs.iter().map(f)),
-            Node::Pow(b, e) => f(b).pow(&f(e)),
-            Node::Call(func, xs) => {
-                let args: Vec<Expr> = xs.iter().map(f).collect();
-                // The arity is that of the original call, so `call` cannot refuse it.
-                Expr::call(*func, &args).unwrap_or_else(|| self.clone())
+        let mut changed = false;
+        let mut g = |c: &Expr| {
+            let out = f(c);
+            changed |= out != *c;
+            out
+        };
+        let rebuilt = match self.node() {
+            Node::Const(_) | Node::Sym(_) => return self.clone(),
+            Node::Add(xs) => {
+                let terms: Vec<Expr> = xs.iter().map(&mut g).collect();
+                changed.then(|| Expr::sum(terms))
             }
+            Node::Mul(xs) => {
+                let factors: Vec<Expr> = xs.iter().map(&mut g).collect();
+                changed.then(|| Expr::product(factors))
+            }
+            Node::Pow(b, e) => {
+                let (b, e) = (g(b), g(e));
+                changed.then(|| b.pow(&e))
+            }
+            Node::Call(func, xs) => {
+                let args: Vec<Expr> = xs.iter().map(&mut g).collect();
+                // The arity is that of the original call, so `call` cannot refuse it.
+                changed.then(|| Expr::call(*func, &args).unwrap_or_else(|| self.clone()))
+            }
+        };
+        rebuilt.unwrap_or_else(|| self.clone())
+    }
+}
+
+/// A product (or a power with a negative exponent) as the printers lay it out: `(coeff * num...) / (den...)`.
+fn fraction_value(e: &Expr, val: &dyn Fn(&Expr) -> f64) -> f64 {
+    let (coeff, factors) = match e.node() {
+        Node::Mul(_) => e.coeff_and_factors(),
+        _ => (1.0, std::slice::from_ref(e)),
+    };
+    let mut num = coeff;
+    let mut den = 1.0;
+    for f in factors {
+        match f.negative_power() {
+            Some((b, x)) => den *= pow_f64(val(b), -val(x)),
+            None => num *= val(f),
         }
     }
+    num / den
 }

@@ -1,23 +1,17 @@
-//! The expression type: shared immutable nodes, structural equality and hashing, and the canonical total order.
+//! The expression type: nodes shared by hash-consing, identity equality, structural hashing, and freeing without
+//! recursion.
 //!
-//! An [`Expr`] is an `Arc` to an immutable node that also caches a structural hash, so cloning is a reference-count
-//! increment, equality between different expressions is usually decided by the hash alone, and expressions can be
-//! sent between threads. Nodes are only ever built by the simplifying constructors of `build.rs`, so every `Expr`
-//! is in canonical form (see the invariants on [`Node`]).
+//! An [`Expr`] is an `Arc` to an immutable node in the hash-consing table (`intern.rs`): equal expressions are one
+//! node, so equality is a pointer comparison, cloning is a reference-count increment, and a subexpression used in
+//! many places is stored once. Each node caches its structural hash (the same in every run, so that hash maps of
+//! expressions iterate alike) and its size as a tree. Nodes are only ever built by the simplifying constructors of
+//! `build.rs`, so every `Expr` is in canonical form (see the invariants on [`Node`]); the canonical order of terms
+//! and factors is in `order.rs`.
 //!
-//! # The total order
-//! Terms of sums and factors of products are sorted by [`Ord for Expr`](Expr#impl-Ord-for-Expr):
-//! - constants come first, ordered by [`f64::total_cmp`];
-//! - any other expression is seen as `coefficient × Π baseᵢ^expᵢ` (a product's own factors; `x^e` is one factor;
-//!   anything else is one factor with exponent 1). Two expressions compare their factor lists lexicographically,
-//!   each factor by base then exponent, then the shorter list first, then the coefficient.
-//! - bases compare by kind (constant < symbol < call < sum < product < power), then structurally: symbols by
-//!   [`Symbol`]'s order (kind, then name), calls by function then arguments, sums by their terms.
-//!
-//! So `x` < `x^2` < `x*y` < `y`, and `2*x` sits next to `x`: like terms are adjacent, which is what collection needs.
+//! Expressions are `Send + Sync` and can be built from any thread: the table is process-wide.
 
+use super::intern::intern;
 use crate::ir::Func;
-use std::cmp::Ordering;
 use std::fmt;
 use std::hash::{DefaultHasher, Hash, Hasher};
 use std::sync::Arc;
@@ -120,24 +114,39 @@ pub enum Node {
     Call(Func, Vec<Expr>),
 }
 
-struct Inner {
-    node: Node,
-    hash: u64,
+pub(super) struct Inner {
+    pub(super) node: Node,
+    pub(super) hash: u64,
+    /// The number of nodes of the expression as a tree (shared subexpressions counted each time), saturating.
+    pub(super) tree_size: u64,
 }
 
-/// A canonical symbolic expression; cheap to clone (an `Arc`).
+/// A canonical symbolic expression: a handle to its node in the hash-consing table; cheap to clone (an `Arc`).
 #[derive(Clone)]
 pub struct Expr(Arc<Inner>);
 
 impl Expr {
-    /// Wraps a node that already satisfies the canonical invariants. Only the simplifying constructors call this.
+    /// The one node equal to `node`, which already satisfies the canonical invariants. Only the simplifying
+    /// constructors call this.
     pub(super) fn from_canonical(node: Node) -> Expr {
         let node = match node {
             Node::Const(c) => Node::Const(normalize_const(c)),
             other => other,
         };
         let hash = structural_hash(&node);
-        Expr(Arc::new(Inner { node, hash }))
+        let mut tree_size = 1u64;
+        node.for_each_child(|c| tree_size = tree_size.saturating_add(c.0.tree_size));
+        Expr(intern(node, hash, tree_size))
+    }
+
+    /// Whether both are the same node, i.e. (by hash-consing) equal expressions.
+    pub(super) fn same_node(&self, other: &Expr) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+
+    /// The node's address: an identity that lasts as long as the node.
+    pub(super) fn address(&self) -> usize {
+        Arc::as_ptr(&self.0) as usize
     }
 
     /// The top node, for inspecting an expression.
@@ -171,15 +180,10 @@ impl Expr {
         self.as_const() == Some(1.0)
     }
 
-    /// Number of nodes in the tree (shared subtrees counted each time): a size measure for choosing pivots.
+    /// Number of nodes in the tree (shared subtrees counted each time, saturating at `usize::MAX`): a size
+    /// measure for choosing pivots. Kept in the node, so this costs nothing.
     pub fn node_count(&self) -> usize {
-        1 + match self.node() {
-            Node::Const(_) | Node::Sym(_) => 0,
-            Node::Add(xs) | Node::Mul(xs) | Node::Call(_, xs) => {
-                xs.iter().map(Expr::node_count).sum()
-            }
-            Node::Pow(b, e) => b.node_count() + e.node_count(),
-        }
+        usize::try_from(self.0.tree_size).unwrap_or(usize::MAX)
     }
 
     /// The numeric coefficient and the remaining factors: `3*x*y` → `(3, [x, y])`, `x` → `(1, [x])`.
@@ -271,9 +275,9 @@ fn structural_hash(node: &Node) -> u64 {
 }
 
 impl PartialEq for Expr {
+    /// Identity: hash-consing makes equal expressions one node.
     fn eq(&self, other: &Expr) -> bool {
-        Arc::ptr_eq(&self.0, &other.0)
-            || (self.0.hash == other.0.hash && self.cmp(other) == Ordering::Equal)
+        self.same_node(other)
     }
 }
 
@@ -285,85 +289,60 @@ impl Hash for Expr {
     }
 }
 
-impl PartialOrd for Expr {
-    fn partial_cmp(&self, other: &Expr) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl Ord for Expr {
-    fn cmp(&self, other: &Expr) -> Ordering {
-        if Arc::ptr_eq(&self.0, &other.0) {
-            return Ordering::Equal;
+impl Node {
+    /// Calls `f` on each child, in order.
+    pub(super) fn for_each_child<'a>(&'a self, mut f: impl FnMut(&'a Expr)) {
+        match self {
+            Node::Const(_) | Node::Sym(_) => {}
+            Node::Add(xs) | Node::Mul(xs) | Node::Call(_, xs) => xs.iter().for_each(f),
+            Node::Pow(b, e) => {
+                f(b);
+                f(e);
+            }
         }
-        match (self.node(), other.node()) {
-            (Node::Const(a), Node::Const(b)) => a.total_cmp(b),
-            (Node::Const(_), _) => Ordering::Less,
-            (_, Node::Const(_)) => Ordering::Greater,
-            _ => {
-                let (ca, fa) = self.coeff_and_factors();
-                let (cb, fb) = other.coeff_and_factors();
-                fa.iter()
-                    .zip(fb)
-                    .map(|(x, y)| cmp_factor(x, y))
-                    .find(|o| o.is_ne())
-                    .unwrap_or_else(|| fa.len().cmp(&fb.len()))
-                    .then_with(|| ca.total_cmp(&cb))
+    }
+
+    /// The `i`-th child.
+    pub(super) fn child(&self, i: usize) -> Option<&Expr> {
+        match self {
+            Node::Const(_) | Node::Sym(_) => None,
+            Node::Add(xs) | Node::Mul(xs) | Node::Call(_, xs) => xs.get(i),
+            Node::Pow(b, e) => match i {
+                0 => Some(b),
+                1 => Some(e),
+                _ => None,
+            },
+        }
+    }
+
+    /// Moves the children out, leaving a leaf.
+    fn take_children(&mut self, out: &mut Vec<Expr>) {
+        match std::mem::replace(self, Node::Const(0.0)) {
+            Node::Const(_) | Node::Sym(_) => {}
+            Node::Add(xs) | Node::Mul(xs) | Node::Call(_, xs) => out.extend(xs),
+            Node::Pow(b, e) => {
+                out.push(b);
+                out.push(e);
             }
         }
     }
 }
 
-fn cmp_factor(x: &Expr, y: &Expr) -> Ordering {
-    let (bx, ex) = x.base_exp();
-    let (by, ey) = y.base_exp();
-    cmp_base(bx, by).then_with(|| match (ex, ey) {
-        (None, None) => Ordering::Equal,
-        (None, Some(e)) => cmp_with_one(e).reverse(),
-        (Some(e), None) => cmp_with_one(e),
-        (Some(a), Some(b)) => a.cmp(b),
-    })
-}
-
-/// `e` compared with the constant 1.
-fn cmp_with_one(e: &Expr) -> Ordering {
-    match e.as_const() {
-        Some(c) => c.total_cmp(&1.0),
-        None => Ordering::Greater,
+impl Drop for Inner {
+    /// Frees the nodes only this one kept alive with a work list, not by recursion, so that dropping a deep
+    /// expression cannot overflow the stack.
+    fn drop(&mut self) {
+        if matches!(self.node, Node::Const(_) | Node::Sym(_)) {
+            return;
+        }
+        let mut pending = Vec::new();
+        self.node.take_children(&mut pending);
+        while let Some(e) = pending.pop() {
+            if let Some(mut inner) = Arc::into_inner(e.0) {
+                inner.node.take_children(&mut pending);
+            }
+        }
     }
-}
-
-fn rank(e: &Expr) -> u8 {
-    match e.node() {
-        Node::Const(_) => 0,
-        Node::Sym(_) => 1,
-        Node::Call(..) => 2,
-        Node::Add(_) => 3,
-        Node::Mul(_) => 4,
-        Node::Pow(..) => 5,
-    }
-}
-
-fn cmp_base(x: &Expr, y: &Expr) -> Ordering {
-    rank(x)
-        .cmp(&rank(y))
-        .then_with(|| match (x.node(), y.node()) {
-            (Node::Const(a), Node::Const(b)) => a.total_cmp(b),
-            (Node::Sym(a), Node::Sym(b)) => a.cmp(b),
-            (Node::Call(f, xs), Node::Call(g, ys)) => f.cmp(g).then_with(|| cmp_lists(xs, ys)),
-            (Node::Add(xs), Node::Add(ys)) => cmp_lists(xs, ys),
-            (Node::Mul(_), Node::Mul(_)) => x.cmp(y),
-            (Node::Pow(b1, e1), Node::Pow(b2, e2)) => b1.cmp(b2).then_with(|| e1.cmp(e2)),
-            _ => Ordering::Equal,
-        })
-}
-
-fn cmp_lists(xs: &[Expr], ys: &[Expr]) -> Ordering {
-    xs.iter()
-        .zip(ys)
-        .map(|(x, y)| x.cmp(y))
-        .find(|o| o.is_ne())
-        .unwrap_or_else(|| xs.len().cmp(&ys.len()))
 }
 
 impl fmt::Debug for Expr {

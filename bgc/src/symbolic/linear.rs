@@ -7,6 +7,7 @@
 //! recognised as linear. Coefficients that expand to 0 are reported as exactly 0.
 
 use super::SymbolicError;
+use super::dag::{Dag, Memo};
 use super::expr::{Expr, Node, Symbol};
 
 /// Products with more terms than this are left partly unexpanded (a guard against exponential growth).
@@ -24,27 +25,35 @@ pub struct LinearForm {
 
 impl Expr {
     /// Distributes products over sums and expands positive integer powers of sums (up to
-    /// [`MAX_EXPANDED_POWER`]), recursively, also inside function arguments and exponents.
+    /// [`MAX_EXPANDED_POWER`]), recursively, also inside function arguments and exponents. Each distinct node is
+    /// expanded once.
     pub fn expand(&self) -> Expr {
-        match self.node() {
-            Node::Const(_) | Node::Sym(_) => self.clone(),
-            Node::Add(xs) => Expr::sum(xs.iter().map(Expr::expand)),
-            Node::Mul(xs) => expand_product(xs.iter().map(Expr::expand)),
-            Node::Pow(b, e) => {
-                let b = b.expand();
-                let e = e.expand();
-                match e.as_const().and_then(super::eval::as_i32) {
-                    Some(n)
-                        if (2..=MAX_EXPANDED_POWER).contains(&n)
-                            && matches!(b.node(), Node::Add(_)) =>
-                    {
-                        expand_product(std::iter::repeat_n(b, n as usize))
+        let dag = Dag::new([self]);
+        let mut memo: Memo<Expr> = Memo::new(&dag);
+        for (i, e) in dag.order.iter().enumerate() {
+            let x = |c: &Expr| memo.get(c).cloned().unwrap_or_else(|| c.clone());
+            let expanded = match e.node() {
+                Node::Const(_) | Node::Sym(_) => (*e).clone(),
+                Node::Add(xs) => Expr::sum(xs.iter().map(x)),
+                Node::Mul(xs) => expand_product(xs.iter().map(x)),
+                Node::Pow(b, ex) => {
+                    let b = x(b);
+                    let ex = x(ex);
+                    match ex.as_const().and_then(super::eval::as_i32) {
+                        Some(n)
+                            if (2..=MAX_EXPANDED_POWER).contains(&n)
+                                && matches!(b.node(), Node::Add(_)) =>
+                        {
+                            expand_product(std::iter::repeat_n(b, n as usize))
+                        }
+                        _ => b.pow(&ex),
                     }
-                    _ => b.pow(&e),
                 }
-            }
-            Node::Call(..) => self.map_children(&Expr::expand),
+                Node::Call(..) => e.map_children(&x),
+            };
+            memo.set(i, expanded);
         }
+        memo.get(self).cloned().unwrap_or_else(|| self.clone())
     }
 
     /// Splits `self = Σᵢ cᵢ varsᵢ + rest`; an error names the first variable found in a non-linear position.
@@ -88,9 +97,56 @@ fn expand_product(factors: impl Iterator<Item = Expr>) -> Expr {
     Expr::product(std::iter::once(Expr::sum(terms)).chain(held_back))
 }
 
+/// The linear form of `e`, computed node by node from the bottom up. Only sums and products are descended into
+/// (anything else that depends on a variable is not linear); the error is that of the first non-linear node met
+/// from the top, as a walk from the top would find it: the first failing term of a sum, the one dependent factor of
+/// a product.
 fn linearize(e: &Expr, vars: &[Symbol]) -> Result<LinearForm, SymbolicError> {
+    let full = Dag::new([e]);
+    let mut depends = vec![false; full.len()];
+    for (i, n) in full.order.iter().enumerate() {
+        let mut d = n.as_symbol().is_some_and(|s| vars.contains(s));
+        n.node().for_each_child(|c| {
+            d |= full
+                .index(c)
+                .and_then(|k| depends.get(k))
+                .copied()
+                .unwrap_or(false);
+        });
+        if let Some(slot) = depends.get_mut(i) {
+            *slot = d;
+        }
+    }
+    let dep = |n: &Expr| {
+        full.index(n)
+            .and_then(|k| depends.get(k))
+            .copied()
+            .unwrap_or(false)
+    };
+    let linear_part = Dag::new_pruned([e], |n| {
+        dep(n) && matches!(n.node(), Node::Add(_) | Node::Mul(_))
+    });
+    // A failure is kept as the node that is not linear; its message is made once, at the end.
+    let mut memo: Memo<Result<LinearForm, Expr>> = Memo::new(&linear_part);
+    for (i, n) in linear_part.order.iter().enumerate() {
+        let form = |c: &Expr| memo.get(c).cloned().unwrap_or_else(|| Err(c.clone()));
+        memo.set(i, linear_node(n, vars, &dep, &form));
+    }
+    memo.get(e)
+        .cloned()
+        .unwrap_or_else(|| Err(e.clone()))
+        .map_err(|failed| not_linear(&failed, vars))
+}
+
+/// The linear form of one node from those of its children.
+fn linear_node(
+    e: &Expr,
+    vars: &[Symbol],
+    dep: &dyn Fn(&Expr) -> bool,
+    form: &dyn Fn(&Expr) -> Result<LinearForm, Expr>,
+) -> Result<LinearForm, Expr> {
     let zeros = || vec![Expr::zero(); vars.len()];
-    if !e.depends_on_any(vars) {
+    if !dep(e) {
         return Ok(LinearForm {
             coefficients: zeros(),
             rest: e.clone(),
@@ -115,7 +171,7 @@ fn linearize(e: &Expr, vars: &[Symbol]) -> Result<LinearForm, SymbolicError> {
             let mut coefficients: Vec<Vec<Expr>> = vec![Vec::new(); vars.len()];
             let mut rest = Vec::new();
             for t in terms {
-                let f = linearize(t, vars)?;
+                let f = form(t)?;
                 for (acc, c) in coefficients.iter_mut().zip(f.coefficients) {
                     acc.push(c);
                 }
@@ -127,18 +183,18 @@ fn linearize(e: &Expr, vars: &[Symbol]) -> Result<LinearForm, SymbolicError> {
             })
         }
         Node::Mul(factors) => {
-            let mut dependent = factors.iter().filter(|f| f.depends_on_any(vars));
+            let mut dependent = factors.iter().filter(|f| dep(f));
             let (Some(linear_factor), None) = (dependent.next(), dependent.next()) else {
-                return Err(not_linear(e, vars));
+                return Err(e.clone());
             };
-            let others = Expr::product(factors.iter().filter(|f| !f.depends_on_any(vars)).cloned());
-            let f = linearize(linear_factor, vars)?;
+            let others = Expr::product(factors.iter().filter(|f| !dep(f)).cloned());
+            let f = form(linear_factor)?;
             Ok(LinearForm {
                 coefficients: f.coefficients.iter().map(|c| c * &others).collect(),
                 rest: f.rest * others,
             })
         }
-        Node::Const(_) | Node::Pow(..) | Node::Call(..) => Err(not_linear(e, vars)),
+        Node::Const(_) | Node::Pow(..) | Node::Call(..) => Err(e.clone()),
     }
 }
 

@@ -8,13 +8,21 @@
 //! Each printer takes a closure mapping a symbol to its printed name, so the caller decides whether `J_m` prints as
 //! `J_m`, `p.J_m` or `x[0]`. The walk itself (which node prints how, and a sum's terms) is [`Layout`]; a printer
 //! that implements it supplies only its own forms of numbers, products, powers, calls and parentheses.
+//!
+//! Printing is memoised: shared subexpressions are printed once, and deep expressions are printed without deep
+//! recursion and in time linear in the length of the text (`plan.rs`, `doc.rs`). [`cse`](super::cse) names the
+//! shared subexpressions instead, for printing them as definitions.
 
+mod doc;
 pub mod latex;
+mod plan;
 pub mod rust;
 pub mod text;
 
 use super::expr::{Expr, Node, Symbol};
 use crate::ir::Func;
+use doc::Doc;
+use plan::{Kept, plan};
 
 /// Binding strength of what a printer produced, weakest first: callers parenthesise a part whose strength is below
 /// what its position needs.
@@ -96,23 +104,45 @@ pub(super) trait Layout {
     /// A symbol's printed name.
     fn symbol(&self, s: &Symbol) -> String;
     /// `s` in the printer's parentheses.
-    fn parenthesised(&self, s: String) -> String;
+    fn parenthesised(&self, s: Doc) -> Doc;
     /// A product, or a power with a visibly negative exponent ([`split_fraction`] gives its parts); it binds as
     /// a product.
-    fn product(&self, e: &Expr) -> String;
+    fn product(&self, e: &Expr) -> Doc;
     /// `base^exp` for an exponent that is not visibly negative, with its binding strength.
-    fn power(&self, base: &Expr, exp: &Expr) -> (String, u8);
+    fn power(&self, base: &Expr, exp: &Expr) -> (Doc, u8);
     /// A function call; it binds as an atom.
-    fn call(&self, f: Func, args: &[Expr]) -> String;
+    fn call(&self, f: Func, args: &[Expr]) -> Doc;
+    /// The nodes printed ahead (see `plan.rs`).
+    fn kept(&self) -> &Kept<Doc>;
+
+    /// The whole text of `e`: the planned nodes first, bottom-up, then `e`.
+    fn print_root(&self, e: &Expr) -> String {
+        for (node, reused) in plan(e) {
+            let printed = self.print_node(node);
+            self.kept().insert(node, printed, reused);
+        }
+        self.print(e).0.into_string()
+    }
 
     /// The text of `e` and its binding strength.
-    fn print(&self, e: &Expr) -> (String, u8) {
+    fn print(&self, e: &Expr) -> (Doc, u8) {
+        match self.kept().fetch(e) {
+            Some(kept) => kept,
+            None => self.print_node(e),
+        }
+    }
+
+    /// The text of `e` and its binding strength, printed from its children.
+    fn print_node(&self, e: &Expr) -> (Doc, u8) {
         match e.node() {
-            Node::Const(c) => (self.number(*c), if *c < 0.0 { UNARY } else { ATOM }),
-            Node::Sym(s) => (self.symbol(s), ATOM),
+            Node::Const(c) => (
+                Doc::text(self.number(*c)),
+                if *c < 0.0 { UNARY } else { ATOM },
+            ),
+            Node::Sym(s) => (Doc::text(self.symbol(s)), ATOM),
             Node::Add(terms) => (self.sum(terms), SUM),
             Node::Mul(_) => match negated(e) {
-                Some(pos) => (format!("-{}", self.product(&pos)), PRODUCT),
+                Some(pos) => (Doc::cat(vec![Doc::text("-"), self.product(&pos)]), PRODUCT),
                 None => (self.product(e), PRODUCT),
             },
             Node::Pow(b, x) => match reciprocal(e) {
@@ -124,28 +154,28 @@ pub(super) trait Layout {
     }
 
     /// `e` parenthesised when it binds less tightly than `need`.
-    fn wrapped(&self, e: &Expr, need: u8) -> String {
+    fn wrapped(&self, e: &Expr, need: u8) -> Doc {
         let (s, p) = self.print(e);
         if p < need { self.parenthesised(s) } else { s }
     }
 
     /// The terms in [`sum_print_order`], joined by ` + ` and, for a term that prints with a leading minus,
     /// ` - ` and the term made positive.
-    fn sum(&self, terms: &[Expr]) -> String {
-        let mut out = String::new();
+    fn sum(&self, terms: &[Expr]) -> Doc {
+        let mut out = Vec::with_capacity(2 * terms.len());
         for (i, t) in sum_print_order(terms).into_iter().enumerate() {
             match (i, negated(t)) {
-                (0, _) => out.push_str(&self.print(t).0),
+                (0, _) => out.push(self.print(t).0),
                 (_, Some(pos)) => {
-                    out.push_str(" - ");
-                    out.push_str(&self.wrapped(&pos, PRODUCT));
+                    out.push(Doc::text(" - "));
+                    out.push(self.wrapped(&pos, PRODUCT));
                 }
                 (_, None) => {
-                    out.push_str(" + ");
-                    out.push_str(&self.print(t).0);
+                    out.push(Doc::text(" + "));
+                    out.push(self.print(t).0);
                 }
             }
         }
-        out
+        Doc::cat(out)
     }
 }

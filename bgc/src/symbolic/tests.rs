@@ -1,11 +1,13 @@
 //! Tests of the symbolic engine.
 
+mod dag;
 mod derivatives;
 mod evaluation;
 mod from_ir;
 mod linear;
 mod printing;
 mod properties;
+mod reference;
 mod simplification;
 mod solver;
 

@@ -6,7 +6,8 @@
 //! `theta_sint` → `\theta_{sint}`, `omega` → `\omega`, `x_theta` → `x_{\theta}`, `Kt` → `\mathrm{Kt}`.
 
 use super::super::expr::{Expr, Symbol};
-use super::{ATOM, Layout, POWER, UNARY, number_text, split_fraction};
+use super::plan::Kept;
+use super::{ATOM, Doc, Layout, POWER, UNARY, number_text, split_fraction};
 use crate::ir::Func;
 
 const GREEK: [&str; 40] = [
@@ -98,7 +99,11 @@ pub fn to_latex(e: &Expr) -> String {
 
 /// `e` in LaTeX, each symbol printed as `names` says.
 pub fn to_latex_with(e: &Expr, names: &dyn Fn(&Symbol) -> String) -> String {
-    LatexPrinter { names }.print(e).0
+    LatexPrinter {
+        names,
+        kept: Kept::new(),
+    }
+    .print_root(e)
 }
 
 /// A constant: `1.5 \cdot 10^{-7}` for exponent notation.
@@ -118,25 +123,32 @@ fn latex_number(c: f64) -> String {
 
 struct LatexPrinter<'a> {
     names: &'a dyn Fn(&Symbol) -> String,
+    kept: Kept<Doc>,
 }
 
 impl LatexPrinter<'_> {
     /// Factors side by side, with `\cdot` where a factor starts with a digit (so `2 \cdot 3^{x}`, not `2 3^{x}`).
-    fn juxtapose(&self, parts: Vec<String>) -> String {
-        let mut out = String::new();
+    fn juxtapose(&self, parts: Vec<Doc>) -> Doc {
+        let mut out = Vec::with_capacity(2 * parts.len());
         for (i, p) in parts.into_iter().enumerate() {
             if i > 0 {
-                let digit = p.chars().next().is_some_and(|c| c.is_ascii_digit());
-                out.push_str(if digit { " \\cdot " } else { " " });
+                out.push(Doc::text(if p.starts_with_digit() {
+                    " \\cdot "
+                } else {
+                    " "
+                }));
             }
-            out.push_str(&p);
+            out.push(p);
         }
-        out
+        Doc::cat(out)
     }
 
-    fn factors(&self, coeff: Option<f64>, fs: &[Expr]) -> String {
+    fn factors(&self, coeff: Option<f64>, fs: &[Expr]) -> Doc {
         let alone = fs.len() + usize::from(coeff.is_some()) == 1;
-        let mut parts: Vec<String> = coeff.map(latex_number).into_iter().collect();
+        let mut parts: Vec<Doc> = coeff
+            .map(|c| Doc::text(latex_number(c)))
+            .into_iter()
+            .collect();
         // A lone sum needs no parentheses inside a `\frac`.
         parts.extend(fs.iter().map(|f| {
             if alone {
@@ -146,7 +158,7 @@ impl LatexPrinter<'_> {
             }
         }));
         if parts.is_empty() {
-            "1".to_string()
+            Doc::text("1")
         } else {
             self.juxtapose(parts)
         }
@@ -162,37 +174,43 @@ impl Layout for LatexPrinter<'_> {
         (self.names)(s)
     }
 
-    fn parenthesised(&self, s: String) -> String {
-        format!("\\left({s}\\right)")
+    fn parenthesised(&self, s: Doc) -> Doc {
+        s.wrap("\\left(", "\\right)")
     }
 
-    fn product(&self, e: &Expr) -> String {
+    fn kept(&self) -> &Kept<Doc> {
+        &self.kept
+    }
+
+    fn product(&self, e: &Expr) -> Doc {
         let fr = split_fraction(e);
         let coeff = (fr.coeff != 1.0).then_some(fr.coeff);
         if fr.den.is_empty() {
             return self.factors(coeff, &fr.num);
         }
-        format!(
-            "\\frac{{{}}}{{{}}}",
+        Doc::cat(vec![
+            Doc::text("\\frac{"),
             self.factors(coeff, &fr.num),
-            self.factors(None, &fr.den)
-        )
+            Doc::text("}{"),
+            self.factors(None, &fr.den),
+            Doc::text("}"),
+        ])
     }
 
-    fn power(&self, base: &Expr, exp: &Expr) -> (String, u8) {
+    fn power(&self, base: &Expr, exp: &Expr) -> (Doc, u8) {
         if exp.as_const() == Some(0.5) {
-            return (format!("\\sqrt{{{}}}", self.print(base).0), ATOM);
+            return (self.print(base).0.wrap("\\sqrt{", "}"), ATOM);
         }
         let b = self.wrapped(base, ATOM);
-        (format!("{b}^{{{}}}", self.print(exp).0), POWER)
+        (Doc::cat(vec![b, self.print(exp).0.wrap("^{", "}")]), POWER)
     }
 
-    fn call(&self, f: Func, args: &[Expr]) -> String {
-        let args: Vec<String> = args.iter().map(|a| self.print(a).0).collect();
-        let inner = args.join(", ");
+    fn call(&self, f: Func, args: &[Expr]) -> Doc {
+        let args: Vec<Doc> = args.iter().map(|a| self.print(a).0).collect();
+        let inner = Doc::join(args, ", ");
         let name = match f {
-            Func::Abs => return format!("\\left|{inner}\\right|"),
-            Func::Sqrt => return format!("\\sqrt{{{inner}}}"),
+            Func::Abs => return inner.wrap("\\left|", "\\right|"),
+            Func::Sqrt => return inner.wrap("\\sqrt{", "}"),
             Func::Sin => "\\sin",
             Func::Cos => "\\cos",
             Func::Tan => "\\tan",
@@ -210,6 +228,6 @@ impl Layout for LatexPrinter<'_> {
             Func::Sinh => "\\sinh",
             Func::Cosh => "\\cosh",
         };
-        format!("{name}\\left({inner}\\right)")
+        inner.wrap(&format!("{name}\\left("), "\\right)")
     }
 }

@@ -23,6 +23,7 @@
 
 use super::super::eval::as_i32;
 use super::super::expr::{Expr, Node, Symbol};
+use super::plan::{Keep, Kept, plan};
 use super::{ATOM, PRODUCT, SUM, UNARY, negated, reciprocal, split_fraction, sum_print_order};
 use crate::ir::Func;
 use std::fmt;
@@ -105,40 +106,105 @@ impl RustCode {
 }
 
 impl fmt::Display for RustCode {
+    /// Writes the code with a work list rather than by recursion, so that deep code cannot overflow the stack.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            RustCode::Atom(s) => f.write_str(s),
-            RustCode::Neg(inner) => write!(f, "-{inner}"),
-            RustCode::Chain(first, rest) => {
-                write!(f, "{first}")?;
-                for (op, operand) in rest {
-                    write!(f, " {} {operand}", op.as_str())?;
+        enum Item<'a> {
+            Code(&'a RustCode),
+            Text(&'a str),
+        }
+        let mut pending = vec![Item::Code(self)];
+        while let Some(item) = pending.pop() {
+            let code = match item {
+                Item::Text(s) => {
+                    f.write_str(s)?;
+                    continue;
                 }
-                Ok(())
-            }
-            RustCode::Paren(inner) => write!(f, "({inner})"),
-            RustCode::Call(callee, args) => {
-                write!(f, "{callee}(")?;
-                for (i, a) in args.iter().enumerate() {
-                    if i > 0 {
-                        f.write_str(", ")?;
+                Item::Code(code) => code,
+            };
+            match code {
+                RustCode::Atom(s) => f.write_str(s)?,
+                RustCode::Neg(inner) => {
+                    f.write_str("-")?;
+                    pending.push(Item::Code(inner));
+                }
+                RustCode::Chain(first, rest) => {
+                    for (op, operand) in rest.iter().rev() {
+                        pending.push(Item::Code(operand));
+                        pending.push(Item::Text(" "));
+                        pending.push(Item::Text(op.as_str()));
+                        pending.push(Item::Text(" "));
                     }
-                    write!(f, "{a}")?;
+                    pending.push(Item::Code(first));
                 }
-                f.write_str(")")
+                RustCode::Paren(inner) => {
+                    f.write_str("(")?;
+                    pending.push(Item::Text(")"));
+                    pending.push(Item::Code(inner));
+                }
+                RustCode::Call(callee, args) => {
+                    write!(f, "{callee}(")?;
+                    pending.push(Item::Text(")"));
+                    for (i, a) in args.iter().enumerate().rev() {
+                        pending.push(Item::Code(a));
+                        if i > 0 {
+                            pending.push(Item::Text(", "));
+                        }
+                    }
+                }
             }
         }
+        Ok(())
+    }
+}
+
+/// Frees `code` with a work list: dropping a deep tree by recursion could overflow the stack.
+fn dismantle(code: RustCode) {
+    let mut pending = vec![code];
+    while let Some(code) = pending.pop() {
+        match code {
+            RustCode::Atom(_) => {}
+            RustCode::Neg(inner) | RustCode::Paren(inner) => pending.push(*inner),
+            RustCode::Chain(first, rest) => {
+                pending.push(*first);
+                pending.extend(rest.into_iter().map(|(_, c)| c));
+            }
+            RustCode::Call(_, args) => pending.extend(args),
+        }
+    }
+}
+
+impl Keep for RustCode {
+    type Stored = RustCode;
+    fn store(self) -> RustCode {
+        self
+    }
+    fn reuse(stored: &RustCode) -> RustCode {
+        stored.clone()
+    }
+    fn take(stored: RustCode) -> RustCode {
+        stored
     }
 }
 
 /// `e` as a Rust `f64` expression, each symbol printed as `names` says.
 pub fn to_rust(e: &Expr, names: &dyn Fn(&Symbol) -> String) -> String {
-    to_rust_code(e, names).to_string()
+    let code = to_rust_code(e, names);
+    let text = code.to_string();
+    dismantle(code);
+    text
 }
 
 /// `e` as a tree of Rust code (whose text is [`to_rust`]), each symbol printed as `names` says.
 pub fn to_rust_code(e: &Expr, names: &dyn Fn(&Symbol) -> String) -> RustCode {
-    RustPrinter { names }.print(e).0
+    let printer = RustPrinter {
+        names,
+        kept: Kept::new(),
+    };
+    for (node, reused) in plan(e) {
+        let printed = printer.print_node(node);
+        printer.kept.insert(node, printed, reused);
+    }
+    printer.print(e).0
 }
 
 fn rust_number(c: f64) -> String {
@@ -201,10 +267,18 @@ fn negate(code: RustCode) -> RustCode {
 
 struct RustPrinter<'a> {
     names: &'a dyn Fn(&Symbol) -> String,
+    kept: Kept<RustCode>,
 }
 
 impl RustPrinter<'_> {
     fn print(&self, e: &Expr) -> (RustCode, u8) {
+        match self.kept.fetch(e) {
+            Some(kept) => kept,
+            None => self.print_node(e),
+        }
+    }
+
+    fn print_node(&self, e: &Expr) -> (RustCode, u8) {
         match e.node() {
             Node::Const(c) => (
                 RustCode::Atom(rust_number(*c)),

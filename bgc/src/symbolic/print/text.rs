@@ -5,7 +5,8 @@
 //! non-finite values print as `inf`, `-inf`, `NaN`, which are not bgc syntax).
 
 use super::super::expr::{Expr, Symbol};
-use super::{ATOM, Layout, POWER, UNARY, number_text, split_fraction};
+use super::plan::Kept;
+use super::{ATOM, Doc, Layout, POWER, UNARY, number_text, split_fraction};
 use crate::ir::Func;
 use std::fmt;
 
@@ -16,7 +17,11 @@ pub fn to_text(e: &Expr) -> String {
 
 /// `e` as text, each symbol printed as `names` says.
 pub fn to_text_with(e: &Expr, names: &dyn Fn(&Symbol) -> String) -> String {
-    TextPrinter { names }.print(e).0
+    TextPrinter {
+        names,
+        kept: Kept::new(),
+    }
+    .print_root(e)
 }
 
 impl fmt::Display for Expr {
@@ -27,6 +32,7 @@ impl fmt::Display for Expr {
 
 struct TextPrinter<'a> {
     names: &'a dyn Fn(&Symbol) -> String,
+    kept: Kept<Doc>,
 }
 
 impl Layout for TextPrinter<'_> {
@@ -38,43 +44,51 @@ impl Layout for TextPrinter<'_> {
         (self.names)(s)
     }
 
-    fn parenthesised(&self, s: String) -> String {
-        format!("({s})")
+    fn parenthesised(&self, s: Doc) -> Doc {
+        s.wrap("(", ")")
     }
 
-    fn product(&self, e: &Expr) -> String {
+    fn kept(&self) -> &Kept<Doc> {
+        &self.kept
+    }
+
+    fn product(&self, e: &Expr) -> Doc {
         let fr = split_fraction(e);
-        let mut num: Vec<String> = Vec::new();
+        let mut num: Vec<Doc> = Vec::new();
         if fr.coeff != 1.0 {
-            num.push(number_text(fr.coeff));
+            num.push(Doc::text(number_text(fr.coeff)));
         }
         num.extend(fr.num.iter().map(|f| self.wrapped(f, UNARY)));
         let num = if num.is_empty() {
-            "1".to_string()
+            Doc::text("1")
         } else {
-            num.join("*")
+            Doc::join(num, "*")
         };
         match fr.den.as_slice() {
             [] => num,
-            [single] => format!("{num}/{}", self.wrapped(single, POWER)),
+            [single] => Doc::cat(vec![num, Doc::text("/"), self.wrapped(single, POWER)]),
             many => {
-                let den: Vec<String> = many.iter().map(|f| self.wrapped(f, UNARY)).collect();
-                format!("{num}/({})", den.join("*"))
+                let den: Vec<Doc> = many.iter().map(|f| self.wrapped(f, UNARY)).collect();
+                Doc::cat(vec![
+                    num,
+                    Doc::text("/"),
+                    Doc::join(den, "*").wrap("(", ")"),
+                ])
             }
         }
     }
 
-    fn power(&self, base: &Expr, exp: &Expr) -> (String, u8) {
+    fn power(&self, base: &Expr, exp: &Expr) -> (Doc, u8) {
         if exp.as_const() == Some(0.5) {
-            return (format!("sqrt({})", self.print(base).0), ATOM);
+            return (self.print(base).0.wrap("sqrt(", ")"), ATOM);
         }
         let b = self.wrapped(base, ATOM);
         let x = self.wrapped(exp, POWER);
-        (format!("{b}^{x}"), POWER)
+        (Doc::cat(vec![b, Doc::text("^"), x]), POWER)
     }
 
-    fn call(&self, f: Func, args: &[Expr]) -> String {
-        let args: Vec<String> = args.iter().map(|a| self.print(a).0).collect();
-        format!("{}({})", f.name(), args.join(", "))
+    fn call(&self, f: Func, args: &[Expr]) -> Doc {
+        let args: Vec<Doc> = args.iter().map(|a| self.print(a).0).collect();
+        Doc::join(args, ", ").wrap(&format!("{}(", f.name()), ")")
     }
 }

@@ -1,0 +1,113 @@
+//! Walks of the expression DAG: every distinct node once, children before parents, on an explicit stack.
+//!
+//! The memoised operations (evaluation, substitution, differentiation, printing) run over [`Dag::order`] and keep one
+//! result per node, looked up by [`Dag::index`]: their cost is linear in the number of distinct nodes, however
+//! often a node is shared and however deep the expression is.
+
+use super::expr::Expr;
+use super::intern::PassThroughState;
+use std::collections::HashMap;
+
+/// The distinct nodes reachable from some roots, in post-order.
+pub(super) struct Dag<'a> {
+    /// Each node after all of its children; every node once.
+    pub order: Vec<&'a Expr>,
+    index: HashMap<usize, usize, PassThroughState>,
+}
+
+impl<'a> Dag<'a> {
+    pub fn new(roots: impl IntoIterator<Item = &'a Expr>) -> Dag<'a> {
+        Dag::new_pruned(roots, |_| true)
+    }
+
+    /// As [`Dag::new`], but the children of a node for which `descend` is false are not visited (the node is).
+    pub fn new_pruned(
+        roots: impl IntoIterator<Item = &'a Expr>,
+        descend: impl Fn(&Expr) -> bool,
+    ) -> Dag<'a> {
+        let mut dag = Dag {
+            order: Vec::new(),
+            index: HashMap::default(),
+        };
+        // Nodes on the stack are marked with `usize::MAX` until they are placed in the order.
+        let mut stack: Vec<(&'a Expr, usize)> = Vec::new();
+        for root in roots {
+            if dag.index.contains_key(&root.address()) {
+                continue;
+            }
+            dag.index.insert(root.address(), usize::MAX);
+            stack.push((root, 0));
+            while let Some((e, next)) = stack.last_mut() {
+                let e: &'a Expr = e;
+                let child = if descend(e) {
+                    e.node().child(*next)
+                } else {
+                    None
+                };
+                match child {
+                    Some(c) => {
+                        *next += 1;
+                        if !dag.index.contains_key(&c.address()) {
+                            dag.index.insert(c.address(), usize::MAX);
+                            stack.push((c, 0));
+                        }
+                    }
+                    None => {
+                        dag.index.insert(e.address(), dag.order.len());
+                        dag.order.push(e);
+                        stack.pop();
+                    }
+                }
+            }
+        }
+        dag
+    }
+
+    /// The position of `e` in [`Dag::order`]; `None` for a node not reached.
+    pub fn index(&self, e: &Expr) -> Option<usize> {
+        self.index
+            .get(&e.address())
+            .copied()
+            .filter(|&i| i != usize::MAX)
+    }
+
+    pub fn len(&self) -> usize {
+        self.order.len()
+    }
+}
+
+/// One value per node of a [`Dag`], filled in post-order.
+pub(super) struct Memo<'d, 'a, T> {
+    dag: &'d Dag<'a>,
+    values: Vec<Option<T>>,
+}
+
+impl<'d, 'a, T: Clone> Memo<'d, 'a, T> {
+    pub fn new(dag: &'d Dag<'a>) -> Memo<'d, 'a, T> {
+        Memo {
+            dag,
+            values: vec![None; dag.len()],
+        }
+    }
+
+    pub fn set(&mut self, i: usize, value: T) {
+        if let Some(slot) = self.values.get_mut(i) {
+            *slot = Some(value);
+        }
+    }
+
+    /// The value of `e`, when `e` is a node of the walk already computed.
+    pub fn get(&self, e: &Expr) -> Option<&T> {
+        self.dag
+            .index(e)
+            .and_then(|i| self.values.get(i))
+            .and_then(Option::as_ref)
+    }
+}
+
+impl Expr {
+    /// The number of distinct nodes of the expressions together: their size as stored.
+    pub fn distinct_nodes(exprs: &[Expr]) -> usize {
+        Dag::new(exprs).len()
+    }
+}

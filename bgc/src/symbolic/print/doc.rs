@@ -1,0 +1,104 @@
+//! Printed text as a tree of pieces (a rope), so that putting a printed part inside a larger one costs a constant,
+//! not the length of the part: printing a deep expression stays linear in the length of the text.
+
+use std::rc::Rc;
+
+/// Text under construction. Dropping and flattening walk it with a work list, so depth is no concern.
+pub(in crate::symbolic) struct Doc {
+    /// The first character of the text, kept so that asking for it costs nothing.
+    first: Option<char>,
+    piece: Piece,
+}
+
+enum Piece {
+    Text(String),
+    Cat(Vec<Doc>),
+    /// The printed form of a subexpression used in several places, printed once.
+    Shared(Rc<Doc>),
+}
+
+impl Doc {
+    pub fn text(s: impl Into<String>) -> Doc {
+        let s = s.into();
+        Doc {
+            first: s.chars().next(),
+            piece: Piece::Text(s),
+        }
+    }
+
+    pub fn cat(parts: Vec<Doc>) -> Doc {
+        Doc {
+            first: parts.iter().find_map(|p| p.first),
+            piece: Piece::Cat(parts),
+        }
+    }
+
+    pub fn shared(doc: &Rc<Doc>) -> Doc {
+        Doc {
+            first: doc.first,
+            piece: Piece::Shared(Rc::clone(doc)),
+        }
+    }
+
+    pub fn starts_with_digit(&self) -> bool {
+        self.first.is_some_and(|c| c.is_ascii_digit())
+    }
+
+    /// `(self)` with the given parentheses.
+    pub fn wrap(self, open: &str, close: &str) -> Doc {
+        Doc::cat(vec![Doc::text(open), self, Doc::text(close)])
+    }
+
+    /// The parts joined by `sep`.
+    pub fn join(parts: Vec<Doc>, sep: &str) -> Doc {
+        let mut out = Vec::with_capacity(2 * parts.len());
+        for (i, p) in parts.into_iter().enumerate() {
+            if i > 0 {
+                out.push(Doc::text(sep));
+            }
+            out.push(p);
+        }
+        Doc::cat(out)
+    }
+
+    /// The whole text.
+    pub fn into_string(self) -> String {
+        let mut out = String::new();
+        let mut pending: Vec<&Doc> = vec![&self];
+        while let Some(d) = pending.pop() {
+            match &d.piece {
+                Piece::Text(s) => out.push_str(s),
+                Piece::Cat(parts) => pending.extend(parts.iter().rev()),
+                Piece::Shared(rc) => pending.push(rc),
+            }
+        }
+        out
+    }
+}
+
+impl Drop for Doc {
+    fn drop(&mut self) {
+        let mut pending: Vec<Piece> = vec![std::mem::replace(
+            &mut self.piece,
+            Piece::Text(String::new()),
+        )];
+        while let Some(piece) = pending.pop() {
+            match piece {
+                Piece::Text(_) => {}
+                Piece::Cat(parts) => {
+                    for mut p in parts {
+                        pending.push(std::mem::replace(&mut p.piece, Piece::Text(String::new())));
+                    }
+                }
+                Piece::Shared(rc) => {
+                    if let Ok(mut doc) = Rc::try_unwrap(rc) {
+                        pending.push(std::mem::replace(
+                            &mut doc.piece,
+                            Piece::Text(String::new()),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+}

@@ -54,7 +54,7 @@
 
 use crate::codegen;
 use crate::diagnostic::{Diagnostic, Severity, render};
-use crate::lower::{STD_NAME, SourceLoader};
+use crate::lower::{Resolved, SourceLoader};
 use crate::span::SourceMap;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -101,6 +101,7 @@ pub struct Config {
     out_dir: Option<PathBuf>,
     cargo_output: bool,
     options: codegen::rust::Options,
+    include: Vec<PathBuf>,
 }
 
 impl Default for Config {
@@ -116,6 +117,7 @@ impl Config {
             out_dir: None,
             cargo_output: true,
             options: codegen::rust::Options::default(),
+            include: Vec::new(),
         }
     }
 
@@ -130,6 +132,13 @@ impl Config {
     /// Writes the generated files to `dir` (created if missing) instead of `OUT_DIR`.
     pub fn out_dir(&mut self, dir: impl Into<PathBuf>) -> &mut Config {
         self.out_dir = Some(dir.into());
+        self
+    }
+
+    /// Adds a directory where imports are looked up when they are not found beside the importing file. Imports
+    /// resolve only to `.bg` files inside the directory of the file compiled and the include directories.
+    pub fn include_dir(&mut self, dir: impl Into<PathBuf>) -> &mut Config {
+        self.include.push(dir.into());
         self
     }
 
@@ -175,19 +184,22 @@ impl Config {
     }
 
     fn compile_one(&self, source: &Path, output: &Path) -> Result<Generated, Error> {
-        let mut loader = RecordingFsLoader::default();
-        let rerun = |inputs: &BTreeSet<PathBuf>| {
+        let mut loader = FsLoader::new(&self.include).map_err(|source| Error::Io {
+            path: self.include.first().cloned().unwrap_or_default(),
+            source,
+        })?;
+        let rerun = |loader: &FsLoader| {
             if self.cargo_output {
-                for p in inputs {
+                println!("cargo:rerun-if-changed={}", source.display());
+                for p in loader.requested().filter(|p| *p != source) {
                     println!("cargo:rerun-if-changed={}", p.display());
                 }
             }
         };
-        loader.requested.insert(source.to_path_buf());
-        let bytes = match std::fs::read(source) {
+        let bytes = match read_source_file(source) {
             Ok(b) => b,
             Err(e) => {
-                rerun(&loader.requested);
+                rerun(&loader);
                 return Err(Error::Io {
                     path: source.to_path_buf(),
                     source: e,
@@ -208,7 +220,7 @@ impl Config {
                 Err(vec![diag])
             }
         };
-        rerun(&loader.requested);
+        rerun(&loader);
         let compiled = match result {
             Ok(c) => c,
             Err(diags) => {
@@ -232,14 +244,22 @@ impl Config {
                 println!("cargo:warning={}", one_line(&sources, d));
             }
         }
-        let code =
-            codegen::rust::generate_with(&compiled, &source.display().to_string(), self.options);
+        let base = std::env::var_os("CARGO_MANIFEST_DIR").map(PathBuf::from);
+        let name = header_name(source, base.as_deref());
+        let code = codegen::rust::generate_with(&compiled, &name, self.options);
         let written = write_if_changed(output, &code)?;
         Ok(Generated {
             source: source.to_path_buf(),
             output: output.to_path_buf(),
             written,
-            inputs: loader.requested.into_iter().collect(),
+            inputs: std::iter::once(source.to_path_buf())
+                .chain(
+                    loader
+                        .requested()
+                        .filter(|p| *p != source)
+                        .map(Path::to_path_buf),
+                )
+                .collect(),
             warnings,
         })
     }
@@ -262,6 +282,28 @@ fn one_line(sources: &SourceMap, d: &Diagnostic) -> String {
     )
 }
 
+/// The name of a source in the `@generated` header: relative to `base` (the crate's directory) when it lies inside
+/// it, with `.` and `..` resolved and `/` between components, so that two checkouts of a crate, on any platform,
+/// generate the same bytes.
+pub fn header_name(source: &Path, base: Option<&Path>) -> String {
+    let relative = base
+        .and_then(|b| {
+            let b = std::fs::canonicalize(b).ok()?;
+            let s = std::fs::canonicalize(source).ok()?;
+            s.strip_prefix(&b).ok().map(Path::to_path_buf)
+        })
+        .unwrap_or_else(|| crate::lower::normalize(source));
+    let parts: Vec<String> = relative
+        .components()
+        .map(|c| match c {
+            // Joined with `/`, the root's empty part gives the leading `/`.
+            std::path::Component::RootDir => String::new(),
+            other => other.as_os_str().to_string_lossy().into_owned(),
+        })
+        .collect();
+    parts.join("/")
+}
+
 /// Compiles `files` into `OUT_DIR` with the default configuration.
 pub fn compile(files: &[impl AsRef<Path>]) -> Result<Vec<Generated>, Error> {
     Config::new().compile(files)
@@ -279,18 +321,164 @@ fn write_if_changed(path: &Path, text: &str) -> Result<bool, Error> {
     Ok(true)
 }
 
-/// Reads imports from the file system and remembers every path asked for.
-#[derive(Default)]
-struct RecordingFsLoader {
+/// The largest source file read (16 MiB): a model is text written by people; anything larger is a mistake or an
+/// attack, and is refused before it fills the memory.
+pub const MAX_SOURCE_BYTES: u64 = 16 << 20;
+
+/// Reads a source file: a regular file (not a FIFO, a device or a directory, which could block or never end) of at
+/// most [`MAX_SOURCE_BYTES`].
+pub fn read_source_file(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let refuse = |why: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, why);
+    // Asked before opening, because opening a FIFO blocks until something writes to it.
+    let kind = std::fs::metadata(path)?.file_type();
+    if !kind.is_file() {
+        return Err(refuse(format!("not a regular file ({})", describe(kind))));
+    }
+    let file = std::fs::File::open(path)?;
+    let len = file.metadata()?.len();
+    if len > MAX_SOURCE_BYTES {
+        return Err(refuse(too_large(len)));
+    }
+    let mut bytes = Vec::with_capacity(len as usize);
+    // The file may grow between the check and the read: read one byte more than allowed to notice.
+    file.take(MAX_SOURCE_BYTES + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_SOURCE_BYTES {
+        return Err(refuse(too_large(bytes.len() as u64)));
+    }
+    Ok(bytes)
+}
+
+fn too_large(len: u64) -> String {
+    format!(
+        "the file is larger than the {} MiB a source file may have ({len} bytes or more)",
+        MAX_SOURCE_BYTES >> 20
+    )
+}
+
+fn describe(kind: std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            return "a FIFO";
+        }
+        if kind.is_char_device() || kind.is_block_device() {
+            return "a device";
+        }
+        if kind.is_socket() {
+            return "a socket";
+        }
+    }
+    if kind.is_dir() {
+        "a directory"
+    } else {
+        "not a file"
+    }
+}
+
+/// Reads sources from the file system for the CLI and [`Config`], and remembers every path asked for.
+///
+/// A file is identified by its canonical path, so that one file reached by different relative paths or through
+/// a symbolic link is one file (a diamond of imports loads it once; a file that imports itself under another name
+/// is a cycle). An import is looked up relative to the importing file, then in each include directory, and must
+/// resolve to a `.bg` file inside the root file's directory or an include directory: a model cannot make bgc read,
+/// or show in a diagnostic, anything else.
+#[derive(Clone, Debug, Default)]
+pub struct FsLoader {
+    /// The include directories as given (for names in diagnostics) and canonical.
+    include: Vec<(PathBuf, PathBuf)>,
+    /// The canonical directories imports may resolve into.
+    allowed: Vec<PathBuf>,
     requested: BTreeSet<PathBuf>,
 }
 
-impl SourceLoader for RecordingFsLoader {
-    fn load(&mut self, path: &Path) -> std::io::Result<String> {
-        if path != Path::new(STD_NAME) {
-            self.requested.insert(path.to_path_buf());
+impl FsLoader {
+    /// A loader with these include directories (each must exist).
+    pub fn new(include: &[PathBuf]) -> std::io::Result<FsLoader> {
+        let mut loader = FsLoader::default();
+        for dir in include {
+            let canonical = std::fs::canonicalize(dir).map_err(|e| {
+                std::io::Error::new(
+                    e.kind(),
+                    format!("include directory {}: {e}", dir.display()),
+                )
+            })?;
+            if !canonical.is_dir() {
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::InvalidInput,
+                    format!("include directory {}: not a directory", dir.display()),
+                ));
+            }
+            loader.allowed.push(canonical.clone());
+            loader.include.push((dir.clone(), canonical));
         }
-        let bytes = std::fs::read(path)?;
+        Ok(loader)
+    }
+
+    /// Every path read or asked for (the root file and its imports, also those that could not be read).
+    pub fn requested(&self) -> impl Iterator<Item = &Path> {
+        self.requested.iter().map(PathBuf::as_path)
+    }
+
+    fn candidate(&self, path: &Path) -> std::io::Result<PathBuf> {
+        let canonical = std::fs::canonicalize(path)?;
+        if canonical.extension().is_none_or(|e| e != "bg") {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "the file it leads to is not a `.bg` file",
+            ));
+        }
+        if !self.allowed.iter().any(|dir| canonical.starts_with(dir)) {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::PermissionDenied,
+                "the file is outside the importing file's directory and the include directories",
+            ));
+        }
+        Ok(canonical)
+    }
+}
+
+impl SourceLoader for FsLoader {
+    fn identify_root(&mut self, name: &Path) -> PathBuf {
+        self.requested.insert(name.to_path_buf());
+        match std::fs::canonicalize(name) {
+            Ok(key) => {
+                if let Some(dir) = key.parent() {
+                    self.allowed.push(dir.to_path_buf());
+                }
+                key
+            }
+            Err(_) => crate::lower::normalize(name),
+        }
+    }
+
+    fn resolve(
+        &mut self,
+        importer_key: &Path,
+        importer_name: &str,
+        import: &str,
+    ) -> std::io::Result<Resolved> {
+        let beside = importer_key.parent().unwrap_or(Path::new("")).join(import);
+        let name_dir = Path::new(importer_name).parent().unwrap_or(Path::new(""));
+        let shown = crate::lower::normalize(&name_dir.join(import));
+        self.requested.insert(shown.clone());
+        let mut first_error = match self.candidate(&beside) {
+            Ok(key) => return Ok(Resolved::new(key, &shown)),
+            Err(e) => e,
+        };
+        for (given, canonical) in &self.include {
+            match self.candidate(&canonical.join(import)) {
+                Ok(key) => return Ok(Resolved::new(key, &given.join(import))),
+                Err(e) if first_error.kind() == std::io::ErrorKind::NotFound => first_error = e,
+                Err(_) => {}
+            }
+        }
+        Err(first_error)
+    }
+
+    fn load(&mut self, key: &Path) -> std::io::Result<String> {
+        let bytes = read_source_file(key)?;
         String::from_utf8(bytes).map_err(|e| {
             std::io::Error::new(
                 std::io::ErrorKind::InvalidData,

@@ -22,6 +22,10 @@ pub struct Cli {
     /// Colour in diagnostics: auto (when stderr is a terminal), always, never.
     #[arg(long, value_enum, default_value_t = ColorChoice::Auto, global = true)]
     color: ColorChoice,
+    /// A directory where imports are looked up when they are not beside the importing file (repeatable). Imports
+    /// resolve only to `.bg` files inside the input file's directory and the include directories.
+    #[arg(short = 'I', long = "include", value_name = "DIR", global = true)]
+    include: Vec<PathBuf>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -226,6 +230,10 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
         ColorChoice::Never => false,
         ColorChoice::Auto => std::io::IsTerminal::is_terminal(&std::io::stderr()),
     };
+    if let Err(e) = io::set_include_dirs(&cli.include) {
+        io::stderrln(&format!("error: {e}"));
+        return ExitCode::from(Status::UsageOrIo as u8);
+    }
     let status = match cli.command {
         Command::Check { files, format } => commands::check(&files, format, color),
         Command::Rust { file, no_runtime } => commands::rust(&file, !no_runtime, color),

@@ -3,6 +3,7 @@
 //! A stage returns its findings as `Vec<Diagnostic>`; nothing here prints. Rendering to text (rustc-like, with
 //! `FILE:LINE:COL` and the source excerpt) and to JSON lives in [`render`].
 
+mod excerpt;
 pub mod render;
 
 use crate::span::Span;

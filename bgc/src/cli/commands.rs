@@ -1,6 +1,6 @@
 //! The subcommands. Each returns the process status; all printing happens here.
 
-use super::io::{FsLoader, read_source, stderr, stderrln, stdout, stdoutln};
+use super::io::{loader, read_source, stderr, stderrln, stdout, stdoutln};
 use super::{DiagFormat, DrawFormat, ReportFormat, Status};
 use bgc::diagnostic::{Diagnostic, Severity, has_errors, render};
 use bgc::span::SourceMap;
@@ -25,7 +25,7 @@ pub fn check(files: &[PathBuf], format: DiagFormat, color: bool) -> Status {
             all_diags.push(d);
             continue;
         }
-        let (models, mut diags) = bgc::lower::lower(&mut sources, id, &mut FsLoader);
+        let (models, mut diags) = bgc::lower::lower(&mut sources, id, &mut loader());
         if !has_errors(&diags) {
             for m in &models {
                 let mut found = bgc::causality::analyse(m).1;
@@ -167,7 +167,7 @@ pub(super) fn load_one(path: &Path, wanted: Option<&str>, color: bool) -> Result
         stderr(&render::to_text(&sources, &[d], color));
         return Err(Status::InputErrors);
     }
-    let (models, diags) = bgc::lower::lower(&mut sources, id, &mut FsLoader);
+    let (models, diags) = bgc::lower::lower(&mut sources, id, &mut loader());
     if has_errors(&diags) {
         stderr(&render::to_text(&sources, &diags, color));
         stderrln(&count_line(&diags));
@@ -283,10 +283,11 @@ pub fn rust(path: &Path, runtime: bool, color: bool) -> Status {
         stderr(&render::to_text(&sources, &[d], color));
         return Status::InputErrors;
     }
-    match bgc::codegen::compile(&mut sources, id, &mut FsLoader) {
+    match bgc::codegen::compile(&mut sources, id, &mut loader()) {
         Ok(compiled) => {
             // Named as `bgc::build` names it, so that both print the same text.
-            let name = path.display().to_string();
+            let cwd = std::env::current_dir().ok();
+            let name = bgc::build::header_name(path, cwd.as_deref());
             let options = bgc::codegen::rust::Options { runtime };
             stdout(&bgc::codegen::rust::generate_with(
                 &compiled, &name, options,

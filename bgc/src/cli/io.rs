@@ -1,26 +1,25 @@
-//! Reading source files for the CLI: the filesystem side of `lower::SourceLoader`.
+//! The CLI's side of the outside world: reading source files (through `bgc::build`'s checks) and writing the
+//! results.
 
+use bgc::build::FsLoader;
 use bgc::diagnostic::Diagnostic;
-use bgc::lower::SourceLoader;
 use bgc::span::{FileId, SourceMap};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
-/// Loads imports from the filesystem.
-pub struct FsLoader;
+/// The loader of this run, with the include directories of `-I`.
+static LOADER: OnceLock<FsLoader> = OnceLock::new();
 
-impl SourceLoader for FsLoader {
-    fn load(&mut self, path: &Path) -> std::io::Result<String> {
-        let bytes = std::fs::read(path)?;
-        String::from_utf8(bytes).map_err(|e| {
-            std::io::Error::new(
-                std::io::ErrorKind::InvalidData,
-                format!(
-                    "not valid UTF-8 (first bad byte at offset {})",
-                    e.utf8_error().valid_up_to()
-                ),
-            )
-        })
-    }
+/// Sets the include directories for the run; an include directory that does not exist is an error.
+pub fn set_include_dirs(dirs: &[PathBuf]) -> std::io::Result<()> {
+    let loader = FsLoader::new(dirs)?;
+    let _ = LOADER.set(loader);
+    Ok(())
+}
+
+/// A fresh loader for one compilation (the allowed directories depend on its root file).
+pub fn loader() -> FsLoader {
+    LOADER.get().cloned().unwrap_or_default()
 }
 
 /// Reads a file into the source map. Invalid UTF-8 is not an I/O error: the file is added with the bad bytes
@@ -29,7 +28,7 @@ pub fn read_source(
     sources: &mut SourceMap,
     path: &Path,
 ) -> std::io::Result<(FileId, Option<Diagnostic>)> {
-    let bytes = std::fs::read(path)?;
+    let bytes = bgc::build::read_source_file(path)?;
     let name = path.display().to_string();
     // The id the file will get, so that the decode diagnostic points into it.
     let next = FileId(sources.files().count() as u32);
@@ -42,12 +41,25 @@ pub fn read_source(
     }
 }
 
-/// Writes to standard output. A closed pipe (`bgc ... | head`) is not an error worth a panic, as `print!` would
-/// make it: the output is simply no longer wanted.
+/// Writes to standard output. A closed pipe (`bgc ... | head`) is not an error: the output is simply no longer
+/// wanted, and the command ends quietly (status 0, as `head` expects). Any other failure (a full disk, `>
+/// /dev/full`) ends the command with status 2 and the OS error, because the result was not delivered.
 pub fn stdout(text: &str) {
     use std::io::Write;
     let mut out = std::io::stdout().lock();
-    let _ = out.write_all(text.as_bytes()).and_then(|_| out.flush());
+    if let Err(e) = out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        drop(out);
+        output_failed(&e);
+    }
+}
+
+/// Ends the process after a failed write to standard output: quietly (0) for a closed pipe, else with status 2.
+pub fn output_failed(e: &std::io::Error) -> ! {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        std::process::exit(0);
+    }
+    stderrln(&format!("error: cannot write the output: {e}"));
+    std::process::exit(2);
 }
 
 /// Writes to standard error, ignoring a closed pipe.

@@ -1,13 +1,15 @@
 //! `bgc simulate`: integrate a model's equations and print CSV.
 
-use super::io::{stderr, stderrln, stdout};
+use super::io::{output_failed, stderr, stderrln};
 use super::model::derive_one;
 use super::params::{Assignment, input_signals, param_values, values_or_zero, zero_inputs_warning};
 use super::quantities;
 use super::{Solver, Status};
 use bgc::simulate::System;
-use bgc::simulate::integrate::{Method, RunOptions, run};
+use bgc::simulate::integrate::{Method, RunOptions, run_streaming};
 use std::fmt::Write as _;
+use std::io::Write as _;
+use std::ops::ControlFlow;
 use std::path::Path;
 
 /// The options of `bgc simulate`.
@@ -27,6 +29,23 @@ pub struct SimulateArgs<'a> {
 /// The number of sample intervals when `--dt-out` is not given.
 const DEFAULT_INTERVALS: f64 = 1000.0;
 
+/// `--dt-out`, or `t-end/1000` when it is not given. A `--t-end` so small that a thousandth of it is not a normal
+/// number is refused in its own name, not in the name of an option the user did not give.
+fn default_dt_out(args: &SimulateArgs<'_>) -> Result<f64, String> {
+    if let Some(dt) = args.dt_out {
+        return Ok(dt);
+    }
+    let dt = args.t_end / DEFAULT_INTERVALS;
+    if args.t_end > 0.0 && args.t_end.is_finite() && !dt.is_normal() {
+        return Err(format!(
+            "--t-end {:e} is too small: the default sampling interval t-end/1000 is {dt:e}, below the smallest \
+             normal number; give a larger --t-end (and --dt-out)",
+            args.t_end
+        ));
+    }
+    Ok(dt)
+}
+
 /// `bgc simulate FILE --t-end T`
 pub fn simulate(path: &Path, wanted: Option<&str>, args: &SimulateArgs<'_>, color: bool) -> Status {
     let (d, _) = match derive_one(path, wanted, color, true) {
@@ -34,14 +53,26 @@ pub fn simulate(path: &Path, wanted: Option<&str>, args: &SimulateArgs<'_>, colo
         Err(s) => return s,
     };
     match csv(&d.loaded.model, &d.eqs, args) {
-        Ok(text) => {
-            stdout(&text);
-            Status::Ok
-        }
-        Err(msg) => {
+        Ok(()) => Status::Ok,
+        Err(Failure::Input(msg)) => {
             stderrln(&format!("error: {msg}"));
             Status::InputErrors
         }
+        Err(Failure::Output(e)) => output_failed(&e),
+    }
+}
+
+/// Why a run printed no complete table.
+enum Failure {
+    /// The model, the arguments or the solver (status 1).
+    Input(String),
+    /// Writing standard output (a closed pipe ends the run quietly; anything else is status 2).
+    Output(std::io::Error),
+}
+
+impl From<String> for Failure {
+    fn from(msg: String) -> Failure {
+        Failure::Input(msg)
     }
 }
 
@@ -49,7 +80,7 @@ fn csv(
     model: &bgc::ir::Model,
     eqs: &bgc::equations::Equations,
     args: &SimulateArgs<'_>,
-) -> Result<String, String> {
+) -> Result<(), Failure> {
     let params = param_values(model, eqs, args.params)?;
     let (signals, held_at_zero) = input_signals(model, args.inputs)?;
     if let Some(w) = zero_inputs_warning(&held_at_zero) {
@@ -78,7 +109,7 @@ fn csv(
     }
     let opts = RunOptions {
         t_end: args.t_end,
-        dt_out: args.dt_out.unwrap_or(args.t_end / DEFAULT_INTERVALS),
+        dt_out: default_dt_out(args)?,
         method: match args.solver {
             Solver::Bdf => Method::Bdf,
             Solver::Esdirk34 => Method::Esdirk34,
@@ -89,17 +120,43 @@ fn csv(
         atol: args.atol,
         max_steps: 10_000_000,
     };
-    let traj = run(&system, &x0, &opts).map_err(|e| e.to_string())?;
-    let mut out = String::new();
-    out.push_str(&quantities::csv_header(model, eqs, &traj.columns));
-    out.push('\n');
-    for (t, row) in traj.times.iter().zip(&traj.rows) {
-        let _ = write!(out, "{t}");
+    // Rows go out as they are computed (a long run's memory does not grow with its length), and the run stops as
+    // soon as the output is closed.
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    let mut header = quantities::csv_header(model, eqs, &system.columns());
+    header.push('\n');
+    let mut write_error: Option<std::io::Error> = None;
+    // The header goes out with the first row, so that a run that cannot start prints nothing.
+    let mut line = header;
+    let mut printed = 0usize;
+    let result = run_streaming(&system, &x0, &opts, &mut |t, row| {
+        let _ = write!(line, "{t}");
         for v in row {
             // Shortest round-trip form: the printed numbers read back exactly.
-            let _ = write!(out, ",{v:e}");
+            let _ = write!(line, ",{v:e}");
         }
-        out.push('\n');
+        line.push('\n');
+        let written = out.write_all(line.as_bytes());
+        line.clear();
+        match written {
+            Ok(()) => {
+                printed += 1;
+                ControlFlow::Continue(())
+            }
+            Err(e) => {
+                write_error = Some(e);
+                ControlFlow::Break(())
+            }
+        }
+    });
+    if let Some(e) = write_error {
+        return Err(Failure::Output(e));
     }
-    Ok(out)
+    // The rows computed before a failure are printed; the error says where the run stopped.
+    let flushed = out.flush();
+    result.map_err(|e| match printed {
+        0 => e.to_string(),
+        n => format!("{e} (the {n} rows before it were printed)"),
+    })?;
+    flushed.map_err(Failure::Output)
 }

@@ -9,7 +9,8 @@
 //!   residuals). It mirrors [`crate::equations::newton`]: the step solves `∂r/∂z Δ = −r`, the damping halves `λ`
 //!   until the Armijo test on `Σ (r_i/w_i)²` passes, and the block has converged when `|r_i| ≤ 10⁻¹² s_i` for every
 //!   residual, `s_i` being the sum of the magnitudes of its terms ([`crate::equations::residual_scale`]), after at
-//!   least one step; at most 100 iterations;
+//!   least one step; at most 100 iterations. A block of one tear whose Newton iteration fails is solved in a
+//!   bracket of a sign change searched outward from the start, as [`crate::equations::newton::bracketed`] does;
 //! - every function that needs the tears (`rhs_into`, `outputs_into`, the Jacobians, the energy functions) starts
 //!   with `let z = loop_values(p, t, x, u);`, which is `solve_loops` with all NaN when it fails: the values are then
 //!   NaN, never silently wrong. Callers that need to know why call `solve_loops`.
@@ -104,13 +105,162 @@ pub(crate) const NEWTON_FN: &str = "
 /// The residuals `r`, their scales `s` and `∂r/∂z` of one block of the algebraic loops.
 pub type LoopEval<const B: usize> = (SVector<f64, B>, SVector<f64, B>, SMatrix<f64, B, B>);
 
-/// Solves the block of `B` tears starting at `first` in `z` by damped Newton's method, from the
-/// values in `z`.
+/// Solves the block of `B` tears starting at `first` in `z`, from the values in `z`: damped
+/// Newton's method, and for a single tear where it fails, a root in a bracket of a sign change.
 fn bgc_newton<const B: usize>(
     z: &mut Tears,
     first: usize,
     block: usize,
     eval: impl Fn(&Tears) -> LoopEval<B>,
+) -> Result<(), LoopError> {
+    let start = *z;
+    let failure = match bgc_damped(z, first, block, &eval) {
+        Ok(()) => return Ok(()),
+        Err(e) => e,
+    };
+    if B == 1 && start[first].is_finite() {
+        if let Some(root) = bgc_bracketed(&start, first, &eval) {
+            z[first] = root;
+            return Ok(());
+        }
+    }
+    Err(failure)
+}
+
+/// The residual, its scale and its derivative of a one-tear block with the tear at `v`.
+fn bgc_at<const B: usize>(
+    start: &Tears,
+    first: usize,
+    eval: &impl Fn(&Tears) -> LoopEval<B>,
+    v: f64,
+) -> (f64, f64, f64) {
+    let mut trial = *start;
+    trial[first] = v;
+    let (r, s, jz) = eval(&trial);
+    if B == 0 {
+        return (f64::NAN, f64::NAN, f64::NAN);
+    }
+    (r[0], s[0], jz[(0, 0)])
+}
+
+/// One tear: a bracket of a sign change searched at `z0 ± h`, `h` doubling from
+/// `1e-6 max(1, |z0|)`, then Newton steps kept inside the bracket that halve it at least every
+/// other step, else bisection.
+fn bgc_bracketed<const B: usize>(
+    start: &Tears,
+    first: usize,
+    eval: &impl Fn(&Tears) -> LoopEval<B>,
+) -> Option<f64> {
+    let z0 = start[first];
+    let (r0, s0, j0) = bgc_at(start, first, eval, z0);
+    if r0.is_nan() {
+        return None;
+    }
+    // Converged: finite and within the tolerance (an infinite residual only gives a direction).
+    let within = |r: f64, s: f64| r.is_finite() && s.is_finite() && libm::fabs(r) <= LOOP_RTOL * s;
+    if within(r0, s0) {
+        return Some(z0);
+    }
+    let mut evaluations = 1;
+    let mut h = 1e-6;
+    if libm::fabs(z0) > 1.0 {
+        h *= libm::fabs(z0);
+    }
+    let mut same = [(z0, r0, s0, j0), (z0, r0, s0, j0)];
+    let mut open = [true, true];
+    let mut found = None;
+    while found.is_none() && evaluations < LOOP_BRACKET_EVALUATIONS && (open[0] || open[1]) {
+        for side in 0..2 {
+            if !open[side] || found.is_some() {
+                continue;
+            }
+            let dir = if side == 0 { 1.0 } else { -1.0 };
+            let v = z0 + dir * h;
+            if !v.is_finite() {
+                open[side] = false;
+                continue;
+            }
+            let (r, s, j) = bgc_at(start, first, eval, v);
+            evaluations += 1;
+            if r.is_nan() {
+                open[side] = false;
+            } else if r == 0.0 || (r < 0.0) != (r0 < 0.0) {
+                let near = same[side];
+                let far = (v, r, s, j);
+                found = Some(if r0 < 0.0 { (near, far) } else { (far, near) });
+            } else {
+                same[side] = (v, r, s, j);
+            }
+        }
+        h *= 2.0;
+    }
+    let (mut lo, mut hi) = found?;
+    let mut x = if libm::fabs(lo.1) < libm::fabs(hi.1) {
+        lo
+    } else {
+        hi
+    };
+    let mut step_before = libm::fabs(hi.0 - lo.0);
+    let mut step = step_before;
+    while evaluations < LOOP_BRACKET_EVALUATIONS {
+        if within(x.1, x.2) {
+            return Some(x.0);
+        }
+        let newton = if x.1.is_finite() {
+            x.0 - x.1 / x.3
+        } else {
+            f64::NAN
+        };
+        let (a, b) = if lo.0 < hi.0 {
+            (lo.0, hi.0)
+        } else {
+            (hi.0, lo.0)
+        };
+        let inside = newton.is_finite() && newton > a && newton < b;
+        let fast = libm::fabs(newton - x.0) <= 0.5 * step_before;
+        step_before = step;
+        let next = if inside && fast {
+            newton
+        } else {
+            a + (b - a) / 2.0
+        };
+        step = libm::fabs(next - x.0);
+        if next <= a || next >= b {
+            break;
+        }
+        let (r, s, j) = bgc_at(start, first, eval, next);
+        evaluations += 1;
+        if r.is_nan() {
+            return None;
+        }
+        if r < 0.0 {
+            lo = (next, r, s, j);
+        } else {
+            hi = (next, r, s, j);
+        }
+        x = (next, r, s, j);
+        if r == 0.0 && s.is_finite() {
+            return Some(x.0);
+        }
+    }
+    let best = if libm::fabs(lo.1) < libm::fabs(hi.1) {
+        lo
+    } else {
+        hi
+    };
+    if within(best.1, best.2) {
+        Some(best.0)
+    } else {
+        None
+    }
+}
+
+/// Damped Newton's method for the block, from the values in `z`.
+fn bgc_damped<const B: usize>(
+    z: &mut Tears,
+    first: usize,
+    block: usize,
+    eval: &impl Fn(&Tears) -> LoopEval<B>,
 ) -> Result<(), LoopError> {
     let (mut r, mut s, mut jz) = eval(z);
     let fail = |kind: LoopFailure, iterations: usize, r: &SVector<f64, B>| {
@@ -207,6 +357,8 @@ pub const LOOP_RTOL: f64 = 1e-12;
 
 /// The most Newton iterations per block of the loops.
 pub const LOOP_MAX_ITERATIONS: usize = 100;
+/// The most residual evaluations of the bracketing fallback for a one-tear block.
+pub const LOOP_BRACKET_EVALUATIONS: usize = 4000;
 
 /// Why Newton's method stopped without solving a block of the algebraic loops.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

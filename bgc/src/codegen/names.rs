@@ -59,6 +59,7 @@ pub const RESERVED: &[&str] = &[
     "TEAR_NAMES",
     "LOOP_RTOL",
     "LOOP_MAX_ITERATIONS",
+    "LOOP_BRACKET_EVALUATIONS",
     "libm",
     "core",
     "N_STATES",

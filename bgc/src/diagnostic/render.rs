@@ -1,5 +1,6 @@
 //! Rendering diagnostics: rustc-like text and JSON.
 
+use super::excerpt::Excerpts;
 use super::{Diagnostic, Severity};
 use crate::span::SourceMap;
 use codespan_reporting::diagnostic as cs;
@@ -7,24 +8,32 @@ use codespan_reporting::files::SimpleFiles;
 use codespan_reporting::term;
 use serde::Serialize;
 
+/// At most this many diagnostics are rendered; the rest are counted in one closing line. A hostile or badly broken
+/// file can give tens of thousands of errors, of which only the first few say anything new.
+pub const MAX_SHOWN: usize = 100;
+
 /// Renders diagnostics as text like rustc's: `error[BG0201]: ...` then `--> FILE:LINE:COL` and the source excerpt.
-/// `color` adds ANSI colours (for terminals).
+/// `color` adds ANSI colours (for terminals). Only the first [`MAX_SHOWN`] are rendered, and a label on a line longer
+/// than 240 bytes shows a window of the line around it.
 pub fn to_text(sources: &SourceMap, diags: &[Diagnostic], color: bool) -> String {
     let mut files = SimpleFiles::new();
+    let mut count = 0;
     for (_, f) in sources.files() {
         files.add(f.name.clone(), f.text.clone());
+        count += 1;
     }
     let config = term::Config::default();
     let mut out = String::new();
-    for d in diags {
-        let cs_diag = to_codespan(d);
+    for d in diags.iter().take(MAX_SHOWN) {
+        let mut excerpts = Excerpts::new(&files, count);
+        let cs_diag = to_codespan(d, &mut excerpts);
         let mut buf: Vec<u8> = Vec::new();
         let ok = if color {
             let mut w = term::termcolor::Ansi::new(&mut buf);
-            term::emit_to_write_style(&mut w, &config, &files, &cs_diag).is_ok()
+            term::emit_to_write_style(&mut w, &config, &excerpts, &cs_diag).is_ok()
         } else {
             let mut w = term::termcolor::NoColor::new(&mut buf);
-            term::emit_to_write_style(&mut w, &config, &files, &cs_diag).is_ok()
+            term::emit_to_write_style(&mut w, &config, &excerpts, &cs_diag).is_ok()
         };
         if ok {
             out.push_str(&String::from_utf8_lossy(&buf));
@@ -38,7 +47,28 @@ pub fn to_text(sources: &SourceMap, diags: &[Diagnostic], color: bool) -> String
             ));
         }
     }
+    if let Some(rest) = diags.get(MAX_SHOWN..).filter(|r| !r.is_empty()) {
+        out.push_str(&omitted_line(rest));
+    }
     out
+}
+
+/// The closing line for the diagnostics not rendered.
+fn omitted_line(rest: &[Diagnostic]) -> String {
+    let count = |s: Severity| rest.iter().filter(|d| d.severity == s).count();
+    let (errors, warnings, notes) = (
+        count(Severity::Error),
+        count(Severity::Warning),
+        count(Severity::Note),
+    );
+    let plural = |n: usize, word: &str| format!("{n} {word}{}", if n == 1 { "" } else { "s" });
+    format!(
+        "note: only the first {MAX_SHOWN} diagnostics are shown; {} more not shown ({}, {}, {})\n",
+        rest.len(),
+        plural(errors, "error"),
+        plural(warnings, "warning"),
+        plural(notes, "note")
+    )
 }
 
 fn severity_word(s: Severity) -> &'static str {
@@ -49,7 +79,7 @@ fn severity_word(s: Severity) -> &'static str {
     }
 }
 
-fn to_codespan(d: &Diagnostic) -> cs::Diagnostic<usize> {
+fn to_codespan(d: &Diagnostic, excerpts: &mut Excerpts<'_>) -> cs::Diagnostic<usize> {
     let severity = match d.severity {
         Severity::Error => cs::Severity::Error,
         Severity::Warning => cs::Severity::Warning,
@@ -64,7 +94,8 @@ fn to_codespan(d: &Diagnostic) -> cs::Diagnostic<usize> {
             } else {
                 cs::LabelStyle::Secondary
             };
-            cs::Label::new(style, l.span.file.0 as usize, l.span.range()).with_message(&l.message)
+            let (file, range) = excerpts.place(l.span.file.0 as usize, l.span.range());
+            cs::Label::new(style, file, range).with_message(&l.message)
         })
         .collect();
     let mut notes = d.notes.clone();

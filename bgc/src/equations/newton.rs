@@ -1,5 +1,5 @@
 //! Damped Newton's method for a small system of nonlinear equations `r(z) = 0` (the nonlinear algebraic loops of
-//! [`super::tear`]).
+//! [`super::tear`]), with a bracketing fallback for a single equation ([`bracketed`]).
 //!
 //! Each iteration solves `J(z_k) Δ = −r(z_k)` (Gaussian elimination with partial pivoting) and takes
 //! `z_{k+1} = z_k + λ Δ` with the first `λ = 1, 1/2, 1/4, …` that passes the Armijo test
@@ -98,12 +98,153 @@ fn merit(r: &[f64], w: &[f64]) -> f64 {
     r.iter().zip(w).map(|(r, w)| (r / w).powi(2)).sum()
 }
 
-/// Solves `problem` from the initial guess in `z`, in place. Returns the number of iterations.
+/// Solves `problem` from the initial guess in `z`, in place. Returns the number of iterations (residual
+/// evaluations of the bracketing fallback included).
+///
+/// Damped Newton first; for a single equation whose Newton iteration fails, a bracket of a sign change is searched
+/// outward from the start and the root is found inside it ([`bracketed`]), which converges wherever the residual is
+/// continuous and changes sign, however steep it is (a diode's exponential). On failure `z` holds the last
+/// iterate of the damped Newton's method and the error is its failure.
 pub fn solve(
     problem: &mut dyn Problem,
     z: &mut [f64],
     settings: Settings,
 ) -> Result<usize, Failure> {
+    let start = z.first().copied();
+    let failure = match damped(problem, z, settings) {
+        Ok(k) => return Ok(k),
+        Err(f) => f,
+    };
+    match (problem.size(), start) {
+        (1, Some(z0)) if z0.is_finite() => match bracketed(problem, z0, settings) {
+            Some((root, evaluations)) => {
+                if let Some(z) = z.first_mut() {
+                    *z = root;
+                }
+                Ok(failure.iterations + evaluations)
+            }
+            None => Err(failure),
+        },
+        _ => Err(failure),
+    }
+}
+
+/// The most residual evaluations of [`bracketed`]: doubling the search interval from `1e-6` reaches `1e300` in
+/// about 1,000, and bisecting such a bracket down to adjacent floats takes as many.
+const BRACKET_EVALUATIONS: usize = 4000;
+
+/// The residual and its scale of a one-equation problem at `z`.
+fn eval1(problem: &mut dyn Problem, z: f64) -> (f64, f64) {
+    let (mut r, mut s) = ([0.0], [0.0]);
+    problem.residual(&[z], &mut r, &mut s);
+    (r[0], s[0])
+}
+
+/// One equation: a root in a bracket of a sign change found outward from `z0`, by Newton steps that stay inside
+/// the bracket and halve it at least every other step, else bisection (`rtsafe`). The root and the number of
+/// evaluations, or `None` when no sign change is found or the bracket closes on a point whose residual is not
+/// below the tolerance (a pole, a jump).
+pub fn bracketed(problem: &mut dyn Problem, z0: f64, settings: Settings) -> Option<(f64, usize)> {
+    let (r0, s0) = eval1(problem, z0);
+    if r0.is_nan() {
+        return None;
+    }
+    // Converged: finite, and within the tolerance of the scale (an infinite residual is only a direction).
+    let within = |r: f64, s: f64| r.is_finite() && s.is_finite() && r.abs() <= settings.rtol * s;
+    if within(r0, s0) {
+        return Some((z0, 1));
+    }
+    let (mut lo, mut hi, mut evaluations) = bracket(problem, (z0, r0, s0))?;
+    // `lo` has the negative residual; `x` is the best point so far.
+    let (mut x, mut rx, mut sx) = if lo.1.abs() < hi.1.abs() { lo } else { hi };
+    let mut step_before = (hi.0 - lo.0).abs();
+    let mut step = step_before;
+    while evaluations < BRACKET_EVALUATIONS {
+        if within(rx, sx) {
+            return Some((x, evaluations));
+        }
+        let mut jac = [f64::NAN];
+        if rx.is_finite() {
+            problem.jacobian(&[x], &mut jac);
+        }
+        let newton = x - rx / jac[0];
+        let (a, b) = (lo.0.min(hi.0), lo.0.max(hi.0));
+        let inside = newton.is_finite() && newton > a && newton < b;
+        let fast = (newton - x).abs() <= 0.5 * step_before;
+        step_before = step;
+        let next = if inside && fast {
+            newton
+        } else {
+            a + (b - a) / 2.0
+        };
+        step = (next - x).abs();
+        if next <= a || next >= b {
+            // The bracket is two adjacent floats.
+            break;
+        }
+        let (r, s) = eval1(problem, next);
+        evaluations += 1;
+        if r.is_nan() {
+            return None;
+        }
+        if r < 0.0 {
+            lo = (next, r, s);
+        } else {
+            hi = (next, r, s);
+        }
+        (x, rx, sx) = (next, r, s);
+        if r == 0.0 && s.is_finite() {
+            return Some((x, evaluations));
+        }
+    }
+    let (x, rx, sx) = if lo.1.abs() < hi.1.abs() { lo } else { hi };
+    within(rx, sx).then_some((x, evaluations))
+}
+
+/// A point with residual and scale.
+type Point = (f64, f64, f64);
+
+/// Points of opposite signs of the residual, searched at `z0 ± h` with `h` doubling from `10⁻⁶ max(1, |z0|)`:
+/// the one with the negative residual first, the number of evaluations last. Infinite residuals count by their
+/// sign (an exponential overflowing on one side still says which side the root is on); NaN ends the search on that
+/// side.
+fn bracket(problem: &mut dyn Problem, start: Point) -> Option<(Point, Point, usize)> {
+    let (z0, r0, _) = start;
+    let mut h = 1e-6 * z0.abs().max(1.0);
+    // The nearest point on each side known to have the sign of `r0`.
+    let mut same = [start, start];
+    let mut open = [true, true];
+    let mut evaluations = 1;
+    while evaluations < BRACKET_EVALUATIONS && open.iter().any(|o| *o) {
+        for (side, dir) in [1.0, -1.0].into_iter().enumerate() {
+            if !open[side] {
+                continue;
+            }
+            let z = z0 + dir * h;
+            if !z.is_finite() {
+                open[side] = false;
+                continue;
+            }
+            let (r, s) = eval1(problem, z);
+            evaluations += 1;
+            if r.is_nan() {
+                open[side] = false;
+            } else if r == 0.0 || (r < 0.0) != (r0 < 0.0) {
+                let near = same[side];
+                let far = (z, r, s);
+                let (neg, pos) = if r0 < 0.0 { (near, far) } else { (far, near) };
+                return Some((neg, pos, evaluations));
+            } else {
+                same[side] = (z, r, s);
+            }
+        }
+        h *= 2.0;
+    }
+    None
+}
+
+/// Damped Newton's method (the module docs); `z` holds the last iterate.
+fn damped(problem: &mut dyn Problem, z: &mut [f64], settings: Settings) -> Result<usize, Failure> {
     let n = problem.size().min(z.len());
     let z = &mut z[..n];
     let (mut r, mut s) = (vec![0.0; n], vec![0.0; n]);
@@ -291,6 +432,87 @@ mod tests {
         assert_eq!(
             solve(&mut NoRoot, &mut z, Settings::default()).map_err(|f| f.kind),
             Err(FailureKind::Singular)
+        );
+    }
+
+    /// `r(i) = i − I_s (exp((u − R i)/V_t) − 1)`: the diode loop of `bgc/tests/corpus/diode_rc.bg` with the
+    /// capacitor uncharged, scales the magnitudes of the terms.
+    struct Diode {
+        u: f64,
+    }
+
+    impl Problem for Diode {
+        fn size(&self) -> usize {
+            1
+        }
+        fn residual(&mut self, z: &[f64], r: &mut [f64], s: &mut [f64]) {
+            let e = (self.u - 100.0 * z[0]) / 0.05;
+            r[0] = z[0] - 1e-6 * (e.exp() - 1.0);
+            s[0] = z[0].abs() + 1e-6 * (e.exp() + 1.0);
+        }
+        fn jacobian(&mut self, z: &[f64], j: &mut [f64]) {
+            j[0] = 1.0 + 1e-6 * ((self.u - 100.0 * z[0]) / 0.05).exp() * 100.0 / 0.05;
+        }
+    }
+
+    #[test]
+    fn a_steep_scalar_loop_is_solved_by_bracketing_where_damped_newton_stops() {
+        // Roots by bisection in Python down to adjacent floats on [0, u/100], where r goes from < 0 to > 0:
+        //   r = lambda i: i - 1e-6*(math.exp((u - 100*i)/0.05) - 1)   (-inf where exp overflows)
+        //   a, b = 0.0, u/100; repeat: m = (a+b)/2; a, b = (m, b) if r(m) < 0 else (a, m)
+        // u = 10: 0.09427301953896923; u = 100: 0.9930957083358242.
+        for (u, root) in [
+            (10.0, 0.094_273_019_538_969_23),
+            (100.0, 0.993_095_708_335_824_2),
+        ] {
+            let mut z = [0.0];
+            assert!(damped(&mut Diode { u }, &mut z, Settings::default()).is_err());
+            let mut z = [0.0];
+            let k = solve(&mut Diode { u }, &mut z, Settings::default());
+            assert!(k.is_ok(), "u = {u}: {k:?}");
+            assert!((z[0] - root).abs() < 1e-10, "u = {u}: {z:?}");
+        }
+        for u in [8.0, 20.0, 1e3] {
+            let mut z = [0.0];
+            assert!(
+                solve(&mut Diode { u }, &mut z, Settings::default()).is_ok(),
+                "u = {u}"
+            );
+            let (mut r, mut s) = ([0.0], [0.0]);
+            Diode { u }.residual(&z, &mut r, &mut s);
+            assert!(r[0].abs() <= 1e-12 * s[0], "u = {u}: {r:?} {s:?}");
+        }
+    }
+
+    /// `r(z) = 1` below `z = 2` and `−1` from there on: a sign change at a jump, which is no root.
+    struct Jump;
+
+    impl Problem for Jump {
+        fn size(&self) -> usize {
+            1
+        }
+        fn residual(&mut self, z: &[f64], r: &mut [f64], s: &mut [f64]) {
+            r[0] = if z[0] < 2.0 { 1.0 } else { -1.0 };
+            s[0] = 1.0;
+        }
+        fn jacobian(&mut self, _z: &[f64], j: &mut [f64]) {
+            j[0] = 0.0;
+        }
+    }
+
+    #[test]
+    fn a_sign_change_without_a_root_is_not_taken_for_one() {
+        let mut z = [0.0];
+        let err = solve(&mut Jump, &mut z, Settings::default());
+        assert!(
+            matches!(
+                err,
+                Err(Failure {
+                    kind: FailureKind::Singular,
+                    ..
+                })
+            ),
+            "{err:?} {z:?}"
         );
     }
 

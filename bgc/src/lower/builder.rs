@@ -63,6 +63,8 @@ pub(crate) struct Builder<'a> {
     pub component_stack: Vec<String>,
     /// Every component instantiated while building this model.
     pub instantiated: Vec<String>,
+    /// How many instances were expanded (bounded by `flatten::MAX_INSTANCES`).
+    pub instance_count: usize,
 }
 
 impl<'a> Builder<'a> {
@@ -94,6 +96,7 @@ impl<'a> Builder<'a> {
             pending_coords: None,
             component_stack: Vec::new(),
             instantiated: Vec::new(),
+            instance_count: 0,
             bad_units: Vec::new(),
             last_unit_ok: true,
             unmatched_name: false,

@@ -17,6 +17,7 @@ use crate::span::Span;
 use crate::syntax::ast::{self, ElementBody, ElementKind as K};
 use crate::units::{Dim, domain_units, storage_parameter_unit};
 use petgraph::graph::NodeIndex;
+use std::collections::HashMap;
 
 impl Builder<'_> {
     pub fn build_relations(&mut self) {
@@ -374,6 +375,10 @@ impl Builder<'_> {
     ) -> Option<Relation> {
         let ports = self.model.graph[n].ports;
         let size = ports as usize;
+        if size > super::flatten::MAX_FIELD_PORTS {
+            // Reported at the declaration.
+            return None;
+        }
         let cx = Cx {
             scope,
             allow: Allow::States {
@@ -382,10 +387,14 @@ impl Builder<'_> {
             host: Some(n),
             what: "a constitutive law",
         };
-        let mut seen: Vec<Option<Span>> =
-            vec![None; if kind == K::IF { size * size } else { size }];
+        // The laws given, by slot: only those written are stored, so that the cost follows the file's length.
+        let mut seen: HashMap<usize, Span> = HashMap::new();
         let mut out = Vec::new();
-        let mut mass: Vec<ir::Expr> = vec![ir::Expr::Const(0.0); size * size];
+        let mut mass: Vec<ir::Expr> = if kind == K::IF {
+            vec![ir::Expr::Const(0.0); size * size]
+        } else {
+            Vec::new()
+        };
         for law in laws {
             let indices: Vec<u32> = law.indices.iter().map(|(i, _)| *i).collect();
             let lhs_ok = match kind {
@@ -436,7 +445,7 @@ impl Builder<'_> {
                 [i] => (i - 1) as usize,
                 _ => continue,
             };
-            if let Some(Some(first)) = seen.get(slot) {
+            if let Some(first) = seen.get(&slot) {
                 self.diags.push(
                     Diagnostic::error(
                         "BG0202",
@@ -448,9 +457,7 @@ impl Builder<'_> {
                 );
                 continue;
             }
-            if let Some(s) = seen.get_mut(slot) {
-                *s = Some(law.span);
-            }
+            seen.insert(slot, law.span);
             let Some((rhs, q)) = self.expr(&law.rhs, cx) else {
                 continue;
             };
@@ -472,8 +479,12 @@ impl Builder<'_> {
                     );
                 }
                 let (i, j) = (i as usize, j as usize);
-                mass[i * size + j] = rhs.clone();
-                mass[j * size + i] = rhs;
+                if let Some(slot) = mass.get_mut(i * size + j) {
+                    *slot = rhs.clone();
+                }
+                if let Some(slot) = mass.get_mut(j * size + i) {
+                    *slot = rhs;
+                }
             } else {
                 let var = port_var(&law.lhs.name).unwrap_or(PortVar::Effort);
                 let port = indices[0] - 1;
@@ -505,8 +516,8 @@ impl Builder<'_> {
                 entries: mass,
             });
         }
-        for (i, s) in seen.iter().enumerate() {
-            if s.is_none() {
+        for i in 0..size {
+            if !seen.contains_key(&i) {
                 self.diags.push(
                     Diagnostic::error(
                         "BG0313",

@@ -15,6 +15,17 @@ use crate::ir::{self, Domain};
 use crate::syntax::ast::{self, ElementKind, Ident, InstanceDecl, ModelDecl, ModelKind, Stmt};
 use crate::units::{Unit, parse_unit, unit_text};
 
+/// How deep components may nest. Real models nest a handful of levels; the bound keeps the recursive flattening
+/// (and every later walk over qualified names) far from the end of the stack.
+pub(crate) const MAX_NESTING: usize = 100;
+/// How many component instances one model may expand to. Two instances per level double the model at each level,
+/// so a short file could otherwise ask for billions of elements.
+pub(crate) const MAX_INSTANCES: usize = 100_000;
+
+/// The most ports a field may have. An I-field's mass matrix has a symbolic entry per pair of ports, and every
+/// port needs its own bond, so a larger count is a typing mistake, not a model.
+pub(crate) const MAX_FIELD_PORTS: usize = 1000;
+
 /// The overrides of an instance, to be evaluated in the enclosing scope.
 pub(crate) struct Overrides<'a> {
     pub instance: &'a InstanceDecl,
@@ -398,6 +409,19 @@ impl<'a> Builder<'a> {
             k if k.is_field() => e.ports.map(|(n, _)| n).unwrap_or(0),
             _ => 1,
         };
+        if let Some((n, span)) = e.ports.filter(|(n, _)| *n as usize > MAX_FIELD_PORTS) {
+            self.diags.push(
+                Diagnostic::error(
+                    "BG0115",
+                    format!(
+                        "a field has at most {MAX_FIELD_PORTS} ports, `{}` declares {n}",
+                        e.name.name
+                    ),
+                )
+                .with_primary(span, "too many ports")
+                .with_help("split the field into smaller fields, or check the port count"),
+            );
+        }
         let node = self.model.graph.add_node(ir::Node {
             name: self.qualified(sid, &e.name.name),
             kind: e.kind,
@@ -481,6 +505,20 @@ impl<'a> Builder<'a> {
             );
             return false;
         }
+        if self.component_stack.len() >= MAX_NESTING || self.instance_count >= MAX_INSTANCES {
+            let what = if self.component_stack.len() >= MAX_NESTING {
+                format!("components nest more than {MAX_NESTING} deep here")
+            } else {
+                format!("the model expands to more than {MAX_INSTANCES} component instances")
+            };
+            self.diags.push(
+                Diagnostic::error("BG0204", what)
+                    .with_primary(inst.span, "this instance is not expanded")
+                    .with_help("a model this large is almost always a mistake: check the components that instantiate one another"),
+            );
+            return false;
+        }
+        self.instance_count += 1;
         self.component_stack.push(name.clone());
         self.instantiated.push(name.clone());
         let prefix = format!("{}{}.", self.scopes[sid].prefix, inst.name.name);

@@ -40,14 +40,59 @@ use petgraph::Direction;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-pub use imports::{STD_NAME, STD_SOURCE};
+pub use imports::{STD_NAME, STD_SOURCE, normalize};
 pub use instances::add_instance_context;
 
-/// Where lowering gets the text of imported files. The path is the import joined to the directory of the importing
-/// file's name in the [`SourceMap`] (so relative to wherever the root file's name is relative to). The CLI reads the
-/// file system; tests and build scripts may serve files from memory. `"std.bg"` never reaches the loader.
+/// Where lowering gets the text of imported files. The loader decides which file an import names and what
+/// identifies it (its key: two imports with one key are one file, so a diamond of imports loads it once and a file
+/// that imports itself under another name is a cycle). The CLI and `bgc::build` use `bgc::build::FsLoader`
+/// (canonical paths, only `.bg` files inside the allowed directories); tests serve files from memory.
+/// `"std.bg"` never reaches the loader, and an import that does not end in `.bg` is refused before it does.
 pub trait SourceLoader {
-    fn load(&mut self, path: &Path) -> std::io::Result<String>;
+    /// The key of the root file, whose name in the [`SourceMap`] is `name`. By default the name with `.` and `..`
+    /// resolved lexically.
+    fn identify_root(&mut self, name: &Path) -> PathBuf {
+        imports::normalize(name)
+    }
+
+    /// The file that `import` names when written in the file with key `importer_key` and display name
+    /// `importer_name`. By default the import joined to the importer's directory, resolved lexically, as key and
+    /// name.
+    fn resolve(
+        &mut self,
+        importer_key: &Path,
+        importer_name: &str,
+        import: &str,
+    ) -> std::io::Result<Resolved> {
+        let _ = importer_name;
+        let dir = importer_key.parent().unwrap_or(Path::new(""));
+        let key = imports::normalize(&dir.join(import));
+        Ok(Resolved {
+            name: key.display().to_string(),
+            key,
+        })
+    }
+
+    /// The text of the file with this key.
+    fn load(&mut self, key: &Path) -> std::io::Result<String>;
+}
+
+/// The file an import names.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Resolved {
+    /// What identifies the file (for [`SourceLoader::load`]).
+    pub key: PathBuf,
+    /// Its name in diagnostics.
+    pub name: String,
+}
+
+impl Resolved {
+    pub fn new(key: PathBuf, name: &Path) -> Resolved {
+        Resolved {
+            key,
+            name: name.display().to_string(),
+        }
+    }
 }
 
 /// A loader that serves files from a map (paths as the importing file names them, joined to its directory).

@@ -11,6 +11,7 @@
 //! without a derivative.
 
 use std::cell::{Cell, RefCell};
+use std::ops::ControlFlow;
 
 use diffsol::error::DiffsolError;
 use diffsol::{
@@ -82,17 +83,37 @@ impl RunOptions {
 
     /// The sample times: `0, dt, 2 dt, …` up to `t_end`, and `t_end` itself.
     pub fn sample_times(&self) -> Vec<f64> {
-        let n = (self.t_end / self.dt_out * (1.0 + 1e-12)).floor() as usize;
-        let mut times: Vec<f64> = (0..=n).map(|k| k as f64 * self.dt_out).collect();
-        if times
-            .last()
-            .is_none_or(|&last| (self.t_end - last) > 1e-9 * self.t_end)
-        {
-            times.push(self.t_end);
-        } else if let Some(last) = times.last_mut() {
-            *last = self.t_end;
+        let s = Samples::new(self);
+        (0..s.count).filter_map(|k| s.get(k)).collect()
+    }
+}
+
+/// The sample times, computed one at a time so that a run's memory does not grow with its number of rows.
+#[derive(Clone, Copy, Debug)]
+struct Samples {
+    dt: f64,
+    t_end: f64,
+    count: usize,
+}
+
+impl Samples {
+    fn new(opts: &RunOptions) -> Samples {
+        let n = (opts.t_end / opts.dt_out * (1.0 + 1e-12)).floor() as usize;
+        // `n dt` is the last multiple; `t_end` replaces it when it is that close, else follows it.
+        let close = (opts.t_end - n as f64 * opts.dt_out) <= 1e-9 * opts.t_end;
+        Samples {
+            dt: opts.dt_out,
+            t_end: opts.t_end,
+            count: if close { n + 1 } else { n + 2 },
         }
-        times
+    }
+
+    fn get(&self, k: usize) -> Option<f64> {
+        match k.cmp(&(self.count - 1)) {
+            std::cmp::Ordering::Less => Some(k as f64 * self.dt),
+            std::cmp::Ordering::Equal => Some(self.t_end),
+            std::cmp::Ordering::Greater => None,
+        }
     }
 }
 
@@ -104,8 +125,40 @@ pub struct Trajectory {
     pub rows: Vec<Vec<f64>>,
 }
 
-/// Integrates `system` from the model state `x0` at `t = 0` (the energy quadratures start at zero).
+/// How a streamed run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Finish {
+    /// Every row up to `t_end` was handed over.
+    Done,
+    /// The receiver asked to stop (its output was closed).
+    Stopped,
+}
+
+/// Integrates `system` from the model state `x0` at `t = 0` (the energy quadratures start at zero) and collects
+/// the rows.
 pub fn run(system: &System, x0: &[f64], opts: &RunOptions) -> Result<Trajectory, SimError> {
+    let mut times = Vec::new();
+    let mut rows = Vec::new();
+    run_streaming(system, x0, opts, &mut |t, row| {
+        times.push(t);
+        rows.push(row.to_vec());
+        ControlFlow::Continue(())
+    })?;
+    Ok(Trajectory {
+        columns: system.columns(),
+        times,
+        rows,
+    })
+}
+
+/// Integrates as [`run`] does, handing each row (of [`System::row`]) to `sink` as soon as it is computed; `sink`
+/// breaks to stop the run. Memory does not depend on the number of rows.
+pub fn run_streaming(
+    system: &System,
+    x0: &[f64],
+    opts: &RunOptions,
+    sink: &mut dyn FnMut(f64, &[f64]) -> ControlFlow<()>,
+) -> Result<Finish, SimError> {
     opts.check()?;
     let n = system.state_count();
     if x0.len() != n {
@@ -116,10 +169,9 @@ pub fn run(system: &System, x0: &[f64], opts: &RunOptions) -> Result<Trajectory,
         });
     }
     let mut y: Vec<f64> = x0.iter().copied().chain([0.0, 0.0]).collect();
-    let times = opts.sample_times();
+    let samples = Samples::new(opts);
     let mut u = Vec::new();
     let mut stack = Vec::new();
-    let mut rows = Vec::with_capacity(times.len());
     let first = system.row(&y, 0.0, &mut u, &mut stack)?;
     if let Some(i) = first.iter().position(|v| !v.is_finite()) {
         let columns = system.columns();
@@ -127,7 +179,9 @@ pub fn run(system: &System, x0: &[f64], opts: &RunOptions) -> Result<Trajectory,
             what: columns.get(i).cloned().unwrap_or_default(),
         });
     }
-    rows.push(first);
+    if sink(0.0, &first).is_break() {
+        return Ok(Finish::Stopped);
+    }
     let mut bounds = vec![0.0];
     bounds.extend(system.breakpoints(opts.t_end));
     bounds.push(opts.t_end);
@@ -138,39 +192,71 @@ pub fn run(system: &System, x0: &[f64], opts: &RunOptions) -> Result<Trajectory,
             _ => continue,
         };
         let start = next;
-        while times.get(next).is_some_and(|&t| t <= b) {
+        while samples.get(next).is_some_and(|t| t <= b) {
             next += 1;
         }
-        let wanted = times.get(start..next).unwrap_or(&[]);
         let last = b >= opts.t_end;
-        let mut states = Vec::with_capacity(wanted.len());
-        y = segment(system, &y, a, b, last, wanted, opts, &mut states)?;
+        // Rows before `b` go out as they come; those at `b` of a segment that is not the last wait for the jump.
+        let mut held: Vec<(f64, Vec<f64>)> = Vec::new();
+        let mut deliver = |t: f64, ys: &[f64]| -> Result<ControlFlow<()>, SimError> {
+            if !last && t >= b {
+                held.push((t, ys.to_vec()));
+                return Ok(ControlFlow::Continue(()));
+            }
+            let row = system.row(ys, t, &mut u, &mut stack)?;
+            Ok(sink(t, &row))
+        };
+        let wanted = Wanted {
+            samples,
+            range: start..next,
+        };
+        let end = segment(system, &y, a, b, last, &wanted, opts, &mut deliver)?;
+        let Some(end) = end else {
+            return Ok(Finish::Stopped);
+        };
+        y = end;
         if !last {
             // The row at `b` itself shows the inputs after their jump, so it gets the jump's energy too.
             let jump = system.stored_jump(&y, just_before(b), b, &mut stack)?;
-            for (t, ys) in wanted.iter().zip(states.iter_mut()) {
-                if *t >= b
-                    && let Some(sup) = ys.get_mut(n + 1)
-                {
-                    *sup += jump;
-                }
-            }
             if let Some(sup) = y.get_mut(n + 1) {
                 *sup += jump;
             }
-        }
-        for (t, ys) in wanted.iter().zip(&states) {
-            rows.push(system.row(ys, *t, &mut u, &mut stack)?);
+            for (t, mut ys) in held {
+                if let Some(sup) = ys.get_mut(n + 1) {
+                    *sup += jump;
+                }
+                let row = system.row(&ys, t, &mut u, &mut stack)?;
+                if sink(t, &row).is_break() {
+                    return Ok(Finish::Stopped);
+                }
+            }
         }
     }
-    Ok(Trajectory {
-        columns: system.columns(),
-        times,
-        rows,
-    })
+    Ok(Finish::Done)
 }
 
-/// Integrates `[a, b]` from `y0`, pushing the extended state at `wanted` times; returns the state at `b`.
+/// The sample times a segment reports.
+struct Wanted {
+    samples: Samples,
+    range: std::ops::Range<usize>,
+}
+
+impl Wanted {
+    fn get(&self, i: usize) -> Option<f64> {
+        let k = self.range.start.checked_add(i)?;
+        if k < self.range.end {
+            self.samples.get(k)
+        } else {
+            None
+        }
+    }
+}
+
+/// Where a segment's extended states at the sample times go; breaks to stop the run.
+type Deliver<'d> = dyn FnMut(f64, &[f64]) -> Result<ControlFlow<()>, SimError> + 'd;
+
+/// Integrates `[a, b]` from `y0`, delivering the extended state at the `wanted` times; returns the state at `b`, or
+/// `None` when the receiver stopped the run.
 #[allow(clippy::too_many_arguments)]
 fn segment(
     system: &System,
@@ -178,10 +264,10 @@ fn segment(
     a: f64,
     b: f64,
     last: bool,
-    wanted: &[f64],
+    wanted: &Wanted,
     opts: &RunOptions,
-    out: &mut Vec<Vec<f64>>,
-) -> Result<Vec<f64>, SimError> {
+    out: &mut Deliver<'_>,
+) -> Result<Option<Vec<f64>>, SimError> {
     let dim = y0.len();
     // Inputs are evaluated before a breakpoint `b`, never at it (see the module docs).
     let t_max = if last { f64::INFINITY } else { just_before(b) };
@@ -286,7 +372,7 @@ struct Drive<'c> {
     loop_failure: &'c RefCell<Option<SimError>>,
     from: f64,
     to: f64,
-    wanted: &'c [f64],
+    wanted: &'c Wanted,
     max_steps: usize,
 }
 
@@ -317,8 +403,8 @@ impl Drive<'_> {
     fn drive<'a, Eqn, S>(
         &self,
         mut solver: S,
-        out: &mut Vec<Vec<f64>>,
-    ) -> Result<Vec<f64>, SimError>
+        out: &mut Deliver<'_>,
+    ) -> Result<Option<Vec<f64>>, SimError>
     where
         Eqn: OdeEquations<T = f64, V = NalgebraVec<f64>> + 'a,
         S: OdeSolverMethod<'a, Eqn>,
@@ -349,19 +435,22 @@ impl Drive<'_> {
                 });
             }
             let reached = matches!(reason, OdeSolverStopReason::TstopReached);
-            while let Some(&t) = self.wanted.get(next) {
-                if reached && t >= self.to {
-                    out.push(y.clone());
+            while let Some(t) = self.wanted.get(next) {
+                let flow = if reached && t >= self.to {
+                    out(t, &y)?
                 } else if t <= t_now {
                     let v = solver.interpolate(t).map_err(|e| self.failure(t, e))?;
-                    out.push(v.clone_as_vec());
+                    out(t, &v.clone_as_vec())?
                 } else {
                     break;
+                };
+                if flow.is_break() {
+                    return Ok(None);
                 }
                 next += 1;
             }
             if reached {
-                return Ok(y);
+                return Ok(Some(y));
             }
         }
         Err(SimError::TooManySteps {

@@ -2,7 +2,7 @@
 
 use super::super::format::{self, Wrap};
 use super::super::layout::Body;
-use super::super::names::{Namer, comment, string_literal};
+use super::super::names::{Namer, comment, sanitize, string_literal};
 use super::{Writer, output_names, rust_f64};
 use crate::ir;
 use crate::symbolic::{Expr, Symbol, from_ir, to_rust_code, to_text};
@@ -447,4 +447,71 @@ pub type OutJacU = SMatrix<f64, N_OUTPUTS, N_INPUTS>;
         self.out.push_str(&text);
         self.out.push_str("    }\n");
     }
+}
+
+/// The methods of the generated `Params`, its own and those of the traits it derives: a derived parameter is a
+/// method too, so one of these names would clash (E0592) or shadow the trait's method.
+pub(super) const PARAMS_METHODS: &[&str] = &[
+    "get",
+    "set",
+    "validate",
+    "default",
+    "clone",
+    "clone_from",
+    "fmt",
+    "eq",
+    "ne",
+];
+
+/// The Rust name of parameter `name` in `Params` (a field when free, a method when derived), unique in `namer`.
+pub(super) fn field_name(namer: &mut Namer, name: &str, derived: bool) -> String {
+    if derived && PARAMS_METHODS.contains(&sanitize(name).as_str()) {
+        // As a keyword gets a `_` suffix, so does a name the generated methods use.
+        namer.ident(&format!("{name}_"))
+    } else {
+        namer.ident(name)
+    }
+}
+
+/// Text from the model file made inert in a comment: the code points rustc refuses in comments (the deny-by-default
+/// `text_direction_codepoint_in_comment` lint: bidirectional overrides and isolates) and other invisible controls
+/// are written as `\u{…}`; a run of three backticks or tildes (which rustdoc would read as a code fence, and then
+/// as a doctest) and a leading indent (an indented code block) are escaped.
+pub(in crate::codegen) fn doc_safe(text: &str) -> String {
+    let mut visible = String::with_capacity(text.len());
+    for c in text.trim_start().chars() {
+        if invisible(c) {
+            visible.push_str(&format!("\\u{{{:x}}}", c as u32));
+        } else {
+            visible.push(c);
+        }
+    }
+    let chars: Vec<char> = visible.chars().collect();
+    let mut out = String::with_capacity(visible.len());
+    let mut i = 0;
+    while let Some(&c) = chars.get(i) {
+        let mut j = i + 1;
+        if c == '`' || c == '~' {
+            while chars.get(j) == Some(&c) {
+                j += 1;
+            }
+        }
+        for _ in i..j {
+            if j - i >= 3 {
+                out.push('\\');
+            }
+            out.push(c);
+        }
+        i = j;
+    }
+    out
+}
+
+/// A code point that changes how text around it reads without showing itself.
+fn invisible(c: char) -> bool {
+    c.is_control() && c != ' '
+        || matches!(
+            c,
+            '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}' | '\u{200E}' | '\u{200F}' | '\u{061C}' | '\u{2028}' | '\u{2029}'
+        )
 }

@@ -1,0 +1,612 @@
+//! The `bgc` command against hostile and careless input: many errors, long lines, special files, imports that
+//! reach out of the project, output that cannot be written, models that would exhaust the stack or the memory.
+//! Each gets a clear answer (exit 0, 1 or 2 with a message), never a crash, a hang or a leak of another file.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+struct Run {
+    status: i32,
+    stdout: String,
+    stderr: String,
+}
+
+impl Run {
+    fn transcript(&self) -> String {
+        let cut = |s: &str| s.chars().take(4000).collect::<String>();
+        format!(
+            "exit: {}\n--- stdout ({} bytes)\n{}\n--- stderr ({} bytes)\n{}",
+            self.status,
+            self.stdout.len(),
+            cut(&self.stdout),
+            self.stderr.len(),
+            cut(&self.stderr)
+        )
+    }
+}
+
+/// How long a run may take before it counts as a hang. Far above what any of these runs needs; it only turns a
+/// process that would never end (a FIFO read, `/dev/zero`) into a failed test instead of a stuck one.
+const HANG: Duration = Duration::from_secs(120);
+
+/// Runs bgc in `dir` with standard output to `stdout`; kills it when it hangs.
+fn bgc_to(dir: &Path, args: &[&str], stdout: Stdio) -> Run {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bgc"))
+        .args(args)
+        .arg("--color=never")
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(stdout)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap_or_else(|e| panic!("cannot start bgc: {e}"));
+    let mut out = child.stdout.take();
+    let mut err = child.stderr.take();
+    let readers = std::thread::spawn(move || {
+        let mut o = Vec::new();
+        let mut e = Vec::new();
+        if let Some(s) = err.as_mut() {
+            let _ = s.take(64 << 20).read_to_end(&mut e);
+        }
+        if let Some(s) = out.as_mut() {
+            let _ = s.take(64 << 20).read_to_end(&mut o);
+        }
+        (o, e)
+    });
+    let start = Instant::now();
+    let status = loop {
+        if let Ok(Some(s)) = child.try_wait() {
+            break s.code().unwrap_or(-1);
+        }
+        if start.elapsed() > HANG {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("bgc {args:?} hangs");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let (o, e) = readers.join().unwrap_or_default();
+    Run {
+        status,
+        stdout: String::from_utf8_lossy(&o).into_owned(),
+        stderr: String::from_utf8_lossy(&e).into_owned(),
+    }
+}
+
+fn bgc(dir: &Path, args: &[&str]) -> Run {
+    bgc_to(dir, args, Stdio::piped())
+}
+
+/// A scratch directory of this test's own.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("bgc-hostile-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+    dir
+}
+
+fn write(path: &Path, text: &str) {
+    if let Some(parent) = path.parent() {
+        std::fs::create_dir_all(parent).unwrap_or_else(|e| panic!("{e}"));
+    }
+    std::fs::write(path, text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+}
+
+fn corpus(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/corpus")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+/// A one-line file with 16,000 errors: before, each diagnostic echoed the whole 40 KB line (about 640 MB of
+/// stderr). Now the first 100 are shown, each with a window of the line, and one line counts the rest.
+#[test]
+fn many_errors_on_one_long_line_give_a_short_report() {
+    let dir = scratch("many");
+    let text = format!("model m {{ {}}}\n", "x x; ".repeat(8000));
+    write(&dir.join("long.bg"), &text);
+    let run = bgc(&dir, &["check", "long.bg"]);
+    assert_eq!(run.status, 1, "{}", run.transcript());
+    assert!(run.stderr.len() < 200_000, "{}", run.transcript());
+    assert!(
+        run.stderr.contains(
+            "only the first 100 diagnostics are shown; 15899 more not shown (15899 errors"
+        ),
+        "{}",
+        run.transcript()
+    );
+    assert!(run.stderr.contains("15999 errors"), "{}", run.transcript());
+    // The 50th `x` that is an unknown component is at byte 10 + 5 * 49 of line 1: column 256, far into the line.
+    // Its excerpt starts with an ellipsis, the caret stands under that `x` and the location is the real one.
+    let block = run
+        .stderr
+        .split("\n\n")
+        .find(|b| b.contains("long.bg:1:256"))
+        .unwrap_or_else(|| panic!("no diagnostic at 1:256\n{}", run.transcript()));
+    let lines: Vec<&str> = block.lines().collect();
+    let source = lines
+        .iter()
+        .find(|l| l.starts_with("1 │ "))
+        .unwrap_or_else(|| panic!("{block}"));
+    assert!(source.starts_with("1 │ …x x;"), "{block}");
+    assert!(source.ends_with('…'), "{block}");
+    assert!(source.chars().count() < 300, "{block}");
+    let caret = lines
+        .iter()
+        .find(|l| l.contains('^'))
+        .unwrap_or_else(|| panic!("{block}"));
+    let col = caret.chars().position(|c| c == '^');
+    let x_col = col.and_then(|c| source.chars().nth(c));
+    assert_eq!(x_col, Some('x'), "{block}");
+}
+
+/// `'model a {' * 10000`: before 66 s, 4 GB of memory and 4 GB of stderr; now a capped report.
+#[test]
+fn ten_thousand_open_models_give_a_short_report() {
+    let dir = scratch("open");
+    write(&dir.join("open.bg"), &"model a {".repeat(10_000));
+    let run = bgc(&dir, &["check", "open.bg"]);
+    assert_eq!(run.status, 1, "{}", run.transcript());
+    assert!(run.stderr.len() < 200_000, "{}", run.transcript());
+    assert!(run.stderr.contains("open.bg:1:"), "{}", run.transcript());
+    assert!(
+        run.stderr.contains("more not shown"),
+        "{}",
+        run.transcript()
+    );
+}
+
+fn mkfifo(path: &Path) {
+    let made = Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .unwrap_or_else(|e| panic!("mkfifo: {e}"));
+    assert!(made.success(), "mkfifo {}", path.display());
+}
+
+/// Devices, FIFOs and directories are refused as the input (exit 2) and as an import (BG0108, exit 1), without
+/// reading them: before, `/dev/zero` filled the memory and a FIFO blocked forever.
+#[test]
+fn special_files_are_refused_without_reading_them() {
+    let dir = scratch("special");
+    mkfifo(&dir.join("fifo.bg"));
+    std::fs::create_dir_all(dir.join("folder.bg")).unwrap_or_else(|e| panic!("{e}"));
+    for (input, kind) in [
+        ("/dev/zero", "a device"),
+        ("/dev/urandom", "a device"),
+        ("fifo.bg", "a FIFO"),
+        ("folder.bg", "a directory"),
+    ] {
+        for command in [
+            vec!["check", input],
+            vec!["rust", input],
+            vec!["simulate", input, "--t-end", "1"],
+        ] {
+            let run = bgc(&dir, &command);
+            assert_eq!(run.status, 2, "{command:?}\n{}", run.transcript());
+            assert!(
+                run.stderr
+                    .contains(&format!("cannot read {input}: not a regular file ({kind})")),
+                "{command:?}\n{}",
+                run.transcript()
+            );
+        }
+    }
+    for (import, why) in [
+        ("fifo.bg", "not a regular file (a FIFO)"),
+        ("folder.bg", "not a regular file (a directory)"),
+    ] {
+        write(
+            &dir.join("importer.bg"),
+            &format!("import \"{import}\";\nmodel m {{ }}\n"),
+        );
+        let run = bgc(&dir, &["check", "importer.bg"]);
+        assert_eq!(run.status, 1, "{}", run.transcript());
+        assert!(
+            run.stderr
+                .contains(&format!("error[BG0108]: cannot import `{import}`: {why}")),
+            "{}",
+            run.transcript()
+        );
+        assert!(
+            run.stderr.contains("importer.bg:1:1"),
+            "{}",
+            run.transcript()
+        );
+    }
+}
+
+/// A source file above the 16 MiB bound is refused before it is read whole.
+#[test]
+fn an_oversized_source_is_refused() {
+    let dir = scratch("big");
+    let mut text = String::from("model m { }\n");
+    text.push_str(
+        &"// padding padding padding padding padding padding padding padding\n".repeat(260_000),
+    );
+    assert!(text.len() as u64 > bgc::build::MAX_SOURCE_BYTES);
+    write(&dir.join("big.bg"), &text);
+    let run = bgc(&dir, &["check", "big.bg"]);
+    assert_eq!(run.status, 2, "{}", run.transcript());
+    assert!(
+        run.stderr.contains(
+            "cannot read big.bg: the file is larger than the 16 MiB a source file may have"
+        ),
+        "{}",
+        run.transcript()
+    );
+    write(&dir.join("main.bg"), "import \"big.bg\";\nmodel m { }\n");
+    let run = bgc(&dir, &["check", "main.bg"]);
+    assert_eq!(run.status, 1, "{}", run.transcript());
+    assert!(
+        run.stderr
+            .contains("cannot import `big.bg`: the file is larger"),
+        "{}",
+        run.transcript()
+    );
+}
+
+/// Imports reach only `.bg` files inside the input's directory tree and the include directories; the message of
+/// a refused import never shows what the file holds. Before, `import "/etc/passwd";` printed its first line and
+/// `/proc/self/environ` the whole environment.
+#[cfg(unix)]
+#[test]
+fn imports_cannot_read_files_outside_the_project() {
+    let dir = scratch("confined");
+    let project = dir.join("project");
+    write(
+        &dir.join("outside/secret.bg"),
+        "component leaked { domain rotational; param J = 1 [kg m^2]; 1 j; I i = J; bond j -> i; port p = j; }\n",
+    );
+    write(&dir.join("outside/plain.txt"), "SECRET-CONTENT\n");
+    std::fs::create_dir_all(project.join("sub")).unwrap_or_else(|e| panic!("{e}"));
+    std::os::unix::fs::symlink(dir.join("outside/plain.txt"), project.join("link.bg"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    std::os::unix::fs::symlink(dir.join("outside/secret.bg"), project.join("secret.bg"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let cases = [
+        ("/etc/passwd", "an import names a `.bg` source file"),
+        (
+            "../../../../../../etc/passwd",
+            "an import names a `.bg` source file",
+        ),
+        ("/proc/self/environ", "an import names a `.bg` source file"),
+        (
+            "../outside/plain.txt",
+            "an import names a `.bg` source file",
+        ),
+        ("link.bg", "the file it leads to is not a `.bg` file"),
+        (
+            "../outside/secret.bg",
+            "outside the importing file's directory",
+        ),
+        ("secret.bg", "outside the importing file's directory"),
+        (
+            "sub/../../outside/secret.bg",
+            "outside the importing file's directory",
+        ),
+    ];
+    for (import, why) in cases {
+        write(
+            &project.join("main.bg"),
+            &format!(
+                "import \"{import}\";\nmodel m {{ domain rotational; leaked c; 1 j; bond j -> c.p; }}\n"
+            ),
+        );
+        let run = bgc(&project, &["check", "main.bg"]);
+        assert_eq!(run.status, 1, "{import}\n{}", run.transcript());
+        assert!(
+            run.stderr.contains(&format!("cannot import `{import}`: ")) && run.stderr.contains(why),
+            "{import}\n{}",
+            run.transcript()
+        );
+        for leak in ["root:", "SECRET-CONTENT", "PATH=", "component leaked"] {
+            assert!(
+                !run.stderr.contains(leak),
+                "{import}: {leak}\n{}",
+                run.transcript()
+            );
+        }
+    }
+    // The same file in an include directory the user gave is fine (through the link or found by the search), with
+    // the CLI flag and with `Config`.
+    write(
+        &project.join("main.bg"),
+        "import \"secret.bg\";\nmodel m { domain rotational; leaked c; input tau [N m]; Se s = tau; bond s -> c.p; }\n",
+    );
+    let outside = dir.join("outside").display().to_string();
+    let run = bgc(&project, &["check", "-I", &outside, "main.bg"]);
+    assert_eq!(run.status, 0, "{}", run.transcript());
+    std::fs::remove_file(project.join("secret.bg")).unwrap_or_else(|e| panic!("{e}"));
+    let run = bgc(&project, &["check", "-I", &outside, "main.bg"]);
+    assert_eq!(run.status, 0, "{}", run.transcript());
+    let run = bgc(&project, &["check", "main.bg"]);
+    assert_eq!(run.status, 1, "{}", run.transcript());
+    let out = dir.join("out");
+    let built = bgc::build::Config::new()
+        .out_dir(&out)
+        .cargo_output(false)
+        .include_dir(dir.join("outside"))
+        .compile(&[project.join("main.bg")]);
+    assert!(built.is_ok(), "{:?}", built.err());
+    let refused = bgc::build::Config::new()
+        .out_dir(&out)
+        .cargo_output(false)
+        .compile(&[project.join("main.bg")]);
+    assert!(
+        matches!(&refused, Err(bgc::build::Error::Diagnostics { rendered, .. }) if rendered.contains("BG0108")),
+        "{:?}",
+        refused.err()
+    );
+    let run = bgc(&project, &["check", "-I", "no-such-dir", "main.bg"]);
+    assert_eq!(run.status, 2, "{}", run.transcript());
+    assert!(
+        run.stderr.contains("include directory no-such-dir"),
+        "{}",
+        run.transcript()
+    );
+}
+
+/// Files are identified by their canonical path: a diamond works from any working directory, and a file that
+/// imports itself by another path or through a link is a cycle (BG0107), not two files declaring one name twice.
+#[cfg(unix)]
+#[test]
+fn import_identity_is_the_canonical_path() {
+    let dir = scratch("identity");
+    write(
+        &dir.join("top/top.bg"),
+        "import \"x/a.bg\";\nimport \"y/b.bg\";\nmodel m { domain rotational; cc c; input tau [N m]; Se s = tau; bond s -> c.p; }\n",
+    );
+    write(&dir.join("top/x/a.bg"), "import \"../common.bg\";\n");
+    write(&dir.join("top/y/b.bg"), "import \"../y/../common.bg\";\n");
+    write(
+        &dir.join("top/common.bg"),
+        "component cc { domain rotational; 1 j; param J = 1 [kg m^2]; I i = J; bond j -> i; port p = j; }\n",
+    );
+    for (cwd, path) in [
+        (dir.clone(), "top/top.bg"),
+        (dir.join("top"), "top.bg"),
+        (dir.join("top/x"), "../top.bg"),
+        (dir.join("top/y"), "../x/../top.bg"),
+    ] {
+        let run = bgc(&cwd, &["check", path]);
+        assert_eq!(
+            run.status,
+            0,
+            "{path} from {}\n{}",
+            cwd.display(),
+            run.transcript()
+        );
+    }
+    write(
+        &dir.join("imp/self.bg"),
+        "import \"../imp/self.bg\";\nmodel m { }\n",
+    );
+    std::os::unix::fs::symlink("self2.bg", dir.join("imp/link.bg"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    write(
+        &dir.join("imp/self2.bg"),
+        "import \"link.bg\";\nmodel n { }\n",
+    );
+    for (cwd, path) in [
+        (dir.clone(), "imp/self.bg"),
+        (dir.join("imp"), "self.bg"),
+        (dir.join("imp"), "self2.bg"),
+        (dir.join("imp"), "link.bg"),
+    ] {
+        let run = bgc(&cwd, &["check", path]);
+        assert_eq!(run.status, 1, "{path}\n{}", run.transcript());
+        assert!(
+            run.stderr.contains("error[BG0107]: import cycle"),
+            "{path}\n{}",
+            run.transcript()
+        );
+        assert!(
+            !run.stderr.contains("BG0202"),
+            "{path}\n{}",
+            run.transcript()
+        );
+    }
+}
+
+/// Output that cannot be written is an error (exit 2 with the OS error), not a silent success.
+#[cfg(target_os = "linux")]
+#[test]
+fn write_errors_exit_2_with_the_os_error() {
+    let dir = scratch("full");
+    let oscillator = corpus("oscillator.bg");
+    for command in [
+        vec!["rust", oscillator.as_str()],
+        vec!["simulate", oscillator.as_str(), "--t-end", "1"],
+        vec!["equations", oscillator.as_str()],
+    ] {
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap_or_else(|e| panic!("/dev/full: {e}"));
+        let run = bgc_to(&dir, &command, Stdio::from(full));
+        assert_eq!(run.status, 2, "{command:?}\n{}", run.transcript());
+        assert!(
+            run.stderr
+                .contains("error: cannot write the output: No space left on device"),
+            "{command:?}\n{}",
+            run.transcript()
+        );
+    }
+}
+
+/// `simulate` streams its rows: a reader that closes the pipe after the first lines ends a run of five million rows
+/// at once (before, every row was computed and kept in memory before the first was printed).
+#[test]
+fn simulate_streams_and_stops_at_a_closed_pipe() {
+    let dir = scratch("pipe");
+    let oscillator = corpus("oscillator.bg");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bgc"))
+        .args([
+            "simulate",
+            &oscillator,
+            "--t-end",
+            "5e3",
+            "--dt-out",
+            "1e-3",
+            "--input",
+            "F=sin(t)",
+        ])
+        .current_dir(&dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut first = [0u8; 4096];
+    let got = child
+        .stdout
+        .as_mut()
+        .map(|o| o.read(&mut first).unwrap_or(0))
+        .unwrap_or(0);
+    let text = String::from_utf8_lossy(&first[..got]).into_owned();
+    assert!(text.starts_with("t,p_mass,q_spring,"), "{text}");
+    drop(child.stdout.take());
+    let start = Instant::now();
+    let status = loop {
+        if let Ok(Some(s)) = child.try_wait() {
+            break s;
+        }
+        if start.elapsed() > HANG {
+            let _ = child.kill();
+            panic!("bgc simulate goes on after its output was closed");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let mut err = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        let _ = e.read_to_string(&mut err);
+    }
+    assert_eq!(status.code(), Some(0), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+/// Components nested 4,000 deep overflowed the stack (SIGABRT); nesting is bounded with BG0204, and so is the
+/// number of instances a model expands to (two instances per level would double it 40 times).
+#[test]
+fn deep_and_exploding_component_nesting_is_a_diagnostic() {
+    let dir = scratch("nesting");
+    let n = 4000;
+    let mut deep = String::new();
+    for i in 0..n - 1 {
+        deep.push_str(&format!(
+            "component c{i} {{ domain rotational; 1 j; c{} inner; port p = j; bond j -> inner.p; }}\n",
+            i + 1
+        ));
+    }
+    deep.push_str(&format!(
+        "component c{} {{ domain rotational; 1 j; param J = 1 [kg m^2]; I i = J; bond j -> i; port p = j; }}\n",
+        n - 1
+    ));
+    deep.push_str(
+        "model m { domain rotational; c0 top; input tau [N m]; Se s = tau; bond s -> top.p; }\n",
+    );
+    write(&dir.join("deep.bg"), &deep);
+    let run = bgc(&dir, &["check", "deep.bg"]);
+    assert_eq!(run.status, 1, "{}", run.transcript());
+    assert!(
+        run.stderr
+            .contains("error[BG0204]: components nest more than 100 deep here"),
+        "{}",
+        run.transcript()
+    );
+    let levels = 40;
+    let mut wide = String::new();
+    for i in 0..levels {
+        wide.push_str(&format!(
+            "component w{i} {{ domain rotational; 0 j; w{n} a; w{n} b; port p = j; bond j -> a.p; bond j -> b.p; }}\n",
+            n = i + 1
+        ));
+    }
+    wide.push_str(&format!(
+        "component w{levels} {{ domain rotational; 1 j; param J = 1 [kg m^2]; I i = J; bond j -> i; port p = j; }}\n"
+    ));
+    wide.push_str(
+        "model m { domain rotational; w0 top; input tau [N m]; Se s = tau; bond s -> top.p; }\n",
+    );
+    write(&dir.join("wide.bg"), &wide);
+    let run = bgc(&dir, &["check", "wide.bg"]);
+    assert_eq!(run.status, 1, "{}", run.transcript());
+    assert!(
+        run.stderr
+            .contains("the model expands to more than 100000 component instances"),
+        "{}",
+        run.transcript()
+    );
+}
+
+/// An import chain of 9,000 files overflowed the stack; the walk is iterative now.
+#[test]
+fn a_long_import_chain_loads() {
+    let dir = scratch("chain");
+    let n = 9000;
+    for i in 0..n {
+        let import = if i + 1 < n {
+            format!("import \"f{}.bg\";\n", i + 1)
+        } else {
+            String::new()
+        };
+        write(
+            &dir.join(format!("f{i}.bg")),
+            &format!(
+                "{import}component c{i} {{ domain rotational; 1 j; param J = 1 [kg m^2]; I i = J; bond j -> i; port p = j; }}\n"
+            ),
+        );
+    }
+    write(
+        &dir.join("main.bg"),
+        &format!(
+            "import \"f0.bg\";\nmodel m {{ domain rotational; c{} x; input tau [N m]; Se s = tau; bond s -> x.p; }}\n",
+            n - 1
+        ),
+    );
+    let run = bgc(&dir, &["check", "main.bg"]);
+    assert_eq!(run.status, 0, "{}", run.transcript());
+    assert!(run.stdout.contains("model `m`"), "{}", run.transcript());
+}
+
+/// `RF r(30000)` allocated a 30000² table (28.8 GB); a field's port count is bounded with BG0115 and its laws are
+/// stored sparsely.
+#[test]
+fn a_huge_field_is_a_diagnostic() {
+    let dir = scratch("field");
+    write(
+        &dir.join("rf.bg"),
+        "model m { domain electrical; RF r(30000) { e[1] = f[1]; }; }\n",
+    );
+    let run = bgc(&dir, &["check", "rf.bg"]);
+    assert_eq!(run.status, 1, "{}", run.transcript());
+    assert!(
+        run.stderr
+            .contains("error[BG0115]: a field has at most 1000 ports, `r` declares 30000"),
+        "{}",
+        run.transcript()
+    );
+    assert!(run.stderr.contains("rf.bg:1:"), "{}", run.transcript());
+}
+
+/// `--t-end 5e-324` without `--dt-out` said "dt_out = 0 is not allowed", naming an option that was not given.
+#[test]
+fn a_tiny_t_end_is_refused_in_its_own_name() {
+    let dir = scratch("tiny");
+    let oscillator = corpus("oscillator.bg");
+    for t_end in ["5e-324", "1e-310"] {
+        let run = bgc(&dir, &["simulate", &oscillator, "--t-end", t_end]);
+        assert_eq!(run.status, 1, "{}", run.transcript());
+        assert!(
+            run.stderr
+                .contains(&format!("error: --t-end {t_end} is too small")),
+            "{}",
+            run.transcript()
+        );
+        assert!(!run.stderr.contains("dt_out"), "{}", run.transcript());
+    }
+}

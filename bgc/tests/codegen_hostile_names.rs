@@ -2,7 +2,7 @@
 //! of the generated `Params` methods, and descriptions with text that means something to rustc (bidirectional
 //! overrides) or to rustdoc (code fences, indented code blocks).
 
-mod codegen_support;
+use crate::codegen_support;
 
 use bgc::codegen::rust::Options;
 use codegen_support::rustc::{compile_no_std, stand_ins};

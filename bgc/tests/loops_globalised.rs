@@ -12,8 +12,8 @@
 //! while (m := (a + b)/2) not in (a, b): a, b = (m, b) if r(m) < 0 else (a, m)
 //! ```
 
-mod cli_support;
-mod codegen_support;
+use crate::cli_support;
+use crate::codegen_support;
 
 use cli_support::{bgc, corpus};
 use codegen_support::rustc::{NALGEBRA, rustc};

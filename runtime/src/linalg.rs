@@ -6,7 +6,8 @@
 //!
 //! - [`care`], [`care_with_cross`], [`dare`], [`dare_with_cross`]: stabilising solutions of the algebraic Riccati
 //!   equations, with balancing, a structured base solver and Newton (Kleinman/Hewer) refinement.
-//! - [`lyap`], [`dlyap`]: Lyapunov equations (Bartels–Stewart).
+//! - [`lyap`], [`dlyap`], [`sylvester()`], [`stein`]: Lyapunov, Sylvester and Stein equations (Bartels–Stewart,
+//!   `O(n³)`).
 //! - [`expm()`], [`c2d_zoh`], [`van_loan`]: matrix exponential, zero-order-hold discretisation, discrete
 //!   process-noise covariance.
 //! - [`pbh`]: PBH tests naming uncontrollable/unobservable modes, stabilisability, detectability, Kalman ranks.
@@ -23,13 +24,14 @@ mod refine;
 pub mod riccati;
 pub mod schur;
 pub mod sign;
+pub mod sylvester;
 
 pub use care::{care, care_with_cross};
 pub use check::MatrixError;
 pub use dare::{dare, dare_with_cross};
 pub use discretize::{DiscretizeError, c2d_zoh, van_loan};
 pub use expm::{ExpmError, expm};
-pub use lyapunov::{LyapunovError, MAX_LYAPUNOV_ORDER, dlyap, lyap};
+pub use lyapunov::{LyapunovError, dlyap, lyap};
 pub use pbh::{
     Domain, Mode, PbhError, controllability_matrix, controllability_rank, is_detectable,
     is_stabilizable, observability_matrix, observability_rank, uncontrollable_modes,
@@ -37,3 +39,4 @@ pub use pbh::{
 };
 pub use riccati::{Riccati, RiccatiError};
 pub use schur::{SchurError, eigenvalues};
+pub use sylvester::{stein, sylvester};

@@ -20,5 +20,7 @@ mod linalg_design;
 mod linalg_expm;
 mod linalg_lyapunov;
 mod linalg_pbh;
+mod linalg_sylvester;
+mod sim_linear;
 mod sim_open_loop;
 mod sim_sampled;

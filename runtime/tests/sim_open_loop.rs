@@ -144,7 +144,7 @@ fn error_time(e: &SimError) -> f64 {
         | SimError::NonFiniteOutput { time, .. }
         | SimError::NonFiniteInput { time, .. }
         | SimError::TooManySteps { time, .. } => *time,
-        SimError::BadSetting { .. } => f64::NAN,
+        SimError::BadSetting { .. } | SimError::Discretisation { .. } => f64::NAN,
     }
 }
 

@@ -66,10 +66,20 @@ pub enum PbhError {
 /// Every mode of `A` (one of each complex-conjugate pair) with its PBH controllability margin, sorted by
 /// increasing margin. [`uncontrollable_modes`] keeps those below [`PBH_TOLERANCE`].
 pub fn controllability_margins(a: &DMatrix<f64>, b: &DMatrix<f64>) -> Result<Vec<Mode>, PbhError> {
+    controllability_margins_where(a, b, |_| true)
+}
+
+/// The modes of `A` whose eigenvalue satisfies `keep`, with their PBH controllability margins, sorted by
+/// increasing margin: one SVD per kept mode, none for the others.
+fn controllability_margins_where(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    keep: impl Fn(Complex<f64>) -> bool,
+) -> Result<Vec<Mode>, PbhError> {
     let n = check::square("A", a)?;
     check::shape("B", b, n, b.ncols())?;
     // The dual system (Aᵀ, Bᵀ): an uncontrollable left eigenvector of A is an unobservable right one of Aᵀ.
-    let mut modes = observability_margins(&a.transpose(), &b.transpose())?;
+    let mut modes = observability_margins_where(&a.transpose(), &b.transpose(), keep)?;
     for m in &mut modes {
         // wᴴ A = λ wᴴ  ⇔  Aᵀ w̄ = λ w̄: the right vector of the dual is the conjugate of w.
         m.direction = m.direction.map(|z| z.conj());
@@ -80,6 +90,16 @@ pub fn controllability_margins(a: &DMatrix<f64>, b: &DMatrix<f64>) -> Result<Vec
 /// Every mode of `A` (one of each complex-conjugate pair) with its PBH observability margin, sorted by
 /// increasing margin. [`unobservable_modes`] keeps those below [`PBH_TOLERANCE`].
 pub fn observability_margins(a: &DMatrix<f64>, c: &DMatrix<f64>) -> Result<Vec<Mode>, PbhError> {
+    observability_margins_where(a, c, |_| true)
+}
+
+/// The modes of `A` whose eigenvalue satisfies `keep`, with their PBH observability margins, sorted by
+/// increasing margin: one SVD per kept mode, none for the others.
+fn observability_margins_where(
+    a: &DMatrix<f64>,
+    c: &DMatrix<f64>,
+    keep: impl Fn(Complex<f64>) -> bool,
+) -> Result<Vec<Mode>, PbhError> {
     let n = check::square("A", a)?;
     check::shape("C", c, c.nrows(), n)?;
     let d = balancing_scales(a);
@@ -101,7 +121,7 @@ pub fn observability_margins(a: &DMatrix<f64>, c: &DMatrix<f64>) -> Result<Vec<M
     let p = cb.nrows();
     let mut modes = Vec::new();
     for lambda in eigenvalues(&ab)? {
-        if lambda.im < 0.0 {
+        if lambda.im < 0.0 || !keep(lambda) {
             continue;
         }
         let mut m = DMatrix::<Complex<f64>>::zeros(n + p, n);
@@ -151,28 +171,29 @@ pub fn unobservable_modes(a: &DMatrix<f64>, c: &DMatrix<f64>) -> Result<Vec<Mode
     Ok(modes)
 }
 
-/// The first uncontrollable mode of `(A, B)` that is not asymptotically stable, if any.
+/// The least controllable of the uncontrollable modes of `(A, B)` that are not asymptotically stable, if any.
+/// Only the modes that are not stable are tested (stable modes need no input), so a stable system costs one
+/// eigenvalue decomposition and no SVD.
 pub fn unstabilizable_mode(
     a: &DMatrix<f64>,
     b: &DMatrix<f64>,
     domain: Domain,
 ) -> Result<Option<Mode>, PbhError> {
     let scale = stability_scale(a, domain);
-    Ok(uncontrollable_modes(a, b)?
-        .into_iter()
-        .find(|m| !domain.is_stable(m.eigenvalue, scale)))
+    let modes = controllability_margins_where(a, b, |l| !domain.is_stable(l, scale))?;
+    Ok(modes.into_iter().find(|m| m.margin < PBH_TOLERANCE))
 }
 
-/// The first unobservable mode of `(A, C)` that is not asymptotically stable, if any.
+/// The least observable of the unobservable modes of `(A, C)` that are not asymptotically stable, if any;
+/// only the modes that are not stable are tested.
 pub fn undetectable_mode(
     a: &DMatrix<f64>,
     c: &DMatrix<f64>,
     domain: Domain,
 ) -> Result<Option<Mode>, PbhError> {
     let scale = stability_scale(a, domain);
-    Ok(unobservable_modes(a, c)?
-        .into_iter()
-        .find(|m| !domain.is_stable(m.eigenvalue, scale)))
+    let modes = observability_margins_where(a, c, |l| !domain.is_stable(l, scale))?;
+    Ok(modes.into_iter().find(|m| m.margin < PBH_TOLERANCE))
 }
 
 /// Whether every mode of `A` that is not asymptotically stable is controllable from `B`.

@@ -19,11 +19,6 @@ use super::lyapunov::LyapunovError;
 use super::pbh::{self, Domain, PbhError};
 use super::schur::{SchurError, eigenvalues};
 
-/// The largest state dimension the Riccati solvers accept. The cost is dominated by `O(n⁴)` parts: the PBH
-/// checks (one SVD of an `(n + m) x n` complex matrix per eigenvalue) and the Lyapunov solves of the Newton
-/// refinement; the 8-state design takes about 0.2 ms, a 100-state one about 0.5 s in an optimised build.
-pub const MAX_RICCATI_ORDER: usize = super::lyapunov::MAX_LYAPUNOV_ORDER;
-
 /// Relative residual above which a Riccati solution is refused (see [`Riccati::relative_residual`]).
 pub const RICCATI_TOLERANCE: f64 = 1e-8;
 
@@ -47,8 +42,6 @@ pub struct Riccati {
 pub enum RiccatiError {
     #[error(transparent)]
     Input(#[from] MatrixError),
-    #[error("order {n} exceeds the limit {max} of the Riccati solver")]
-    TooLarge { n: usize, max: usize },
     #[error(
         "not stabilisable: the mode with eigenvalue {eigenvalue} is not stable and cannot be moved by the input (for an estimator: is not excited by the process noise){}",
         format_direction(.direction)
@@ -151,12 +144,6 @@ impl Problem {
         cross: Option<&DMatrix<f64>>,
     ) -> Result<Self, RiccatiError> {
         let n = check::square("A", a)?;
-        if n > MAX_RICCATI_ORDER {
-            return Err(RiccatiError::TooLarge {
-                n,
-                max: MAX_RICCATI_ORDER,
-            });
-        }
         let m = b.ncols();
         check::shape("B", b, n, m)?;
         check::shape("Q", q, n, n)?;

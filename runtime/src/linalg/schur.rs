@@ -56,3 +56,27 @@ pub fn diagonal_blocks(t: &DMatrix<f64>) -> Result<Vec<(usize, usize)>, SchurErr
     }
     Ok(blocks)
 }
+
+/// The eigenvalues of an upper quasi-triangular matrix (a real Schur factor), read from its diagonal blocks.
+pub fn block_eigenvalues(t: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, SchurError> {
+    let mut out = Vec::with_capacity(t.nrows());
+    for (s, size) in diagonal_blocks(t)? {
+        if size == 1 {
+            out.push(Complex::new(t[(s, s)], 0.0));
+            continue;
+        }
+        let (a, b, c, d) = (t[(s, s)], t[(s, s + 1)], t[(s + 1, s)], t[(s + 1, s + 1)]);
+        let mean = 0.5 * (a + d);
+        let disc = (0.5 * (a - d)).powi(2) + b * c;
+        if disc >= 0.0 {
+            let r = disc.sqrt();
+            out.push(Complex::new(mean + r, 0.0));
+            out.push(Complex::new(mean - r, 0.0));
+        } else {
+            let r = (-disc).sqrt();
+            out.push(Complex::new(mean, r));
+            out.push(Complex::new(mean, -r));
+        }
+    }
+    Ok(out)
+}

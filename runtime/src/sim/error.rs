@@ -36,4 +36,7 @@ pub enum SimError {
         value: f64,
         reason: &'static str,
     },
+    /// The exact discretisation of a linear plant failed (its matrix exponential overflowed).
+    #[error("the zero-order-hold discretisation of the linear plant failed: {message}")]
+    Discretisation { message: String },
 }

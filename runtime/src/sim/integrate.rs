@@ -3,10 +3,10 @@
 //! The segment solves `ẋ = f(t, x, u(t)) + w` from `(t0, x0)` to `t_end` with the chosen method, reporting the
 //! state at requested times inside the segment by the solver's own dense output (Hermite/Nordsieck
 //! interpolation of the accepted steps, of the method's order). The Jacobian handed to the implicit methods
-//! is the model's `jac_x`. A fresh solver is started for each segment, so an input that jumps at the segment
+//! is the model's `jac_x`, evaluated once per point at which the solver assembles it. A fresh solver is started for each segment, so an input that jumps at the segment
 //! boundary (a zero-order hold) never enters an implicit method's step history.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 
 use diffsol::error::DiffsolError;
 use diffsol::{
@@ -80,6 +80,9 @@ impl SolverOptions {
     }
 }
 
+/// The model's Jacobian `∂f/∂x` at `(t, x)`, kept for the next column product at the same point.
+type JacobianAt<const NX: usize> = (f64, SVector<f64, NX>, SMatrix<f64, NX, NX>);
+
 /// A segment to integrate.
 pub(crate) struct Segment<'a, const NX: usize> {
     pub t0: f64,
@@ -122,10 +125,21 @@ where
         }
         dx.copy_from_slice(d.as_slice());
     };
+    // diffsol assembles its Jacobian from one product per column, all at the same point: the model's
+    // Jacobian is evaluated once per point and reused for the other columns.
+    let cached: RefCell<Option<JacobianAt<NX>>> = RefCell::new(None);
     let jac = |x: &[f64], _p: &[f64], t: f64, v: &[f64], jv: &mut [f64]| {
         let xs = SVector::<f64, NX>::from_column_slice(x);
-        let mut j = SMatrix::<f64, NX, NX>::zeros();
-        model.jac_x(t, &xs, &input(t), &mut j);
+        let mut cache = cached.borrow_mut();
+        let j = match &*cache {
+            Some((tc, xc, j)) if *tc == t && *xc == xs => *j,
+            _ => {
+                let mut j = SMatrix::<f64, NX, NX>::zeros();
+                model.jac_x(t, &xs, &input(t), &mut j);
+                *cache = Some((t, xs, j));
+                j
+            }
+        };
         let prod = j * SVector::<f64, NX>::from_column_slice(v);
         jv.copy_from_slice(prod.as_slice());
     };

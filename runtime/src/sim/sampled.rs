@@ -13,11 +13,20 @@
 //! and a last measurement `y_N` is taken at `t_N`. Noise is drawn from one seeded [`Rng`] in a fixed order —
 //! at each sample first the `NY` measurement noises, then the `NX` process noises — so a run is repeatable
 //! from its seed. Zero standard deviations draw nothing.
+//!
+//! Step 3 is an ODE solve of the model for [`simulate_sampled_loop`] (any plant, also nonlinear), and the exact
+//! zero-order-hold step of [`super::linear`] for [`simulate_sampled_linear_loop`] (a [`LinearPlant`]). The
+//! `_streaming` variants hand each sample to a sink instead of recording it, so a run's memory does not grow
+//! with its length; the recording variants refuse runs whose record would exceed [`MAX_RECORD_BYTES`].
+
+use std::collections::VecDeque;
+use std::ops::ControlFlow;
 
 use nalgebra::SVector;
 
 use super::error::SimError;
 use super::integrate::{Segment, SolverOptions, integrate_segment};
+use super::linear::{LinearPlant, ZohStep};
 use super::open_loop::check_initial;
 use crate::model::ContinuousModel;
 use crate::noise::Rng;
@@ -44,12 +53,13 @@ pub struct SampledLoopConfig<const NX: usize, const NU: usize, const NY: usize> 
     pub t0: f64,
     /// The sample time `T` (s).
     pub sample_time: f64,
-    /// The number of sample intervals `N`; the run ends at `t0 + N T`.
+    /// The number of sample intervals `N`; the run ends at `t0 + N T`, which must be finite, with `t_N` and
+    /// `t_{N−1}` distinct in floating point.
     pub samples: usize,
     pub x0: SVector<f64, NX>,
     /// The input assumed before the first controller update (used in the first measurement only).
     pub initial_input: SVector<f64, NU>,
-    /// Whole samples by which measurements reach the controller late.
+    /// Whole samples by which measurements reach the controller late (at most [`MAX_MEASUREMENT_DELAY`]).
     pub measurement_delay: usize,
     /// Standard deviation of the additive measurement noise of each output.
     pub measurement_noise_std: SVector<f64, NY>,
@@ -97,6 +107,22 @@ impl<const NX: usize, const NU: usize, const NY: usize> SampledLoopConfig<NX, NU
                 reason: "noise standard deviations must be finite and non-negative",
             });
         }
+        let end = self.t0 + self.samples as f64 * self.sample_time;
+        let before_end = self.t0 + self.samples.saturating_sub(1) as f64 * self.sample_time;
+        if !end.is_finite() || (self.samples > 0 && end <= before_end) {
+            return Err(SimError::BadSetting {
+                name: "samples",
+                value: self.samples as f64,
+                reason: "the sample instants t0 + k T must stay finite and distinct up to k = samples",
+            });
+        }
+        if self.measurement_delay > MAX_MEASUREMENT_DELAY {
+            return Err(SimError::BadSetting {
+                name: "measurement_delay",
+                value: self.measurement_delay as f64,
+                reason: "a measurement delay of more than 2²⁰ samples is not supported",
+            });
+        }
         if let Some(v) = self.initial_input.iter().find(|v| !v.is_finite()) {
             return Err(SimError::BadSetting {
                 name: "initial_input",
@@ -106,7 +132,33 @@ impl<const NX: usize, const NU: usize, const NY: usize> SampledLoopConfig<NX, NU
         }
         Ok(())
     }
+
+    /// Refuses a run whose record ([`SampledTrajectory`]) would take more than [`MAX_RECORD_BYTES`].
+    fn check_record_size(&self) -> Result<(), SimError> {
+        let per_sample = (1 + NX + NU + NY) * std::mem::size_of::<f64>();
+        let fits = self
+            .samples
+            .checked_add(1)
+            .and_then(|rows| rows.checked_mul(per_sample))
+            .is_some_and(|bytes| bytes <= MAX_RECORD_BYTES);
+        if fits {
+            Ok(())
+        } else {
+            Err(SimError::BadSetting {
+                name: "samples",
+                value: self.samples as f64,
+                reason: "recording every sample would take more than 1 GiB; use a _streaming variant, which hands each sample to a sink",
+            })
+        }
+    }
 }
+
+/// The largest record [`simulate_sampled_loop`] and [`simulate_sampled_linear_loop`] build (1 GiB).
+pub const MAX_RECORD_BYTES: usize = 1 << 30;
+
+/// The largest [`SampledLoopConfig::measurement_delay`] in samples (the delay line holds that many
+/// measurements).
+pub const MAX_MEASUREMENT_DELAY: usize = 1 << 20;
 
 /// The record of a sampled-data run.
 #[derive(Clone, Debug, PartialEq)]
@@ -121,7 +173,21 @@ pub struct SampledTrajectory<const NX: usize, const NU: usize, const NY: usize> 
     pub inputs: Vec<SVector<f64, NU>>,
 }
 
-/// Runs the sampled-data loop described in the module documentation.
+/// One sample of a run as handed to the sink of a `_streaming` variant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample<const NX: usize, const NU: usize, const NY: usize> {
+    pub k: usize,
+    /// `t_k`.
+    pub time: f64,
+    /// `x(t_k)`.
+    pub state: SVector<f64, NX>,
+    /// The noisy measurement `y_k` taken at `t_k` (before any delay).
+    pub measurement: SVector<f64, NY>,
+    /// The input `u_k` held over `[t_k, t_{k+1})`; `None` at the last sample `k = N`.
+    pub input: Option<SVector<f64, NU>>,
+}
+
+/// Runs the sampled-data loop described in the module documentation, integrating the model by ODE solves.
 pub fn simulate_sampled_loop<Mdl, Ctl, const NX: usize, const NU: usize, const NY: usize>(
     model: &Mdl,
     controller: &mut Ctl,
@@ -131,40 +197,168 @@ where
     Mdl: ContinuousModel<NX, NU, NY>,
     Ctl: SampledController<NY, NU>,
 {
+    cfg.check_record_size()?;
+    record(cfg, |sink| {
+        simulate_sampled_loop_streaming(model, controller, cfg, sink)
+    })
+}
+
+/// [`simulate_sampled_loop`] handing each sample to `sink` (in order, `k = 0 … N`) instead of recording it;
+/// the run stops early when `sink` breaks. Returns the number of samples handed over.
+pub fn simulate_sampled_loop_streaming<
+    Mdl,
+    Ctl,
+    const NX: usize,
+    const NU: usize,
+    const NY: usize,
+>(
+    model: &Mdl,
+    controller: &mut Ctl,
+    cfg: &SampledLoopConfig<NX, NU, NY>,
+    sink: impl FnMut(&Sample<NX, NU, NY>) -> ControlFlow<()>,
+) -> Result<usize, SimError>
+where
+    Mdl: ContinuousModel<NX, NU, NY>,
+    Ctl: SampledController<NY, NU>,
+{
     cfg.check()?;
+    let mut scratch = Vec::new();
+    let advance = |k: usize, x: &SVector<f64, NX>, u: &SVector<f64, NU>, w: &SVector<f64, NX>| {
+        let seg = Segment {
+            t0: cfg.t0 + k as f64 * cfg.sample_time,
+            t_end: cfg.t0 + (k + 1) as f64 * cfg.sample_time,
+            x0: x,
+            disturbance: w,
+            output_times: &[],
+        };
+        integrate_segment::<Mdl, _, NX, NU, NY>(model, |_t| *u, &seg, &cfg.solver, &mut scratch)
+    };
+    run(model, controller, cfg, advance, sink)
+}
+
+/// The sampled-data loop of a linear plant with the exact zero-order-hold step (see [`super::linear`]);
+/// the same record as [`simulate_sampled_loop`] up to the ODE solver's error. `cfg.solver` is not used.
+pub fn simulate_sampled_linear_loop<Ctl, const NX: usize, const NU: usize, const NY: usize>(
+    plant: &LinearPlant<NX, NU, NY>,
+    controller: &mut Ctl,
+    cfg: &SampledLoopConfig<NX, NU, NY>,
+) -> Result<SampledTrajectory<NX, NU, NY>, SimError>
+where
+    Ctl: SampledController<NY, NU>,
+{
+    cfg.check_record_size()?;
+    record(cfg, |sink| {
+        simulate_sampled_linear_loop_streaming(plant, controller, cfg, sink)
+    })
+}
+
+/// [`simulate_sampled_linear_loop`] handing each sample to `sink` instead of recording it (see
+/// [`simulate_sampled_loop_streaming`]).
+pub fn simulate_sampled_linear_loop_streaming<
+    Ctl,
+    const NX: usize,
+    const NU: usize,
+    const NY: usize,
+>(
+    plant: &LinearPlant<NX, NU, NY>,
+    controller: &mut Ctl,
+    cfg: &SampledLoopConfig<NX, NU, NY>,
+    sink: impl FnMut(&Sample<NX, NU, NY>) -> ControlFlow<()>,
+) -> Result<usize, SimError>
+where
+    Ctl: SampledController<NY, NU>,
+{
+    cfg.check()?;
+    let step = ZohStep::new(plant, cfg.sample_time)?;
+    let advance = |k: usize, x: &SVector<f64, NX>, u: &SVector<f64, NU>, w: &SVector<f64, NX>| {
+        let next = step.advance(x, u, w);
+        match next.iter().position(|v| !v.is_finite()) {
+            Some(index) => Err(SimError::NonFiniteState {
+                time: cfg.t0 + (k + 1) as f64 * cfg.sample_time,
+                index,
+            }),
+            None => Ok(next),
+        }
+    };
+    run(plant, controller, cfg, advance, sink)
+}
+
+/// Collects the samples that `stream` hands to its sink into a [`SampledTrajectory`].
+fn record<const NX: usize, const NU: usize, const NY: usize>(
+    cfg: &SampledLoopConfig<NX, NU, NY>,
+    stream: impl FnOnce(
+        &mut dyn FnMut(&Sample<NX, NU, NY>) -> ControlFlow<()>,
+    ) -> Result<usize, SimError>,
+) -> Result<SampledTrajectory<NX, NU, NY>, SimError> {
+    // check_record_size bounds `samples`, so the reservation is at most MAX_RECORD_BYTES.
     let n = cfg.samples;
-    let mut rng = Rng::new(cfg.seed);
     let mut out = SampledTrajectory {
         times: Vec::with_capacity(n + 1),
         states: Vec::with_capacity(n + 1),
         measurements: Vec::with_capacity(n + 1),
         inputs: Vec::with_capacity(n),
     };
+    stream(&mut |s: &Sample<NX, NU, NY>| {
+        out.times.push(s.time);
+        out.states.push(s.state);
+        out.measurements.push(s.measurement);
+        if let Some(u) = s.input {
+            out.inputs.push(u);
+        }
+        ControlFlow::Continue(())
+    })?;
+    Ok(out)
+}
+
+/// The loop of the module docs with `advance(k, x_k, u_k, w_k) = x_{k+1}`.
+fn run<Mdl, Ctl, const NX: usize, const NU: usize, const NY: usize>(
+    model: &Mdl,
+    controller: &mut Ctl,
+    cfg: &SampledLoopConfig<NX, NU, NY>,
+    mut advance: impl FnMut(
+        usize,
+        &SVector<f64, NX>,
+        &SVector<f64, NU>,
+        &SVector<f64, NX>,
+    ) -> Result<SVector<f64, NX>, SimError>,
+    mut sink: impl FnMut(&Sample<NX, NU, NY>) -> ControlFlow<()>,
+) -> Result<usize, SimError>
+where
+    Mdl: ContinuousModel<NX, NU, NY>,
+    Ctl: SampledController<NY, NU>,
+{
+    let n = cfg.samples;
+    let mut rng = Rng::new(cfg.seed);
+    // The last `measurement_delay + 1` measurements; the front is the one delivered, y_{max(k − d, 0)}.
+    let mut delay_line = VecDeque::with_capacity(cfg.measurement_delay.min(n) + 1);
     let mut x = cfg.x0;
     let mut u_prev = cfg.initial_input;
-    let mut scratch = Vec::new();
     for k in 0..=n {
         let t = cfg.t0 + k as f64 * cfg.sample_time;
-        let mut y = SVector::<f64, NY>::zeros();
-        model.outputs(t, &x, &u_prev, &mut y);
-        if let Some(index) = y.iter().position(|v| !v.is_finite()) {
-            return Err(SimError::NonFiniteOutput { time: t, index });
-        }
-        for (yi, &s) in y.iter_mut().zip(cfg.measurement_noise_std.iter()) {
-            if s > 0.0 {
-                *yi += rng.gaussian(0.0, s);
-            }
-        }
-        out.times.push(t);
-        out.states.push(x);
-        out.measurements.push(y);
+        let y = measure(model, cfg, &mut rng, t, &x, &u_prev)?;
+        let mut sample = Sample {
+            k,
+            time: t,
+            state: x,
+            measurement: y,
+            input: None,
+        };
         if k == n {
-            break;
+            let _ = sink(&sample);
+            return Ok(n + 1);
         }
-        let delivered = out.measurements[k.saturating_sub(cfg.measurement_delay)];
+        delay_line.push_back(y);
+        if delay_line.len() > cfg.measurement_delay + 1 {
+            delay_line.pop_front();
+        }
+        let delivered = delay_line.front().copied().unwrap_or(y);
         let u = controller.update(k, t, &delivered);
         if let Some(index) = u.iter().position(|v| !v.is_finite()) {
             return Err(SimError::NonFiniteInput { time: t, index });
+        }
+        sample.input = Some(u);
+        if sink(&sample).is_break() {
+            return Ok(k + 1);
         }
         let mut w = SVector::<f64, NX>::zeros();
         for (wi, &s) in w.iter_mut().zip(cfg.process_noise_std.iter()) {
@@ -172,22 +366,33 @@ where
                 *wi = rng.gaussian(0.0, s);
             }
         }
-        let seg = Segment {
-            t0: t,
-            t_end: cfg.t0 + (k + 1) as f64 * cfg.sample_time,
-            x0: &x,
-            disturbance: &w,
-            output_times: &[],
-        };
-        x = integrate_segment::<Mdl, _, NX, NU, NY>(
-            model,
-            |_t| u,
-            &seg,
-            &cfg.solver,
-            &mut scratch,
-        )?;
-        out.inputs.push(u);
+        x = advance(k, &x, &u, &w)?;
         u_prev = u;
     }
-    Ok(out)
+    Ok(n + 1)
+}
+
+/// `y_k = h(t_k, x_k, u_{k−1}) + v_k`, refusing a non-finite model output.
+fn measure<Mdl, const NX: usize, const NU: usize, const NY: usize>(
+    model: &Mdl,
+    cfg: &SampledLoopConfig<NX, NU, NY>,
+    rng: &mut Rng,
+    t: f64,
+    x: &SVector<f64, NX>,
+    u_prev: &SVector<f64, NU>,
+) -> Result<SVector<f64, NY>, SimError>
+where
+    Mdl: ContinuousModel<NX, NU, NY>,
+{
+    let mut y = SVector::<f64, NY>::zeros();
+    model.outputs(t, x, u_prev, &mut y);
+    if let Some(index) = y.iter().position(|v| !v.is_finite()) {
+        return Err(SimError::NonFiniteOutput { time: t, index });
+    }
+    for (yi, &s) in y.iter_mut().zip(cfg.measurement_noise_std.iter()) {
+        if s > 0.0 {
+            *yi += rng.gaussian(0.0, s);
+        }
+    }
+    Ok(y)
 }

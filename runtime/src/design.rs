@@ -13,10 +13,15 @@
 mod kalman;
 mod lqi;
 mod lqr;
+mod ltr;
 
 pub use kalman::{DiscreteKalman, Kalman, dlqe, lqe};
 pub use lqi::{IntegralAction, Lqi, lqi};
 pub use lqr::{dlqr, dlqr_with_cross, lqr, lqr_with_cross};
+pub use ltr::{
+    LtrError, ObserverNoise, RecoveryPoint, recovery_lqe, recovery_sweep, recovery_sweep_with,
+    state_feedback_margins,
+};
 
 use crate::linalg::{MatrixError, RiccatiError};
 

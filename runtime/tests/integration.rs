@@ -7,6 +7,7 @@ mod analysis_margins;
 mod analysis_robustness;
 mod control_gait;
 mod control_impedance;
+mod design_ltr;
 mod estimation_alloc;
 mod estimation_dual;
 mod estimation_equivalence;

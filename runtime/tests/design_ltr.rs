@@ -205,10 +205,10 @@ fn bad_weights_and_discrete_plants_are_refused() {
         }
     }
     let sampled = StateSpace::new_discrete(
-        c.plant.a.clone(),
-        c.plant.b.clone(),
-        c.plant.c.clone(),
-        c.plant.d.clone(),
+        c.plant.a().clone(),
+        c.plant.b().clone(),
+        c.plant.c().clone(),
+        c.plant.d().clone(),
         0.01,
     )
     .unwrap();

@@ -76,18 +76,18 @@ pub fn recovery_lqe(
     let (n, w, m) = (plant.n_states(), noise.g.ncols(), plant.n_inputs());
     // A G with the wrong row count is reported by lqe; build [G B] only when the rows agree.
     if noise.g.nrows() != n || noise.qn.shape() != (w, w) {
-        return lqe(&plant.a, noise.g, &plant.c, noise.qn, noise.rn)
+        return lqe(plant.a(), noise.g, plant.c(), noise.qn, noise.rn)
             .map_err(|source| LtrError::Kalman { q, source });
     }
     let mut g = DMatrix::zeros(n, w + m);
     g.view_mut((0, 0), (n, w)).copy_from(noise.g);
-    g.view_mut((0, w), (n, m)).copy_from(&plant.b);
+    g.view_mut((0, w), (n, m)).copy_from(plant.b());
     let mut qn = DMatrix::zeros(w + m, w + m);
     qn.view_mut((0, 0), (w, w)).copy_from(noise.qn);
     for i in 0..m {
         qn[(w + i, w + i)] = q;
     }
-    lqe(&plant.a, &g, &plant.c, &qn, noise.rn).map_err(|source| LtrError::Kalman { q, source })
+    lqe(plant.a(), &g, plant.c(), &qn, noise.rn).map_err(|source| LtrError::Kalman { q, source })
 }
 
 /// The recovery sweep of the plain observer-based loop `u = −K x̂` (module docs), one point per entry of
@@ -144,13 +144,13 @@ pub fn state_feedback_margins(
         source,
     };
     let d = DMatrix::zeros(gain.nrows(), plant.n_inputs());
-    let target = StateSpace::new(plant.a.clone(), plant.b.clone(), gain.clone(), d)
+    let target = StateSpace::new(plant.a().clone(), plant.b().clone(), gain.clone(), d)
         .map_err(|e| analysis(AnalysisError::from(e)))?;
     stability_margins(&target).map_err(analysis)
 }
 
 fn check_weight(plant: &StateSpace, q: f64) -> Result<(), LtrError> {
-    if let Some(dt) = plant.dt {
+    if let Some(dt) = plant.dt() {
         return Err(LtrError::Discrete { dt });
     }
     if q.is_finite() && q >= 0.0 {

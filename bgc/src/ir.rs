@@ -267,6 +267,7 @@ pub struct Param {
     pub derived: Option<Expr>,
 }
 
+/// An input. Its values are in its declared unit; expressions use it as `Const(unit.scale) * Input(id)`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Input {
     pub name: String,
@@ -275,6 +276,8 @@ pub struct Input {
     pub description: Option<String>,
 }
 
+/// An output, in its declared unit: `value` is the SI expression divided by `unit.scale`, and an expression that
+/// uses the output multiplies it back.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Output {
     pub name: String,
@@ -284,13 +287,14 @@ pub struct Output {
     pub description: Option<String>,
 }
 
-/// A named integrated flow: `var theta = int(f(x))`.
+/// A named integrated flow: `var theta = int(f(x))`. Its state is in its declared unit (`integrand` is the flow
+/// divided by `unit.scale`); an expression that uses it multiplies it back.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Var {
     pub name: String,
     pub unit: Unit,
     pub unit_text: String,
-    /// A flow expression.
+    /// A flow expression, in the declared unit per second.
     pub integrand: Expr,
 }
 
@@ -346,7 +350,8 @@ impl Expr {
 }
 
 /// A lowered, checked model. Parameter defaults and the constants of expressions are in SI base units; a declared
-/// unit's `scale` converts a value written in that unit to SI.
+/// unit's `scale` converts a value written in that unit to SI. Inputs, outputs and vars are in their declared
+/// units (the conversions are in the expressions).
 #[derive(Clone, Debug, Serialize)]
 pub struct Model {
     pub name: String,

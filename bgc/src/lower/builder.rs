@@ -59,6 +59,8 @@ pub(crate) struct Builder<'a> {
     /// An unknown name without a close match was reported: any unused parameter may be the one it meant, so
     /// BG0402 is left out until that error is fixed.
     pub unmatched_name: bool,
+    /// The domains a BG0303 hint has already suggested: later hints for the same domain stay short.
+    pub suggested_domains: Vec<Domain>,
     /// The components being instantiated, to catch a component that contains itself.
     pub component_stack: Vec<String>,
     /// Every component instantiated while building this model.
@@ -100,6 +102,7 @@ impl<'a> Builder<'a> {
             bad_units: Vec::new(),
             last_unit_ok: true,
             unmatched_name: false,
+            suggested_domains: Vec::new(),
             suspect_nodes: std::collections::HashSet::new(),
         }
     }

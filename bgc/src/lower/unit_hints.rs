@@ -98,16 +98,26 @@ impl Builder<'_> {
                 )
             }
         };
-        let (d, side) = match place {
-            Place::OnePort(_) => (din, format!("`{name}`")),
-            Place::TwoPort(_) if din != current.0 => (din, format!("the input side of `{name}`")),
-            Place::TwoPort(_) => (dout, format!("the output side of `{name}`")),
+        let (d, example) = match place {
+            Place::OnePort(kind) => (
+                din,
+                format!("`{} {name}: {} ...`", kind.keyword(), din.name()),
+            ),
+            Place::TwoPort(_) if din != current.0 => {
+                (din, format!("an element on the input side of `{name}`"))
+            }
+            Place::TwoPort(_) => (dout, format!("an element on the output side of `{name}`")),
         };
-        let help = format!(
-            "declare the domain: `domain {d};` in the model (the default of its elements), or `: {d}` after the name \
-             of an element on {side} (`KIND NAME: {d} = ...;`)",
-            d = d.name()
-        );
+        let help = if self.suggested_domains.contains(&d) {
+            format!("the same missing {} domain as above", d.name())
+        } else {
+            self.suggested_domains.push(d);
+            format!(
+                "give the {d} part of the model its domain: `: {d}` after the name of one of its elements \
+                 ({example}) spreads along its bonds; or `domain {d};` if the whole model is {d}",
+                d = d.name()
+            )
+        };
         if let Some(last) = self.diags.last_mut() {
             last.notes.push(note);
             last.help = Some(help);

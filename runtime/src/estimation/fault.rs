@@ -66,10 +66,10 @@ pub enum EstimationError {
         quantity: &'static str,
     },
     /// The sigma-point weights sum to one from terms far larger than one, so their cancellation amplifies
-    /// rounding; here it would leave a covariance entry with fewer than half of its digits.
+    /// rounding; here it would leave a covariance entry with fewer than four significant digits.
     #[error(
         "{quantity} of the {filter}, entry {index}: estimated relative rounding error {relative_error:.1e} exceeds \
-         sqrt(eps) = 1.5e-8, because the sigma-point mean weights (sum of magnitudes {amplification:.1e}) cancel; \
+         1e-4 (four significant digits), because the sigma-point mean weights (sum of magnitudes {amplification:.1e}) cancel; \
          increase alpha or kappa"
     )]
     PrecisionLoss {

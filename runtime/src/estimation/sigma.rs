@@ -129,7 +129,7 @@ impl<const N: usize, const NS: usize> SigmaPoints<N, NS> {
 
     /// `Σ |W⁽ᵐ⁾ᵢ|`, the factor by which the weights' cancellation amplifies the rounding of a weighted mean
     /// (1 for `α² (L + κ) ≥ L`, about `2/α²` for small `α` and `κ = 0`). The filters estimate from it the
-    /// rounding error of every covariance they form and refuse a step that would keep fewer than half of the
+    /// rounding error of every covariance they form and refuse a step that would keep fewer than four significant
     /// digits ([`EstimationError::PrecisionLoss`]); weights with `NS · ε · Σ|W| ≥ 1` are refused here.
     pub fn rounding_amplification(&self) -> f64 {
         self.wm.iter().map(|w| w.abs()).sum()

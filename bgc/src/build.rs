@@ -60,7 +60,13 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 /// Why a compilation failed.
-#[derive(Debug, thiserror::Error)]
+///
+/// `Display` is the full message; for [`Error::Diagnostics`] that includes the rendered diagnostics. `Debug` is
+/// the same except for [`Error::Diagnostics`], where it is the one-line summary `FILE: bgc found errors (shown
+/// above)`: [`Config::compile`] has already printed the diagnostics to standard error, and a build script's
+/// `fn main() -> Result<(), bgc::build::Error>` (or `Result<(), Box<dyn std::error::Error>>`) reports its error
+/// with `Debug`, so each diagnostic appears once, readable, and not again as an escaped dump of the fields.
+#[derive(thiserror::Error)]
 pub enum Error {
     #[error(
         "no output directory: OUT_DIR is not set (not run by Cargo?) and Config::out_dir was not given"
@@ -72,6 +78,7 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+    /// Errors in a `.bg` file: `rendered` holds them as text (`FILE:LINE:COL` and the source excerpt).
     #[error("{file}: bgc found errors:\n{rendered}")]
     Diagnostics { file: PathBuf, rendered: String },
     #[error("{first} and {second} would both generate {output}")]
@@ -80,6 +87,17 @@ pub enum Error {
         second: PathBuf,
         output: PathBuf,
     },
+}
+
+impl std::fmt::Debug for Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Error::Diagnostics { file, .. } => {
+                write!(f, "{}: bgc found errors (shown above)", file.display())
+            }
+            other => std::fmt::Display::fmt(other, f),
+        }
+    }
 }
 
 /// What one `.bg` file gave.

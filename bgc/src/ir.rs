@@ -317,6 +317,8 @@ pub struct SpanTable {
     /// For nodes that come from a component instance: the instance declaration.
     pub node_instances: Vec<Option<Span>>,
     pub model: Span,
+    /// The findings the model acknowledges as intended (`allow CODE NODE;`); the analyses leave them out.
+    pub allowed: Vec<Allowance>,
 }
 
 impl Expr {
@@ -365,6 +367,15 @@ pub struct Model {
     /// Declared state coordinates, if any.
     pub coords: Option<Vec<Expr>>,
     pub spans: SpanTable,
+}
+
+/// `allow CODE NODE;`: the finding `code` located at node `node` (by `NodeIndex::index()`) is intended.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Allowance {
+    pub code: String,
+    pub node: usize,
+    /// The `allow` statement.
+    pub span: Span,
 }
 
 impl Model {

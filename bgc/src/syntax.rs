@@ -12,6 +12,7 @@
 //! `BG0114` (warning) doc comment documenting nothing, `BG0115` bad port count or index, `BG0116` malformed unit,
 //! `BG0117` port count on a non-field or missing on a field.
 
+mod allow;
 pub mod ast;
 mod bond;
 mod decode;

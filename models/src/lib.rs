@@ -31,5 +31,7 @@ pub mod walking_leg {
     include!(concat!(env!("OUT_DIR"), "/walking_leg.rs"));
 }
 
+/// The compiler's test corpus, for this crate's tests (feature `corpus`).
+#[cfg(feature = "corpus")]
 #[doc(hidden)]
 pub mod corpus;

@@ -7,7 +7,7 @@
 //!
 //! - [`lqr`], [`lqr_with_cross`], [`dlqr`], [`dlqr_with_cross`]: optimal state feedback;
 //! - [`lqi`]: LQR with single or double integral action on chosen outputs (sign conventions in [`lqi`]'s
-//!   module docs);
+//!   documentation);
 //! - [`lqe`], [`dlqe`]: steady-state Kalman gains (continuous; discrete predictor and innovation gains).
 
 mod kalman;

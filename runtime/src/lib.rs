@@ -1,6 +1,7 @@
 //! The bgc runtime: design, estimation, control and simulation for bond-graph models.
 //!
-//! - [`model`]: the traits generated models implement; [`statespace`]: linear models.
+//! - [`model`]: the traits generated models implement; [`statespace`]: linear models; [`linearize`]: the linear
+//!   model of a nonlinear one at an operating point; [`matrix`]: `SMatrix` ↔ `DMatrix` conversions.
 //! - [`linalg`]: Riccati and Lyapunov equations, discretisation, controllability and observability.
 //! - [`design`]: LQR (with integral action) and Kalman gains.
 //! - [`estimation`]: Kalman filters, the UKF and dual UKF, sensor fusion, filter health.
@@ -13,6 +14,8 @@ pub mod control;
 pub mod design;
 pub mod estimation;
 pub mod linalg;
+pub mod linearize;
+pub mod matrix;
 pub mod model;
 pub mod noise;
 pub mod sim;

@@ -38,18 +38,18 @@ pub struct Setup {
     pub imu: ImuSpec,
     pub camera: CameraSpec,
     pub filter: ImuFilterTuning,
-    /// IMU mounting radius from the pivot, per segment (rig: the pendulum; leg: thigh, calf) [m].
+    /// IMU mounting radius from the pivot, per segment (rig: the pendulum; leg: thigh, calf) \[m\].
     pub imu_radius: [f64; 2],
-    /// Oldest vision frame the first-order hold extrapolates from [s].
+    /// Oldest vision frame the first-order hold extrapolates from \[s\].
     pub max_vision_age: f64,
-    /// Process variance per sample of the Eqs. 19–21 stage after the weighted fusion [rad²]; `None` leaves the
+    /// Process variance per sample of the Eqs. 19–21 stage after the weighted fusion \[rad²\]; `None` leaves the
     /// stage out.
     pub smoothing_q: Option<f64>,
-    /// Step of the true-motion grid [s].
+    /// Step of the true-motion grid \[s\].
     pub truth_dt: f64,
-    /// Length of the run [s].
+    /// Length of the run \[s\].
     pub t_end: f64,
-    /// Window of the E figures [s].
+    /// Window of the E figures \[s\].
     pub window: (f64, f64),
 }
 
@@ -96,7 +96,7 @@ impl Setup {
     }
 }
 
-/// The E figures of Eq. 28 of one segment [deg²].
+/// The E figures of Eq. 28 of one segment \[deg²\].
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Figures {
     pub e_vision: f64,
@@ -122,13 +122,13 @@ pub struct SegmentRun {
 #[derive(Clone, Debug, PartialEq)]
 pub struct RigRun {
     pub segment: SegmentRun,
-    /// Variances measured on the rig (Eq. 28) of the IMU and the vision [rad²].
+    /// Variances measured on the rig (Eq. 28) of the IMU and the vision \[rad²\].
     pub variances: [f64; 2],
     /// Weights of Eq. 27 for the IMU and the vision.
     pub weights: [f64; 2],
-    /// Accelerometer-angle variance measured on the rig (Eq. 28), the IMU filter's `R` [rad²].
+    /// Accelerometer-angle variance measured on the rig (Eq. 28), the IMU filter's `R` \[rad²\].
     pub accel_variance: f64,
-    /// Fused variance of Eq. 25 [rad²].
+    /// Fused variance of Eq. 25 \[rad²\].
     pub fused_variance: f64,
     pub calibration: Calibration,
 }

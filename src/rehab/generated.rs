@@ -39,15 +39,15 @@ fn position(
 /// Where the rig's pendulum quantities sit in the generated model's vectors.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RigLayout {
-    /// State: the coupling twist `q_coupling` [rad].
+    /// State: the coupling twist `q_coupling` \[rad\].
     pub twist: usize,
-    /// State: the pendulum momentum `p_pendulum` [N m s].
+    /// State: the pendulum momentum `p_pendulum` \[N m s\].
     pub momentum: usize,
-    /// State: the rotor angle `theta_m` [rad] (its rate is the stepper speed).
+    /// State: the rotor angle `theta_m` \[rad\] (its rate is the stepper speed).
     pub rotor: usize,
-    /// Output: the pendulum angle `theta_pend` [rad].
+    /// Output: the pendulum angle `theta_pend` \[rad\].
     pub angle: usize,
-    /// Output: the pendulum angular velocity `omega_pend` [rad/s].
+    /// Output: the pendulum angular velocity `omega_pend` \[rad/s\].
     pub rate: usize,
 }
 
@@ -69,13 +69,13 @@ impl RigLayout {
 /// Where the leg's segment quantities sit in the generated model's outputs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LegLayout {
-    /// Output: the thigh angle from the downward vertical `theta_thigh` [rad].
+    /// Output: the thigh angle from the downward vertical `theta_thigh` \[rad\].
     pub thigh_angle: usize,
-    /// Output: the calf inclination from the downward vertical `theta_calf` [rad].
+    /// Output: the calf inclination from the downward vertical `theta_calf` \[rad\].
     pub calf_angle: usize,
-    /// Output: the thigh angular velocity `omega_thigh` [rad/s].
+    /// Output: the thigh angular velocity `omega_thigh` \[rad/s\].
     pub thigh_rate: usize,
-    /// Output: the calf angular velocity `omega_calf` [rad/s].
+    /// Output: the calf angular velocity `omega_calf` \[rad/s\].
     pub calf_rate: usize,
 }
 
@@ -126,7 +126,7 @@ pub fn rig_initial_state(
     Ok(x)
 }
 
-/// The pendulum's angular acceleration `ṗ / J_p` at `(t, x)` [rad/s²], from the model's right-hand side.
+/// The pendulum's angular acceleration `ṗ / J_p` at `(t, x)` \[rad/s²\], from the model's right-hand side.
 pub fn rig_angular_acceleration(
     rig: &PendulumRigModel,
     layout: &RigLayout,

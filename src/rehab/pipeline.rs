@@ -29,13 +29,13 @@ use nalgebra::{Matrix2, Vector2};
 /// Tuning of the IMU angle filter of Eqs. 5–6 (radians).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct ImuFilterTuning {
-    /// Angle process variance per sample [rad²].
+    /// Angle process variance per sample \[rad²\].
     pub q_angle: f64,
     /// Bias process variance per sample [(rad/s)²].
     pub q_bias: f64,
-    /// Accelerometer-angle measurement variance [rad²]; the experiments measure it on the rig (Eq. 28).
+    /// Accelerometer-angle measurement variance \[rad²\]; the experiments measure it on the rig (Eq. 28).
     pub r: f64,
-    /// Initial angle variance [rad²].
+    /// Initial angle variance \[rad²\].
     pub p_angle0: f64,
     /// Initial bias variance [(rad/s)²].
     pub p_bias0: f64,
@@ -61,17 +61,17 @@ impl ImuFilterTuning {
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct SourceEstimates {
     pub times: Vec<f64>,
-    /// True angle [rad].
+    /// True angle \[rad\].
     pub truth: Vec<f64>,
-    /// Eq. 2 [rad] (NaN when the accelerometer sample is not finite).
+    /// Eq. 2 \[rad\] (NaN when the accelerometer sample is not finite).
     pub accel_angle: Vec<f64>,
-    /// Eq. 4 [rad].
+    /// Eq. 4 \[rad\].
     pub gyro_angle: Vec<f64>,
-    /// Eqs. 5–6 [rad], always finite.
+    /// Eqs. 5–6 \[rad\], always finite.
     pub imu: Vec<f64>,
     /// Whether the IMU sample was finite, i.e. `imu` is a reading the fusion may use.
     pub imu_valid: Vec<bool>,
-    /// First-order-hold vision angle [rad] (NaN when no recent frame).
+    /// First-order-hold vision angle \[rad\] (NaN when no recent frame).
     pub vision: Vec<f64>,
 }
 
@@ -232,7 +232,7 @@ pub fn fuse(
 }
 
 /// Eq. 28 of `estimate` against `reference` over the samples whose time is in `[from, to]` (non-finite estimates
-/// are left out) [rad²].
+/// are left out) \[rad²\].
 pub fn error_variance(
     times: &[f64],
     estimate: &[f64],

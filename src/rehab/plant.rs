@@ -35,23 +35,23 @@ const DEG: f64 = PI / 180.0;
 /// Parameters of `models/pendulum_rig.bg`, in SI units.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct PendulumRigParams {
-    /// Amplitude of the stepper's sinusoidal angle profile [rad].
+    /// Amplitude of the stepper's sinusoidal angle profile \[rad\].
     pub a_ref: f64,
-    /// Period of the profile [s].
+    /// Period of the profile \[s\].
     pub t_ref: f64,
-    /// Magnetic stiffness of the stepper [N m/rad].
+    /// Magnetic stiffness of the stepper \[N m/rad\].
     pub k_s: f64,
-    /// Damping of the drive and coupling [N m s/rad].
+    /// Damping of the drive and coupling \[N m s/rad\].
     pub d_s: f64,
-    /// Pendulum inertia about the pivot [kg m²].
+    /// Pendulum inertia about the pivot \[kg m²\].
     pub j_p: f64,
-    /// Pivot bearing friction [N m s/rad].
+    /// Pivot bearing friction \[N m s/rad\].
     pub b_p: f64,
-    /// Pendulum mass [kg].
+    /// Pendulum mass \[kg\].
     pub m_p: f64,
-    /// Pivot to centre of mass [m].
+    /// Pivot to centre of mass \[m\].
     pub l_p: f64,
-    /// Gravity [m/s²].
+    /// Gravity \[m/s²\].
     pub g: f64,
 }
 
@@ -88,13 +88,13 @@ impl PendulumRig {
     /// Number of states, inputs and outputs.
     pub const NX: usize = 4;
 
-    /// The stepper's angle profile `A sin(2π t/T)` [rad].
+    /// The stepper's angle profile `A sin(2π t/T)` \[rad\].
     pub fn reference_angle(&self, t: f64) -> f64 {
         let p = &self.params;
         p.a_ref * (2.0 * PI * t / p.t_ref).sin()
     }
 
-    /// The stepper's rotor speed, the flow of the `MSf` [rad/s].
+    /// The stepper's rotor speed, the flow of the `MSf` \[rad/s\].
     pub fn motor_speed(&self, t: f64) -> f64 {
         let p = &self.params;
         let w0 = 2.0 * PI / p.t_ref;
@@ -131,18 +131,18 @@ impl ContinuousModel<4, 0, 3> for PendulumRig {
 /// A periodic curve `c₀ + Σᵢ (aᵢ cos(i ω t) + bᵢ sin(i ω t))`, `ω = 2π/period` (the form of the paper's Eq. 36).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct GaitCurve {
-    /// Mean [rad].
+    /// Mean \[rad\].
     pub c0: f64,
-    /// Cosine coefficients of harmonics 1..=4 [rad].
+    /// Cosine coefficients of harmonics 1..=4 \[rad\].
     pub a: [f64; 4],
-    /// Sine coefficients of harmonics 1..=4 [rad].
+    /// Sine coefficients of harmonics 1..=4 \[rad\].
     pub b: [f64; 4],
-    /// Period [s].
+    /// Period \[s\].
     pub period: f64,
 }
 
 impl GaitCurve {
-    /// The angle at `t` [rad].
+    /// The angle at `t` \[rad\].
     pub fn value(&self, t: f64) -> f64 {
         let w = 2.0 * PI / self.period;
         let mut v = self.c0;
@@ -153,7 +153,7 @@ impl GaitCurve {
         v
     }
 
-    /// The angular velocity at `t` [rad/s].
+    /// The angular velocity at `t` \[rad/s\].
     pub fn rate(&self, t: f64) -> f64 {
         let w = 2.0 * PI / self.period;
         let mut v = 0.0;
@@ -172,9 +172,9 @@ pub struct RehabLegParams {
     pub hip: GaitCurve,
     /// The knee flexion curve.
     pub knee: GaitCurve,
-    /// Thigh inertia about the hip [kg m²] (the hip motor's load; it does not change the angles).
+    /// Thigh inertia about the hip \[kg m²\] (the hip motor's load; it does not change the angles).
     pub j_t: f64,
-    /// Calf inertia about the knee [kg m²] (the knee motor's load).
+    /// Calf inertia about the knee \[kg m²\] (the knee motor's load).
     pub j_c: f64,
 }
 

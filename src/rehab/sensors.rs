@@ -20,32 +20,32 @@ use super::error::{RehabError, non_negative, positive};
 use super::truth::Truth;
 use bgc_runtime::noise::Rng;
 
-/// Standard gravity [m/s²].
+/// Standard gravity \[m/s²\].
 pub const GRAVITY: f64 = 9.81;
 
 /// The inertial unit and its sampling.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct ImuSpec {
-    /// Sample interval [s].
+    /// Sample interval \[s\].
     pub dt: f64,
-    /// Accelerometer noise per axis, standard deviation [m/s²].
+    /// Accelerometer noise per axis, standard deviation \[m/s²\].
     pub accel_noise: f64,
-    /// Gyro noise, standard deviation [rad/s].
+    /// Gyro noise, standard deviation \[rad/s\].
     pub gyro_noise: f64,
-    /// Gyro bias left after the start-up calibration [rad/s].
+    /// Gyro bias left after the start-up calibration \[rad/s\].
     pub gyro_bias: f64,
 }
 
 /// The camera of the visual measurement unit.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct CameraSpec {
-    /// Frames per second [Hz].
+    /// Frames per second \[Hz\].
     pub frame_rate: f64,
-    /// Capture-to-arrival delay [s].
+    /// Capture-to-arrival delay \[s\].
     pub latency: f64,
-    /// Marker location noise per image axis, standard deviation [px].
+    /// Marker location noise per image axis, standard deviation \[px\].
     pub pixel_noise: f64,
-    /// Image scale in the plane of motion [px/m].
+    /// Image scale in the plane of motion \[px/m\].
     pub scale: f64,
     /// Probability that a frame is lost.
     pub lost_probability: f64,
@@ -54,20 +54,20 @@ pub struct CameraSpec {
 /// One IMU sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImuSample {
-    /// Arduino time stamp [s].
+    /// Arduino time stamp \[s\].
     pub t: f64,
-    /// Accelerometer `(x, y, z)` [m/s²].
+    /// Accelerometer `(x, y, z)` \[m/s²\].
     pub acc: [f64; 3],
-    /// Gyro rate about `y`, bias-compensated by the calibration [rad/s].
+    /// Gyro rate about `y`, bias-compensated by the calibration \[rad/s\].
     pub gyro: f64,
 }
 
 /// One delivered camera frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frame {
-    /// Arrival time at the fusion node, its time stamp [s].
+    /// Arrival time at the fusion node, its time stamp \[s\].
     pub arrival: f64,
-    /// Segment angle from the two markers [rad].
+    /// Segment angle from the two markers \[rad\].
     pub angle: f64,
 }
 
@@ -112,7 +112,7 @@ fn unknown_segment(segment: usize) -> RehabError {
     }
 }
 
-/// The IMU samples of segment `segment` over the whole run, the unit mounted at `radius` [m] from the pivot.
+/// The IMU samples of segment `segment` over the whole run, the unit mounted at `radius` \[m\] from the pivot.
 pub fn sample_imu(
     truth: &Truth,
     segment: usize,

@@ -32,17 +32,17 @@ use nalgebra::SVector;
 #[derive(Clone, Debug, PartialEq)]
 pub struct SegmentTrack {
     pub name: &'static str,
-    /// Angle from the downward vertical [rad].
+    /// Angle from the downward vertical \[rad\].
     pub angle: Vec<f64>,
-    /// Angular velocity [rad/s].
+    /// Angular velocity \[rad/s\].
     pub rate: Vec<f64>,
-    /// Angular acceleration [rad/s²].
+    /// Angular acceleration \[rad/s²\].
     pub accel: Vec<f64>,
-    /// Pivot position `(x, z)` [m].
+    /// Pivot position `(x, z)` \[m\].
     pub pivot_pos: Vec<[f64; 2]>,
-    /// Pivot acceleration `(x, z)` [m/s²].
+    /// Pivot acceleration `(x, z)` \[m/s²\].
     pub pivot_acc: Vec<[f64; 2]>,
-    /// Distance from the pivot to the distal marker (length seen by the camera) [m].
+    /// Distance from the pivot to the distal marker (length seen by the camera) \[m\].
     pub length: f64,
 }
 
@@ -57,13 +57,13 @@ pub struct SegmentState {
 }
 
 impl SegmentState {
-    /// Position of the point at distance `r` along the segment [m].
+    /// Position of the point at distance `r` along the segment \[m\].
     pub fn point(&self, r: f64) -> [f64; 2] {
         let (s, c) = self.angle.sin_cos();
         [self.pivot_pos[0] + r * s, self.pivot_pos[1] - r * c]
     }
 
-    /// Acceleration of the point at distance `r` along the segment [m/s²].
+    /// Acceleration of the point at distance `r` along the segment \[m/s²\].
     pub fn point_acc(&self, r: f64) -> [f64; 2] {
         let (s, c) = self.angle.sin_cos();
         let w2 = self.rate * self.rate;
@@ -111,7 +111,7 @@ impl Truth {
 /// Geometry of the rig as the sensors see it.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct RigGeometry {
-    /// Pivot to the distal vision marker [m].
+    /// Pivot to the distal vision marker \[m\].
     pub marker_length: f64,
 }
 
@@ -126,9 +126,9 @@ impl Default for RigGeometry {
 /// Geometry of the leg as the sensors see it.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct LegGeometry {
-    /// Hip to knee [m].
+    /// Hip to knee \[m\].
     pub thigh_length: f64,
-    /// Knee to ankle marker [m].
+    /// Knee to ankle marker \[m\].
     pub calf_length: f64,
 }
 

@@ -24,6 +24,7 @@
 //! A causally complete model (no conflict, no derivative causality, no loop, no arbitrary choice, no hint) gets no
 //! diagnostics at all.
 
+mod allow;
 mod conflicts;
 mod context;
 mod engine;
@@ -163,5 +164,6 @@ impl Causality {
 pub fn analyse(model: &Model) -> (Causality, Vec<Diagnostic>) {
     let assignment = scap::assign(model);
     let loops = loops::find(model, &assignment.engine);
-    findings::conclude(model, assignment, loops)
+    let (causality, diags) = findings::conclude(model, assignment, loops);
+    (causality, allow::apply(model, diags))
 }

@@ -14,7 +14,8 @@
 use super::adapter::{AdaptError, to_symbolic};
 use crate::equations::sym::Ex;
 use crate::equations::{
-    EnergyKind, Equations, StateSelection, declared_state_space_symbolic, linear_state_space,
+    EnergyKind, Equations, LinearError, StateSelection, declared_state_space_symbolic, jacobians,
+    linear_state_space,
 };
 use crate::symbolic::{Expr, Symbol, SymbolKind};
 use std::collections::{BTreeSet, HashMap};
@@ -50,8 +51,11 @@ pub(crate) struct Plan {
     pub dfdu: Vec<Vec<Expr>>,
     pub dhdx: Vec<Vec<Expr>>,
     pub dhdu: Vec<Vec<Expr>>,
-    /// `A, B, C, D` in the energy states, or why there is none.
-    pub energy_ss: Result<StateSpace, String>,
+    /// `A, B, C, D` in the energy states, or (when the rates or outputs read an integrated flow) in all states,
+    /// or why there is none.
+    pub linear_ss: Result<StateSpace, String>,
+    /// The states of `linear_ss`.
+    pub linear_selection: StateSelection,
     /// `A, B, C, D` in the declared coordinates (`None`: the model declares none), or why there is none.
     pub declared_ss: Option<Result<StateSpace, String>>,
     /// Stored energy, dissipated and supplied power: the terms `(element, value)`, or the elements without a closed
@@ -109,7 +113,8 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
     let rhs = block(eqs, &eqs.rates, &f);
     let readable_outputs: Vec<Ex> = eqs.outputs.iter().map(|o| o.value.clone()).collect();
     let outputs = block(eqs, &readable_outputs, &h);
-    let energy_ss = linear_state_space(eqs, StateSelection::Energy)
+    let linear_selection = linear_selection(eqs);
+    let linear_ss = linear_state_space(eqs, linear_selection)
         .map_err(|e| e.to_string())
         .and_then(|j| state_space(eqs, j.states, &j.dfdx, &j.dfdu, &j.dhdx, &j.dhdu));
     let declared_ss = eqs.coords.as_ref().map(|_| {
@@ -167,10 +172,20 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
         inputs,
         rhs,
         outputs,
-        energy_ss,
+        linear_ss,
+        linear_selection,
         declared_ss,
         energy,
     })
+}
+
+/// The states of the generated `state_space`: the energy states, unless a rate or an output reads an integrated
+/// flow (`var theta = int(f(load))` as an output); then the integrated flows join them, as in `bgc statespace`.
+fn linear_selection(eqs: &Equations) -> StateSelection {
+    match jacobians(eqs, StateSelection::Energy) {
+        Err(LinearError::NeedsIntegratedState { .. }) => StateSelection::All,
+        _ => StateSelection::Energy,
+    }
 }
 
 fn state_space(

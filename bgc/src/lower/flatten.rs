@@ -156,6 +156,7 @@ impl<'a> Builder<'a> {
                         scope.port_order.push(p.name.name.clone());
                     }
                 }
+                Stmt::Allow(a) => self.allow(sid, a),
                 Stmt::Coords(c) => {
                     if decl.kind == ModelKind::Component {
                         self.diags.push(

@@ -10,6 +10,7 @@
 //! counts, TF/GY and field port numbers), domain inference, element relations with unit and value checks,
 //! outputs/vars/coordinates, unused parameters.
 
+mod allow;
 mod bonds;
 mod builder;
 mod consteval;

@@ -283,7 +283,7 @@ impl Builder<'_> {
 
     /// The node or bond an `e`/`f`/`p`/`q` argument names: `x`, `inst.x` (an element inside an instance),
     /// `inst.port`, `field[i]` (the bond on that port), or a named bond.
-    fn reference_target(&mut self, r: &NodeRef, scope: usize) -> Option<(Target, ())> {
+    pub(super) fn reference_target(&mut self, r: &NodeRef, scope: usize) -> Option<(Target, ())> {
         let (last, walk) = r.path.split_last()?;
         let mut cur = scope;
         for step in walk {

@@ -75,6 +75,7 @@ pub enum Stmt {
     Instance(InstanceDecl),
     Bond(BondStmt),
     Port(PortDecl),
+    Allow(AllowDecl),
 }
 
 impl Stmt {
@@ -91,6 +92,7 @@ impl Stmt {
             Stmt::Instance(x) => x.span,
             Stmt::Bond(x) => x.span,
             Stmt::Port(x) => x.span,
+            Stmt::Allow(x) => x.span,
         }
     }
 }
@@ -283,6 +285,19 @@ pub struct InstanceDecl {
     pub component: Ident,
     pub name: Ident,
     pub overrides: Vec<(Ident, Expr)>,
+    pub span: Span,
+}
+
+/// `allow BG0510 gear_in "the gear's input inertia moves with the rotor";`: a finding of the analysis that the
+/// model intends, acknowledged at the element it concerns.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AllowDecl {
+    /// The diagnostic code (`BG0510`).
+    pub code: Ident,
+    /// The element (or junction) the finding is located at.
+    pub target: NodeRef,
+    /// Why it is intended.
+    pub reason: Option<String>,
     pub span: Span,
 }
 

@@ -275,6 +275,12 @@ impl Printer<'_> {
             }
             Stmt::Bond(b) => bond(b),
             Stmt::Port(p) => format!("port {} = {};", p.name.name, node(&p.target)),
+            Stmt::Allow(a) => {
+                let mut line = format!("allow {} {}", a.code.name, node(&a.target));
+                description(&mut line, &a.reason);
+                line.push(';');
+                line
+            }
         };
         self.pad();
         self.out.push_str(&line);

@@ -28,6 +28,7 @@ pub const KEYWORDS: &[&str] = &[
     "import",
     "domain",
     "coords",
+    "allow",
     "hint",
     "stroke",
     "Se",

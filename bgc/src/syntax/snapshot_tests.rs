@@ -193,6 +193,7 @@ fn stmt(s: &Stmt) -> String {
             format!("bond {label}{}{hint} {}", chain.join(" -> "), at(b.span))
         }
         Stmt::Port(p) => format!("port {} = {} {}", p.name.name, node(&p.target), at(p.span)),
+        Stmt::Allow(a) => format!("allow {} {} {}", a.code.name, node(&a.target), at(a.span)),
     }
 }
 

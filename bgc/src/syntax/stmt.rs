@@ -50,7 +50,7 @@ impl<'a> Parser<'a> {
             return self.element(docs, kind).map(Stmt::Element);
         }
         let docs = match word {
-            "domain" | "coords" | "bond" | "port" => {
+            "domain" | "coords" | "bond" | "port" | "allow" => {
                 self.reject_docs(docs, &format!("a `{word}` statement"));
                 Vec::new()
             }
@@ -122,6 +122,7 @@ impl<'a> Parser<'a> {
                 })
             }
             "bond" => Stmt::Bond(self.bond()?),
+            "allow" => Stmt::Allow(self.allow()?),
             "port" => {
                 self.bump();
                 let name = self.expect_name("the name of the port")?;
@@ -204,7 +205,7 @@ impl<'a> Parser<'a> {
     }
 
     /// An optional description string.
-    fn description(&mut self) -> Option<String> {
+    pub(super) fn description(&mut self) -> Option<String> {
         match self.peek().kind {
             Tok::Str(i) => {
                 self.bump();

@@ -1,21 +1,5 @@
-//! Steady-state Kalman gains, continuous (`lqe`) and discrete (`dlqe`), by duality with the LQR.
-//!
-//! Continuous: `ẋ = A x + B u + G w`, `y = C x + v`, `E[wwᵀ] = Q_n δ`, `E[vvᵀ] = R_n δ`. The error covariance
-//! `P` solves the filter Riccati equation `A P + P Aᵀ − P Cᵀ R_n⁻¹ C P + G Q_n Gᵀ = 0` (Eq. 9 of the
-//! back-support paper), i.e. the CARE of `(Aᵀ, Cᵀ, G Q_n Gᵀ, R_n)`, and the observer
-//! `x̂̇ = A x̂ + B u + L (y − C x̂)` has `L = P Cᵀ R_n⁻¹` (MATLAB/python-control `lqe`).
-//!
-//! Discrete: `x[k+1] = A x[k] + B u[k] + G w[k]`, `y[k] = C x[k] + v[k]`. `P` (the a-priori covariance of
-//! `x[k]` given `y` up to `k − 1`) solves the DARE of `(Aᵀ, Cᵀ, G Q_n Gᵀ, R_n)`. Two gains are returned:
-//!
-//! - the predictor gain `L = A P Cᵀ (C P Cᵀ + R_n)⁻¹` for `x̂[k+1|k] = A x̂[k|k−1] + B u[k] + L (y[k] − C x̂[k|k−1])`
-//!   (python-control's `dlqe` returns this `L`);
-//! - the innovation (filter) gain `M = P Cᵀ (C P Cᵀ + R_n)⁻¹` for the measurement update
-//!   `x̂[k|k] = x̂[k|k−1] + M (y[k] − C x̂[k|k−1])` (MATLAB's `dlqe` returns this `M`); `L = A M`.
-//!
-//! By duality an undetectable mode of `(C, A)` is reported as [`RiccatiError::NotDetectable`] (with the right
-//! eigenvector `v`, `A v = λ v`, `C v = 0`), and an unstable mode that the process noise does not excite
-//! (`(A, G Q_n^{1/2})` not stabilisable) as [`RiccatiError::NotStabilizable`] (with the left eigenvector).
+//! Steady-state Kalman gains, continuous ([`lqe`]) and discrete ([`dlqe`]), by duality with the LQR (the
+//! equations and conventions are in their documentation).
 
 use nalgebra::{Complex, DMatrix};
 
@@ -88,7 +72,16 @@ fn dual_error(e: RiccatiError) -> RiccatiError {
     }
 }
 
-/// The continuous steady-state Kalman gain; see the module docs.
+/// The continuous steady-state Kalman gain, by duality with the LQR.
+///
+/// Model: `ẋ = A x + B u + G w`, `y = C x + v`, `E[wwᵀ] = Q_n δ`, `E[vvᵀ] = R_n δ`. The error covariance
+/// `P` solves the filter Riccati equation `A P + P Aᵀ − P Cᵀ R_n⁻¹ C P + G Q_n Gᵀ = 0` (Eq. 9 of the
+/// back-support paper), i.e. the CARE of `(Aᵀ, Cᵀ, G Q_n Gᵀ, R_n)`, and the observer
+/// `x̂̇ = A x̂ + B u + L (y − C x̂)` has `L = P Cᵀ R_n⁻¹` (MATLAB/python-control `lqe`).
+///
+/// By duality an undetectable mode of `(C, A)` is reported as [`RiccatiError::NotDetectable`] (with the right
+/// eigenvector `v`, `A v = λ v`, `C v = 0`), and an unstable mode that the process noise does not excite
+/// (`(A, G Q_n^{1/2})` not stabilisable) as [`RiccatiError::NotStabilizable`] (with the left eigenvector).
 pub fn lqe(
     a: &DMatrix<f64>,
     g: &DMatrix<f64>,
@@ -106,7 +99,19 @@ pub fn lqe(
     })
 }
 
-/// The discrete steady-state Kalman filter; see the module docs.
+/// The discrete steady-state Kalman filter, by duality with the discrete LQR.
+///
+/// Model: `x[k+1] = A x[k] + B u[k] + G w[k]`, `y[k] = C x[k] + v[k]`, `E[w wᵀ] = Q_n`, `E[v vᵀ] = R_n`. `P`
+/// (the a-priori covariance of `x[k]` given `y` up to `k − 1`) solves the DARE of `(Aᵀ, Cᵀ, G Q_n Gᵀ, R_n)`. Two
+/// gains are returned:
+///
+/// - the predictor gain `L = A P Cᵀ (C P Cᵀ + R_n)⁻¹` for
+///   `x̂[k+1|k] = A x̂[k|k−1] + B u[k] + L (y[k] − C x̂[k|k−1])` (python-control's `dlqe` returns this `L`);
+/// - the innovation (filter) gain `M = P Cᵀ (C P Cᵀ + R_n)⁻¹` for the measurement update
+///   `x̂[k|k] = x̂[k|k−1] + M (y[k] − C x̂[k|k−1])` (MATLAB's `dlqe` returns this `M`); `L = A M`. This is the
+///   gain [`crate::estimation::KalmanFilter::with_fixed_gain`] takes.
+///
+/// Undetectable and unexcited unstable modes are reported as for [`lqe`].
 pub fn dlqe(
     a: &DMatrix<f64>,
     g: &DMatrix<f64>,

@@ -1,16 +1,5 @@
-//! The continuous-time algebraic Riccati equation
-//!
-//! `AᵀX + XA − (XB + N) R⁻¹ (BᵀX + Nᵀ) + Q = 0`, `K = R⁻¹(BᵀX + Nᵀ)`,
-//!
-//! for the stabilising solution `X = Xᵀ ≥ 0` (all eigenvalues of `A − BK` in the open left half plane).
-//!
-//! Method: validate the inputs and the PBH conditions ((A, B) stabilisable, (Q̃, Ã) detectable), reduce the cross
-//! term and balance (see [`super::riccati`]); compute `W = sign(H)` of the Hamiltonian `H = [Ã, −G; −Q̃, −Ãᵀ]`
-//! ([`super::sign`]), whose stable invariant subspace `[I; X]` is the null space of `W + I`, giving `X` as the
-//! least-squares solution of `[W₁₂; W₂₂ + I] X = −[W₁₁ + I; W₂₁]`; then Newton–Kleinman refinement in correction
-//! form: `(Ã − GX)ᵀ Δ + Δ (Ã − GX) + Res(X) = 0`, `X ← X + Δ`, until the residual stops decreasing. The final
-//! relative residual `‖Res(X)‖ / (‖ÃᵀX‖ + ‖XÃ‖ + ‖XGX‖ + ‖Q̃‖)` (Frobenius norms, original coordinates) must
-//! be below [`super::riccati::RICCATI_TOLERANCE`] and `A − BK` must be stable, else an error is returned.
+//! The continuous-time algebraic Riccati equation: [`care`] and [`care_with_cross`] (the equation and the
+//! method are in [`care`]'s documentation).
 
 use nalgebra::DMatrix;
 
@@ -25,7 +14,20 @@ use super::sign::hamiltonian_sign;
 /// Newton–Kleinman steps at most.
 const MAX_NEWTON_STEPS: usize = 30;
 
-/// Solves `AᵀX + XA − XBR⁻¹BᵀX + Q = 0`; see the module docs.
+/// Solves `AᵀX + XA − XBR⁻¹BᵀX + Q = 0` for the stabilising solution `X = Xᵀ ≥ 0` (all eigenvalues of
+/// `A − BK`, `K = R⁻¹BᵀX`, in the open left half plane).
+///
+/// With a cross weight ([`care_with_cross`]) the equation is `AᵀX + XA − (XB + N) R⁻¹ (BᵀX + Nᵀ) + Q = 0`,
+/// `K = R⁻¹(BᵀX + Nᵀ)`.
+///
+/// Method: validate the inputs and the PBH conditions ((A, B) stabilisable, (Q̃, Ã) detectable), reduce the cross
+/// term and balance (see [`crate::linalg::riccati`]); compute `W = sign(H)` of the Hamiltonian
+/// `H = [Ã, −G; −Q̃, −Ãᵀ]` ([`crate::linalg::sign`]), whose stable invariant subspace `[I; X]` is the null space of
+/// `W + I`, giving `X` as the least-squares solution of `[W₁₂; W₂₂ + I] X = −[W₁₁ + I; W₂₁]`; then Newton–Kleinman
+/// refinement in correction form: `(Ã − GX)ᵀ Δ + Δ (Ã − GX) + Res(X) = 0`, `X ← X + Δ`, until the residual stops
+/// decreasing. The final relative residual `‖Res(X)‖ / (‖ÃᵀX‖ + ‖XÃ‖ + ‖XGX‖ + ‖Q̃‖)` (Frobenius norms, original
+/// coordinates) must be below [`crate::linalg::riccati::RICCATI_TOLERANCE`] and `A − BK` must be stable, else an
+/// error is returned.
 ///
 /// `Q` must be symmetric positive semidefinite, `R` symmetric positive definite.
 pub fn care(

@@ -1,20 +1,5 @@
-//! The discrete-time algebraic Riccati equation
-//!
-//! `AᵀXA − X − (AᵀXB + N)(R + BᵀXB)⁻¹(BᵀXA + Nᵀ) + Q = 0`, `K = (R + BᵀXB)⁻¹(BᵀXA + Nᵀ)`,
-//!
-//! for the stabilising solution `X = Xᵀ ≥ 0` (all eigenvalues of `A − BK` inside the unit circle).
-//!
-//! Method: validate the inputs and the PBH conditions, reduce the cross term and balance (see
-//! [`super::riccati`]); the structure-preserving doubling algorithm (SDA, Chu, Fan, Lin & Wang 2004) on the
-//! symplectic pencil, which needs no inverse of `A`:
-//!
-//! `A₀ = Ã, G₀ = BR⁻¹Bᵀ, H₀ = Q̃`; with `W = I + GₖHₖ`:
-//! `Aₖ₊₁ = Aₖ W⁻¹ Aₖ`, `Gₖ₊₁ = Gₖ + Aₖ W⁻¹ Gₖ Aₖᵀ`, `Hₖ₊₁ = Hₖ + Aₖᵀ Hₖ W⁻¹ Aₖ`,
-//!
-//! where `Hₖ → X` quadratically; then Hewer's (Newton's) refinement in correction form
-//! `(Ã − BK)ᵀ Δ (Ã − BK) − Δ + Res(X) = 0`, `X ← X + Δ`, while the residual decreases. The relative residual
-//! `‖Res(X)‖ / (‖ÃᵀXÃ‖ + ‖X‖ + ‖ÃᵀXB(R + BᵀXB)⁻¹BᵀXÃ‖ + ‖Q̃‖)` must be below [`super::riccati::RICCATI_TOLERANCE`] and
-//! `A − BK` stable, else an error is returned.
+//! The discrete-time algebraic Riccati equation: [`dare`] and [`dare_with_cross`] (the equation and the
+//! method are in [`dare`]'s documentation).
 
 use nalgebra::DMatrix;
 
@@ -30,7 +15,23 @@ const MAX_DOUBLING_STEPS: usize = 100;
 /// Hewer steps at most.
 const MAX_HEWER_STEPS: usize = 30;
 
-/// Solves `AᵀXA − X − AᵀXB(R + BᵀXB)⁻¹BᵀXA + Q = 0`; see the module docs.
+/// Solves `AᵀXA − X − AᵀXB(R + BᵀXB)⁻¹BᵀXA + Q = 0` for the stabilising solution `X = Xᵀ ≥ 0` (all eigenvalues
+/// of `A − BK`, `K = (R + BᵀXB)⁻¹BᵀXA`, inside the unit circle).
+///
+/// With a cross weight ([`dare_with_cross`]) the equation is
+/// `AᵀXA − X − (AᵀXB + N)(R + BᵀXB)⁻¹(BᵀXA + Nᵀ) + Q = 0`, `K = (R + BᵀXB)⁻¹(BᵀXA + Nᵀ)`.
+///
+/// Method: validate the inputs and the PBH conditions, reduce the cross term and balance (see
+/// [`crate::linalg::riccati`]); the structure-preserving doubling algorithm (SDA, Chu, Fan, Lin & Wang 2004) on the
+/// symplectic pencil, which needs no inverse of `A`:
+///
+/// `A₀ = Ã, G₀ = BR⁻¹Bᵀ, H₀ = Q̃`; with `W = I + GₖHₖ`:
+/// `Aₖ₊₁ = Aₖ W⁻¹ Aₖ`, `Gₖ₊₁ = Gₖ + Aₖ W⁻¹ Gₖ Aₖᵀ`, `Hₖ₊₁ = Hₖ + Aₖᵀ Hₖ W⁻¹ Aₖ`,
+///
+/// where `Hₖ → X` quadratically; then Hewer's (Newton's) refinement in correction form
+/// `(Ã − BK)ᵀ Δ (Ã − BK) − Δ + Res(X) = 0`, `X ← X + Δ`, while the residual decreases. The relative residual
+/// `‖Res(X)‖ / (‖ÃᵀXÃ‖ + ‖X‖ + ‖ÃᵀXB(R + BᵀXB)⁻¹BᵀXÃ‖ + ‖Q̃‖)` must be below
+/// [`crate::linalg::riccati::RICCATI_TOLERANCE`] and `A − BK` stable, else an error is returned.
 pub fn dare(
     a: &DMatrix<f64>,
     b: &DMatrix<f64>,

@@ -8,7 +8,7 @@ use super::super::layout::Body;
 use super::super::names::{Namer, comment};
 use super::calls::{call_name, early_calls, with_bound_calls};
 use super::{Arg, Function, Uses, Writer, output_names};
-use crate::equations::EnergyKind;
+use crate::equations::{EnergyKind, StateSelection};
 use crate::symbolic::{Expr, RustCode, Symbol, SymbolKind};
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -390,12 +390,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         );
     }
 
-    fn state_space_fn(&mut self, name: &str, size: &str, ss: &StateSpace, doc: &str) {
-        let ty = if name == "state_space" {
-            "EnergyStateSpace"
-        } else {
-            "DeclaredStateSpace"
-        };
+    fn state_space_fn(&mut self, (name, ty): (&str, &str), size: &str, ss: &StateSpace, doc: &str) {
         self.out.push('\n');
         self.doc(
             0,
@@ -459,13 +454,21 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
     }
 
     pub(super) fn state_spaces(&mut self) {
-        match &self.plan.energy_ss {
-            Ok(ss) => self.state_space_fn(
-                "state_space",
+        let (ty, size, states) = match self.plan.linear_selection {
+            StateSelection::Energy => (
+                "EnergyStateSpace",
                 "N_ENERGY_STATES",
-                &ss.clone(),
                 "in the energy states (the first `N_ENERGY_STATES` states)",
             ),
+            StateSelection::All => (
+                "FullStateSpace",
+                "N_STATES",
+                "in all states `STATE_NAMES` (the energy states, then the integrated flows, which the outputs or \
+                 rates read)",
+            ),
+        };
+        match &self.plan.linear_ss {
+            Ok(ss) => self.state_space_fn(("state_space", ty), size, &ss.clone(), states),
             Err(why) => {
                 self.out.push('\n');
                 self.note(0, &format!("No `state_space`: {}.", comment(why)));
@@ -483,7 +486,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
                     .push_str(&format!("pub const N_COORDS: usize = {};\n", names.len()));
                 self.name_array("COORD_NAMES", "N_COORDS", "declared coordinates", &names);
                 self.state_space_fn(
-                    "state_space_declared",
+                    ("state_space_declared", "DeclaredStateSpace"),
                     "N_COORDS",
                     &ss.clone(),
                     "in the declared coordinates `COORD_NAMES`",

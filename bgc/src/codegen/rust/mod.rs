@@ -9,8 +9,10 @@
 //!   `get`, `set`; a derived parameter, defined from others in the file, is a method that follows them);
 //! - `rhs`/`rhs_into` (`ẋ = f(t, x, u)`), `outputs`/`outputs_into` (`y = h(t, x, u)`) and the Jacobians
 //!   `jac_x_into`, `jac_u_into`, `output_jac_x_into`, `output_jac_u_into` from symbolic derivatives;
-//! - for a linear model `state_space(&Params) -> (A, B, C, D)` in the energy states and, when the model declares
-//!   coordinates, `state_space_declared`;
+//! - for a linear model `state_space(&Params) -> (A, B, C, D)` whenever `bgc statespace` prints one: in the energy
+//!   states (type `EnergyStateSpace`), or, when the outputs or rates read an integrated flow (`var`), in all states,
+//!   energy states then integrated flows (type `FullStateSpace`); and, when the model declares coordinates,
+//!   `state_space_declared` (type `DeclaredStateSpace`, sizes `N_COORDS`, names `COORD_NAMES`);
 //! - `stored_energy`, `dissipated_power`, `supplied_power` when every term has a closed form;
 //! - for a model with nonlinear algebraic loops, `N_TEARS`, `TEAR_NAMES`, `Tears`, `LoopFailure`, `LoopError` and
 //!   `solve_loops(p, t, x, u) -> Result<Tears, LoopError>` (damped Newton's method per block, see
@@ -34,10 +36,13 @@
 //! the header, which holds the source path as given, and a single name or number wider than a line.
 //!
 //! # Lints
-//! The code passes `clippy -D warnings`. An unused argument is named `_x`. Only two lints are allowed, and only on
-//! the items that need it: `non_snake_case` where a local name is the model's and not snake case (`J_m`), and
+//! The code passes `clippy -D warnings` in the crate that includes it, whichever of its items that crate uses. An
+//! unused argument is named `_x`. Every item carries `#[allow(dead_code)]` (as `prost` and `lalrpop` output do):
+//! a binary crate that calls `rhs` but not `stored_energy` would otherwise get a warning for each item it leaves
+//! unused, and its `-D warnings` build would fail. Beyond that only two lints are allowed, and only on the items
+//! that need it: `non_snake_case` where a local name is the model's and not snake case (`J_m`), and
 //! `clippy::approx_constant` where a number of the model (three or more significant digits) could be taken for a
-//! rounded `π`, `e`, ...: the number is what the model file says. A comment at the top of such a file says so.
+//! rounded `π`, `e`, ...: the number is what the model file says. A comment at the top of the file says so.
 
 mod calls;
 mod functions;
@@ -121,19 +126,18 @@ pub fn generate_with(file: &CompiledFile, source_name: &str, options: Options) -
     out.push_str(
         "\n// Do not edit: this file is regenerated from the .bg source when it changes.\n",
     );
-    if body.contains("#[allow(") {
-        for line in format::comment(
-            0,
-            "//",
-            "Allowed lints: `non_snake_case` where local names are the model's (`J_m`), \
-             `clippy::approx_constant` where a number of the model, as written or folded (`2*pi`), looks \
-             like one of `core::f64::consts` (the number is the model's).",
-            Wrap::Prose,
-            MAX_WIDTH,
-        ) {
-            out.push_str(&line);
-            out.push('\n');
-        }
+    for line in format::comment(
+        0,
+        "//",
+        "Allowed lints: `dead_code` on every item (the including crate may use only some of them), \
+         `non_snake_case` where local names are the model's (`J_m`), `clippy::approx_constant` where a number \
+         of the model, as written or folded (`2*pi`), looks like one of `core::f64::consts` (the number is the \
+         model's).",
+        Wrap::Prose,
+        MAX_WIDTH,
+    ) {
+        out.push_str(&line);
+        out.push('\n');
     }
     out.push_str(&body);
     out
@@ -143,7 +147,7 @@ pub fn generate_with(file: &CompiledFile, source_name: &str, options: Options) -
 fn model_code(m: &CompiledModel, options: Options, base_indent: usize) -> String {
     let width = MAX_WIDTH - base_indent;
     match emit::plan(&m.equations) {
-        Ok(plan) => Writer::new(m, &plan, options, width).write(),
+        Ok(plan) => allow_dead_code(&Writer::new(m, &plan, options, width).write()),
         Err(why) => {
             let message = format!("bgc cannot generate `{}`: {why}", m.model.name);
             let head = "compile_error!(";
@@ -153,6 +157,48 @@ fn model_code(m: &CompiledModel, options: Options, base_indent: usize) -> String
             )
         }
     }
+}
+
+/// The item keywords that start a line of a model's code at the top level.
+const ITEM_STARTS: &[&str] = &[
+    "pub const ",
+    "pub static ",
+    "pub type ",
+    "pub fn ",
+    "pub struct ",
+    "pub enum ",
+    "const ",
+    "static ",
+    "type ",
+    "fn ",
+    "struct ",
+    "enum ",
+    "impl ",
+    "impl<",
+];
+
+/// `code` (a model's items at the top level) with `dead_code` allowed on each item, right above its keyword line
+/// (below its documentation and other attributes; joined to an `#[allow(...)]` line already there), so that a
+/// crate that uses some of them builds without warnings.
+fn allow_dead_code(code: &str) -> String {
+    let mut lines: Vec<String> = Vec::with_capacity(code.lines().count() * 2);
+    for line in code.lines() {
+        if ITEM_STARTS.iter().any(|k| line.starts_with(k)) {
+            match lines.last_mut() {
+                Some(prev) if prev.starts_with("#[allow(") && prev.ends_with(")]") => {
+                    prev.truncate(prev.len() - 2);
+                    prev.push_str(", dead_code)]");
+                }
+                _ => lines.push("#[allow(dead_code)]".into()),
+            }
+        }
+        lines.push(line.to_string());
+    }
+    let mut out = lines.join("\n");
+    if code.ends_with('\n') {
+        out.push('\n');
+    }
+    out
 }
 
 fn rust_f64(v: f64) -> String {

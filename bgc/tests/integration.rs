@@ -4,6 +4,7 @@ mod cli_support;
 mod codegen_support;
 mod equations_support;
 
+mod causality_allow;
 mod causality_models;
 mod cli;
 mod cli_equations;
@@ -16,6 +17,7 @@ mod codegen_generate;
 mod codegen_hostile_names;
 mod codegen_no_std;
 mod codegen_rustfmt;
+mod codegen_state_space;
 mod equations_back_support;
 mod equations_corpus;
 mod equations_derivative;

@@ -25,3 +25,4 @@ mod linalg_sylvester;
 mod sim_linear;
 mod sim_open_loop;
 mod sim_sampled;
+mod user_drive_example;

@@ -43,3 +43,34 @@ fn every_solver_runs_the_forced_oscillator_for_1000_seconds() {
         );
     }
 }
+
+/// A stiff, tiny oscillator (k = 1e12 N/m, m = 1e-6 kg) under the default tolerances: the absolute tolerance
+/// 1e-9 is far above its states (1e-12 m), so the run loses 46 % of the energy balance. bgc exits 0 as before but
+/// says so, with the figure; a well-resolved run says nothing.
+#[test]
+fn an_energy_balance_that_drifts_is_reported_with_its_figure() {
+    let path = corpus("oscillator.bg");
+    let stiff = [
+        "simulate", &path, "--t-end", "1", "--param", "k=1e12", "--param", "m=1e-6", "--input",
+        "F=1",
+    ];
+    let (code, _, err) = bgc(&stiff);
+    assert_eq!(code, 0, "{err}");
+    let figure: f64 = err
+        .split("energy + dissipated - supplied changed by ")
+        .nth(1)
+        .and_then(|rest| rest.split(", ").nth(1))
+        .and_then(|pct| pct.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(f64::NAN);
+    assert!(figure > 10.0 && figure <= 100.0, "{err}");
+    assert!(err.contains("give a smaller --rtol and --atol"), "{err}");
+    for args in [
+        vec!["simulate", &path, "--t-end", "3", "--input", "F=1"],
+        vec!["simulate", &path, "--t-end", "1000", "--input", "F=sin(t)"],
+    ] {
+        let (code, _, err) = bgc(&args);
+        assert_eq!(code, 0, "{err}");
+        assert!(!err.contains("energy balance"), "{args:?}: {err}");
+    }
+}

@@ -88,6 +88,8 @@ fn csv(
     }
     let (system, warnings) =
         System::new(eqs, params.clone(), signals).map_err(|e| e.to_string())?;
+    // An energy term without a closed form is left out of its column: the balance cannot be checked then.
+    let mut balance = Balance::new(warnings.is_empty(), args.rtol);
     for w in warnings {
         stderrln(&format!("warning: {w}"));
     }
@@ -130,6 +132,7 @@ fn csv(
     let mut line = header;
     let mut printed = 0usize;
     let result = run_streaming(&system, &x0, &opts, &mut |t, row| {
+        balance.see(t, row);
         let _ = write!(line, "{t}");
         for v in row {
             // Shortest round-trip form: the printed numbers read back exactly.
@@ -154,9 +157,71 @@ fn csv(
     }
     // The rows computed before a failure are printed; the error says where the run stopped.
     let flushed = out.flush();
+    if let Some(warning) = balance.warning() {
+        stderrln(&format!("warning: {warning}"));
+    }
     result.map_err(|e| match printed {
         0 => e.to_string(),
         n => format!("{e} (the {n} rows before it were printed)"),
     })?;
     flushed.map_err(Failure::Output)
+}
+
+/// The energy balance of a run: `energy + dissipated − supplied` stays at its initial value in the exact solution,
+/// so its drift measures the integration error of the whole run in one number.
+struct Balance {
+    check: bool,
+    rtol: f64,
+    start: Option<f64>,
+    /// The largest drift, when it happened, and the largest magnitude of the three terms.
+    worst: (f64, f64),
+    scale: f64,
+}
+
+/// The drift, relative to the largest energy term, above which a run is reported: a thousand times `--rtol`.
+const BALANCE_FACTOR: f64 = 1e3;
+
+impl Balance {
+    fn new(check: bool, rtol: f64) -> Balance {
+        Balance {
+            check,
+            rtol,
+            start: None,
+            worst: (0.0, 0.0),
+            scale: 0.0,
+        }
+    }
+
+    /// A row: its last three values are energy, dissipated and supplied.
+    fn see(&mut self, t: f64, row: &[f64]) {
+        let [energy, dissipated, supplied] = match row.get(row.len().saturating_sub(3)..) {
+            Some(&[e, d, s]) => [e, d, s],
+            _ => return,
+        };
+        let total = energy + dissipated - supplied;
+        let start = *self.start.get_or_insert(total);
+        let drift = (total - start).abs();
+        self.scale = self
+            .scale
+            .max(energy.abs())
+            .max(dissipated.abs())
+            .max(supplied.abs());
+        if drift > self.worst.0 {
+            self.worst = (drift, t);
+        }
+    }
+
+    /// The warning when the drift exceeded the bound.
+    fn warning(&self) -> Option<String> {
+        let (drift, t) = self.worst;
+        let relative = drift / self.scale;
+        (self.check && self.scale > 0.0 && relative > BALANCE_FACTOR * self.rtol).then(|| {
+            format!(
+                "the energy balance drifted: energy + dissipated - supplied changed by {drift:.3e} (by t = {t}), \
+                 {:.3} % of the largest energy term, more than {BALANCE_FACTOR} times --rtol; the results are not \
+                 accurate to the tolerances: give a smaller --rtol and --atol or another --solver",
+                100.0 * relative
+            )
+        })
+    }
 }

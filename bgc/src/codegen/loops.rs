@@ -226,7 +226,20 @@ fn bgc_bracketed<const B: usize>(
         };
         step = libm::fabs(next - x.0);
         if next <= a || next >= b {
-            break;
+            // Adjacent floats: accepted when the terms still cancel to half the digits.
+            let best = if libm::fabs(lo.1) < libm::fabs(hi.1) {
+                lo
+            } else {
+                hi
+            };
+            let floor = best.1.is_finite()
+                && best.2.is_finite()
+                && libm::fabs(best.1) <= 1.4901161193847656e-8 * best.2;
+            return if within(best.1, best.2) || floor {
+                Some(best.0)
+            } else {
+                None
+            };
         }
         let (r, s, j) = bgc_at(start, first, eval, next);
         evaluations += 1;

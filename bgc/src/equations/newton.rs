@@ -133,6 +133,9 @@ pub fn solve(
 /// about 1,000, and bisecting such a bracket down to adjacent floats takes as many.
 const BRACKET_EVALUATIONS: usize = 4000;
 
+/// The relative residual accepted when the bracket has closed to adjacent floats: `√ε`.
+const ROUNDING_FLOOR: f64 = 1.490_116_119_384_765_6e-8;
+
 /// The residual and its scale of a one-equation problem at `z`.
 fn eval1(problem: &mut dyn Problem, z: f64) -> (f64, f64) {
     let (mut r, mut s) = ([0.0], [0.0]);
@@ -179,8 +182,12 @@ pub fn bracketed(problem: &mut dyn Problem, z0: f64, settings: Settings) -> Opti
         };
         step = (next - x).abs();
         if next <= a || next >= b {
-            // The bracket is two adjacent floats.
-            break;
+            // The bracket is two adjacent floats: the root is known to the last bit. A law steep enough that no
+            // float meets the tolerance is accepted when its terms still cancel to half the digits (a pole or
+            // a jump, whose residual is as large as its terms, is not).
+            let (x, rx, sx) = if lo.1.abs() < hi.1.abs() { lo } else { hi };
+            let floor = rx.is_finite() && sx.is_finite() && rx.abs() <= ROUNDING_FLOOR * sx;
+            return (within(rx, sx) || floor).then_some((x, evaluations));
         }
         let (r, s) = eval1(problem, next);
         evaluations += 1;

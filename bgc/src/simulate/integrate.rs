@@ -324,7 +324,7 @@ fn segment(
             *d = *s;
         }
     };
-    let problem = OdeBuilder::<M>::new()
+    let mut problem = OdeBuilder::<M>::new()
         .t0(a)
         .rtol(opts.rtol)
         .atol([opts.atol])
@@ -332,6 +332,11 @@ fn segment(
         .init(init, dim)
         .build()
         .map_err(|e| solver_error(a, e))?;
+    // diffsol counts the failed Newton iterations of a whole run, not in a row, and gives up after 50 by default:
+    // each is a normal event (a stale Jacobian, a step too long) that it recovers from by refreshing the Jacobian
+    // or cutting the step, so a long run of a linear oscillator failed at t ≈ 600 (BDF) or 118 (ESDIRK34). A run
+    // that really cannot go on still ends: the step becomes too small, or `max_steps` is reached.
+    problem.ode_options.max_nonlinear_solver_failures = opts.max_steps;
     let ctx = Drive {
         system,
         bad: &bad,

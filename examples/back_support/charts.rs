@@ -271,7 +271,7 @@ fn disturbance_bode(s: &Study, dir: &Path) -> PlotResult<()> {
     let mut phase = Panel::new(
         "phase",
         "frequency (Hz)",
-        "phase (deg)",
+        "phase (°)",
         vec![
             line(
                 "closed loop (LQR + Eq. 9 observer)",
@@ -455,7 +455,7 @@ fn recovery_sweep(s: &Study, dir: &Path) -> PlotResult<()> {
     let mut phase = Panel::new(
         "phase margin against q",
         "fictitious motor-torque noise intensity q (N² m² s)",
-        "phase margin (deg)",
+        "phase margin (°)",
         vec![
             line("LQR + observer with q B_m B_mᵀ", &q, &pm, BLUE_),
             dashed("required 45°", &ends, &pm_req, GREY),

@@ -589,3 +589,31 @@ pub fn print_table(s: &Study) {
         println!("{line}");
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_fit_the_width_and_carry_a_status_and_a_reason() {
+        let long = "a reason that goes on for a while, ".repeat(12);
+        let r = row(
+            "peak |τ_m|, Eq. 15, Eq. 9 observer",
+            "0.607 N m at 0.115 s".to_string(),
+            "within ±0.56 N m",
+            Status::Differs,
+            long.clone(),
+        );
+        let lines = render(&r);
+        assert!(lines.len() >= 4, "{lines:?}");
+        assert!(
+            lines.iter().all(|l| l.chars().count() <= WIDTH),
+            "{lines:?}"
+        );
+        assert!(lines[0].ends_with("differs"), "{}", lines[0]);
+        assert!(lines[0].starts_with("  peak |τ_m|"));
+        // The reason is printed whole, under the row.
+        let reason: Vec<&str> = lines[1..].iter().map(|l| l.trim()).collect();
+        assert_eq!(reason.join(" "), long.trim());
+    }
+}

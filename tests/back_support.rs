@@ -85,8 +85,8 @@ use bgc_workspace::back_support::model_check::model_check;
 use bgc_workspace::back_support::observer::{self, NoiseModel};
 use bgc_workspace::back_support::params::Params;
 use bgc_workspace::back_support::plant::{self, DesignModel, NU, NX, NY, Plant};
-use bgc_workspace::back_support::robustness;
 use bgc_workspace::back_support::scenario::{self, ScenarioConfig};
+use bgc_workspace::back_support::{recovery, robustness};
 
 fn setup() -> (Params, Plant, DesignModel) {
     let p = Params::paper();
@@ -438,4 +438,89 @@ fn margins_and_rejection_bandwidth_match_python_control() {
     assert!(r.disturbance_dc_gain < 1e-9);
     let bw = r.rejection_bandwidth_hz.unwrap();
     assert!(rel(bw, 5.0349307169) < 1e-6, "{bw}");
+}
+
+#[test]
+fn recovered_observer_meets_the_margins_and_the_estimation_bounds() {
+    // Reference: the script above with the recovery weight q added to the motor-torque intensity,
+    //   for q in [0.0, 1e-11, 1e-6]:
+    //       L, _, _ = ct.lqe(A1, np.hstack([Bm, Bh]), Cm, np.diag([sw**2 * T + q, sh**2 * T]),
+    //                        np.diag([sv**2, st**2]) * T)
+    //       (controller and loop as above); print(q, *ct.stability_margins(loop)[:2], wgc, dm)
+    // -> 0      1.2021457581  14.3798879873  35.4972484667  0.0070703055
+    //    1e-11  1.2e15 (no crossing)  52.0179234859  49.4007988351  0.0183779221
+    //    1e-6   0.2969146520  60.3431450603  110.099330902  0.0095657853   (the LQR's own: 60.34°)
+    let (p, plant, model) = setup();
+    let designs = lqr::designs(&model).unwrap();
+    let cfg = ScenarioConfig::paper();
+    let rec = recovery::recover(&p, &plant, &model, &designs.double, &cfg).unwrap();
+    let rel = |got: f64, want: f64| (got - want).abs() / want.abs();
+    let at = |q: f64| {
+        rec.sweep
+            .iter()
+            .find(|pt| rel(pt.q, q) < 1e-9 || (q == 0.0 && pt.q == 0.0))
+            .unwrap()
+    };
+    // q = 0 is the plain design of Eq. 9 (the margins test above).
+    let plain = &at(0.0).margins;
+    assert!(rel(plain.gain_margin, 1.2021457581) < 1e-4, "{plain:?}");
+    assert!(rel(plain.phase_margin, 14.3798879873) < 1e-4, "{plain:?}");
+
+    // The chosen weight: the smallest of the sweep meeting 6 dB / 45° in both loops.
+    assert!(rel(rec.q, 1e-11) < 1e-9, "q = {}", rec.q);
+    let m = &rec.robustness.observer_loop;
+    assert!(rel(m.phase_margin, 52.0179234859) < 1e-4, "{m:?}");
+    assert!(
+        rel(m.gain_crossover.unwrap(), 49.4007988351) < 1e-4,
+        "{m:?}"
+    );
+    assert!(rel(m.delay_margin, 0.0183779221) < 1e-4, "{m:?}");
+    // No phase crossover at all: the gain can grow or shrink without limit (python-control's 1.2e15 is a
+    // numerically infinite gain margin).
+    assert_eq!(m.gain_increase_margin, None);
+    assert_eq!(m.gain_reduction_margin, None);
+    assert!(recovery::meets_margins(m));
+    let ms = &rec.robustness.sampled_loop;
+    assert!(recovery::meets_margins(ms), "{ms:?}");
+    assert!(ms.phase_margin >= 45.0 && ms.delay_margin > 0.015, "{ms:?}");
+    // The grid point below the chosen one does not meet them: the choice is the smallest.
+    let below = rec.sweep.iter().rev().find(|pt| pt.q < rec.q).unwrap();
+    assert!(
+        !recovery::meets_margins(&below.margins),
+        "{:?}",
+        below.margins
+    );
+
+    // The recovered design of the example is the runtime's LTR gain: observer::design with the recovery noise.
+    let swept = &at(rec.q).observer.l;
+    let designed = &rec.observer.continuous.l;
+    assert!((swept - designed).norm() <= 1e-8 * designed.norm());
+
+    // Estimation errors of the lifting scenario within the paper's figures (Figs. 17, 19).
+    let run = &rec.scenario;
+    assert!(
+        run.human_torque_mse <= recovery::PAPER_HUMAN_TORQUE_MSE,
+        "{}",
+        run.human_torque_mse
+    );
+    assert!(
+        run.motor_velocity_mse <= recovery::PAPER_MOTOR_VELOCITY_MSE,
+        "{}",
+        run.motor_velocity_mse
+    );
+
+    // Recovery: as q grows the loop tends to the LQR's (python-control at q = 1e-6; LQR alone 60.34°).
+    let high = &at(1e-6).margins;
+    assert!(rel(high.phase_margin, 60.3431450603) < 1e-4, "{high:?}");
+    assert!(
+        rel(high.gain_reduction_margin.unwrap(), 0.2969146520) < 1e-4,
+        "{high:?}"
+    );
+    let lqr_loop = &rec.robustness.state_feedback_loop;
+    let last = &rec.sweep[rec.sweep.len() - 1].margins;
+    assert!(
+        (last.phase_margin - lqr_loop.phase_margin).abs() < 1e-3,
+        "{last:?}"
+    );
+    assert!((last.stability_margin - lqr_loop.stability_margin).abs() < 1e-6);
 }

@@ -24,11 +24,43 @@ fn margins_json(m: &StabilityMargins) -> Value {
     json!({
         "gain_margin_db": db(m.gain_increase_margin),
         "gain_reduction_margin_db": db(m.gain_reduction_margin),
+        "gain_increase_unbounded": m.gain_increase_margin.is_none(),
         "phase_margin_deg": m.phase_margin,
         "phase_crossover_rad_s": m.phase_crossover,
         "gain_crossover_rad_s": m.gain_crossover,
         "delay_margin_s": m.delay_margin,
         "stability_margin": m.stability_margin,
+    })
+}
+
+/// The design tuned by loop transfer recovery: the chosen weight, its margins, scenario and the sweep.
+fn recovery_json(s: &Study) -> Value {
+    let r = &s.recovery;
+    let sweep: Vec<Value> = r
+        .sweep
+        .iter()
+        .map(|p| {
+            json!({
+                "q": p.q,
+                "gain_margin_db": db(p.margins.gain_increase_margin),
+                "phase_margin_deg": p.margins.phase_margin,
+                "delay_margin_s": p.margins.delay_margin,
+            })
+        })
+        .collect();
+    json!({
+        "q": r.q,
+        "observer_noise_std": [r.observer.noise.motor_torque, r.observer.noise.trunk_velocity,
+                               r.observer.noise.motor_velocity, r.observer.noise.sensor_torque],
+        "continuous_gain": r.observer.continuous.l.iter().collect::<Vec<_>>(),
+        "discrete_filter_gain": r.observer.discrete.filter_gain.iter().collect::<Vec<_>>(),
+        "margins": margins_json(&r.robustness.observer_loop),
+        "sampled_margins": margins_json(&r.robustness.sampled_loop),
+        "peak_tau_m": r.scenario.peak_motor_torque,
+        "tau_h_estimation_mse": r.scenario.human_torque_mse,
+        "omega_m_estimation_mse": r.scenario.motor_velocity_mse,
+        "omega_m_estimation_mse_true": r.scenario.motor_velocity_mse_true,
+        "sweep": sweep,
     })
 }
 
@@ -79,6 +111,7 @@ pub fn json(s: &Study) -> Value {
         "margins": margins_json(&rb.observer_loop),
         "sampled_margins": margins_json(&rb.sampled_loop),
         "state_feedback_margins": margins_json(&rb.state_feedback_loop),
+        "recovery": recovery_json(s),
         "disturbance": {
             "dc_gain": rb.disturbance_dc_gain,
             "peak_gain": rb.disturbance_peak_gain,

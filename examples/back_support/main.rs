@@ -6,9 +6,10 @@
 //! cargo run --release --example back_support -- [--json PATH] [--out DIR]
 //! ```
 //!
-//! Prints a summary table; `--json PATH` writes the figures; SVG plots (analogs of Figs. 10–11 and 14–20) go
-//! to `--out DIR` (default `target/exo/back_support/`). The computations live in
-//! `bgc_workspace::back_support`.
+//! Prints a summary table (each row with its status against the paper and the reason); `--json PATH` writes
+//! the figures, the observer retuned by loop transfer recovery included (`recovery`); SVG plots (analogs of
+//! Figs. 10–11 and 14–20, and the margins against the recovery weight) go to `--out DIR` (default
+//! `target/exo/back_support/`). The computations live in `bgc_workspace::back_support`.
 
 mod charts;
 mod figures;

@@ -242,34 +242,51 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         .map_err(|e| format!("cannot create {}: {e}", args.out.display()))?;
     let out = |name: &str| args.out.join(name);
     let full = (0.0, rig_setup.t_end);
+    let rig_note = format!(
+        "Pendulum rig run (Sec. 2.3.3) that measures the sensor variances and sets the fusion weights; seed {}.",
+        args.seed
+    );
+    let leg_note = format!(
+        "Exoskeleton test without load (Sec. 3.1), thigh and calf, fusion weights from the rig run; seed {}.",
+        args.seed
+    );
     plots::draw(
         &out("fig10_rig_sources.svg"),
         &plots::source_panels(&rig.segment, full),
         (4, 1),
         full,
-        "pendulum angle [deg]",
+        "pendulum angle (°)",
+        &rig_note,
     )?;
     let zoom = (4.0, 5.0);
     plots::draw(
         &out("fig11_rig_zoom.svg"),
         &[(
-            "Rig, 4th to 5th second".to_string(),
+            "Fig. 11 analog: rig, 4th to 5th second".to_string(),
             plots::angle_curves(&rig.segment, zoom),
         )],
         (1, 1),
         zoom,
-        "pendulum angle [deg]",
+        "pendulum angle (°)",
+        &rig_note,
     )?;
     let cycles = (9.0, 15.0);
     plots::draw(
         &out("fig12_leg.svg"),
         &[
-            ("Thigh".to_string(), plots::angle_curves(thigh, cycles)),
-            ("Calf".to_string(), plots::angle_curves(calf, cycles)),
+            (
+                "Fig. 12 analog: thigh".to_string(),
+                plots::angle_curves(thigh, cycles),
+            ),
+            (
+                "Fig. 12 analog: calf".to_string(),
+                plots::angle_curves(calf, cycles),
+            ),
         ],
         (1, 2),
         cycles,
-        "segment angle from vertical [deg]",
+        "segment angle from vertical (°)",
+        &leg_note,
     )?;
     let rig_errors = (2.0, 8.0);
     plots::draw(
@@ -280,7 +297,8 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         )],
         (1, 1),
         rig_errors,
-        "estimate - standard [deg]",
+        "estimate − standard (°)",
+        &rig_note,
     )?;
     plots::draw(
         &out("errors_leg.svg"),
@@ -296,7 +314,8 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         ],
         (2, 1),
         cycles,
-        "estimate - standard [deg]",
+        "estimate − standard (°)",
+        &leg_note,
     )?;
     println!("\nplots in {}", args.out.display());
     if let Some(path) = &args.json {

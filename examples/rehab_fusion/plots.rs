@@ -4,9 +4,12 @@ use bgc_workspace::rehab::experiment::SegmentRun;
 use plotters::prelude::*;
 use std::path::Path;
 
+#[path = "../common/legend.rs"]
+mod legend;
+
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 
-/// One curve: legend, colour, dashed, points (time [s], angle [deg]).
+/// One curve: legend, colour, points (time in s, angle in °).
 pub struct Curve {
     pub name: String,
     pub color: RGBColor,
@@ -144,21 +147,49 @@ fn y_range(panels: &[(String, Vec<Curve>)]) -> (f64, f64) {
     if !(lo.is_finite() && hi.is_finite()) {
         return (-1.0, 1.0);
     }
-    // Room above the data for the legend.
     let span = (hi - lo).max(1e-3);
-    (lo - 0.08 * span, hi + 0.55 * span)
+    (lo - 0.06 * span, hi + 0.06 * span)
 }
 
-/// Draws panels stacked in a `rows x cols` grid into an SVG file; all panels share the time window and the y label.
+const MARGIN: u32 = 10;
+const X_LABEL_AREA: u32 = 38;
+const Y_LABEL_AREA: u32 = 55;
+const NOTE_HEIGHT: u32 = 26;
+const LEGEND_FONT: f64 = 13.0;
+
+/// Draws panels stacked in a `rows x cols` grid into an SVG file, with `note` (the scenario) under them; all
+/// panels share the time window, the y range and the y label.
 pub fn draw(
     path: &Path,
     panels: &[(String, Vec<Curve>)],
     grid: (usize, usize),
     window: (f64, f64),
     y_label: &str,
+    note: &str,
 ) -> Result<(), String> {
-    draw_panels(path, panels, grid, window, y_label)
+    draw_panels(path, panels, grid, window, y_label, note)
         .map_err(|e| format!("cannot draw {}: {e}", path.display()))
+}
+
+/// The legend placement of one panel's curves in the shared ranges.
+fn placement(
+    curves: &[Curve],
+    window: (f64, f64),
+    y: (f64, f64),
+    plot_px: (f64, f64),
+) -> legend::Placement {
+    let norm: Vec<Vec<(f64, f64)>> = curves
+        .iter()
+        .map(|c| {
+            c.points
+                .iter()
+                .filter(|p| p.1.is_finite())
+                .map(|p| (legend::normalise(p.0, window), legend::normalise(p.1, y)))
+                .collect()
+        })
+        .collect();
+    let labels: Vec<&str> = curves.iter().map(|c| c.name.as_str()).collect();
+    legend::place(&norm, plot_px, legend::legend_size(&labels, LEGEND_FONT))
 }
 
 fn draw_panels(
@@ -167,24 +198,50 @@ fn draw_panels(
     grid: (usize, usize),
     window: (f64, f64),
     y_label: &str,
+    note: &str,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let (rows, cols) = grid;
     let width = if cols == 1 { 900 } else { 640 * cols as u32 };
-    let size = (width, 330 * rows as u32);
-    let root = SVGBackend::new(path, size).into_drawing_area();
+    let charts_height = 330 * rows as u32;
+    let root = SVGBackend::new(path, (width, charts_height + NOTE_HEIGHT)).into_drawing_area();
     root.fill(&WHITE)?;
-    let areas = root.split_evenly((rows, cols));
+    let (charts, strip) = root.split_vertically(charts_height);
+    strip.draw(&Text::new(
+        note.to_string(),
+        (12, 4),
+        ("sans-serif", 14).into_font().color(&BLACK),
+    ))?;
+    let areas = charts.split_evenly((rows, cols));
+    let titled: Vec<_> = areas
+        .iter()
+        .zip(panels)
+        .map(|(area, (title, _))| area.titled(title, ("sans-serif", 18)))
+        .collect::<Result<_, _>>()?;
     let (y0, y1) = y_range(panels);
-    for (area, (title, curves)) in areas.iter().zip(panels) {
+    // One y range for all panels: the largest headroom any panel's legend needs.
+    let placements: Vec<legend::Placement> = titled
+        .iter()
+        .zip(panels)
+        .map(|(area, (_, curves))| {
+            let (w, h) = area.dim_in_pixel();
+            let plot_px = (
+                f64::from(w.saturating_sub(2 * MARGIN + Y_LABEL_AREA).max(1)),
+                f64::from(h.saturating_sub(2 * MARGIN + X_LABEL_AREA).max(1)),
+            );
+            placement(curves, window, (y0, y1), plot_px)
+        })
+        .collect();
+    let headroom = placements.iter().map(|p| p.headroom).fold(1.0, f64::max);
+    let y1 = y0 + (y1 - y0) * headroom;
+    for ((area, (_, curves)), place) in titled.iter().zip(panels).zip(&placements) {
         let mut chart = ChartBuilder::on(area)
-            .caption(title, ("sans-serif", 18))
-            .margin(10)
-            .x_label_area_size(38)
-            .y_label_area_size(55)
+            .margin(MARGIN)
+            .x_label_area_size(X_LABEL_AREA)
+            .y_label_area_size(Y_LABEL_AREA)
             .build_cartesian_2d(window.0..window.1, y0..y1)?;
         chart
             .configure_mesh()
-            .x_desc("time [s]")
+            .x_desc("time (s)")
             .y_desc(y_label)
             .label_style(("sans-serif", 13))
             .light_line_style(RGBColor(235, 235, 235))
@@ -203,12 +260,18 @@ fn draw_panels(
                 }
             }
         }
+        // With a free corner the legend sits there; otherwise above the data in the headroom.
+        let position = if place.headroom > 1.0 {
+            SeriesLabelPosition::UpperRight
+        } else {
+            place.position.clone()
+        };
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
+            .position(position)
+            .background_style(WHITE.mix(0.9))
             .border_style(BLACK)
-            .label_font(("sans-serif", 13))
+            .label_font(("sans-serif", LEGEND_FONT as u32))
             .draw()?;
     }
     root.present()?;

@@ -224,11 +224,12 @@ const NOTES: &str = "Notes
   hip in walking, more than twice the 38 N m motor; the wearer here leaves the motors the share of the
   gait torque they can deliver and supplies the rest, so the paper's EMG reductions (43-60 %) are not
   reproduced. The motors are clipped at their ratings in the plant.
-- Versus the paper: our position errors come out below the paper's, our velocity errors 3-4x above. The simulated exoskeleton has no transmission compliance, backlash or
-  communication delay (the paper names its hardware response rate); what remains here is the 1 ms
-  zero-order hold against torques that change within a period (Coulomb friction at speed reversals, the
-  ground reaction and torso load coming on), the thigh-mass estimate lagging the torso load, and sensor
-  noise. The ankle row is the passive joint: the wearer carries it, and its reference (the filter's
+- Versus the paper: our position errors come out below the paper's, our velocity errors 3-4x above. The
+  simulated exoskeleton has no transmission compliance, backlash or communication delay (the paper names
+  its hardware response rate); what remains here is the 1 ms zero-order hold against torques that change
+  within a period (Coulomb friction at speed reversals, the ground reaction and torso load coming on), the
+  thigh-mass estimate lagging the torso load, and sensor noise. The ankle row is the passive joint: the
+  wearer carries it, and its reference (the filter's
   ankle estimate, a light foot) is not tracked.";
 
 fn main() -> ExitCode {

@@ -8,6 +8,9 @@ use plotters::prelude::*;
 use std::error::Error;
 use std::path::Path;
 
+#[path = "../common/legend.rs"]
+mod legend;
+
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 type PlotResult<T> = Result<T, Box<dyn Error>>;
 
@@ -17,6 +20,11 @@ const MEASURED: RGBColor = RGBColor(170, 170, 170);
 const REFERENCE: RGBColor = RGBColor(214, 39, 40);
 const BOUND: RGBColor = RGBColor(255, 127, 14);
 const INTENT: RGBColor = RGBColor(44, 160, 44);
+
+const MARGIN: u32 = 8;
+const NOTE_HEIGHT: u32 = 26;
+const X_LABEL_AREA: u32 = 38;
+const Y_LABEL_AREA: u32 = 62;
 
 /// Knee and hip indices in the state order (ankle, knee, hip).
 const JOINTS: [(usize, &str); 2] = [(2, "hip"), (1, "knee")];
@@ -28,16 +36,38 @@ struct Line {
     points: Vec<(f64, f64)>,
 }
 
-/// A white SVG canvas of `size` pixels at `path`, split into `grid` (rows, columns) panels.
-fn canvas(
-    path: &Path,
+/// A white SVG canvas of `size` pixels at `path`, split into `grid` (rows, columns) panels above a strip
+/// with `note` (the scenario the figure shows).
+fn canvas<'a>(
+    path: &'a Path,
     size: (u32, u32),
     grid: (usize, usize),
-) -> PlotResult<(Area<'_>, Vec<Area<'_>>)> {
-    let root = SVGBackend::new(path, size).into_drawing_area();
+    note: &str,
+) -> PlotResult<(Area<'a>, Vec<Area<'a>>)> {
+    let root = SVGBackend::new(path, (size.0, size.1 + NOTE_HEIGHT)).into_drawing_area();
     root.fill(&WHITE)?;
-    let areas = root.split_evenly(grid);
+    let (charts, strip) = root.split_vertically(size.1);
+    strip.draw(&Text::new(
+        note.to_string(),
+        (12, 4),
+        ("sans-serif", 14).into_font().color(&BLACK),
+    ))?;
+    let areas = charts.split_evenly(grid);
     Ok((root, areas))
+}
+
+/// What every figure shows, for its note.
+fn scenario_note(cfg: &WalkingConfig) -> String {
+    let (t0, t1) = window(cfg);
+    format!(
+        "Walking: {:.0} s simulated, control at {:.0} Hz, dual UKF at {:.0} Hz, masses start {:.0} % heavy, \
+         seed {}; time series show {t0:.0}–{t1:.0} s (masses: the whole run).",
+        cfg.duration,
+        1.0 / cfg.control_period,
+        1.0 / (cfg.control_period * cfg.filter_decimation as f64),
+        100.0 * cfg.mass_error,
+        cfg.seed
+    )
 }
 
 fn line(name: &str, color: RGBColor, width: u32, points: Vec<(f64, f64)>) -> Line {
@@ -60,15 +90,42 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-/// One chart with a legend.
+/// One chart with a legend where it covers no curve (`common/legend.rs`).
 fn panel(area: &Area, title: &str, x_desc: &str, y_desc: &str, lines: &[Line]) -> PlotResult<()> {
     let (x0, x1) = range(lines.iter().flat_map(|l| l.points.iter().map(|p| p.0)));
     let (y0, y1) = range(lines.iter().flat_map(|l| l.points.iter().map(|p| p.1)));
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", 18))
-        .margin(8)
-        .x_label_area_size(38)
-        .y_label_area_size(62)
+    let titled = area.titled(title, ("sans-serif", 18))?;
+    let (w, h) = titled.dim_in_pixel();
+    let plot_px = (
+        f64::from(w.saturating_sub(2 * MARGIN + Y_LABEL_AREA).max(1)),
+        f64::from(h.saturating_sub(2 * MARGIN + X_LABEL_AREA).max(1)),
+    );
+    let curves: Vec<Vec<(f64, f64)>> = lines
+        .iter()
+        .map(|l| {
+            l.points
+                .iter()
+                .filter(|p| p.0.is_finite() && p.1.is_finite())
+                .map(|p| {
+                    (
+                        legend::normalise(p.0, (x0, x1)),
+                        legend::normalise(p.1, (y0, y1)),
+                    )
+                })
+                .collect()
+        })
+        .collect();
+    let labels: Vec<&str> = lines
+        .iter()
+        .map(|l| l.name.as_str())
+        .filter(|n| !n.is_empty())
+        .collect();
+    let placement = legend::place(&curves, plot_px, legend::legend_size(&labels, 13.0));
+    let y1 = y0 + (y1 - y0) * placement.headroom;
+    let mut chart = ChartBuilder::on(&titled)
+        .margin(MARGIN)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(x0..x1, y0..y1)?;
     chart
         .configure_mesh()
@@ -96,8 +153,8 @@ fn panel(area: &Area, title: &str, x_desc: &str, y_desc: &str, lines: &[Line]) -
     }
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
+        .position(placement.position)
+        .background_style(WHITE.mix(0.9))
         .border_style(RGBColor(120, 120, 120))
         .label_font(("sans-serif", 13))
         .draw()?;
@@ -150,7 +207,7 @@ fn series<T>(samples: &[&T], f: impl Fn(&T) -> (f64, f64)) -> Vec<(f64, f64)> {
 }
 
 fn fig11(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
-    let (root, areas) = canvas(path, (1200, 800), (2, 2))?;
+    let (root, areas) = canvas(path, (1200, 800), (2, 2), &scenario_note(cfg))?;
     let s = filter_in(r, window(cfg));
     for (col, (j, name)) in JOINTS.iter().enumerate() {
         let j = *j;
@@ -200,7 +257,7 @@ fn after_warmup<'a>(r: &'a WalkingRun, cfg: &WalkingConfig) -> Vec<&'a FilterSam
 }
 
 fn fig12(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
-    let (root, areas) = canvas(path, (1200, 800), (2, 2))?;
+    let (root, areas) = canvas(path, (1200, 800), (2, 2), &scenario_note(cfg))?;
     let s = filter_in(r, window(cfg));
     let all = after_warmup(r, cfg);
     for (col, (j, name)) in JOINTS.iter().enumerate() {
@@ -231,7 +288,7 @@ fn fig12(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
 }
 
 fn fig13(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
-    let (root, areas) = canvas(path, (1200, 800), (2, 2))?;
+    let (root, areas) = canvas(path, (1200, 800), (2, 2), &scenario_note(cfg))?;
     let s = filter_in(r, window(cfg));
     for (col, (j, name)) in JOINTS.iter().enumerate() {
         let j = *j;
@@ -273,7 +330,7 @@ fn fig13(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
 }
 
 fn fig14(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
-    let (root, areas) = canvas(path, (1200, 800), (2, 2))?;
+    let (root, areas) = canvas(path, (1200, 800), (2, 2), &scenario_note(cfg))?;
     let all = after_warmup(r, cfg);
     for (col, (j, name)) in JOINTS.iter().enumerate() {
         let j = *j;
@@ -302,7 +359,7 @@ fn fig14(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
 }
 
 fn fig16(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
-    let (root, areas) = canvas(path, (1200, 800), (2, 2))?;
+    let (root, areas) = canvas(path, (1200, 800), (2, 2), &scenario_note(cfg))?;
     let s = control_in(r, window(cfg));
     for (col, (j, name)) in JOINTS.iter().enumerate() {
         let j = *j;
@@ -347,8 +404,8 @@ fn fig16(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
     Ok(())
 }
 
-fn fig17(r: &WalkingRun, path: &Path) -> PlotResult<()> {
-    let (root, areas) = canvas(path, (1200, 900), (3, 1))?;
+fn fig17(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
+    let (root, areas) = canvas(path, (1200, 900), (3, 1), &scenario_note(cfg))?;
     let s: Vec<&FilterSample> = r.filter.iter().collect();
     let names = ["m1 (foot)", "m2 (shank)", "m3 (thigh, + torso in stance)"];
     for (i, name) in names.iter().enumerate() {
@@ -390,7 +447,7 @@ fn state_number(label: &str) -> f64 {
 }
 
 fn supervisor(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
-    let (root, areas) = canvas(path, (1200, 1000), (3, 1))?;
+    let (root, areas) = canvas(path, (1200, 1000), (3, 1), &scenario_note(cfg))?;
     let s = control_in(r, window(cfg));
     let index = |f: fn(&ControlSample) -> Option<f64>| -> Vec<(f64, f64)> {
         // An unloaded foot has no P: the line breaks there.
@@ -443,7 +500,7 @@ fn supervisor(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()
 }
 
 fn torques(r: &WalkingRun, cfg: &WalkingConfig, path: &Path) -> PlotResult<()> {
-    let (root, areas) = canvas(path, (1200, 800), (2, 1))?;
+    let (root, areas) = canvas(path, (1200, 800), (2, 1), &scenario_note(cfg))?;
     let s = control_in(r, window(cfg));
     for (row, (j, name)) in JOINTS.iter().enumerate() {
         let j = *j;
@@ -497,7 +554,7 @@ pub fn write_all(r: &WalkingRun, cfg: &WalkingConfig, dir: &Path) -> PlotResult<
     fig13(r, cfg, &dir.join(files[2]))?;
     fig14(r, cfg, &dir.join(files[3]))?;
     fig16(r, cfg, &dir.join(files[4]))?;
-    fig17(r, &dir.join(files[5]))?;
+    fig17(r, cfg, &dir.join(files[5]))?;
     supervisor(r, cfg, &dir.join(files[6]))?;
     torques(r, cfg, &dir.join(files[7]))?;
     Ok(files.iter().map(|f| f.to_string()).collect())

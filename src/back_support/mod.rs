@@ -8,7 +8,8 @@
 //!   6-state design model in angles relative to the trunk;
 //! - [`block_diagram`]: Eq. 1, coded independently, and [`model_check`]: Sec. 5.1;
 //! - [`lqr`]: Eqs. 10–17; [`observer`]: Eqs. 4–9 with the noise of Sec. 4;
-//! - [`scenario`]: the lifting task of Sec. 5.2; [`robustness`]: margins and disturbance rejection.
+//! - [`scenario`]: the lifting task of Sec. 5.2; [`robustness`]: margins and disturbance rejection;
+//! - [`recovery`]: the observer retuned by loop transfer recovery for margins.
 //!
 //! [`study`] runs all of it.
 
@@ -18,6 +19,7 @@ pub mod model_check;
 pub mod observer;
 pub mod params;
 pub mod plant;
+pub mod recovery;
 pub mod robustness;
 pub mod scenario;
 
@@ -58,6 +60,7 @@ pub enum BackSupportError {
     Pbh(PbhError),
     Estimation(EstimationError),
     Analysis(AnalysisError),
+    Recovery(bgc_runtime::design::LtrError),
 }
 
 impl fmt::Display for BackSupportError {
@@ -83,6 +86,7 @@ impl fmt::Display for BackSupportError {
             BackSupportError::Pbh(e) => write!(f, "observability test: {e}"),
             BackSupportError::Estimation(e) => write!(f, "Kalman filter: {e}"),
             BackSupportError::Analysis(e) => write!(f, "frequency analysis: {e}"),
+            BackSupportError::Recovery(e) => write!(f, "loop transfer recovery: {e}"),
         }
     }
 }
@@ -124,6 +128,8 @@ pub struct Study {
     /// The scenario with the double design with `q_z = 10¹³` ([`lqr::LqrDesigns::double_reproducing`]).
     pub scenario_reproducing: scenario::ScenarioResult,
     pub robustness: robustness::Robustness,
+    /// The observer retuned by loop transfer recovery, with its margins and scenario.
+    pub recovery: recovery::Recovery,
 }
 
 /// Runs the whole study with the paper's parameters and the given scenario settings.
@@ -138,6 +144,7 @@ pub fn study(cfg: &scenario::ScenarioConfig) -> Result<Study, BackSupportError> 
     let run = scenario::run(&p, &plant, &model, &lqr.double, &obs, cfg)?;
     let run_reproducing = scenario::run(&p, &plant, &model, &lqr.double_reproducing, &obs, cfg)?;
     let robustness = robustness::analyse(&model, &lqr.double, &obs.continuous.l, &obs)?;
+    let recovery = recovery::recover(&p, &plant, &model, &lqr.double, cfg)?;
     Ok(Study {
         params: p,
         model_check: check,
@@ -147,5 +154,6 @@ pub fn study(cfg: &scenario::ScenarioConfig) -> Result<Study, BackSupportError> 
         scenario: run,
         scenario_reproducing: run_reproducing,
         robustness,
+        recovery,
     })
 }

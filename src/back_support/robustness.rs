@@ -61,6 +61,8 @@ pub struct Robustness {
     pub rejection_bandwidth_hz: Option<f64>,
     /// The observer-based loop transfer at the plant input (for Nyquist plots).
     pub loop_at_input: StateSpace,
+    /// The full-state LQR loop transfer `K (sI − A_aug)⁻¹ B_aug` (for Nyquist plots).
+    pub state_feedback_loop_transfer: StateSpace,
     /// The disturbance path as a model (for Bode plots).
     pub disturbance_path: StateSpace,
     /// The uncontrolled disturbance path `(A₁, B_h, C_b, d_b)`.
@@ -257,8 +259,8 @@ pub fn analyse(
     k.view_mut((0, 0), (1, 6)).copy_from(&kx);
     k[(0, 6)] = kz;
     k[(0, 7)] = kzz;
-    let state_feedback_loop =
-        stability_margins(&StateSpace::new(a_aug, b_aug, k, DMatrix::zeros(1, 1))?)?;
+    let state_feedback_loop_transfer = StateSpace::new(a_aug, b_aug, k, DMatrix::zeros(1, 1))?;
+    let state_feedback_loop = stability_margins(&state_feedback_loop_transfer)?;
     let path = disturbance_path(model, lqr, l)?;
     let open = StateSpace::new(
         model.a.clone(),
@@ -276,6 +278,7 @@ pub fn analyse(
         disturbance_peak_frequency_hz: peak_w / (2.0 * std::f64::consts::PI),
         rejection_bandwidth_hz: ratio_crossing(&path, &open, -3.0)?,
         loop_at_input,
+        state_feedback_loop_transfer,
         disturbance_path: path,
         open_loop_disturbance_path: open,
     })

@@ -38,6 +38,8 @@ pub(crate) struct MassPlan {
 /// The blocks of every I-field of the equations.
 pub(crate) fn plan(eqs: &Equations, states: &[Symbol]) -> Result<Vec<MassPlan>, String> {
     let mut out = Vec::with_capacity(eqs.mass.len());
+    // `a.leg` and `a_leg` give one sanitized name; each field gets its own function.
+    let mut idents = super::names::Namer::default();
     for b in &eqs.mass {
         let matrix: Vec<Vec<Expr>> = b
             .matrix
@@ -55,7 +57,7 @@ pub(crate) fn plan(eqs: &Equations, states: &[Symbol]) -> Result<Vec<MassPlan>, 
                 derivatives.push((k, d));
             }
         }
-        let ident = super::names::sanitize(&b.element);
+        let ident = idents.ident(&b.element);
         out.push(MassPlan {
             element: b.element.clone(),
             ident,

@@ -1,14 +1,17 @@
 //! The causal equations of every node: each bond variable gets exactly one defining equation, written by the node
 //! at the end of the bond that computes it (the effort by the end that sets it, the flow by the other end).
 //!
-//! Sign convention: a 1-port element's own effort is its bond's effort, its own flow is the bond's flow taken into
-//! the element (`s = +1` when the bond points at it, `-1` otherwise), so its absorbed power is `e·f`. Sources set
-//! their bond's variable directly. Junction sums use `+` for bonds pointing in and `-` for bonds pointing out.
+//! Sign convention (docs/language.md, "Effort and flow of an element"): a 1-port element's own effort is its bond's
+//! effort; its own flow is its bond's flow counted in the element's standard direction, into a C, I or R and out of
+//! a source: `own f = s · f_bond` with `s = +1` when the bond is drawn that way and `-1` otherwise. So `e·f` is the
+//! power a C, I or R absorbs and the power a source delivers, whichever way the bond is drawn, and a source's value
+//! is its own variable (`Sf x = v` gives `f(x) = v`). Junction sums use `+` for bonds pointing in and `-` for bonds
+//! pointing out.
 //!
 //! | node | causality | definitions |
 //! |---|---|---|
 //! | `Se` | sets e | `e = value` |
-//! | `Sf` | sets f | `f = value` |
+//! | `Sf` | sets f | `f = s · value` |
 //! | `C` | integral | `e = q/C` or `e = g(q)` (or `q = g(e)` inverted when affine in `e`) |
 //! | `C` | derivative | `f = s · d/dt(C·e)` (or `d/dt(g(e))`) |
 //! | `I` | integral | `f = s · p/I` or `f = g(p)` (or `p = g(f)` inverted) |
@@ -61,6 +64,9 @@ pub(crate) struct Built {
     pub definer: Vec<Option<NodeIndex>>,
     /// Per bond variable: its readable name.
     pub names: Vec<String>,
+    /// Per bond variable: true when its name comes from an instance's element (a qualified name), which yields a
+    /// shared name to the model's own elements ([`super::naming`]).
+    pub qualified: Vec<bool>,
     /// The states: integral storages, then integrated flows.
     pub states: Vec<StateSpec>,
     /// Per state: its rate in terms of bond variables (`ṗ = e`, `q̇ = s·f`, `θ̇ = integrand`); for the flow states
@@ -73,7 +79,8 @@ pub(crate) struct Built {
 /// The conversion context of IR expressions.
 pub(crate) struct Ctx<'a> {
     pub model: &'a Model,
-    /// Per node: its single bond and the sign of its own flow, for 1-port elements.
+    /// Per node: its single bond and the sign of its own flow (into a C, I or R, out of a source), for 1-port
+    /// elements.
     pub port: Vec<Option<(EdgeIndex, f64)>>,
     /// Per node: the state of its energy variable when in integral causality.
     pub node_state: Vec<Option<usize>>,
@@ -288,9 +295,15 @@ pub(crate) fn context<'a>(model: &'a Model, causality: &Causality) -> (Ctx<'a>, 
         }
         let incoming = model.graph.edges_directed(node, Direction::Incoming).next();
         let outgoing = model.graph.edges_directed(node, Direction::Outgoing).next();
+        // The standard direction: into a storage or a resistor, out of a source.
+        let source = matches!(
+            w.kind,
+            ElementKind::Se | ElementKind::Sf | ElementKind::MSe | ElementKind::MSf
+        );
+        let inward = if source { -1.0 } else { 1.0 };
         port[node.index()] = match (incoming, outgoing) {
-            (Some(e), _) => Some((petgraph::visit::EdgeRef::id(&e), 1.0)),
-            (None, Some(e)) => Some((petgraph::visit::EdgeRef::id(&e), -1.0)),
+            (Some(e), _) => Some((petgraph::visit::EdgeRef::id(&e), inward)),
+            (None, Some(e)) => Some((petgraph::visit::EdgeRef::id(&e), -inward)),
             (None, None) => None,
         };
     }
@@ -345,6 +358,7 @@ pub(crate) fn context<'a>(model: &'a Model, causality: &Causality) -> (Ctx<'a>, 
             port: None,
         });
     }
+    super::naming::unique_states(model, &mut states);
     (ctx, states)
 }
 
@@ -361,8 +375,8 @@ pub(crate) fn sanitize(name: &str) -> String {
         .collect()
 }
 
-/// Readable names of the bond variables.
-pub(crate) fn names(model: &Model) -> Vec<String> {
+/// Readable names of the bond variables, qualified (`e_s.spring`) as the elements are.
+fn names(model: &Model) -> Vec<String> {
     let mut names = vec![String::new(); 2 * model.graph.edge_count()];
     for b in model.graph.edge_indices() {
         let Some((a, z)) = model.graph.edge_endpoints(b) else {
@@ -393,8 +407,8 @@ pub(crate) fn names(model: &Model) -> Vec<String> {
             };
             (e, f)
         };
-        names[effort_var(b)] = sanitize(&e);
-        names[flow_var(b)] = sanitize(&f);
+        names[effort_var(b)] = e;
+        names[flow_var(b)] = f;
     }
     names
 }
@@ -535,6 +549,7 @@ pub(crate) fn build(
         };
         rates.push(rate.unwrap_or(Ex::zero()));
     }
+    let raw_names = names(model);
     let mut mass = Vec::new();
     for node in model.graph.node_indices() {
         if let Some(block) = super::field::rates(model, ctx, node, &mut rates, diags) {
@@ -544,7 +559,8 @@ pub(crate) fn build(
     Built {
         defs,
         definer,
-        names: names(model),
+        qualified: raw_names.iter().map(|n| n.contains('.')).collect(),
+        names: raw_names.iter().map(|n| sanitize(n)).collect(),
         states,
         rates,
         mass,
@@ -659,17 +675,16 @@ fn node_defs(
             let Relation::Source(v) = &w.relation else {
                 return Err(unsupported("a source without a value".into()));
             };
-            let (b, _) = incident
-                .first()
-                .copied()
-                .ok_or_else(|| unsupported("no bond".into()))?;
-            let effort_source = matches!(w.kind, ElementKind::Se | ElementKind::MSe);
-            let var = if effort_source {
-                effort_var(b)
-            } else {
-                flow_var(b)
+            let Some((b, s)) = ctx.port.get(node.index()).copied().flatten() else {
+                return Err(unsupported("no bond".into()));
             };
-            out.push((var, Def::Plain(conv(v)?)));
+            // The value is the source's own variable: its effort, or its flow out of it.
+            let def = if matches!(w.kind, ElementKind::Se | ElementKind::MSe) {
+                (effort_var(b), conv(v)?)
+            } else {
+                (flow_var(b), mul(vec![Ex::Num(s), conv(v)?]))
+            };
+            out.push((def.0, Def::Plain(def.1)));
         }
         ElementKind::C | ElementKind::I | ElementKind::R => {
             let Some((b, s)) = ctx.port.get(node.index()).copied().flatten() else {

@@ -62,8 +62,9 @@ pub(crate) fn derive_coords(
 ) -> Option<Vec<(String, Ex)>> {
     let mut out = Vec::new();
     let mut ok = true;
+    let mut names = super::naming::UniqueNames::default();
     for (k, e) in list.iter().enumerate() {
-        let name = coord_name(model, e, k);
+        let name = names.claim(&coord_name(model, e, k));
         let fail = |msg: String| {
             let d = Diagnostic::error(codes::COORDS, format!("declared coordinate `{name}` {msg}"))
                 .with_help("a coordinate must be a linear combination of p(x), q(x), flows of inertias and integrated flows");

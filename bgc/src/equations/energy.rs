@@ -2,10 +2,11 @@
 //! supplied by each source, as explicit expressions of states, inputs, parameters and `t`.
 //!
 //! - Stored: `E = ∫ e dq` for a compliance, `∫ f dp` for an inertia: `q²/(2C)`, `p²/(2I)` for linear ones; for a law
-//!   `e = g(q)` (`f = g(p)`) the integral is taken symbolically when `g` is a polynomial in `q` (`p`) whose
-//!   coefficients do not depend on it; other laws are reported (`BG0607`) and get no expression.
+//!   in either form (`e = g(q)`, or `q = g(e)` solved for `e`) the integral is taken symbolically when the effort
+//!   (flow) is a polynomial in `q` (`p`) whose coefficients do not depend on it; in derivative causality, from the
+//!   law `q = g(e)` as `e g(e) − ∫ g de`. Other laws are reported (`BG0607`) and get no expression.
 //! - Dissipated: `e·f` of each resistor (its own effort and flow, so positive for a passive resistor).
-//! - Supplied: `e·f` of each source along its bond's direction (positive when the source delivers power).
+//! - Supplied: `e·f` of each source, its own effort and flow (the flow out of it), so positive when it delivers power.
 //!
 //! A source that drives a storage in derivative causality (a flow source imposing an inertia's velocity) has an
 //! effort with the time derivative of its input in it (`e = J·dω/dt`): its power keeps that derivative as
@@ -14,10 +15,11 @@
 use super::build::{Ctx, effort_var, flow_var};
 use super::codes;
 use super::resolve::Resolver;
-use super::sym::{Ex, Sym, add, div, mul, pow};
+use super::sym::{self, Ex, Sym, add, div, mul, pow};
 use crate::diagnostic::Diagnostic;
-use crate::ir::{Law, Model, PortVar, Relation};
+use crate::ir::{Model, Relation};
 use crate::syntax::ast::ElementKind;
+use petgraph::graph::{EdgeIndex, NodeIndex};
 
 /// What an energy term measures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -85,8 +87,74 @@ pub(crate) fn integrate_polynomial(g: &Ex, q: Sym) -> Option<Ex> {
     Some(add(out))
 }
 
-fn law(laws: &[Law], lhs: PortVar) -> Option<&Law> {
-    laws.iter().find(|l| l.lhs == lhs)
+/// The stored energy of a C or I with bond `b` and own-flow sign `s`, in bond variables and states.
+///
+/// In integral causality it is `∫ e dq` (C) or `∫ f dp` (I) with the element's own effort or flow as its law gives
+/// it in the state, whichever form the law is written in (`e = g(q)`, or `q = g(e)` inverted). In derivative
+/// causality the law gives the energy variable `x = g(y)` of the own effort or flow `y`, and the energy is
+/// `∫ y dx = y g(y) − ∫ g dy`. Both integrals are taken when the integrand is a polynomial in the variable.
+fn stored_energy(
+    ctx: &Ctx,
+    resolver: &mut Resolver,
+    node: NodeIndex,
+    b: EdgeIndex,
+    s: f64,
+) -> Result<Ex, &'static str> {
+    let w = &ctx.model.graph[node];
+    let capacitor = w.kind == ElementKind::C;
+    // The own variable conjugate to the energy variable: the effort of a C, the flow of an I.
+    let own = if capacitor {
+        Ex::S(Sym::Var(effort_var(b)))
+    } else {
+        mul(vec![Ex::Num(s), Ex::S(Sym::Var(flow_var(b)))])
+    };
+    if let Some(i) = ctx.node_state.get(node.index()).copied().flatten() {
+        let x = Sym::State(i);
+        if let Relation::Linear(param) = &w.relation {
+            let p = ctx
+                .convert(param)
+                .map_err(|_| "its value cannot be converted")?;
+            return Ok(div(pow(Ex::S(x), Ex::Num(2.0)), mul(vec![Ex::Num(2.0), p])));
+        }
+        let conjugate = resolver
+            .expr(&own)
+            .map_err(|_| "its effort or flow has no explicit form")?;
+        return integrate_polynomial(&sym::expand(&conjugate), x)
+            .ok_or("its law is not a polynomial in its energy variable");
+    }
+    let energy_var = ctx
+        .energy_expr
+        .get(node.index())
+        .cloned()
+        .flatten()
+        .ok_or("it has no energy variable")?;
+    if let Relation::Linear(param) = &w.relation {
+        let p = ctx
+            .convert(param)
+            .map_err(|_| "its value cannot be converted")?;
+        return Ok(div(
+            pow(energy_var, Ex::Num(2.0)),
+            mul(vec![Ex::Num(2.0), p]),
+        ));
+    }
+    // x = g(y) with y the own variable: write g in a placeholder for y, integrate, put y back.
+    let y = Sym::Tear(usize::MAX);
+    let bond_var = if capacitor {
+        effort_var(b)
+    } else {
+        flow_var(b)
+    };
+    let in_y = |e: &Ex| {
+        sym::subst(e, &mut |v| match v {
+            Sym::Var(k) if k == bond_var => Some(mul(vec![Ex::Num(s), Ex::S(y)])),
+            _ => None,
+        })
+    };
+    let g = sym::expand(&in_y(&energy_var));
+    let integral =
+        integrate_polynomial(&g, y).ok_or("its law is not a polynomial in its effort or flow")?;
+    let energy = sym::sub(mul(vec![Ex::S(y), g]), integral);
+    Ok(sym::subst(&energy, &mut |v| (v == y).then(|| own.clone())))
 }
 
 /// Every element's energy term.
@@ -126,55 +194,21 @@ pub(crate) fn terms(
         };
         let (kind, raw): (EnergyKind, Option<Ex>) = match w.kind {
             ElementKind::C | ElementKind::I => {
-                let energy_var = match ctx.node_state.get(node.index()).copied().flatten() {
-                    Some(i) => Some(Ex::S(Sym::State(i))),
-                    None => ctx.energy_expr.get(node.index()).cloned().flatten(),
-                };
-                let stored = match (&w.relation, energy_var) {
-                    (Relation::Linear(param), Some(x)) => ctx
-                        .convert(param)
-                        .ok()
-                        .map(|p| div(pow(x, Ex::Num(2.0)), mul(vec![Ex::Num(2.0), p]))),
-                    (Relation::Laws(laws), Some(Ex::S(state @ Sym::State(_)))) => {
-                        let form = if w.kind == ElementKind::C {
-                            PortVar::Effort
-                        } else {
-                            PortVar::Flow
-                        };
-                        let g = law(laws, form).and_then(|l| ctx.convert(&l.rhs).ok());
-                        let g = g.map(|g| {
-                            if w.kind == ElementKind::I {
-                                mul(vec![Ex::Num(s), g])
-                            } else {
-                                g
-                            }
-                        });
-                        let integral = g.as_ref().and_then(|g| integrate_polynomial(g, state));
-                        if integral.is_none() {
-                            diags.push(warn(format!(
-                                "the stored energy of `{}` is not computed: its law is not a polynomial in its energy variable written in the {} form",
-                                w.name,
-                                if w.kind == ElementKind::C { "e = g(q)" } else { "f = g(p)" }
-                            )));
-                        }
-                        integral
-                    }
-                    _ => {
-                        diags.push(warn(format!(
-                            "the stored energy of `{}` is not computed: its law in derivative causality is not linear",
-                            w.name
-                        )));
-                        None
-                    }
-                };
-                (EnergyKind::Stored, stored)
+                let stored = stored_energy(ctx, resolver, node, b, s);
+                if let Err(why) = &stored {
+                    diags.push(warn(format!(
+                        "the stored energy of `{}` is not computed: {why}",
+                        w.name
+                    )));
+                }
+                (EnergyKind::Stored, stored.ok())
             }
             ElementKind::R => (
                 EnergyKind::Dissipated,
                 Some(mul(vec![Ex::Num(s), e_b, f_b])),
             ),
             ElementKind::Se | ElementKind::Sf | ElementKind::MSe | ElementKind::MSf => {
-                (EnergyKind::Supplied, Some(mul(vec![Ex::Num(-s), e_b, f_b])))
+                (EnergyKind::Supplied, Some(mul(vec![Ex::Num(s), e_b, f_b])))
             }
             _ => continue,
         };
@@ -195,7 +229,6 @@ pub(crate) fn terms(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::equations::sym;
 
     #[test]
     fn polynomial_integral() {

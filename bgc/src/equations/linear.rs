@@ -46,6 +46,10 @@ pub enum LinearError {
         "the rates of `{element}` come from its mass matrix M(q) ẋ = F: they have no symbolic state space; linearise at an operating point instead"
     )]
     MassMatrix { element: String },
+    #[error(
+        "{what} depends on time through {elements}, whose value uses `t`: the state space ẋ = A x + B u has no column for a signal of time. Make it an input: declare `input NAME [UNIT];`, write the element's value in it (`Se mains = NAME;`), and give the signal at run time (`bgc simulate --input 'NAME=V0*sin(w*t)'`)"
+    )]
+    TimeDependent { what: String, elements: String },
     #[error("the mass matrix of `{element}` is singular at this point")]
     SingularMass { element: String },
     #[error("expected {expected} {what} values, got {got}")]
@@ -264,7 +268,14 @@ pub fn linear_state_space(
     eqs: &Equations,
     selection: StateSelection,
 ) -> Result<SymbolicStateSpace, LinearError> {
-    if let Some(b) = eqs.mass.first() {
+    // An I-field with a configuration-dependent inertia matrix has no symbolic state space; a constant one is
+    // solved below.
+    let variable = |s: Sym| matches!(s, Sym::State(_) | Sym::Input(_) | Sym::Time);
+    if let Some(b) = eqs
+        .mass
+        .iter()
+        .find(|b| b.matrix.iter().flatten().any(|m| m.any_sym(&variable)))
+    {
         return Err(LinearError::MassMatrix {
             element: b.element.clone(),
         });
@@ -282,8 +293,8 @@ pub fn linear_state_space(
             symbol,
         });
     }
-    let j = jacobians(eqs, selection)?;
-    let variable = |s: Sym| matches!(s, Sym::State(_) | Sym::Input(_) | Sym::Time);
+    let mut j = jacobians(eqs, selection)?;
+    solve_constant_mass(eqs, &mut j)?;
     let check = |m: &[Vec<Ex>], name: &str, what: &str| -> Result<(), LinearError> {
         for (r, row) in m.iter().enumerate() {
             for (c, e) in row.iter().enumerate() {
@@ -308,24 +319,75 @@ pub fn linear_state_space(
     check(&j.dfdu, "B", "f")?;
     check(&j.dhdx, "C", "h")?;
     check(&j.dhdu, "D", "h")?;
-    // Linear, not affine: f(0, 0) = 0 and h(0, 0) = 0.
-    let (f, h) = selected(eqs, selection)?;
-    let at_zero = |e: &Ex| sym::subst(e, &mut |s| variable(s).then(Ex::zero));
-    for (i, e) in f.iter().enumerate() {
-        if !at_zero(e).is_zero() {
-            return Err(LinearError::Affine {
-                what: format!("the rate of `{}`", eqs.sym_name(Sym::State(i))),
+    // Linear, not affine: f(0, 0, t) = 0 and h(0, 0, t) = 0 for every t. A term in `t` alone (a signal written into
+    // the model) would vanish from A and B, so it is an error of its own.
+    let at_zero = |e: &Ex| {
+        sym::subst(e, &mut |s| {
+            matches!(s, Sym::State(_) | Sym::Input(_)).then(Ex::zero)
+        })
+    };
+    let remainder = |e: &Ex, what: String| -> Result<(), LinearError> {
+        let rest = at_zero(e);
+        if rest.contains(Sym::Time) {
+            return Err(LinearError::TimeDependent {
+                what,
+                elements: time_elements_text(eqs),
             });
         }
+        if !rest.is_zero() {
+            return Err(LinearError::Affine { what });
+        }
+        Ok(())
+    };
+    for (i, e) in f.iter().enumerate() {
+        remainder(e, format!("the rate of `{}`", eqs.sym_name(Sym::State(i))))?;
     }
     for (k, e) in h.iter().enumerate() {
-        if !at_zero(e).is_zero() {
-            return Err(LinearError::Affine {
-                what: format!("output `{}`", j.outputs.get(k).cloned().unwrap_or_default()),
-            });
-        }
+        let name = j.outputs.get(k).cloned().unwrap_or_default();
+        remainder(e, format!("output `{name}`"))?;
     }
     Ok(j)
+}
+
+/// The elements whose values use `t`, as a phrase: "`mains`", "`a`, `b`".
+fn time_elements_text(eqs: &Equations) -> String {
+    if eqs.time_signals.is_empty() {
+        return "a value that uses `t`".into();
+    }
+    let names: Vec<String> = eqs.time_signals.iter().map(|n| format!("`{n}`")).collect();
+    names.join(", ")
+}
+
+/// The rows of the I-fields' flow states in `j`, solved: for a constant inertia matrix `M`, `M ẋ = F` gives
+/// `∂ẋ/∂v = M⁻¹ ∂F/∂v` (symbolic elimination; `M` is symmetric positive definite for a physical field, so its pivots
+/// are positive). The callers have checked that every `M` is free of states, inputs and time.
+// Column loops read like the elimination they feed.
+#[allow(clippy::needless_range_loop)]
+fn solve_constant_mass(eqs: &Equations, j: &mut Jacobians) -> Result<(), LinearError> {
+    let n = j.dfdx.len();
+    for block in &eqs.mass {
+        if block.states.iter().any(|&s| s >= n) {
+            return Err(LinearError::MassMatrix {
+                element: block.element.clone(),
+            });
+        }
+        for m in [&mut j.dfdx, &mut j.dfdu] {
+            let columns = m.first().map_or(0, Vec::len);
+            for c in 0..columns {
+                let mut a = block.matrix.clone();
+                let mut rhs: Vec<Ex> = block.states.iter().map(|&r| m[r][c].clone()).collect();
+                let solved = super::solve::gauss(&mut a, &mut rhs).ok_or_else(|| {
+                    LinearError::SingularMass {
+                        element: block.element.clone(),
+                    }
+                })?;
+                for (&r, v) in block.states.iter().zip(solved) {
+                    m[r][c] = v;
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 pub(crate) fn check_len(

@@ -58,6 +58,7 @@ pub(crate) mod dense;
 mod energy;
 mod field;
 mod linear;
+mod naming;
 pub mod newton;
 mod numeric;
 mod print;
@@ -65,6 +66,7 @@ mod resolve;
 mod solve;
 pub mod sym;
 pub mod tear;
+mod time;
 
 pub use bridge::{symbol, to_symbolic};
 pub use coords::{CoordsError, declared_state_space};
@@ -183,6 +185,9 @@ pub struct Equations {
     /// The nonlinear algebraic loops, kept implicit, in solving order: the explicit rates, outputs and energy terms
     /// hold their tear variables ([`Sym::Tear`]), whose values solve `0 = r(z, x, u, p, t)`.
     pub tear_blocks: Vec<TearBlock>,
+    /// The elements whose values or laws use time `t` (signals written into the model, such as
+    /// `Se mains = V0*sin(w*t);`): the rates hold them, a linear state space cannot ([`LinearError::TimeDependent`]).
+    pub time_signals: Vec<String>,
 }
 
 impl Equations {
@@ -278,6 +283,7 @@ fn empty_equations(model: &Model) -> Equations {
         mass: Vec::new(),
         loops: Vec::new(),
         tear_blocks: Vec::new(),
+        time_signals: time::time_elements(model),
     }
 }
 
@@ -494,10 +500,15 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
 
     // Readable forms.
     let output_values: Vec<Ex> = eqs.outputs.iter().map(|o| o.value.clone()).collect();
+    let mut taken = naming::user_names(model);
+    for s in &built.states {
+        taken.reserve(&s.name);
+    }
     let readable = print::readable(
         &built,
         &resolver_rates(&built, &solved, &implicit),
         &output_values,
+        taken,
     );
     for o in &mut eqs.outputs {
         o.value = readable.alias(&o.value);

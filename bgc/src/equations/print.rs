@@ -6,11 +6,11 @@
 //! unless an algebraic loop joins them. Output is deterministic: same model, same text.
 
 use super::build::{Built, Def};
+use super::naming::UniqueNames;
 use super::sym::{self, Ex, Sym};
 use super::{Equations, Intermediate, StateKind};
 use crate::ir::Func;
 use serde_json::{Value, json};
-use std::collections::HashMap;
 
 pub(crate) struct Readable {
     pub rates: Vec<Ex>,
@@ -30,7 +30,13 @@ impl Readable {
     }
 }
 
-pub(crate) fn readable(built: &Built, rates: &[Ex], outputs: &[Ex]) -> Readable {
+/// `taken` holds the names the intermediates must not take (parameters, inputs, outputs, states).
+pub(crate) fn readable(
+    built: &Built,
+    rates: &[Ex],
+    outputs: &[Ex],
+    mut taken: UniqueNames,
+) -> Readable {
     let n = built.defs.len();
     let mut rep: Vec<usize> = (0..n).collect();
     for (v, slot) in rep.iter_mut().enumerate() {
@@ -95,15 +101,14 @@ pub(crate) fn readable(built: &Built, rates: &[Ex], outputs: &[Ex]) -> Readable 
             }
         }
     }
-    // Unique names: a second variable with a taken name gets a numeric suffix.
+    // Unique names: a variable whose name is taken gets the first free numeric suffix; the model's own elements
+    // claim before those of instances.
     let mut names: Vec<String> = built.names.clone();
-    let mut taken: HashMap<String, usize> = HashMap::new();
-    for &v in &order {
-        let base = names[v].clone();
-        let count = taken.entry(base.clone()).or_insert(0);
-        *count += 1;
-        if *count > 1 {
-            names[v] = format!("{base}_{count}");
+    for qualified in [false, true] {
+        for &v in &order {
+            if built.qualified.get(v).copied().unwrap_or(false) == qualified {
+                names[v] = taken.claim(&names[v]);
+            }
         }
     }
     r.names = (0..n).map(|v| names[r.rep[v]].clone()).collect();
@@ -434,7 +439,30 @@ pub fn to_text(eqs: &Equations) -> String {
     for o in &eqs.outputs {
         out.push_str(&format!("  {} = {}\n", o.name, expr_text(eqs, &o.value)));
     }
+    if !eqs.energy.is_empty() {
+        out.push_str("energy (stored energy, dissipated and supplied power):\n");
+        for t in &eqs.energy {
+            let value = t
+                .value
+                .as_ref()
+                .map_or_else(|| NOT_COMPUTED.to_string(), |v| expr_text(eqs, v));
+            out.push_str(&format!("  {} {} = {value}\n", t.kind.name(), t.element));
+        }
+    }
     out
+}
+
+/// What an energy term without a closed form prints (a warning, BG0607, says why).
+const NOT_COMPUTED: &str = "not computed (see warning BG0607)";
+
+/// The left-hand side of an energy term in LaTeX: `E_{x}` stored, `P^{diss}_{x}`, `P^{sup}_{x}`.
+fn energy_latex(t: &super::EnergyTerm) -> String {
+    let name = latex_name(&t.element);
+    match t.kind {
+        super::EnergyKind::Stored => format!("E_{{{name}}}"),
+        super::EnergyKind::Dissipated => format!("P^{{\\mathrm{{diss}}}}_{{{name}}}"),
+        super::EnergyKind::Supplied => format!("P^{{\\mathrm{{sup}}}}_{{{name}}}"),
+    }
 }
 
 /// The equations in LaTeX: one `aligned` environment per group.
@@ -513,6 +541,21 @@ pub fn to_latex(eqs: &Equations) -> String {
             .map(|o| (latex_name(&o.name), expr_latex(eqs, &o.value)))
             .collect(),
     );
+    if !eqs.energy.is_empty() {
+        group(
+            "energy: stored energy E, dissipated and supplied power P",
+            eqs.energy
+                .iter()
+                .map(|t| {
+                    let value = t.value.as_ref().map_or_else(
+                        || format!("\\text{{{NOT_COMPUTED}}}"),
+                        |v| expr_latex(eqs, v),
+                    );
+                    (energy_latex(t), value)
+                })
+                .collect(),
+        );
+    }
     out
 }
 

@@ -1,0 +1,120 @@
+//! The linear state space never drops a term and accepts every linear model:
+//! - a source whose value is a signal of time (`Se mains = V0*sin(w*t);`) is refused with an error naming it and
+//!   saying how to make it an input (it used to vanish: A and B for the other input alone);
+//! - an I-field with a constant inertia matrix (coupled coils) is linear: `M ḟ = F` gives `A = M⁻¹ ∂F/∂x`, checked
+//!   against the hand-derived 2×2 inverse.
+
+use bgc::causality::analyse;
+use bgc::equations::{
+    Equations, LinearError, StateSelection, derive, linear_state_space, numeric_state_space,
+};
+use bgc::lower::{MemoryLoader, lower};
+use bgc::span::SourceMap;
+
+fn equations_of(text: &str) -> Equations {
+    let mut sources = SourceMap::new();
+    let root = sources.add("model.bg", text);
+    let (models, mut diags) = lower(&mut sources, root, &mut MemoryLoader::new());
+    assert_eq!(models.len(), 1, "{diags:?}");
+    let (causality, cdiags) = analyse(&models[0]);
+    diags.extend(cdiags);
+    let (eqs, ediags) = derive(&models[0], &causality);
+    diags.extend(ediags);
+    assert!(!bgc::diagnostic::has_errors(&diags), "{diags:?}");
+    eqs
+}
+
+#[test]
+fn a_signal_of_time_is_refused_by_name() {
+    let eqs = equations_of(
+        "
+model mains {
+    domain electrical;
+    param V0 = 230 [V];
+    param w = 314 [rad/s];
+    param L = 0.1 [H];
+    param Rl = 5 [Ohm];
+    input u [V];
+    Se mains = V0*sin(w*t);
+    Se drive = u;
+    1 loop;
+    I coil = L;
+    R res = Rl;
+    bond mains -> loop -> coil, res;
+    bond drive -> loop;
+}
+",
+    );
+    assert_eq!(eqs.time_signals, ["mains"]);
+    match linear_state_space(&eqs, StateSelection::Energy) {
+        Err(e @ LinearError::TimeDependent { .. }) => {
+            let msg = e.to_string();
+            assert!(msg.contains("`mains`"), "{msg}");
+            assert!(msg.contains("input"), "{msg}");
+        }
+        other => panic!("expected a refusal naming `mains`, got {other:?}"),
+    }
+    assert!(numeric_state_space(&eqs, StateSelection::Energy, &eqs.default_params()).is_err());
+}
+
+#[test]
+fn coupled_coils_with_a_constant_matrix_are_linear() {
+    let eqs = equations_of(
+        "
+model coils {
+    domain electrical;
+    param L1 = 0.2 [H];
+    param L2 = 0.3 [H];
+    param Lm = 0.1 [H];
+    param R1 = 2 [Ohm];
+    param R2 = 3 [Ohm];
+    input u [V];
+    Se drive = u;
+    1 l1;
+    1 l2;
+    IF coupled(2) {
+        mass[1, 1] = L1;
+        mass[1, 2] = Lm;
+        mass[2, 2] = L2;
+    }
+    R r1 = R1;
+    R r2 = R2;
+    bond drive -> l1 -> coupled[1];
+    bond l1 -> r1;
+    bond l2 -> coupled[2];
+    bond l2 -> r2;
+}
+",
+    );
+    let names: Vec<&str> = eqs.states.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["q_coupled_1", "q_coupled_2", "f_coupled_1", "f_coupled_2"]
+    );
+    let ss = numeric_state_space(&eqs, StateSelection::Energy, &eqs.default_params())
+        .unwrap_or_else(|e| panic!("a constant inertia matrix is linear: {e}"));
+    // M ḟ = [u − R1 f1, −R2 f2]; M⁻¹ = [[L2, −Lm], [−Lm, L1]] / (L1 L2 − Lm²).
+    let (l1, l2, lm, r1, r2) = (0.2, 0.3, 0.1, 2.0, 3.0);
+    let det = l1 * l2 - lm * lm;
+    let inv = [[l2 / det, -lm / det], [-lm / det, l1 / det]];
+    let want_a = [
+        [0.0, 0.0, 1.0, 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+        [0.0, 0.0, -inv[0][0] * r1, -inv[0][1] * r2],
+        [0.0, 0.0, -inv[1][0] * r1, -inv[1][1] * r2],
+    ];
+    let want_b = [0.0, 0.0, inv[0][0], inv[1][0]];
+    assert_eq!((ss.a.len(), ss.b.len()), (4, 4));
+    for (r, (row, want_row)) in ss.a.iter().zip(&want_a).enumerate() {
+        for (c, (got, want)) in row.iter().zip(want_row).enumerate() {
+            assert!((got - want).abs() < 1e-12, "A[{r}][{c}] = {got} vs {want}");
+        }
+    }
+    for (r, (row, want)) in ss.b.iter().zip(&want_b).enumerate() {
+        assert!(
+            (row[0] - want).abs() < 1e-12,
+            "B[{r}] = {} vs {want}",
+            row[0]
+        );
+    }
+}

@@ -7,7 +7,7 @@
 //! decays as `exp(−d t / 2m)`, gone by t = 1000. In Python: `A = 1/math.hypot(798, 4)`, `phi = math.atan2(4, 798)`,
 //! `A*math.sin(1000 - phi)` = 0.001032631445368177, `2*A*math.cos(1000 - phi)` = 0.0014198235640907244.
 
-mod cli_support;
+use crate::cli_support;
 
 use cli_support::{bgc, corpus};
 

@@ -10,7 +10,7 @@
 //! Each law is checked at random states and inputs, on a series circuit (one 1-junction, driven by an effort source)
 //! and a parallel one (one 0-junction, driven by a flow source), for every combination of bond directions.
 
-mod equations_support;
+use crate::equations_support;
 
 use bgc::causality::analyse;
 use bgc::equations::sym::{self, Sym};

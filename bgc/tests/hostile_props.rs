@@ -2,7 +2,7 @@
 //! errors and the length of the lines; generated code keeps the user's names out of the generated methods' and
 //! descriptions inert in comments; a steep one-tear loop that has a root is solved.
 
-mod codegen_support;
+use crate::codegen_support;
 
 use bgc::codegen::rust::Options;
 use bgc::diagnostic::render::{MAX_SHOWN, to_text};

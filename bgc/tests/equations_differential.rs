@@ -16,7 +16,7 @@
 // Index loops read like the textbook elimination and matrix products they implement.
 #![allow(clippy::needless_range_loop)]
 
-mod equations_support;
+use crate::equations_support;
 
 use bgc::causality::analyse;
 use bgc::equations::{StateSelection, derive, numeric_state_space};

@@ -22,6 +22,7 @@ mod codegen_state_space;
 mod equations_back_support;
 mod equations_corpus;
 mod equations_derivative;
+mod equations_differential;
 mod equations_energy_laws;
 mod equations_fields;
 mod equations_linear;

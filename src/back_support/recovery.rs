@@ -99,9 +99,9 @@ pub fn recover(
 ) -> Result<Recovery, BackSupportError> {
     let ss = model.measurement_model()?;
     let plant_input = StateSpace::new(
-        ss.a.clone(),
+        ss.a().clone(),
         model.b_m.clone(),
-        ss.c.clone(),
+        ss.c().clone(),
         DMatrix::zeros(2, 1),
     )?;
     let dt = cfg.sample_time;
@@ -116,7 +116,7 @@ pub fn recover(
         n.sensor_torque.powi(2) * dt,
     ]));
     let noise = ObserverNoise {
-        g: &ss.b,
+        g: ss.b(),
         qn: &qn,
         rn: &rn,
     };

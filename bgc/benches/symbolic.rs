@@ -6,7 +6,7 @@
 //! - the deep chain `e_{k+1} = (e_k + a_k)*b_k`, 100,000 levels (nesting depth 200,000);
 //! - the wide sum `Σ c_k*a_k*b_k` of 100,000 products.
 
-use bgc::symbolic::{Expr, Symbol, solve_linear, to_rust, to_text};
+use bgc::symbolic::{Expr, Symbol, cse, solve_linear, to_rust, to_rust_cse, to_text, to_text_cse};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::collections::HashMap;
 use std::hint::black_box;
@@ -137,6 +137,17 @@ fn bench_shared(c: &mut Criterion) {
                 b.iter(|| to_text(e).len())
             });
         }
+        let names = |s: &Symbol| s.name().to_string();
+        let one = std::slice::from_ref(&e);
+        g.bench_with_input(BenchmarkId::new("cse", levels), &e, |b, _| {
+            b.iter(|| cse(one).0.len())
+        });
+        g.bench_with_input(BenchmarkId::new("print_text_cse", levels), &e, |b, _| {
+            b.iter(|| to_text_cse(one, &names).len())
+        });
+        g.bench_with_input(BenchmarkId::new("print_rust_cse", levels), &e, |b, _| {
+            b.iter(|| to_rust_cse(one, &names).len())
+        });
     }
     g.finish();
 }
@@ -175,6 +186,7 @@ fn bench_deep_and_wide(c: &mut Criterion) {
         g.bench_with_input(BenchmarkId::new("wide_diff", n), &e, |b, e| {
             b.iter(|| e.diff(&a0))
         });
+
         g.bench_with_input(BenchmarkId::new("wide_eval", n), &e, |b, e| {
             b.iter(|| e.eval(|s| env.get(s).copied()))
         });
@@ -185,6 +197,22 @@ fn bench_deep_and_wide(c: &mut Criterion) {
             b.iter(|| to_rust(e, &names).len())
         });
     }
+    // ẋ_i = x_{i-1} - 2 x_i + x_{i+1} for 10,000 states: 3 non-zeros a row.
+    let n = 10_000;
+    let xs: Vec<Symbol> = (0..n).map(|i| Symbol::state(format!("x_{i}"))).collect();
+    let x = |i: usize| Expr::symbol(xs[i].clone());
+    let rows: Vec<Expr> = (0..n)
+        .map(|i| {
+            let left = if i > 0 { x(i - 1) } else { Expr::zero() };
+            let right = if i + 1 < n { x(i + 1) } else { Expr::zero() };
+            left - 2.0 * x(i) + right
+        })
+        .collect();
+    g.bench_with_input(
+        BenchmarkId::new("tridiagonal_sparse_jacobian", n),
+        &rows,
+        |b, rows| b.iter(|| Expr::sparse_jacobian(rows, &xs).len()),
+    );
     g.finish();
 }
 

@@ -29,17 +29,29 @@
 //! same bits on every platform.
 //!
 //! # Representation
-//! Nodes are shared behind `Arc` with a cached structural hash, rather than interned in an arena. Expressions here
-//! are small (element laws, state equations of a few dozen states), so hash-consing would save little memory, while
-//! `Arc` nodes need no interner threaded through every call or kept alive beside the expressions, can be built from
-//! any thread, and make `clone` a reference-count increment. The cached hash makes equality of different trees
-//! cheap to refute; the total order makes sorting, and therefore printing, deterministic.
+//! Expressions form a hash-consed DAG: every node is interned in one process-wide table (`intern.rs`), so equal
+//! expressions are one node, `==` is a pointer comparison, and a subexpression used in many places is stored once.
+//! The table holds weak references (it never keeps an expression alive) and is sharded by hash, so expressions need
+//! no context threaded through calls, can be built from any thread, and `clone` is a reference-count increment.
+//! The total order makes sorting, and therefore printing, deterministic.
+//!
+//! Operations walk the distinct nodes in post-order on an explicit stack (`dag.rs`) and keep one result per node:
+//! evaluation, substitution, differentiation, free symbols, expansion and linear forms cost linear in the number of
+//! distinct nodes, and no operation recurses to a depth that grows with the expression (comparison and freeing use
+//! work lists too), so deep expressions cannot overflow the stack. Printers keep the printed form of shared nodes
+//! and build text as a rope (`print/plan.rs`, `print/doc.rs`), so they print what a tree walk prints, in time
+//! linear in the length of the text. Building a flattened sum or product one term at a time remains quadratic in
+//! its length (each partial sum is a node of its own); [`Expr::sum`] and [`Expr::product`] take all terms at once.
 //!
 //! # Operations
 //! - construction: [`Expr::constant`], [`Expr::symbol`], [`Expr::sum`], [`Expr::product`], [`Expr::pow`],
 //!   [`Expr::call`], the operators `+ - * /` and unary `-` on `Expr`, `&Expr` and `f64`;
 //! - [`Expr::substitute`], [`Expr::diff`], [`Expr::jacobian`], [`Expr::eval`], [`Expr::free_symbols`],
 //!   [`Expr::expand`], [`Expr::linear_form`];
+//! - sparsity: [`Expr::symbols_read`] (which symbols each expression reads) and [`Expr::sparse_jacobian`]
+//!   (entries only where a variable occurs); [`Expr::distinct_nodes`], the stored size;
+//! - [`cse`] names the subexpressions used more than once, [`to_text_cse`] and [`to_rust_cse`] print them as
+//!   definitions (the default printers do not);
 //! - [`solve_linear`] for small linear systems;
 //! - printers [`to_text`] (also `Display`), [`to_latex`], [`to_rust`] (and [`to_rust_code`], its tree);
 //! - [`from_ir`] from the IR's expressions.

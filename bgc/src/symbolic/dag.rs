@@ -32,10 +32,12 @@ impl<'a> Dag<'a> {
         // Nodes on the stack are marked with `usize::MAX` until they are placed in the order.
         let mut stack: Vec<(&'a Expr, usize)> = Vec::new();
         for root in roots {
-            if dag.index.contains_key(&root.address()) {
-                continue;
+            match dag.index.entry(root.address()) {
+                std::collections::hash_map::Entry::Occupied(_) => continue,
+                std::collections::hash_map::Entry::Vacant(slot) => {
+                    slot.insert(usize::MAX);
+                }
             }
-            dag.index.insert(root.address(), usize::MAX);
             stack.push((root, 0));
             while let Some((e, next)) = stack.last_mut() {
                 let e: &'a Expr = e;
@@ -47,8 +49,10 @@ impl<'a> Dag<'a> {
                 match child {
                     Some(c) => {
                         *next += 1;
-                        if !dag.index.contains_key(&c.address()) {
-                            dag.index.insert(c.address(), usize::MAX);
+                        if let std::collections::hash_map::Entry::Vacant(slot) =
+                            dag.index.entry(c.address())
+                        {
+                            slot.insert(usize::MAX);
                             stack.push((c, 0));
                         }
                     }

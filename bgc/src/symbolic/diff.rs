@@ -14,7 +14,7 @@
 use super::dag::{Dag, Memo};
 use super::expr::{Expr, Node, Symbol};
 use crate::ir::Func;
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::f64::consts::LN_10;
 
 impl Expr {
@@ -39,18 +39,24 @@ impl Expr {
             .collect()
     }
 
-    /// The entries of the Jacobian `∂ exprsᵢ / ∂ varsⱼ` that are not structurally zero, as `(i, j, entry)` sorted
-    /// by row then column. Only the variables an expression reads are differentiated for: the cost follows the
-    /// non-zeros, not `exprs.len() * vars.len()`. An entry that simplifies to 0 although its variable occurs
-    /// (`x - x` cannot occur in canonical form, but `d(x*y)/dx` at `y = 0` is `y`, not 0) is kept only when it is
-    /// not the constant 0.
+    /// The entries of the Jacobian `∂ exprsᵢ / ∂ varsⱼ` that are not the constant 0, as `(i, j, entry)` sorted by
+    /// row then column. An expression is differentiated only by the variables it reads, and each variable is one
+    /// walk over the rows that read it: the cost follows the non-zeros, not `exprs.len() * vars.len()`.
     pub fn sparse_jacobian(exprs: &[Expr], vars: &[Symbol]) -> Vec<(usize, usize, Expr)> {
-        let reads = Expr::symbols_read(exprs);
-        let mut out = Vec::new();
+        let mut columns: BTreeMap<&Symbol, Vec<usize>> = BTreeMap::new();
         for (j, v) in vars.iter().enumerate() {
-            let rows: Vec<usize> = (0..exprs.len())
-                .filter(|&i| reads.get(i).is_some_and(|r| r.contains(v)))
-                .collect();
+            columns.entry(v).or_default().push(j);
+        }
+        let mut rows_of: Vec<Vec<usize>> = vec![Vec::new(); vars.len()];
+        for (i, read) in Expr::symbols_read(exprs).iter().enumerate() {
+            for j in read.iter().filter_map(|s| columns.get(s)).flatten() {
+                if let Some(rows) = rows_of.get_mut(*j) {
+                    rows.push(i);
+                }
+            }
+        }
+        let mut out = Vec::new();
+        for ((j, v), rows) in vars.iter().enumerate().zip(&rows_of) {
             let picked: Vec<Expr> = rows.iter().filter_map(|&i| exprs.get(i).cloned()).collect();
             for (&i, d) in rows.iter().zip(diff_all(&picked, v)) {
                 if !d.is_zero() {

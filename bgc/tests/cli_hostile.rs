@@ -468,7 +468,10 @@ fn simulate_streams_and_stops_at_a_closed_pipe() {
         .map(|o| o.read(&mut first).unwrap_or(0))
         .unwrap_or(0);
     let text = String::from_utf8_lossy(&first[..got]).into_owned();
-    assert!(text.starts_with("t,p_mass,q_spring,"), "{text}");
+    assert!(
+        text.starts_with("t [s],p_mass [N s],q_spring [m],"),
+        "{text}"
+    );
     drop(child.stdout.take());
     let start = Instant::now();
     let status = loop {

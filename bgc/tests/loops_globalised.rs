@@ -30,7 +30,10 @@ const ROOTS: [(f64, f64); 4] = [
 fn first_current(csv: &str) -> Option<f64> {
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next()?.split(',').collect();
-    let col = header.iter().position(|c| *c == "i")?;
+    // Header cells carry their unit: `i [A]`.
+    let col = header
+        .iter()
+        .position(|c| c.split(" [").next() == Some("i"))?;
     lines.next()?.split(',').nth(col)?.parse().ok()
 }
 

@@ -181,7 +181,9 @@ fn a_build_script_error_is_printed_once() {
     let manifest = std::fs::read_to_string(example.join("Cargo.toml"))
         .unwrap_or_else(|e| panic!("Cargo.toml: {e}"))
         .replace("name = \"user-drive\"", "name = \"broken-drive\"")
-        .replace("../../", &format!("{}/", workspace().display()));
+        .replace("../../", &format!("{}/", workspace().display()))
+        // It lies under the workspace's target directory: a workspace of its own, not a member of this one.
+        + "\n[workspace]\n";
     let model = std::fs::read_to_string(example.join("drive.bg"))
         .unwrap_or_else(|e| panic!("drive.bg: {e}"))
         .replace("= int(f(load))", "= int(f(lod))");

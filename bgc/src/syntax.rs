@@ -1,7 +1,7 @@
 //! The front end's syntax: the AST, the parser and the formatter.
 //!
 //! [`decode`] checks that a file is UTF-8, [`parse`] turns its text into an [`ast::File`] plus diagnostics (it
-//! never fails: the tree holds everything that parsed) and [`format`] prints a tree back in the canonical layout.
+//! never fails: the tree holds everything that parsed) and [`format()`](fn@format) prints a tree back in the canonical layout.
 //! [`format_source`] parses and formats, refusing text with syntax errors; [`format_expr`], [`format_unit`],
 //! [`format_node`] and [`format_number`] print pieces of a tree (for messages of later stages).
 //!

@@ -10,7 +10,7 @@
 //! - [`plant`]: the leg as a runtime `ContinuousModel`, alone and worn by the wearer;
 //! - [`wearer`]: the synthetic wearer (trajectories, insoles, torso load, human torque);
 //! - [`estimator`]: the dual UKF;
-//! - [`reference`]: the controller's reference at the control rate from the filter's predictions;
+//! - [`reference`](mod@reference): the controller's reference at the control rate from the filter's predictions;
 //! - [`scenario`]: the closed loop, its settings and records, and the figures of Tables 7 and 9.
 
 pub mod anthropometry;

@@ -2,9 +2,9 @@
 //!
 //! Every bond gets a causality: which of its two ends sets the effort (the other end then sets the flow; the causal
 //! stroke is drawn at the end that receives the effort). The assignment follows the sequential causality assignment
-//! procedure with priorities (see [`scap`]): sources and fixed hints are constraints, preferred hints come next, then
+//! procedure with priorities (see `scap`): sources and fixed hints are constraints, preferred hints come next, then
 //! storage in integral causality, then the form of nonlinear resistor laws, and last arbitrary choices. Constraints
-//! propagate through junctions, transformers and gyrators ([`engine`]) in time linear in the number of bonds.
+//! propagate through junctions, transformers and gyrators (`engine`) in time linear in the number of bonds.
 //!
 //! The result, [`Causality`], is complete even when the model has findings: the equations stage can rely on a
 //! causality for every bond and for every storage port. Findings are [`Diagnostic`]s:

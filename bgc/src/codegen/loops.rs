@@ -118,13 +118,18 @@ fn bgc_newton<const B: usize>(
         Ok(()) => return Ok(()),
         Err(e) => e,
     };
-    if B == 1 && start[first].is_finite() {
-        if let Some(root) = bgc_bracketed(&start, first, &eval) {
+    let bracketed = if B == 1 && start[first].is_finite() {
+        bgc_bracketed(&start, first, &eval)
+    } else {
+        None
+    };
+    match bracketed {
+        Some(root) => {
             z[first] = root;
-            return Ok(());
+            Ok(())
         }
+        None => Err(failure),
     }
-    Err(failure)
 }
 
 /// The residual, its scale and its derivative of a one-tear block with the tear at `v`.

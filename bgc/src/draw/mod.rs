@@ -1,6 +1,6 @@
 //! Drawing bond graphs as SVG (self-contained, laid out here in pure Rust) and as Graphviz DOT text.
 //!
-//! The layout ([`layout`]) puts junctions, transformers and gyrators in layers along the power direction and
+//! The layout (`layout`) puts junctions, transformers and gyrators in layers along the power direction and
 //! hangs each 1-port next to its junction. Bonds carry the half-arrow of positive power at their `to` end and,
 //! when a [`Causality`] is given, the causal stroke at the end that receives the effort. Element labels are in the
 //! usual `KIND:parameter` style (`I:J_m`, `C:1/k_g`) with the element's name underneath. Storage in derivative

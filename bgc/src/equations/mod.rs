@@ -7,7 +7,7 @@
 //! 2. Every node writes the causal equation of each bond variable it computes (`build.rs`).
 //! 3. The rates and outputs are expressed in states, inputs, parameters and `t` by substitution in dependency order
 //!    (`resolve.rs`); algebraic loops are torn and solved exactly when affine, storages in derivative causality
-//!    contribute `ẋ` terms, solved for by a symbolic linear solve (`solve.rs`). Multiport fields are in [`field`]:
+//!    contribute `ẋ` terms, solved for by a symbolic linear solve (`solve.rs`). Multiport fields are in `field`:
 //!    an I-field gives the mass-matrix form `M(q) ẋ = F` for its flow states ([`Equations::mass`]), solved
 //!    numerically by its consumers ([`Equations::rates_at`]).
 //! 4. A nonlinear algebraic loop stays implicit (`tear.rs`): its tear variable `z` (`Sym::Tear`, printed

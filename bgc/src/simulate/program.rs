@@ -1,6 +1,6 @@
 //! Symbolic expressions compiled into flat stack programs for fast repeated evaluation.
 //!
-//! An [`Ex`] tree of the equations stage is walked once into a postfix list of [`Op`]s; evaluating it is then a
+//! An [`Ex`] tree of the equations stage is walked once into a postfix list of `Op`s; evaluating it is then a
 //! loop over that list with a small value stack and no allocation per call (the stack is reused). Only the symbols
 //! a simulation has values for are accepted: parameters, states, inputs and time. Every index is checked when the
 //! program is compiled, and evaluation uses checked access anyway, so a program never panics: a missing value reads

@@ -9,7 +9,7 @@
 //!
 //! **Paper inconsistency.** Eq. 20 of paper 000 prints `Wᵢ = λ/(2(L+λ))`; with that the mean weights do not
 //! sum to one (for `α = 1e-3` they sum to about `−2·10⁶`), so the mean of Eq. 17 would be wrong. We follow
-//! Wan and van der Merwe (2000), the paper's reference [51], with `1/(2(L+λ))`.
+//! Wan and van der Merwe (2000), the paper's reference \[51\], with `1/(2(L+λ))`.
 //!
 //! Because stable Rust cannot write `2N + 1` as a const generic, the number of points is a second parameter
 //! `NS`; [`SigmaPoints::new`] refuses any `NS ≠ 2N + 1` at compile time:

@@ -5,7 +5,7 @@
 //! Predict: points `x̂, x̂ ± γ Sᵢ`; `χ*ᵢ = f(χᵢ, u)`; `x̂⁻ = mean(χ*)`;
 //! `S⁻ = qr([√W₁⁽ᶜ⁾ (χ*₁…₂ₗ − x̂⁻), √Q])` followed by `cholupdate(S⁻, χ*₀ − x̂⁻, W₀⁽ᶜ⁾)` (a downdate when
 //! `W₀⁽ᶜ⁾ < 0`). The "qr" is done as a sequence of Givens rotations that absorb each weighted column into the
-//! triangular factor started from `√Q` ([`super::dense::givens_absorb`]), which is the R factor of the QR
+//! triangular factor started from `√Q` (`dense::givens_absorb`), which is the R factor of the QR
 //! decomposition of the stacked matrix without forming it (its width `3L` is not expressible as a const
 //! generic).
 //!

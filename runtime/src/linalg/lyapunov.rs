@@ -6,7 +6,7 @@
 //! `A = U T Uᵀ` (one real Schur decomposition) turns either equation into one for `Y = Uᵀ X U` with the
 //! quasi-triangular `T`: `T Y + Y Tᵀ = −UᵀQU` resp. `T Y Tᵀ − Y = −UᵀQU`. Reversing the order of the columns of
 //! `Y` makes the second factor `P Tᵀ P` upper quasi-triangular too, and the block substitution of
-//! [`super::sylvester`] solves the result in `O(n³)` flops and `O(n²)` memory; the Schur decomposition
+//! [`super::sylvester`](fn@super::sylvester) solves the result in `O(n³)` flops and `O(n²)` memory; the Schur decomposition
 //! dominates the cost. Every solution is checked by its relative residual.
 
 use nalgebra::DMatrix;

@@ -4,7 +4,7 @@
 //! - discrete (Stein): `A X B − X + C = 0`, unique when `λᵢ(A) μⱼ(B) ≠ 1` for all pairs.
 //!
 //! `A = U T Uᵀ`, `B = V S Vᵀ` (real Schur forms) turn either equation into one for `Y = Uᵀ X V` with the
-//! quasi-triangular `T` and `S`, which [`solve_quasi_triangular`] solves by substitution over the `1x1` and `2x2`
+//! quasi-triangular `T` and `S`, which `solve_quasi_triangular` solves by substitution over the `1x1` and `2x2`
 //! diagonal blocks: the column blocks of `S` forwards, in each the row blocks of `T` backwards, each a linear
 //! system of order at most 4. The substitution costs `O(m²n + mn²)` flops and the two Schur decompositions
 //! `O(m³ + n³)`, so the whole solve is `O(n³)` (no `n x n` system per column). The Lyapunov equations

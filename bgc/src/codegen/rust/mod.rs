@@ -16,7 +16,7 @@
 //! - `stored_energy`, `dissipated_power`, `supplied_power` when every term has a closed form;
 //! - for a model with nonlinear algebraic loops, `N_TEARS`, `TEAR_NAMES`, `Tears`, `LoopFailure`, `LoopError` and
 //!   `solve_loops(p, t, x, u) -> Result<Tears, LoopError>` (damped Newton's method per block, see
-//!   [`super::loops`]); the functions above solve the loops first and give NaN where `solve_loops` fails;
+//!   `codegen::loops`); the functions above solve the loops first and give NaN where `solve_loops` fails;
 //! - `Model` (the parameters, validated) and, with [`Options::runtime`], its implementations of
 //!   `bgc_runtime::model::ContinuousModel` and `Parametric`.
 //!
@@ -30,8 +30,8 @@
 //!
 //! # Layout
 //! The text is what `rustfmt --edition 2024` makes of it and no line is longer than 100 columns: statements too
-//! long for a line bind parts of their expression to `let`s first ([`super::layout`]), comments and documentation
-//! are wrapped ([`super::format`]), lists and signatures take `rustfmt`'s layout. Each statement of a body has the
+//! long for a line bind parts of their expression to `let`s first (`codegen::layout`), comments and documentation
+//! are wrapped (`codegen::format`), lists and signatures take `rustfmt`'s layout. Each statement of a body has the
 //! equation it computes in a comment above it (and above the `let`s it needs). Two things can make a line longer:
 //! the header, which holds the source path as given, and a single name or number wider than a line.
 //!

@@ -177,6 +177,46 @@ fn elementary_functions_are_libm_calls_bound_once() {
 }
 
 #[test]
+fn each_distinct_elementary_call_is_computed_once_per_body() {
+    // The walking leg's gravity and ground terms take cos and sin of angle differences in several equations
+    // (`cos(q_leg_1 - q_leg_2 + q_leg_3)` in three of the rhs): each distinct call is bound once per body.
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../models/walking_leg.bg");
+    let text = std::fs::read_to_string(path).unwrap();
+    let code = generate(&text);
+    let mut bodies = 0;
+    for body in code.split("\npub fn ").skip(1) {
+        let body = &body[..body.find("\n}\n").unwrap_or(body.len())];
+        let mut seen = std::collections::BTreeMap::<&str, usize>::new();
+        let mut rest = body;
+        while let Some(at) = rest.find("libm::") {
+            let call = &rest[at..];
+            let mut depth = 0;
+            let end = call
+                .char_indices()
+                .find(|&(_, c)| {
+                    match c {
+                        '(' => depth += 1,
+                        ')' => depth -= 1,
+                        _ => return false,
+                    }
+                    depth == 0
+                })
+                .map_or(call.len(), |(i, _)| i + 1);
+            *seen.entry(&call[..end]).or_default() += 1;
+            rest = &call[6..];
+        }
+        let repeated: Vec<_> = seen.iter().filter(|&(_, &n)| n > 1).collect();
+        assert!(repeated.is_empty(), "{repeated:?} in\n{body}");
+        bodies += usize::from(!seen.is_empty());
+    }
+    assert!(bodies >= 3, "{bodies} bodies with libm calls");
+    assert!(
+        code.contains("libm::cos(q_leg_1 - q_leg_2 + q_leg_3)"),
+        "{code}"
+    );
+}
+
+#[test]
 fn unused_arguments_are_named_with_an_underscore() {
     let code = generate(PENDULUM);
     // No input and no time: `_u`, `_t`; the output depends on theta only, not on the parameters' p_bob.

@@ -1,26 +1,51 @@
-//! Calls of elementary functions bound once at the top of a body: a `libm` call whose arguments are states,
-//! inputs, parameters, time or literals (`libm::cos(theta)`) is computed once (`let cos_theta = ...;`) and its
-//! name replaces it in the statements. The same call on the same values gives the same bits, so nothing changes
+//! Calls of elementary functions bound once at the top of a body: a `libm` call whose arguments are computed
+//! from states, inputs, parameters, time and literals alone (`libm::cos(theta)`, `libm::cos(q_1 - q_2)`) is
+//! computed once (`let cos_theta = ...;`, calls nested in its arguments first) and its name replaces it in the
+//! statements. The same call on the same values gives the same bits, so nothing changes
 //! but the number of calls and the length of the lines.
 
 use crate::symbolic::RustCode;
 use std::collections::{BTreeMap, BTreeSet};
 
-/// Whether `code` is a call of a `libm` function on names and literals available from the start of the body.
+/// Whether `code` is a value known from the start of the body: a name of `early` or a literal, or arithmetic
+/// and `libm` calls on such values.
+fn is_early_value(code: &RustCode, early: &BTreeSet<String>) -> bool {
+    match code {
+        RustCode::Atom(s) => early.contains(s) || s.parse::<f64>().is_ok(),
+        RustCode::Neg(inner) | RustCode::Paren(inner) => is_early_value(inner, early),
+        RustCode::Chain(first, rest) => {
+            is_early_value(first, early) && rest.iter().all(|(_, o)| is_early_value(o, early))
+        }
+        RustCode::Call(..) => is_early_call(code, early),
+    }
+}
+
+/// Whether `code` is a call of a `libm` function on values known from the start of the body
+/// (`libm::cos(q_1 - q_2 + q_3)` as well as `libm::cos(theta)`).
 fn is_early_call(code: &RustCode, early: &BTreeSet<String>) -> bool {
     match code {
         RustCode::Call(callee, args) => {
-            callee.starts_with("libm::")
-                && args.iter().all(|a| match a {
-                    RustCode::Atom(s) => early.contains(s) || s.parse::<f64>().is_ok(),
-                    _ => false,
-                })
+            callee.starts_with("libm::") && args.iter().all(|a| is_early_value(a, early))
         }
         _ => false,
     }
 }
 
-/// Collects the calls of `code` that [`is_early_call`] accepts, by text.
+/// How many calls are nested in `code`, itself included: a call is bound after those in its arguments.
+pub(super) fn call_depth(code: &RustCode) -> usize {
+    match code {
+        RustCode::Atom(_) => 0,
+        RustCode::Neg(inner) | RustCode::Paren(inner) => call_depth(inner),
+        RustCode::Chain(first, rest) => rest
+            .iter()
+            .map(|(_, o)| call_depth(o))
+            .fold(call_depth(first), usize::max),
+        RustCode::Call(_, args) => 1 + args.iter().map(call_depth).max().unwrap_or(0),
+    }
+}
+
+/// Collects the calls of `code` that [`is_early_call`] accepts, by text, with the early calls nested in their
+/// arguments.
 pub(super) fn early_calls(
     code: &RustCode,
     early: &BTreeSet<String>,
@@ -28,7 +53,6 @@ pub(super) fn early_calls(
 ) {
     if is_early_call(code, early) {
         out.insert(code.to_string(), code.clone());
-        return;
     }
     match code {
         RustCode::Atom(_) => {}
@@ -69,17 +93,38 @@ pub(super) fn with_bound_calls(code: RustCode, calls: &BTreeMap<String, String>)
     }
 }
 
-/// A local name for the value of `call`: the function's name and its arguments' (`cos_theta`, `sqrt_k`).
+/// A local name for the value of `call`: the function's name and the names and literals of its arguments
+/// (`cos_theta`, `sqrt_k`, `cos_q_1_q_2_q_3` for `libm::cos(q_1 - q_2 + q_3)`).
 pub(super) fn call_name(call: &RustCode) -> String {
-    match call {
-        RustCode::Call(callee, args) => {
-            let mut name = callee.trim_start_matches("libm::").to_string();
-            for a in args {
-                name.push('_');
-                name.push_str(a.to_string().trim_start_matches("p."));
+    fn words(code: &RustCode, out: &mut Vec<String>) {
+        match code {
+            RustCode::Atom(s) => out.push(s.trim_start_matches("p.").to_string()),
+            RustCode::Neg(inner) | RustCode::Paren(inner) => words(inner, out),
+            RustCode::Chain(first, rest) => {
+                words(first, out);
+                rest.iter().for_each(|(_, o)| words(o, out));
             }
-            name
+            RustCode::Call(callee, args) => {
+                out.push(callee.trim_start_matches("libm::").to_string());
+                args.iter().for_each(|a| words(a, out));
+            }
         }
-        other => other.to_string(),
     }
+    let mut parts = Vec::new();
+    words(call, &mut parts);
+    // A name of a few words: the binding is right above its uses, and the name only has to be unique there.
+    let mut name = String::new();
+    for part in parts {
+        if !name.is_empty() && name.len() + part.len() > MAX_NAME {
+            break;
+        }
+        if !name.is_empty() {
+            name.push('_');
+        }
+        name.push_str(&part);
+    }
+    name
 }
+
+/// The longest name [`call_name`] builds from several words.
+const MAX_NAME: usize = 24;

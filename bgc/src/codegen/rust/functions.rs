@@ -6,7 +6,7 @@
 use super::super::emit::{Block, MAX_LETS, StateSpace};
 use super::super::layout::Body;
 use super::super::names::{Namer, comment};
-use super::calls::{call_name, early_calls, with_bound_calls};
+use super::calls::{call_depth, call_name, early_calls, with_bound_calls};
 use super::{Arg, Function, Uses, Writer, output_names};
 use crate::equations::{EnergyKind, StateSelection};
 use crate::symbolic::{Expr, RustCode, Symbol, SymbolKind};
@@ -75,9 +75,20 @@ impl Writer<'_> {
         for e in exprs {
             early_calls(&self.code(e), &early, &mut calls);
         }
+        let mut calls: Vec<(String, RustCode)> = calls.into_iter().collect();
+        calls.sort_by_key(|(_, call)| call_depth(call));
         for (text, call) in calls {
             let name = d.namer.ident(&call_name(&call));
-            d.lines.push(format!("    let {name} = {text};"));
+            let bound = match call {
+                RustCode::Call(callee, args) => RustCode::Call(
+                    callee,
+                    args.into_iter()
+                        .map(|a| with_bound_calls(a, &d.calls))
+                        .collect(),
+                ),
+                other => other,
+            };
+            self.statement_code(&mut d, Vec::new(), &bound, &format!("let {name} = "), ";");
             d.locals.push(name.clone());
             d.calls.insert(text, name);
         }

@@ -33,10 +33,11 @@ use nalgebra::{Complex, DMatrix, DVector};
 
 use bgc_runtime::design::{DiscreteKalman, Kalman, dlqe, lqe};
 use bgc_runtime::linalg::{Domain, Mode, RiccatiError, c2d_zoh, is_detectable, unobservable_modes};
+use bgc_runtime::matrix::dynamic;
 
 use super::BackSupportError;
 use super::params::Params;
-use super::plant::{DesignModel, Plant, dynamic};
+use super::plant::{DesignModel, Plant};
 
 /// The noise bounds of Sec. 4: motor torque (N m), trunk velocity (rad/s), encoder velocity (rad/s), torque
 /// sensor (N m).

@@ -27,9 +27,10 @@
 //! state feedback of Eq. 16 stays meaningful (`θ_m` itself ramps at `r_g θ̇_h`). The trunk velocity is then a
 //! known input of the observer, as in Eq. 8.
 
-use nalgebra::{DMatrix, SMatrix, SVector};
+use nalgebra::{DMatrix, SVector};
 
-use bgc_runtime::model::ContinuousModel;
+use bgc_runtime::matrix::dynamic;
+use bgc_runtime::sim::LinearPlant;
 use bgc_runtime::statespace::StateSpace;
 
 use bgc_models::back_support as generated;
@@ -66,13 +67,7 @@ pub mod output {
 }
 
 /// The linear plant `ẋ = A x + B u`, `y = C x + D u`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Plant {
-    pub a: SMatrix<f64, NX, NX>,
-    pub b: SMatrix<f64, NX, NU>,
-    pub c: SMatrix<f64, NY, NX>,
-    pub d: SMatrix<f64, NY, NU>,
-}
+pub type Plant = LinearPlant<NX, NU, NY>;
 
 /// The coordinates, inputs and outputs the generated model must declare, in this order, for its
 /// `state_space_declared` to be Eq. 3 in the coordinates of Eq. 2.
@@ -140,74 +135,6 @@ pub fn plant(p: &Params) -> Result<Plant, BackSupportError> {
     let model = bond_graph_model(p)?;
     let (a, b, c, d) = generated::state_space_declared(model.params());
     Ok(Plant { a, b, c, d })
-}
-
-impl Plant {
-    /// The plant as a continuous-time [`StateSpace`].
-    pub fn state_space(&self) -> Result<StateSpace, BackSupportError> {
-        Ok(StateSpace::new(
-            dynamic(&self.a),
-            dynamic(&self.b),
-            dynamic(&self.c),
-            dynamic(&self.d),
-        )?)
-    }
-}
-
-impl ContinuousModel<NX, NU, NY> for Plant {
-    fn rhs(&self, _t: f64, x: &SVector<f64, NX>, u: &SVector<f64, NU>, dx: &mut SVector<f64, NX>) {
-        *dx = self.a * x + self.b * u;
-    }
-
-    fn outputs(
-        &self,
-        _t: f64,
-        x: &SVector<f64, NX>,
-        u: &SVector<f64, NU>,
-        y: &mut SVector<f64, NY>,
-    ) {
-        *y = self.c * x + self.d * u;
-    }
-
-    fn jac_x(
-        &self,
-        _t: f64,
-        _x: &SVector<f64, NX>,
-        _u: &SVector<f64, NU>,
-        jac: &mut SMatrix<f64, NX, NX>,
-    ) {
-        *jac = self.a;
-    }
-
-    fn jac_u(
-        &self,
-        _t: f64,
-        _x: &SVector<f64, NX>,
-        _u: &SVector<f64, NU>,
-        jac: &mut SMatrix<f64, NX, NU>,
-    ) {
-        *jac = self.b;
-    }
-
-    fn output_jac_x(
-        &self,
-        _t: f64,
-        _x: &SVector<f64, NX>,
-        _u: &SVector<f64, NU>,
-        jac: &mut SMatrix<f64, NY, NX>,
-    ) {
-        *jac = self.c;
-    }
-
-    fn output_jac_u(
-        &self,
-        _t: f64,
-        _x: &SVector<f64, NX>,
-        _u: &SVector<f64, NU>,
-        jac: &mut SMatrix<f64, NY, NU>,
-    ) {
-        *jac = self.d;
-    }
 }
 
 /// The 6-state design model in angles relative to the trunk (module docs).
@@ -281,9 +208,4 @@ impl DesignModel {
             DMatrix::zeros(2, 2),
         )?)
     }
-}
-
-/// A fixed-size matrix as a dynamic one.
-pub fn dynamic<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> DMatrix<f64> {
-    DMatrix::from_fn(R, C, |i, j| m[(i, j)])
 }

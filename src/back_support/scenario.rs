@@ -6,16 +6,18 @@
 //! (the trunk velocity is a known input, Eq. 8), updates with the noisy `y_v`, `y_t`, and the controller
 //! applies `τ_m = −K_x x̂ − K_z z − K_∫z ∫z` (Eq. 13) held over the interval; the integrators advance by forward
 //! Euler, `z ← z + T (τ_ref − ŷ_b)`, `∫z ← ∫z + T z`, with the estimated torque `ŷ_b = C_b x̂ − d_eh θ̇_h`
-//! (Fig. 12). The plant is [`super::plant`] in absolute angles, integrated by
-//! `bgc_runtime::sim::simulate_sampled_loop`, with the input noises as held process disturbances (`w_τm / (J_m
-//! + J_g)` on `θ̈_m`, `w_θ̇h` on `θ̇_h`) and the measurement noises on `y_v`, `y_t`.
+//! (Fig. 12). The plant is [`super::plant`] in absolute angles, advanced exactly over each held interval by
+//! `bgc_runtime::sim::simulate_sampled_linear_loop` (the zero-order-hold step; [`PlantIntegration::Ode`]
+//! integrates it with an ODE solver instead, as a check), with the input noises as held process disturbances
+//! (`w_τm / (J_m + J_g)` on `θ̈_m`, `w_θ̇h` on `θ̇_h`) and the measurement noises on `y_v`, `y_t`.
 
 use nalgebra::{SMatrix, SVector};
 
 use bgc_runtime::estimation::kalman::fixed_from_dynamic;
 use bgc_runtime::estimation::{EstimationError, KalmanFilter, LinearDiscreteModel};
 use bgc_runtime::sim::{
-    SampledController, SampledLoopConfig, SolverOptions, simulate_sampled_loop,
+    SampledController, SampledLoopConfig, SolverOptions, simulate_sampled_linear_loop,
+    simulate_sampled_loop,
 };
 
 use super::BackSupportError;
@@ -23,6 +25,15 @@ use super::lqr::LqrDesign;
 use super::observer::{NoiseModel, ObserverDesign};
 use super::params::Params;
 use super::plant::{DesignModel, NX, Plant, output, state};
+
+/// How the plant is advanced between samples.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PlantIntegration {
+    /// The exact zero-order-hold step of the linear plant (one matrix exponential per run).
+    ExactZoh,
+    /// An ODE solve per sample interval, with these settings: the same record up to the solver's tolerance.
+    Ode(SolverOptions),
+}
 
 /// Settings of the scenario.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -38,7 +49,7 @@ pub struct ScenarioConfig {
     pub reference_duration: f64,
     pub noise: NoiseModel,
     pub seed: u64,
-    pub solver: SolverOptions,
+    pub integration: PlantIntegration,
 }
 
 impl ScenarioConfig {
@@ -53,7 +64,7 @@ impl ScenarioConfig {
             reference_duration: 0.5,
             noise: NoiseModel::three_sigma(),
             seed: 2020,
-            solver: SolverOptions::default(),
+            integration: PlantIntegration::ExactZoh,
         }
     }
 
@@ -229,9 +240,17 @@ pub fn run(
         ),
         process_noise_std: process,
         seed: cfg.seed,
-        solver: cfg.solver,
+        solver: match cfg.integration {
+            PlantIntegration::Ode(solver) => solver,
+            PlantIntegration::ExactZoh => SolverOptions::default(),
+        },
     };
-    let simulated = simulate_sampled_loop(plant, &mut controller, &loop_cfg);
+    let simulated = match cfg.integration {
+        PlantIntegration::ExactZoh => {
+            simulate_sampled_linear_loop(plant, &mut controller, &loop_cfg)
+        }
+        PlantIntegration::Ode(_) => simulate_sampled_loop(plant, &mut controller, &loop_cfg),
+    };
     if let Some(e) = controller.failure {
         return Err(e.into());
     }

@@ -288,16 +288,13 @@ pub fn fixed_from_dynamic<const R: usize, const C: usize>(
     name: &'static str,
     m: &DMatrix<f64>,
 ) -> Result<SMatrix<f64, R, C>, EstimationError> {
-    if m.nrows() != R || m.ncols() != C {
-        return Err(EstimationError::Shape {
-            name,
-            rows: m.nrows(),
-            cols: m.ncols(),
-            expected_rows: R,
-            expected_cols: C,
-        });
-    }
-    Ok(SMatrix::from_fn(|i, j| m[(i, j)]))
+    crate::matrix::fixed(name, m).map_err(|_| EstimationError::Shape {
+        name,
+        rows: m.nrows(),
+        cols: m.ncols(),
+        expected_rows: R,
+        expected_cols: C,
+    })
 }
 
 /// The predictor gain `L = A K` from the innovation gain `K`.

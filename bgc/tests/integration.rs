@@ -10,6 +10,7 @@ mod cli;
 mod cli_equations;
 mod cli_hostile;
 mod cli_messages;
+mod cli_root_files;
 mod cli_simulate;
 mod cli_solver_long;
 mod cli_units;

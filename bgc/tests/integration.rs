@@ -37,5 +37,6 @@ mod front_end_props;
 mod hostile_props;
 mod language_examples;
 mod loops_globalised;
+mod loops_warm_start;
 mod syntax_fixtures;
 mod syntax_fuzz;

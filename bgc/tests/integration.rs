@@ -38,5 +38,6 @@ mod hostile_props;
 mod language_examples;
 mod loops_globalised;
 mod loops_warm_start;
+mod pipeline_props;
 mod syntax_fixtures;
 mod syntax_fuzz;

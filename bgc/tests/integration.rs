@@ -7,6 +7,7 @@ mod equations_support;
 mod causality_allow;
 mod causality_models;
 mod cli;
+mod cli_energy_balance;
 mod cli_equations;
 mod cli_hostile;
 mod cli_messages;

@@ -158,3 +158,28 @@ fn a_resolved_undamped_run_keeps_its_energy_and_says_nothing() {
         assert!((e - 0.04).abs() <= 1e3 * 1e-9 * 0.04, "{e}");
     }
 }
+
+/// A relative tolerance below what f64 arithmetic can hold a step to is refused before the run, naming the option
+/// and the reason. Before, `--rtol 1e-15 --atol 1e-300` failed with "Step size is too small at time = 0" and
+/// `--rtol 1e-20` ran and warned against a tolerance of 1e-17.
+#[test]
+fn a_relative_tolerance_below_rounding_is_refused_up_front() {
+    let path = corpus("oscillator.bg");
+    for rtol in ["1e-20", "1e-15", "2e-14"] {
+        let (code, out, err) = bgc(&[
+            "simulate", &path, "--t-end", "1", "--input", "F=1", "--rtol", rtol, "--atol", "1e-300",
+        ]);
+        assert_eq!(code, 1, "{rtol}: {err}");
+        assert!(out.is_empty(), "{rtol}: {out}");
+        assert!(
+            err.starts_with("error: rtol = ")
+                && err.contains(" is not allowed: it is below 100 times the machine epsilon"),
+            "{rtol}: {err}"
+        );
+    }
+    // 100 ε = 2.22e-14 itself is allowed.
+    let (code, _, err) = bgc(&[
+        "simulate", &path, "--t-end", "0.01", "--input", "F=1", "--rtol", "3e-14",
+    ]);
+    assert_eq!(code, 0, "{err}");
+}

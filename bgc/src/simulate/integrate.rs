@@ -51,6 +51,10 @@ pub struct RunOptions {
     pub max_steps: usize,
 }
 
+/// The smallest relative tolerance: 100 machine epsilons, as MATLAB's ODE solvers also raise `RelTol` to. Below
+/// it a step's error test compares rounding errors.
+pub const MIN_RTOL: f64 = 100.0 * f64::EPSILON;
+
 /// The most rows a run produces.
 pub const MAX_ROWS: usize = 10_000_000;
 
@@ -70,6 +74,14 @@ impl RunOptions {
                     reason: "it must be finite and positive",
                 });
             }
+        }
+        if self.rtol < MIN_RTOL {
+            return Err(SimError::BadSetting {
+                name: "rtol",
+                value: self.rtol,
+                reason: "it is below 100 times the machine epsilon (2.2e-14), the smallest relative error to which \
+                         f64 arithmetic can hold a step: the solver could only fail or stall on rounding errors",
+            });
         }
         let rows = (self.t_end / self.dt_out).floor() + 2.0;
         if rows > MAX_ROWS as f64 {

@@ -172,3 +172,27 @@ fn bgc_simulate_follows_the_diode_loop_through_a_ramp() {
     // The loop current grows with the source (checked against the bracketed references at the two ends).
     assert!((i[0] - ROOTS[0].1).abs() <= 1e-9 * ROOTS[0].1, "{}", i[0]);
 }
+
+/// Across a breakpoint (a fresh solver starts there) the loop is solved from the solution before it: the source
+/// jumps from 8 V to 100 V at t = 0.5 ms, and every row, on both sides, satisfies the diode law.
+#[test]
+fn bgc_simulate_solves_the_diode_loop_across_a_jump_of_the_source() {
+    let path = corpus("diode_rc.bg");
+    let csv: Csv = simulate(&[
+        &path,
+        "--t-end",
+        "1e-3",
+        "--dt-out",
+        "1e-4",
+        "--input",
+        "u=8+92*step(0.5e-3)",
+    ]);
+    let (t, q, i) = (csv.col("t"), csv.col("q_cap"), csv.col("i"));
+    assert_eq!(t.len(), 11);
+    for k in 0..t.len() {
+        let u = if t[k] < 0.5e-3 { 8.0 } else { 100.0 };
+        let r = relative_residual(i[k], u, q[k] / C_V);
+        assert!(r <= 1e-9, "t = {}: i = {}, residual {r:e}", t[k], i[k]);
+    }
+    assert!(i[10] > 0.9 && i[4] < 0.08, "{i:?}");
+}

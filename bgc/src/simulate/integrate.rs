@@ -221,6 +221,8 @@ pub fn run_streaming_noted(
         }
         let last = b >= opts.t_end;
         // Rows before `b` go out as they come; those at `b` of a segment that is not the last wait for the jump.
+        // The loops' solution at `a` (in the tear slots of the last row's inputs) starts the segment's first solve.
+        let warm = u.clone();
         let mut held: Vec<(f64, Vec<f64>)> = Vec::new();
         let mut deliver = |t: f64, ys: &[f64]| -> Result<ControlFlow<()>, SimError> {
             if !last && t >= b {
@@ -234,7 +236,18 @@ pub fn run_streaming_noted(
             samples,
             range: start..next,
         };
-        let end = segment(system, &y, a, b, last, &wanted, opts, &mut deliver, notes)?;
+        let end = segment(
+            system,
+            &y,
+            a,
+            b,
+            last,
+            &wanted,
+            opts,
+            &mut deliver,
+            notes,
+            &warm,
+        )?;
         let Some(end) = end else {
             return Ok(Finish::Stopped);
         };
@@ -302,8 +315,9 @@ fn segment(
     opts: &RunOptions,
     out: &mut Deliver<'_>,
     notes: &mut Vec<String>,
+    warm: &[f64],
 ) -> Result<Option<Vec<f64>>, SimError> {
-    match segment_once(system, y0, a, b, last, wanted, opts, out)? {
+    match segment_once(system, y0, a, b, last, wanted, opts, out, warm)? {
         Outcome::Reached(y) => Ok(Some(y)),
         Outcome::Stopped => Ok(None),
         Outcome::Stalled {
@@ -322,7 +336,8 @@ fn segment(
                 max_steps: opts.max_steps.saturating_sub(steps),
                 ..*opts
             };
-            match segment_once(system, &y, t, b, last, &wanted.after(delivered), &rest, out)? {
+            let rest_of = wanted.after(delivered);
+            match segment_once(system, &y, t, b, last, &rest_of, &rest, out, warm)? {
                 Outcome::Reached(y) => Ok(Some(y)),
                 Outcome::Stopped => Ok(None),
                 Outcome::Stalled { .. } => Err(SimError::TooManySteps {
@@ -362,11 +377,13 @@ fn segment_once(
     wanted: &Wanted,
     opts: &RunOptions,
     out: &mut Deliver<'_>,
+    warm: &[f64],
 ) -> Result<Outcome, SimError> {
     let dim = y0.len();
     // Inputs are evaluated before a breakpoint `b`, never at it (see the module docs).
     let t_max = if last { f64::INFINITY } else { just_before(b) };
-    let scratch = RefCell::new((Vec::new(), Vec::new(), vec![0.0; dim], vec![0.0; dim]));
+    // The inputs' vector keeps the loops' last solution in its tear slots, from which the next solve starts.
+    let scratch = RefCell::new((warm.to_vec(), Vec::new(), vec![0.0; dim], vec![0.0; dim]));
     let bad: Cell<Option<(f64, usize)>> = Cell::new(None);
     // The latest failure of the algebraic loops' solve at a finite state, reported if the solver then gives up (it
     // may recover from a failed trial step; evaluations at the non-finite states a failed step leads to are

@@ -9,6 +9,11 @@
 //! quadrature there, so `energy + dissipated − supplied` stays constant across steps. The Jacobian handed to the
 //! implicit methods is the symbolic one of the equations, or finite differences when a rate uses a function
 //! without a derivative.
+//!
+//! BDF's orders 3 to 5 are not A-stable: a lightly damped fast mode that the tolerances resolve holds its steps at a
+//! fraction of that mode's period. When BDF advances so slowly that the rest of a segment would exceed the step
+//! budget, the segment goes on with TR-BDF2 (A- and L-stable) from the last accepted step, and
+//! [`run_streaming_noted`] returns a note that says so.
 
 use std::cell::{Cell, RefCell};
 use std::ops::ControlFlow;

@@ -343,8 +343,9 @@ fn write_if_changed(path: &Path, text: &str) -> Result<bool, Error> {
 /// attack, and is refused before it fills the memory.
 pub const MAX_SOURCE_BYTES: u64 = 16 << 20;
 
-/// Reads a source file: a regular file (not a FIFO, a device or a directory, which could block or never end) of at
-/// most [`MAX_SOURCE_BYTES`].
+/// Reads a source file: a `.bg` file (by the name it resolves to, so a link named `x.bg` to another file is
+/// refused too) that is a regular file (not a FIFO, a device or a directory, which could block or never end) of at
+/// most [`MAX_SOURCE_BYTES`]. Refusing other files keeps their contents out of diagnostics, which quote the source.
 pub fn read_source_file(path: &Path) -> std::io::Result<Vec<u8>> {
     use std::io::Read;
     let refuse = |why: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, why);
@@ -352,6 +353,17 @@ pub fn read_source_file(path: &Path) -> std::io::Result<Vec<u8>> {
     let kind = std::fs::metadata(path)?.file_type();
     if !kind.is_file() {
         return Err(refuse(format!("not a regular file ({})", describe(kind))));
+    }
+    let resolved = std::fs::canonicalize(path)?;
+    if resolved.extension().is_none_or(|e| e != "bg") {
+        return Err(refuse(if path.extension().is_some_and(|e| e == "bg") {
+            format!(
+                "it leads to {}, which is not a `.bg` file (only `.bg` files are read as models)",
+                resolved.display()
+            )
+        } else {
+            "not a `.bg` file (only `.bg` files are read as models)".to_string()
+        }));
     }
     let file = std::fs::File::open(path)?;
     let len = file.metadata()?.len();

@@ -8,7 +8,7 @@ use proptest::prelude::*;
 use std::path::Path;
 
 /// Complete models to mutate: the exoskeleton models, the corpus and the valid fixtures.
-fn seeds() -> Vec<Vec<u8>> {
+pub(crate) fn seeds() -> Vec<Vec<u8>> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut out = Vec::new();
     for dir in ["../models", "tests/corpus", "tests/fixtures/valid"] {
@@ -75,7 +75,7 @@ fn check(bytes: &[u8]) -> Result<(), TestCaseError> {
 }
 
 #[derive(Clone, Debug)]
-enum Mutation {
+pub(crate) enum Mutation {
     Delete { at: usize, len: usize },
     Insert { at: usize, text: &'static str },
     Duplicate { at: usize, len: usize },
@@ -107,7 +107,7 @@ const INSERTS: &[&str] = &[
     " param z = -1 [kg];",
 ];
 
-fn mutation() -> impl Strategy<Value = Mutation> {
+pub(crate) fn mutation() -> impl Strategy<Value = Mutation> {
     prop_oneof![
         (any::<usize>(), 1usize..40).prop_map(|(at, len)| Mutation::Delete { at, len }),
         (any::<usize>(), prop::sample::select(INSERTS))
@@ -116,7 +116,7 @@ fn mutation() -> impl Strategy<Value = Mutation> {
     ]
 }
 
-fn apply(mut bytes: Vec<u8>, muts: &[Mutation]) -> Vec<u8> {
+pub(crate) fn apply(mut bytes: Vec<u8>, muts: &[Mutation]) -> Vec<u8> {
     for m in muts {
         let n = bytes.len().max(1);
         match *m {

@@ -19,7 +19,7 @@ use cli_support::{bgc, corpus};
 use codegen_support::rustc::{NALGEBRA, rustc};
 use codegen_support::{generate_text, scratch};
 
-const ROOTS: [(f64, f64); 4] = [
+pub(crate) const ROOTS: [(f64, f64); 4] = [
     (8.0, 0.074_391_445_163_915_23),
     (10.0, 0.094_273_019_538_969_23),
     (20.0, 0.193_912_416_484_180_8),
@@ -64,7 +64,7 @@ fn bgc_statespace_linearises_at_the_steep_diode_loop() {
 }
 
 /// `libm` with the real functions (the generated code calls them; `std` computes them here).
-const LIBM_STD: &str = r#"
+pub(crate) const LIBM_STD: &str = r#"
 macro_rules! unary {
     ($($name:ident = $f:ident),*) => { $(pub fn $name(x: f64) -> f64 { x.$f() })* };
 }

@@ -6,7 +6,7 @@ use super::params::{Assignment, input_signals, param_values, values_or_zero, zer
 use super::quantities;
 use super::{Solver, Status};
 use bgc::simulate::System;
-use bgc::simulate::integrate::{Method, RunOptions, run_streaming};
+use bgc::simulate::integrate::{Method, RunOptions, run_streaming_noted};
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::ops::ControlFlow;
@@ -131,27 +131,37 @@ fn csv(
     // The header goes out with the first row, so that a run that cannot start prints nothing.
     let mut line = header;
     let mut printed = 0usize;
-    let result = run_streaming(&system, &x0, &opts, &mut |t, row| {
-        balance.see(t, row);
-        let _ = write!(line, "{t}");
-        for v in row {
-            // Shortest round-trip form: the printed numbers read back exactly.
-            let _ = write!(line, ",{v:e}");
-        }
-        line.push('\n');
-        let written = out.write_all(line.as_bytes());
-        line.clear();
-        match written {
-            Ok(()) => {
-                printed += 1;
-                ControlFlow::Continue(())
+    let mut notes = Vec::new();
+    let result = run_streaming_noted(
+        &system,
+        &x0,
+        &opts,
+        &mut |t, row| {
+            balance.see(t, row);
+            let _ = write!(line, "{t}");
+            for v in row {
+                // Shortest round-trip form: the printed numbers read back exactly.
+                let _ = write!(line, ",{v:e}");
             }
-            Err(e) => {
-                write_error = Some(e);
-                ControlFlow::Break(())
+            line.push('\n');
+            let written = out.write_all(line.as_bytes());
+            line.clear();
+            match written {
+                Ok(()) => {
+                    printed += 1;
+                    ControlFlow::Continue(())
+                }
+                Err(e) => {
+                    write_error = Some(e);
+                    ControlFlow::Break(())
+                }
             }
-        }
-    });
+        },
+        &mut notes,
+    );
+    for note in notes {
+        stderrln(&format!("warning: {note}"));
+    }
     if let Some(e) = write_error {
         return Err(Failure::Output(e));
     }
@@ -217,11 +227,24 @@ impl Balance {
         let relative = drift / self.scale;
         (self.check && self.scale > 0.0 && relative > BALANCE_FACTOR * self.rtol).then(|| {
             format!(
-                "the energy balance drifted: energy + dissipated - supplied changed by {drift:.3e} (by t = {t}), \
-                 {:.3} % of the largest energy term, more than {BALANCE_FACTOR} times --rtol; the results are not \
-                 accurate to the tolerances: give a smaller --rtol and --atol or another --solver",
-                100.0 * relative
+                "the energy balance drifted: energy + dissipated - supplied changed by {drift:.3e} J (largest by t = \
+                 {t}), {} % of the largest energy term ({:.3e} J), above the tolerance of {} % ({BALANCE_FACTOR} \
+                 times --rtol {:e}); the results are not accurate to the tolerances: give a smaller --rtol, an \
+                 --atol well below the smallest state and energy that matter, or another --solver",
+                significant(100.0 * relative),
+                self.scale,
+                significant(100.0 * BALANCE_FACTOR * self.rtol),
+                self.rtol
             )
         })
     }
+}
+
+/// `x` with four significant digits in positional notation (`46.07`, `0.1000`, `0.00001234`).
+fn significant(x: f64) -> String {
+    if !(x.is_finite() && x > 0.0) {
+        return format!("{x}");
+    }
+    let decimals = (3.0 - x.log10().floor()).clamp(0.0, 20.0) as usize;
+    format!("{x:.decimals$}")
 }

@@ -5,7 +5,8 @@
 //! module gets:
 //! - `N_TEARS`, `TEAR_NAMES` and `Tears` (an `SVector<f64, N_TEARS>`), the error type `LoopError`;
 //! - `solve_loops(p, t, x, u) -> Result<Tears, LoopError>`: each block in turn by damped Newton's method on
-//!   fixed-size values ([`NEWTON_FN`]), from `z = 0`, with the analytic `∂r/∂z` (symbolic derivatives of the
+//!   fixed-size values ([`NEWTON_FN`]), from `z = 0` (`solve_loops_from(p, t, x, u, guess)` starts from the
+//!   caller's guess, the last solution of a time-stepping caller, and retries from zero when that fails), with the analytic `∂r/∂z` (symbolic derivatives of the
 //!   residuals). It mirrors [`crate::equations::newton`]: the step solves `∂r/∂z Δ = −r`, the damping halves `λ`
 //!   until the Armijo test on `Σ (r_i/w_i)²` passes, and the block has converged when `|r_i| ≤ 10⁻¹² s_i` for every
 //!   residual, `s_i` being the sum of the magnitudes of its terms ([`crate::equations::residual_scale`]), after at
@@ -130,6 +131,21 @@ fn bgc_newton<const B: usize>(
         }
         None => Err(failure),
     }
+}
+
+/// Copies the finite values of `guess` for the `len` tears from `first` into `z`; true when one of
+/// them is nonzero (a start that differs from zero).
+fn bgc_start(z: &mut Tears, guess: &Tears, first: usize, len: usize) -> bool {
+    let mut warm = false;
+    let mut i = first;
+    while i < first + len && i < N_TEARS {
+        if guess[i].is_finite() {
+            z[i] = guess[i];
+            warm |= guess[i] != 0.0;
+        }
+        i += 1;
+    }
+    warm
 }
 
 /// The residual, its scale and its derivative of a one-tear block with the tear at `v`.
@@ -511,22 +527,52 @@ impl Writer<'_> {
                 d,
             );
         }
+        // Each block from the caller's guess (a non-finite guess counts as zero); when that fails and the guess
+        // was not zero, once more from zero, as the compiler's evaluator does.
         let mut body = String::from("    let mut z = Tears::zeros();\n");
         for (k, b) in lp.blocks.iter().enumerate() {
-            let _ = writeln!(
+            let n = b.residuals.len();
+            let _ = write!(
                 body,
-                "    bgc_newton(&mut z, {}, {k}, |at| bgc_loop_block_{k}(p, t, x, u, at))?;",
-                b.first
+                "    let block = |at: &Tears| bgc_loop_block_{k}(p, t, x, u, at);
+    let warm = bgc_start(&mut z, guess, {first}, {n});
+    if let Err(e) = bgc_newton(&mut z, {first}, {k}, block) {{
+        if !warm {{
+            return Err(e);
+        }}
+        bgc_start(&mut z, &Tears::zeros(), {first}, {n});
+        bgc_newton(&mut z, {first}, {k}, block)?;
+    }}
+",
+                first = b.first,
             );
         }
         body.push_str("    Ok(z)\n");
         self.out.push('\n');
         self.doc(
             0,
-            "Solves the nonlinear algebraic loops at `(t, x, u)`: each block in turn by damped Newton's method from zero, to `|r| ≤ LOOP_RTOL` times the magnitudes of each residual's terms. The error names the block that was not solved.",
+            "Solves the nonlinear algebraic loops at `(t, x, u)`: each block in turn by damped Newton's method from zero, to `|r| ≤ LOOP_RTOL` times the magnitudes of each residual's terms. The error names the block that was not solved. A caller that steps through time starts from the last solution with `solve_loops_from`.",
         );
         self.out.push_str(
-            "pub fn solve_loops(p: &Params, t: f64, x: &State, u: &Inputs) -> Result<Tears, LoopError> {\n",
+            "pub fn solve_loops(p: &Params, t: f64, x: &State, u: &Inputs) -> Result<Tears, LoopError> {
+    solve_loops_from(p, t, x, u, &Tears::zeros())
+}
+",
+        );
+        self.out.push('\n');
+        self.doc(
+            0,
+            "Solves the nonlinear algebraic loops as `solve_loops` does, with Newton's method starting from `guess` (typically the solution at the previous time step, which is close and keeps the solution on its branch when the loop has several); a block that fails from a nonzero guess is solved once more from zero. A non-finite guess counts as zero. The model functions (`rhs`, `outputs`, ...) start from zero, so that they are pure functions of their arguments.",
+        );
+        self.out.push_str(
+            "pub fn solve_loops_from(
+    p: &Params,
+    t: f64,
+    x: &State,
+    u: &Inputs,
+    guess: &Tears,
+) -> Result<Tears, LoopError> {
+",
         );
         self.out.push_str(&body);
         self.out.push_str("}\n");

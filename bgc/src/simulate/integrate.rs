@@ -9,6 +9,11 @@
 //! quadrature there, so `energy + dissipated − supplied` stays constant across steps. The Jacobian handed to the
 //! implicit methods is the symbolic one of the equations, or finite differences when a rate uses a function
 //! without a derivative.
+//!
+//! BDF's orders 3 to 5 are not A-stable: a lightly damped fast mode that the tolerances resolve holds its steps at a
+//! fraction of that mode's period. When BDF advances so slowly that the rest of a segment would exceed the step
+//! budget, the segment goes on with TR-BDF2 (A- and L-stable) from the last accepted step, and
+//! [`run_streaming_noted`] returns a note that says so.
 
 use std::cell::{Cell, RefCell};
 use std::ops::ControlFlow;
@@ -51,6 +56,10 @@ pub struct RunOptions {
     pub max_steps: usize,
 }
 
+/// The smallest relative tolerance: 100 machine epsilons, as MATLAB's ODE solvers also raise `RelTol` to. Below
+/// it a step's error test compares rounding errors.
+pub const MIN_RTOL: f64 = 100.0 * f64::EPSILON;
+
 /// The most rows a run produces.
 pub const MAX_ROWS: usize = 10_000_000;
 
@@ -70,6 +79,14 @@ impl RunOptions {
                     reason: "it must be finite and positive",
                 });
             }
+        }
+        if self.rtol < MIN_RTOL {
+            return Err(SimError::BadSetting {
+                name: "rtol",
+                value: self.rtol,
+                reason: "it is below 100 times the machine epsilon (2.2e-14), the smallest relative error to which \
+                         f64 arithmetic can hold a step: the solver could only fail or stall on rounding errors",
+            });
         }
         let rows = (self.t_end / self.dt_out).floor() + 2.0;
         if rows > MAX_ROWS as f64 {
@@ -159,6 +176,18 @@ pub fn run_streaming(
     opts: &RunOptions,
     sink: &mut dyn FnMut(f64, &[f64]) -> ControlFlow<()>,
 ) -> Result<Finish, SimError> {
+    run_streaming_noted(system, x0, opts, sink, &mut Vec::new())
+}
+
+/// [`run_streaming`], with the notes about how the run went (a change of method, see [`Method::Bdf`]) pushed onto
+/// `notes` for the caller to show.
+pub fn run_streaming_noted(
+    system: &System,
+    x0: &[f64],
+    opts: &RunOptions,
+    sink: &mut dyn FnMut(f64, &[f64]) -> ControlFlow<()>,
+    notes: &mut Vec<String>,
+) -> Result<Finish, SimError> {
     opts.check()?;
     let n = system.state_count();
     if x0.len() != n {
@@ -197,6 +226,8 @@ pub fn run_streaming(
         }
         let last = b >= opts.t_end;
         // Rows before `b` go out as they come; those at `b` of a segment that is not the last wait for the jump.
+        // The loops' solution at `a` (in the tear slots of the last row's inputs) starts the segment's first solve.
+        let warm = u.clone();
         let mut held: Vec<(f64, Vec<f64>)> = Vec::new();
         let mut deliver = |t: f64, ys: &[f64]| -> Result<ControlFlow<()>, SimError> {
             if !last && t >= b {
@@ -210,7 +241,18 @@ pub fn run_streaming(
             samples,
             range: start..next,
         };
-        let end = segment(system, &y, a, b, last, &wanted, opts, &mut deliver)?;
+        let end = segment(
+            system,
+            &y,
+            a,
+            b,
+            last,
+            &wanted,
+            opts,
+            &mut deliver,
+            notes,
+            &warm,
+        )?;
         let Some(end) = end else {
             return Ok(Finish::Stopped);
         };
@@ -242,6 +284,15 @@ struct Wanted {
 }
 
 impl Wanted {
+    /// The times after the first `delivered`.
+    fn after(&self, delivered: usize) -> Wanted {
+        let start = (self.range.start + delivered).min(self.range.end);
+        Wanted {
+            samples: self.samples,
+            range: start..self.range.end,
+        }
+    }
+
     fn get(&self, i: usize) -> Option<f64> {
         let k = self.range.start.checked_add(i)?;
         if k < self.range.end {
@@ -256,7 +307,8 @@ impl Wanted {
 type Deliver<'d> = dyn FnMut(f64, &[f64]) -> Result<ControlFlow<()>, SimError> + 'd;
 
 /// Integrates `[a, b]` from `y0`, delivering the extended state at the `wanted` times; returns the state at `b`, or
-/// `None` when the receiver stopped the run.
+/// `None` when the receiver stopped the run. When BDF stalls ([`Outcome::Stalled`]) the rest of the segment is
+/// integrated by TR-BDF2 from the last accepted step, and a note says so.
 #[allow(clippy::too_many_arguments)]
 fn segment(
     system: &System,
@@ -267,11 +319,76 @@ fn segment(
     wanted: &Wanted,
     opts: &RunOptions,
     out: &mut Deliver<'_>,
+    notes: &mut Vec<String>,
+    warm: &[f64],
 ) -> Result<Option<Vec<f64>>, SimError> {
+    match segment_once(system, y0, a, b, last, wanted, opts, out, warm)? {
+        Outcome::Reached(y) => Ok(Some(y)),
+        Outcome::Stopped => Ok(None),
+        Outcome::Stalled {
+            t,
+            y,
+            delivered,
+            steps,
+        } => {
+            notes.push(format!(
+                "BDF stalled at t = {t:e} ({steps} steps from t = {a:e}, too short to reach t = {b:e} in the step \
+                 budget): a lightly damped fast mode makes its orders above 2, which are not A-stable, unstable once \
+                 the tolerances resolve that mode; the run went on with --solver tr_bdf2 (A- and L-stable) from there"
+            ));
+            let rest = RunOptions {
+                method: Method::TrBdf2,
+                max_steps: opts.max_steps.saturating_sub(steps),
+                ..*opts
+            };
+            let rest_of = wanted.after(delivered);
+            match segment_once(system, &y, t, b, last, &rest_of, &rest, out, warm)? {
+                Outcome::Reached(y) => Ok(Some(y)),
+                Outcome::Stopped => Ok(None),
+                Outcome::Stalled { .. } => Err(SimError::TooManySteps {
+                    from: a,
+                    to: b,
+                    time: t,
+                    max_steps: opts.max_steps,
+                }),
+            }
+        }
+    }
+}
+
+/// How one solver's integration of a segment ended.
+enum Outcome {
+    /// At the segment's end, with the extended state there.
+    Reached(Vec<f64>),
+    /// The receiver stopped the run.
+    Stopped,
+    /// BDF advanced too slowly to finish within its step budget ([`Drive::stalled`]): at `t` with the state `y`,
+    /// after `steps` steps and `delivered` of the wanted rows.
+    Stalled {
+        t: f64,
+        y: Vec<f64>,
+        delivered: usize,
+        steps: usize,
+    },
+}
+
+#[allow(clippy::too_many_arguments)]
+fn segment_once(
+    system: &System,
+    y0: &[f64],
+    a: f64,
+    b: f64,
+    last: bool,
+    wanted: &Wanted,
+    opts: &RunOptions,
+    out: &mut Deliver<'_>,
+    warm: &[f64],
+) -> Result<Outcome, SimError> {
     let dim = y0.len();
     // Inputs are evaluated before a breakpoint `b`, never at it (see the module docs).
     let t_max = if last { f64::INFINITY } else { just_before(b) };
-    let scratch = RefCell::new((Vec::new(), Vec::new(), vec![0.0; dim], vec![0.0; dim]));
+    // The inputs' vector keeps the loops' last solution in its tear slots, from which the next solve starts.
+    let scratch = RefCell::new((warm.to_vec(), Vec::new(), vec![0.0; dim], vec![0.0; dim]));
     let bad: Cell<Option<(f64, usize)>> = Cell::new(None);
     // The latest failure of the algebraic loops' solve at a finite state, reported if the solver then gives up (it
     // may recover from a failed trial step; evaluations at the non-finite states a failed step leads to are
@@ -345,6 +462,7 @@ fn segment(
         to: b,
         wanted,
         max_steps: opts.max_steps,
+        may_stall: opts.method == Method::Bdf,
     };
     match opts.method {
         Method::Bdf => {
@@ -379,7 +497,12 @@ struct Drive<'c> {
     to: f64,
     wanted: &'c Wanted,
     max_steps: usize,
+    /// Whether a stall ends the drive with [`Outcome::Stalled`] (BDF) instead of running into `max_steps`.
+    may_stall: bool,
 }
+
+/// The steps between two looks at BDF's progress.
+const STALL_WINDOW: usize = 10_000;
 
 impl Drive<'_> {
     fn name(&self, i: usize) -> String {
@@ -388,6 +511,17 @@ impl Drive<'_> {
             Some(0) => "dissipated".into(),
             Some(_) => "supplied".into(),
         }
+    }
+
+    /// Whether the last [`STALL_WINDOW`] steps, from `window_start` to `t_now`, went so slowly that the rest of the
+    /// segment at that pace needs more steps than are left of `max_steps`: the run would fail. BDF does so when a
+    /// lightly damped fast mode (eigenvalues near the imaginary axis) lies outside the stability region of its
+    /// orders 3 to 5 and the tolerances resolve it: the error test holds the spurious growth at the tolerance by
+    /// cutting the step to a fraction of that mode's period, for the rest of the run.
+    fn stalled(&self, window_start: f64, t_now: f64, steps: usize) -> bool {
+        let pace = (t_now - window_start) / STALL_WINDOW as f64;
+        let left = self.max_steps.saturating_sub(steps) as f64;
+        !(pace > 0.0 && (self.to - t_now) / pace <= left)
     }
 
     /// A solver error, attributed to the model when its algebraic loops could not be solved or it had returned a
@@ -405,11 +539,7 @@ impl Drive<'_> {
         }
     }
 
-    fn drive<'a, Eqn, S>(
-        &self,
-        mut solver: S,
-        out: &mut Deliver<'_>,
-    ) -> Result<Option<Vec<f64>>, SimError>
+    fn drive<'a, Eqn, S>(&self, mut solver: S, out: &mut Deliver<'_>) -> Result<Outcome, SimError>
     where
         Eqn: OdeEquations<T = f64, V = NalgebraVec<f64>> + 'a,
         S: OdeSolverMethod<'a, Eqn>,
@@ -418,7 +548,8 @@ impl Drive<'_> {
             .set_stop_time(self.to)
             .map_err(|e| self.failure(self.from, e))?;
         let mut next = 0;
-        for _ in 0..self.max_steps {
+        let mut window_start = self.from;
+        for step in 0..self.max_steps {
             let reason = solver
                 .step()
                 .map_err(|e| self.failure(solver.state().t, e))?;
@@ -450,12 +581,23 @@ impl Drive<'_> {
                     break;
                 };
                 if flow.is_break() {
-                    return Ok(None);
+                    return Ok(Outcome::Stopped);
                 }
                 next += 1;
             }
             if reached {
-                return Ok(Some(y));
+                return Ok(Outcome::Reached(y));
+            }
+            if (step + 1) % STALL_WINDOW == 0 {
+                if self.may_stall && self.stalled(window_start, t_now, step + 1) {
+                    return Ok(Outcome::Stalled {
+                        t: t_now,
+                        y,
+                        delivered: next,
+                        steps: step + 1,
+                    });
+                }
+                window_start = t_now;
             }
         }
         Err(SimError::TooManySteps {

@@ -25,6 +25,7 @@ mod equations_derivative;
 mod equations_differential;
 mod equations_energy_laws;
 mod equations_fields;
+mod equations_kinematic;
 mod equations_linear;
 mod equations_loops;
 mod equations_names;

@@ -57,6 +57,7 @@ mod coords_symbolic;
 pub(crate) mod dense;
 mod energy;
 mod field;
+mod kinematic;
 mod linear;
 mod naming;
 pub mod newton;
@@ -304,7 +305,13 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
         ));
         return (eqs, diags);
     }
-    let (mut ctx, states) = build::context(model, causality);
+    // Dependent storage behind a modulus that varies with the state: derive on the graph with velocity states.
+    let augmented = kinematic::augment_if_needed(model, causality);
+    let (model, causality, velocities) = match &augmented {
+        Some(a) => (&a.model, &a.causality, a.velocities.as_slice()),
+        None => (model, causality, &[][..]),
+    };
+    let (mut ctx, states) = build::context(model, causality, velocities);
     eqs.derived = model
         .params
         .iter()
@@ -352,7 +359,16 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
             ));
         }
     }
-    let solved = match solve::solve_rates(&implicit) {
+    let mut kinematic_mass = None;
+    let solved_rates = if built.implicit_rows.iter().any(|&r| r) {
+        solve::mass_form(&implicit, &built.implicit_rows).map(|(f, rows, matrix)| {
+            kinematic_mass = Some(kinematic::block(model, &built.states, rows, matrix));
+            f
+        })
+    } else {
+        solve::solve_rates(&implicit)
+    };
+    let solved = match solved_rates {
         Ok(x) => x,
         Err(e) => {
             let msg = match e {
@@ -382,13 +398,21 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
     };
     // A storage in derivative causality whose rate involves an I-field's flows would add to its inertia matrix;
     // that coupling is not supported, and substituting `ẋ` of a mass-matrix row would be wrong.
-    let mass_states: Vec<usize> = built
+    let field_states: Vec<usize> = built
         .mass
         .iter()
         .flat_map(|b| b.states.iter().copied())
         .collect();
+    let mass_states: Vec<usize> = field_states
+        .iter()
+        .copied()
+        .chain(kinematic_mass.iter().flat_map(|b| b.states.iter().copied()))
+        .collect();
     let needs_mass_rate = |e: &Ex| mass_states.iter().any(|&j| e.contains(Sym::StateDot(j)));
-    if implicit.iter().any(needs_mass_rate) {
+    if implicit
+        .iter()
+        .any(|e| field_states.iter().any(|&j| e.contains(Sym::StateDot(j))))
+    {
         diags.push(with_span(
             Diagnostic::error(
                 codes::DERIVATIVE_CAUSALITY,
@@ -504,12 +528,20 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
     for s in &built.states {
         taken.reserve(&s.name);
     }
-    let readable = print::readable(
-        &built,
-        &resolver_rates(&built, &solved, &implicit),
-        &output_values,
-        taken,
-    );
+    let shown_rates = match &kinematic_mass {
+        // The generalised forces of the mass-matrix rows are shown explicit (the junction's balance holds `ẋ`).
+        Some(block) => {
+            let mut r = resolver_rates(&built, &solved, &implicit);
+            for &i in &block.states {
+                if let (Some(slot), Some(v)) = (r.get_mut(i), solved.get(i)) {
+                    *slot = v.clone();
+                }
+            }
+            r
+        }
+        None => resolver_rates(&built, &solved, &implicit),
+    };
+    let readable = print::readable(&built, &shown_rates, &output_values, taken);
     for o in &mut eqs.outputs {
         o.value = readable.alias(&o.value);
     }
@@ -524,6 +556,7 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
     eqs.tear_blocks = tear::blocks(resolver.implicit_loops(), &|s| eqs.sym_name(s));
     eqs.states = built.states;
     eqs.mass = built.mass;
+    eqs.mass.extend(kinematic_mass);
     (eqs, diags)
 }
 

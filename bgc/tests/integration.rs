@@ -31,6 +31,7 @@ mod equations_loops;
 mod equations_names;
 mod equations_nonlinear;
 mod equations_robustness;
+mod equations_scaling;
 mod equations_signs;
 mod equations_state_space;
 mod front_end_props;

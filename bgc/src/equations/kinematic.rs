@@ -56,10 +56,20 @@ pub(crate) fn augment_if_needed(model: &Model, causality: &Causality) -> Option<
                 None => velocity_junctions(model, causality, &[], phase)?,
             };
             let before = junctions.len();
-            for j in needed {
-                if !junctions.contains(&j) {
-                    junctions.push(j);
+            let fresh: Vec<NodeIndex> = needed.into_iter().rev().fold(Vec::new(), |mut acc, j| {
+                if !junctions.contains(&j) && !acc.contains(&j) {
+                    acc.push(j);
                 }
+                acc
+            });
+            // A quotient found later lies further down the causal path: its velocity is hinted first, so that
+            // the flows propagate back from it through the moduli as products (a chain of MTFs gets its
+            // velocity at the far end). The coupled inertias' velocities come after all of them.
+            match phase {
+                Phase::Dividing => {
+                    junctions.splice(0..0, fresh);
+                }
+                Phase::Coupled => junctions.extend(fresh),
             }
             if junctions.len() == before {
                 break;

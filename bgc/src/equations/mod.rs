@@ -563,6 +563,11 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
 /// The rates to show: the readable rate when it needs no solve, the solved explicit rate for rates coupled through
 /// derivative causality.
 fn resolver_rates(built: &build::Built, solved: &[Ex], implicit: &[Ex]) -> Vec<Ex> {
+    let coupled = solve::rates_appearing(implicit);
+    if coupled.is_empty() {
+        // No derivative causality: every rate is readable as built.
+        return built.rates.clone();
+    }
     // The coupled rates in intermediates: inline the intermediates that lead to a derivative-causality output,
     // drop those outputs (their ẋ terms are on the left-hand side), and solve the same block.
     let mut leads = vec![None::<bool>; built.defs.len()];
@@ -614,8 +619,7 @@ fn resolver_rates(built: &build::Built, solved: &[Ex], implicit: &[Ex]) -> Vec<E
         .iter()
         .enumerate()
         .map(|(i, r)| {
-            let coupled = implicit.iter().any(|e| e.contains(Sym::StateDot(i)));
-            if coupled {
+            if coupled.binary_search(&i).is_ok() {
                 readable.get(i).cloned().unwrap_or_else(|| r.clone())
             } else {
                 r.clone()

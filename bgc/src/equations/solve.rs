@@ -31,9 +31,7 @@ pub(crate) fn solve_rates(f: &[Ex]) -> Result<Vec<Ex>, SolveError> {
 /// values, such as intermediates) instead of computed from `f`.
 pub(crate) fn solve_rates_with(f: &[Ex], f0_given: Option<&[Ex]>) -> Result<Vec<Ex>, SolveError> {
     let n = f.len();
-    let coupled: Vec<usize> = (0..n)
-        .filter(|&j| f.iter().any(|fi| fi.contains(Sym::StateDot(j))))
-        .collect();
+    let coupled = rates_appearing(f);
     if coupled.is_empty() {
         return Ok(f.to_vec());
     }
@@ -94,10 +92,7 @@ pub(crate) type MassForm = (Vec<Ex>, Vec<usize>, Vec<Vec<Ex>>);
 /// `M ẋ_U = F` with `M_ab = δ_ab − ∂F_a/∂ẋ_b` for an explicit row, `−∂F_a/∂ẋ_b` for an implicit one, and
 /// `F = F(ẋ = 0)`. No symbolic division: the consumers solve `M` numerically, so a pivot that vanishes at some
 /// configuration is never divided by. Returns the rates (the generalised forces in the rows `U`), `U` and `M`.
-pub(crate) fn mass_form(
-    f: &[Ex],
-    implicit_rows: &[bool],
-) -> Result<MassForm, SolveError> {
+pub(crate) fn mass_form(f: &[Ex], implicit_rows: &[bool]) -> Result<MassForm, SolveError> {
     let n = f.len();
     let is_rate = |s: Sym| matches!(s, Sym::StateDot(_));
     let implicit = |i: usize| implicit_rows.get(i).copied().unwrap_or(false);
@@ -162,6 +157,19 @@ pub(crate) fn mass_form(
         f[i] = sym::subst(&f[i], &mut |s| is_rate(s).then(Ex::zero));
     }
     Ok((f, rows, matrix))
+}
+
+/// The states whose rate `ẋ_j` appears in some of `f`, in increasing order (one walk over each expression).
+pub(crate) fn rates_appearing(f: &[Ex]) -> Vec<usize> {
+    let mut seen = std::collections::BTreeSet::new();
+    for fi in f {
+        fi.for_each_sym(&mut |s| {
+            if let Sym::StateDot(j) = s {
+                seen.insert(j);
+            }
+        });
+    }
+    seen.into_iter().collect()
 }
 
 /// Symbolic Gaussian elimination of `a x = b`; pivots on numeric entries first, then on any structurally non-zero

@@ -240,3 +240,24 @@ fn pendulum_of_mtfs_is_regular_when_horizontal() {
         assert!((got - want).abs() < 1e-12, "θ = {theta}: {got} vs {want}");
     }
 }
+
+#[test]
+fn capacitor_behind_a_modulated_gyrator_is_regular_where_the_modulus_vanishes() {
+    // L = ½ (J + c m²) ω² with m = k cos θ: (J + c m²) ω̇ + c m m' ω² = −b ω.
+    let eqs = fixture("fields/gyrator_mgy");
+    let p = eqs.default_params();
+    let (c, j, k, b) = (0.5, 2.0, 1.5, 0.1);
+    for &theta in &[std::f64::consts::FRAC_PI_2, 0.0, 1.2, -2.5] {
+        let w = -0.9;
+        let mut x = vec![0.0; eqs.states.len()];
+        x[state(&eqs, "theta")] = theta;
+        x[state(&eqs, "f_a")] = w;
+        let r = eqs
+            .rates_at(&p, &x, &[], 0.0)
+            .unwrap_or_else(|e| panic!("θ = {theta}: {e}"));
+        let (m, dm) = (k * theta.cos(), -k * theta.sin());
+        let want = (-c * m * dm * w * w - b * w) / (j + c * m * m);
+        let got = r[state(&eqs, "f_a")];
+        assert!((got - want).abs() < 1e-12, "θ = {theta}: {got} vs {want}");
+    }
+}

@@ -426,8 +426,15 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
         ));
         rate_ok.iter_mut().for_each(|ok| *ok = false);
     }
+    // The rate of a mass-matrix row of the velocity states is not `solved[j]` (that holds the generalised force):
+    // it stays `ẋ_j`, and whatever still holds it has no closed form.
+    let kinematic_rows: Vec<usize> = kinematic_mass
+        .iter()
+        .flat_map(|b| b.states.iter().copied())
+        .collect();
     let rate_of = |e: &Ex| {
         sym::subst(e, &mut |s| match s {
+            Sym::StateDot(j) if kinematic_rows.contains(&j) => None,
             Sym::StateDot(j) => solved.get(j).cloned(),
             _ => None,
         })
@@ -521,6 +528,26 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
         &built.mass,
         &mut diags,
     );
+    for term in &mut eqs.energy {
+        if term
+            .value
+            .as_ref()
+            .is_some_and(|v| v.any_sym(&|s| matches!(s, Sym::StateDot(_))))
+        {
+            term.value = None;
+            let d = Diagnostic::warning(
+                codes::ENERGY,
+                format!(
+                    "the power of `{}` is not computed: it needs an acceleration that the equations give only through a mass matrix",
+                    term.element
+                ),
+            );
+            let span = model
+                .node_by_name(&term.element)
+                .and_then(|n| model.spans.nodes.get(n.index()));
+            diags.push(with_span(d, span, "this element"));
+        }
+    }
 
     // Readable forms.
     let output_values: Vec<Ex> = eqs.outputs.iter().map(|o| o.value.clone()).collect();

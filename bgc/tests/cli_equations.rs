@@ -177,13 +177,15 @@ fn nonlinear_model_needs_an_operating_point() {
     assert!(out.is_empty());
     assert!(err.contains("not linear"), "{err}");
     assert!(err.contains("--at"), "{err}");
-    // At theta = 0.3 rad, at rest: the state is [p_mass_x, theta] and d(theta)/dt = p_mass_x / (m l cos(theta)).
+    // At theta = 0.3 rad, at rest: the state is [f_pivot, theta] (the pivot's angular velocity: the bob's
+    // inertias are coupled through l cos(theta), l sin(theta)); m l² ω̇ = -m g l sin θ - b ω.
     let v = ok_json(&["statespace", &corpus("pendulum.bg"), "--at", "theta=0.3"]);
-    assert_eq!(names(&v, "states"), ["p_mass_x", "theta"]);
+    assert_eq!(names(&v, "states"), ["f_pivot", "theta"]);
     let a = matrix(&v, "A");
-    let (m, l, th) = (1.0f64, 0.5f64, 0.3f64);
-    assert!((a[1][0] - 1.0 / (m * l * th.cos())).abs() < 1e-12, "{a:?}");
-    assert_eq!(a[1][1], 0.0);
+    let (m, l, g, b, th) = (1.0f64, 0.5f64, 9.81f64, 0.01f64, 0.3f64);
+    assert!((a[0][0] + b / (m * l * l)).abs() < 1e-12, "{a:?}");
+    assert!((a[0][1] + g * th.cos() / l).abs() < 1e-12, "{a:?}");
+    assert_eq!(a[1], [1.0, 0.0]);
     let (code, _, err) = bgc(&["statespace", &corpus("pendulum.bg"), "--at", "phi=1"]);
     assert_eq!(code, 1);
     assert!(err.contains("unknown state or input `phi`"), "{err}");

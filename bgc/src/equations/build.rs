@@ -74,6 +74,9 @@ pub(crate) struct Built {
     pub rates: Vec<Ex>,
     /// The inertia matrices of the I-fields.
     pub mass: Vec<super::field::MassBlock>,
+    /// Per state: true when its rate equation is the implicit `0 = rates[i]` (the effort balance of a velocity
+    /// state's junction, see [`super::kinematic`]).
+    pub implicit_rows: Vec<bool>,
 }
 
 /// The conversion context of IR expressions.
@@ -94,6 +97,9 @@ pub(crate) struct Ctx<'a> {
     pub field_f: HashMap<NodeIndex, Vec<usize>>,
     /// Per multiport field with states: the bond and own-flow sign of each port.
     pub field_ports: HashMap<NodeIndex, Vec<(EdgeIndex, f64)>>,
+    /// Per node: true for the massless inertia that makes its junction's flow a velocity state
+    /// ([`super::kinematic`]).
+    pub velocity: Vec<bool>,
 }
 
 /// Why an IR expression could not be converted.
@@ -285,8 +291,18 @@ impl Ctx<'_> {
 }
 
 /// Builds the conversion context: 1-port bonds and signs, states.
-pub(crate) fn context<'a>(model: &'a Model, causality: &Causality) -> (Ctx<'a>, Vec<StateSpec>) {
+pub(crate) fn context<'a>(
+    model: &'a Model,
+    causality: &Causality,
+    velocities: &[NodeIndex],
+) -> (Ctx<'a>, Vec<StateSpec>) {
     let n = model.graph.node_count();
+    let mut velocity = vec![false; n];
+    for v in velocities {
+        if let Some(slot) = velocity.get_mut(v.index()) {
+            *slot = true;
+        }
+    }
     let mut port = vec![None; n];
     for node in model.graph.node_indices() {
         let w = &model.graph[node];
@@ -320,19 +336,25 @@ pub(crate) fn context<'a>(model: &'a Model, causality: &Causality) -> (Ctx<'a>, 
             continue;
         }
         let kind = match w.kind {
+            _ if velocity[s.node.index()] => StateKind::Velocity,
             ElementKind::I => StateKind::Momentum,
             _ => StateKind::Displacement,
         };
-        let prefix = if kind == StateKind::Momentum {
-            "p"
-        } else {
-            "q"
+        let prefix = match kind {
+            StateKind::Momentum => "p",
+            StateKind::Velocity => "f",
+            _ => "q",
+        };
+        // A velocity state belongs to its junction (the massless inertia is not the user's element).
+        let owner = match kind {
+            StateKind::Velocity => super::kinematic::junction_of(model, s.node),
+            _ => Some(s.node),
         };
         node_state[s.node.index()] = Some(states.len());
         states.push(StateSpec {
             name: format!("{prefix}_{}", sanitize(&w.name)),
             kind,
-            node: Some(s.node),
+            node: owner,
             var: None,
             port: None,
         });
@@ -346,6 +368,7 @@ pub(crate) fn context<'a>(model: &'a Model, causality: &Causality) -> (Ctx<'a>, 
         field_q: HashMap::new(),
         field_f: HashMap::new(),
         field_ports: HashMap::new(),
+        velocity,
     };
     super::field::add_states(&mut ctx, causality, &mut states);
     for (i, v) in model.vars.iter().enumerate() {
@@ -514,7 +537,19 @@ pub(crate) fn build(
         }
     }
     let mut rates = Vec::new();
-    for st in &states {
+    let mut implicit_rows = vec![false; states.len()];
+    for (i, st) in states.iter().enumerate() {
+        if st.kind == StateKind::Velocity && st.port.is_none() {
+            // The junction's effort balance: the massless inertia's effort, which must vanish.
+            let bond = (0..ctx.node_state.len())
+                .find(|&n| ctx.velocity[n] && ctx.node_state[n] == Some(i))
+                .and_then(|n| ctx.port.get(n).copied().flatten());
+            if let Some((b, _)) = bond {
+                implicit_rows[i] = true;
+                rates.push(Ex::S(Sym::Var(effort_var(b))));
+                continue;
+            }
+        }
         let rate = match (st.kind, st.node, st.var) {
             (StateKind::Momentum, Some(n), _) => ctx
                 .port
@@ -564,6 +599,7 @@ pub(crate) fn build(
         states,
         rates,
         mass,
+        implicit_rows,
     }
 }
 
@@ -595,6 +631,7 @@ fn derivative_law(
         field_q: ctx.field_q.clone(),
         field_f: ctx.field_f.clone(),
         field_ports: ctx.field_ports.clone(),
+        velocity: ctx.velocity.clone(),
     };
     c.energy_expr[node.index()] = Some(Ex::S(placeholder));
     let g = c.convert(&l.rhs)?;
@@ -729,6 +766,11 @@ fn node_defs(
                     let p = ctx
                         .energy_of(node, "p")
                         .map_err(|ConvertError::Unsupported(what)| unsupported(what))?;
+                    if ctx.velocity.get(node.index()).copied().unwrap_or(false) {
+                        // A velocity state: the state is the flow itself.
+                        out.push((flow_var(b), Def::Plain(mul(vec![Ex::Num(s), p]))));
+                        return Ok(out);
+                    }
                     let def = match &w.relation {
                         Relation::Linear(i) => div(p, conv(i)?),
                         Relation::Laws(laws) => {

@@ -169,6 +169,10 @@ pub(crate) fn terms(
     let mut out = Vec::new();
     for node in model.graph.node_indices() {
         let w = &model.graph[node];
+        if ctx.velocity.get(node.index()).copied().unwrap_or(false) {
+            // A massless inertia of a velocity state stores nothing; it is not the user's element.
+            continue;
+        }
         if w.kind.is_field() {
             if let Some((kind, raw)) = super::field::energy(model, ctx, node, mass, diags) {
                 let value = raw.and_then(|r| resolver.expr(&r).ok().map(|v| rate_of(&v)));

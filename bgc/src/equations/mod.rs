@@ -57,6 +57,7 @@ mod coords_symbolic;
 pub(crate) mod dense;
 mod energy;
 mod field;
+mod kinematic;
 mod linear;
 mod naming;
 pub mod newton;
@@ -304,7 +305,13 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
         ));
         return (eqs, diags);
     }
-    let (mut ctx, states) = build::context(model, causality);
+    // Dependent storage behind a modulus that varies with the state: derive on the graph with velocity states.
+    let augmented = kinematic::augment_if_needed(model, causality);
+    let (model, causality, velocities) = match &augmented {
+        Some(a) => (&a.model, &a.causality, a.velocities.as_slice()),
+        None => (model, causality, &[][..]),
+    };
+    let (mut ctx, states) = build::context(model, causality, velocities);
     eqs.derived = model
         .params
         .iter()
@@ -352,7 +359,16 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
             ));
         }
     }
-    let solved = match solve::solve_rates(&implicit) {
+    let mut kinematic_mass = None;
+    let solved_rates = if built.implicit_rows.iter().any(|&r| r) {
+        solve::mass_form(&implicit, &built.implicit_rows).map(|(f, rows, matrix)| {
+            kinematic_mass = Some(kinematic::block(model, &built.states, rows, matrix));
+            f
+        })
+    } else {
+        solve::solve_rates(&implicit)
+    };
+    let solved = match solved_rates {
         Ok(x) => x,
         Err(e) => {
             let msg = match e {
@@ -382,13 +398,21 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
     };
     // A storage in derivative causality whose rate involves an I-field's flows would add to its inertia matrix;
     // that coupling is not supported, and substituting `ẋ` of a mass-matrix row would be wrong.
-    let mass_states: Vec<usize> = built
+    let field_states: Vec<usize> = built
         .mass
         .iter()
         .flat_map(|b| b.states.iter().copied())
         .collect();
+    let mass_states: Vec<usize> = field_states
+        .iter()
+        .copied()
+        .chain(kinematic_mass.iter().flat_map(|b| b.states.iter().copied()))
+        .collect();
     let needs_mass_rate = |e: &Ex| mass_states.iter().any(|&j| e.contains(Sym::StateDot(j)));
-    if implicit.iter().any(needs_mass_rate) {
+    if implicit
+        .iter()
+        .any(|e| field_states.iter().any(|&j| e.contains(Sym::StateDot(j))))
+    {
         diags.push(with_span(
             Diagnostic::error(
                 codes::DERIVATIVE_CAUSALITY,
@@ -402,8 +426,15 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
         ));
         rate_ok.iter_mut().for_each(|ok| *ok = false);
     }
+    // The rate of a mass-matrix row of the velocity states is not `solved[j]` (that holds the generalised force):
+    // it stays `ẋ_j`, and whatever still holds it has no closed form.
+    let kinematic_rows: Vec<usize> = kinematic_mass
+        .iter()
+        .flat_map(|b| b.states.iter().copied())
+        .collect();
     let rate_of = |e: &Ex| {
         sym::subst(e, &mut |s| match s {
+            Sym::StateDot(j) if kinematic_rows.contains(&j) => None,
             Sym::StateDot(j) => solved.get(j).cloned(),
             _ => None,
         })
@@ -497,6 +528,26 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
         &built.mass,
         &mut diags,
     );
+    for term in &mut eqs.energy {
+        if term
+            .value
+            .as_ref()
+            .is_some_and(|v| v.any_sym(&|s| matches!(s, Sym::StateDot(_))))
+        {
+            term.value = None;
+            let d = Diagnostic::warning(
+                codes::ENERGY,
+                format!(
+                    "the power of `{}` is not computed: it needs an acceleration that the equations give only through a mass matrix",
+                    term.element
+                ),
+            );
+            let span = model
+                .node_by_name(&term.element)
+                .and_then(|n| model.spans.nodes.get(n.index()));
+            diags.push(with_span(d, span, "this element"));
+        }
+    }
 
     // Readable forms.
     let output_values: Vec<Ex> = eqs.outputs.iter().map(|o| o.value.clone()).collect();
@@ -504,12 +555,20 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
     for s in &built.states {
         taken.reserve(&s.name);
     }
-    let readable = print::readable(
-        &built,
-        &resolver_rates(&built, &solved, &implicit),
-        &output_values,
-        taken,
-    );
+    let shown_rates = match &kinematic_mass {
+        // The generalised forces of the mass-matrix rows are shown explicit (the junction's balance holds `ẋ`).
+        Some(block) => {
+            let mut r = resolver_rates(&built, &solved, &implicit);
+            for &i in &block.states {
+                if let (Some(slot), Some(v)) = (r.get_mut(i), solved.get(i)) {
+                    *slot = v.clone();
+                }
+            }
+            r
+        }
+        None => resolver_rates(&built, &solved, &implicit),
+    };
+    let readable = print::readable(&built, &shown_rates, &output_values, taken);
     for o in &mut eqs.outputs {
         o.value = readable.alias(&o.value);
     }
@@ -524,12 +583,18 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
     eqs.tear_blocks = tear::blocks(resolver.implicit_loops(), &|s| eqs.sym_name(s));
     eqs.states = built.states;
     eqs.mass = built.mass;
+    eqs.mass.extend(kinematic_mass);
     (eqs, diags)
 }
 
 /// The rates to show: the readable rate when it needs no solve, the solved explicit rate for rates coupled through
 /// derivative causality.
 fn resolver_rates(built: &build::Built, solved: &[Ex], implicit: &[Ex]) -> Vec<Ex> {
+    let coupled = solve::rates_appearing(implicit);
+    if coupled.is_empty() {
+        // No derivative causality: every rate is readable as built.
+        return built.rates.clone();
+    }
     // The coupled rates in intermediates: inline the intermediates that lead to a derivative-causality output,
     // drop those outputs (their ẋ terms are on the left-hand side), and solve the same block.
     let mut leads = vec![None::<bool>; built.defs.len()];
@@ -581,8 +646,7 @@ fn resolver_rates(built: &build::Built, solved: &[Ex], implicit: &[Ex]) -> Vec<E
         .iter()
         .enumerate()
         .map(|(i, r)| {
-            let coupled = implicit.iter().any(|e| e.contains(Sym::StateDot(i)));
-            if coupled {
+            if coupled.binary_search(&i).is_ok() {
                 readable.get(i).cloned().unwrap_or_else(|| r.clone())
             } else {
                 r.clone()

@@ -18,13 +18,22 @@ pub(crate) struct Readable {
     /// Per bond variable: the printed name of its representative.
     pub names: Vec<String>,
     rep: Vec<usize>,
+    /// Per bond variable: the junction velocity state it equals, when it is one (see `equations::kinematic`).
+    velocity: Vec<Option<usize>>,
 }
 
 impl Readable {
-    /// Replaces copies by the variable they copy.
+    /// Replaces copies by the variable they copy (a junction's velocity by its state).
     pub fn alias(&self, e: &Ex) -> Ex {
         sym::subst(e, &mut |s| match s {
-            Sym::Var(v) => self.rep.get(v).map(|&r| Ex::S(Sym::Var(r))),
+            Sym::Var(v) => {
+                self.rep
+                    .get(v)
+                    .map(|&r| match self.velocity.get(r).copied().flatten() {
+                        Some(k) => Ex::S(Sym::State(k)),
+                        None => Ex::S(Sym::Var(r)),
+                    })
+            }
             _ => None,
         })
     }
@@ -50,11 +59,28 @@ pub(crate) fn readable(
         }
         *slot = cur;
     }
+    // The flow of a junction with a velocity state is that state (its massless inertia's bond copies it).
+    let velocity: Vec<Option<usize>> = built
+        .defs
+        .iter()
+        .map(|d| match d {
+            Some(Def::Plain(Ex::S(Sym::State(k))))
+                if built
+                    .states
+                    .get(*k)
+                    .is_some_and(|s| s.kind == StateKind::Velocity && s.port.is_none()) =>
+            {
+                Some(*k)
+            }
+            _ => None,
+        })
+        .collect();
     let mut r = Readable {
         rates: Vec::new(),
         intermediates: Vec::new(),
         names: Vec::new(),
         rep,
+        velocity,
     };
     r.rates = rates.iter().map(|e| r.alias(e)).collect();
     let defs: Vec<Option<(Ex, bool)>> = built

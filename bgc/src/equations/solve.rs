@@ -31,9 +31,7 @@ pub(crate) fn solve_rates(f: &[Ex]) -> Result<Vec<Ex>, SolveError> {
 /// values, such as intermediates) instead of computed from `f`.
 pub(crate) fn solve_rates_with(f: &[Ex], f0_given: Option<&[Ex]>) -> Result<Vec<Ex>, SolveError> {
     let n = f.len();
-    let coupled: Vec<usize> = (0..n)
-        .filter(|&j| f.iter().any(|fi| fi.contains(Sym::StateDot(j))))
-        .collect();
+    let coupled = rates_appearing(f);
     if coupled.is_empty() {
         return Ok(f.to_vec());
     }
@@ -83,6 +81,95 @@ pub(crate) fn solve_rates_with(f: &[Ex], f0_given: Option<&[Ex]>) -> Result<Vec<
         }
     }
     Ok(out)
+}
+
+/// The rates (generalised forces in the block rows), the block's rows and its matrix `M`.
+pub(crate) type MassForm = (Vec<Ex>, Vec<usize>, Vec<Vec<Ex>>);
+
+/// The rates of a system with implicit rows (`0 = F_i(x, u, ẋ)` for the velocity states of
+/// [`super::kinematic`]) in the mass-matrix form: rows whose rate is explicit and free of `ẋ` are substituted
+/// into the others; the remaining rows `U` (the implicit ones and those coupled through `ẋ`) give
+/// `M ẋ_U = F` with `M_ab = δ_ab − ∂F_a/∂ẋ_b` for an explicit row, `−∂F_a/∂ẋ_b` for an implicit one, and
+/// `F = F(ẋ = 0)`. No symbolic division: the consumers solve `M` numerically, so a pivot that vanishes at some
+/// configuration is never divided by. Returns the rates (the generalised forces in the rows `U`), `U` and `M`.
+pub(crate) fn mass_form(f: &[Ex], implicit_rows: &[bool]) -> Result<MassForm, SolveError> {
+    let n = f.len();
+    let is_rate = |s: Sym| matches!(s, Sym::StateDot(_));
+    let implicit = |i: usize| implicit_rows.get(i).copied().unwrap_or(false);
+    let mut f = f.to_vec();
+    // Explicit rows free of ẋ, substituted until none is left to substitute (each round frees more rows).
+    let mut known = vec![false; n];
+    loop {
+        let fresh: Vec<usize> = (0..n)
+            .filter(|&i| !known[i] && !implicit(i) && !f[i].any_sym(&is_rate))
+            .collect();
+        if fresh.is_empty() {
+            break;
+        }
+        fresh.iter().for_each(|&i| known[i] = true);
+        let values: Vec<Option<Ex>> = (0..n)
+            .map(|i| fresh.contains(&i).then(|| f[i].clone()))
+            .collect();
+        for fi in f.iter_mut().filter(|fi| fi.any_sym(&is_rate)) {
+            *fi = sym::subst(fi, &mut |s| match s {
+                Sym::StateDot(j) => values.get(j).cloned().flatten(),
+                _ => None,
+            });
+        }
+    }
+    let mut rows: Vec<usize> = (0..n)
+        .filter(|&i| implicit(i) || (!known[i] && f[i].any_sym(&is_rate)))
+        .collect();
+    for fi in &f {
+        fi.for_each_sym(&mut |s| {
+            if let Sym::StateDot(j) = s
+                && !rows.contains(&j)
+            {
+                rows.push(j);
+            }
+        });
+    }
+    rows.sort_unstable();
+    let mut matrix = Vec::with_capacity(rows.len());
+    for &i in &rows {
+        let mut row = Vec::with_capacity(rows.len());
+        for &j in &rows {
+            let d =
+                sym::diff(&f[i], Sym::StateDot(j)).map_err(|_| SolveError::NotDifferentiable(i))?;
+            if d.any_sym(&is_rate) {
+                return Err(SolveError::Nonlinear(i));
+            }
+            let identity = if i == j && !implicit(i) {
+                Ex::one()
+            } else {
+                Ex::zero()
+            };
+            // −d term by term, so that `M + m` prints as such rather than `-(-M - m)`.
+            let minus_d = match d {
+                Ex::Add(terms) => sym::add(terms.into_iter().map(sym::neg).collect()),
+                other => sym::neg(other),
+            };
+            row.push(sym::add(vec![identity, minus_d]));
+        }
+        matrix.push(row);
+    }
+    for &i in &rows {
+        f[i] = sym::subst(&f[i], &mut |s| is_rate(s).then(Ex::zero));
+    }
+    Ok((f, rows, matrix))
+}
+
+/// The states whose rate `ẋ_j` appears in some of `f`, in increasing order (one walk over each expression).
+pub(crate) fn rates_appearing(f: &[Ex]) -> Vec<usize> {
+    let mut seen = std::collections::BTreeSet::new();
+    for fi in f {
+        fi.for_each_sym(&mut |s| {
+            if let Sym::StateDot(j) = s {
+                seen.insert(j);
+            }
+        });
+    }
+    seen.into_iter().collect()
 }
 
 /// Symbolic Gaussian elimination of `a x = b`; pivots on numeric entries first, then on any structurally non-zero

@@ -1,0 +1,263 @@
+//! Dependent storage behind a modulus that varies with the state: a cart-pole written with modulated
+//! transformers and the same system as an I-field give the same rates at every angle (including those where the
+//! plain sequential causality would divide by a vanishing `l sin θ` or `l cos θ`), both equal the hand-derived
+//! equations of motion, simulate from θ = 0, and linearise at θ = 0 to the hand-derived state space.
+//!
+//! Hand derivation (θ from the downward vertical, bob at `(x + l sin θ, −l cos θ)`):
+//! `T = ½ M v² + ½ m ((v + l cos θ ω)² + (l sin θ ω)²)`, `V = −m g l cos θ`, so
+//! ```text
+//! (M + m) v̇ + m l cos θ ω̇ = F + m l sin θ ω²
+//! m l cos θ v̇ + m l² ω̇    = −m g l sin θ
+//! ```
+
+use bgc::causality::analyse;
+use bgc::diagnostic::Diagnostic;
+use bgc::equations::{Equations, StateSelection, derive, linearise};
+use bgc::lower::{MemoryLoader, lower};
+use bgc::simulate::System;
+use bgc::simulate::input::Signal;
+use bgc::simulate::integrate::{Method, RunOptions, run};
+use bgc::span::SourceMap;
+use std::path::Path;
+
+fn fixture(name: &str) -> Equations {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/fixtures/{name}.bg"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut sources = SourceMap::new();
+    let root = sources.add(format!("{name}.bg"), text);
+    let (models, mut diags) = lower(&mut sources, root, &mut MemoryLoader::new());
+    assert_eq!(models.len(), 1, "{name}: {diags:?}");
+    let (causality, cdiags) = analyse(&models[0]);
+    diags.extend(cdiags);
+    let (eqs, ediags) = derive(&models[0], &causality);
+    diags.extend(ediags);
+    let errors: Vec<&Diagnostic> = diags.iter().filter(|d| d.is_error()).collect();
+    assert!(errors.is_empty(), "{name}: {errors:?}");
+    eqs
+}
+
+fn state(eqs: &Equations, name: &str) -> usize {
+    eqs.states
+        .iter()
+        .position(|s| s.name == name)
+        .unwrap_or_else(|| panic!("no state {name} in {:?}", eqs.states))
+}
+
+const M: f64 = 2.0;
+const MB: f64 = 0.5;
+const L: f64 = 0.6;
+const G: f64 = 9.81;
+
+/// `(v̇, ω̇)` of the hand-derived equations of motion.
+fn hand_rates(theta: f64, w: f64, force: f64) -> (f64, f64) {
+    let (a, b, d) = (M + MB, MB * L * theta.cos(), MB * L * L);
+    let r1 = force + MB * L * theta.sin() * w * w;
+    let r2 = -MB * G * L * theta.sin();
+    let det = a * d - b * b;
+    ((d * r1 - b * r2) / det, (a * r2 - b * r1) / det)
+}
+
+/// The MTF model's state vector for `(x, θ, v, ω)`.
+fn mtf_point(eqs: &Equations, x: f64, theta: f64, v: f64, w: f64) -> Vec<f64> {
+    let mut s = vec![0.0; eqs.states.len()];
+    s[state(eqs, "x")] = x;
+    s[state(eqs, "theta")] = theta;
+    s[state(eqs, "f_cart")] = v;
+    s[state(eqs, "f_pivot")] = w;
+    s
+}
+
+fn field_point(eqs: &Equations, x: f64, theta: f64, v: f64, w: f64) -> Vec<f64> {
+    let mut s = vec![0.0; eqs.states.len()];
+    s[state(eqs, "q_body_1")] = x;
+    s[state(eqs, "q_body_2")] = theta;
+    s[state(eqs, "f_body_1")] = v;
+    s[state(eqs, "f_body_2")] = w;
+    s
+}
+
+#[test]
+fn cart_pole_as_mtfs_equals_the_i_field_and_the_hand_derivation_at_every_angle() {
+    let mtf = fixture("fields/cart_pole_mtf");
+    let field = fixture("fields/cart_pole_field");
+    let (pm, pf) = (mtf.default_params(), field.default_params());
+    let angles = [
+        0.0,
+        std::f64::consts::FRAC_PI_2,
+        std::f64::consts::PI,
+        -std::f64::consts::FRAC_PI_2,
+        1.1,
+        -2.3,
+    ];
+    for &theta in &angles {
+        for &(v, w, force) in &[(0.0, 0.0, 0.0), (0.4, -1.3, 2.0), (-1.1, 0.7, -0.5)] {
+            let a = mtf
+                .rates_at(&pm, &mtf_point(&mtf, 0.2, theta, v, w), &[force], 0.0)
+                .unwrap_or_else(|e| panic!("MTF model at θ = {theta}: {e}"));
+            let b = field
+                .rates_at(&pf, &field_point(&field, 0.2, theta, v, w), &[force], 0.0)
+                .unwrap_or_else(|e| panic!("I-field model at θ = {theta}: {e}"));
+            let (dv, dw) = hand_rates(theta, w, force);
+            let pairs = [
+                (a[state(&mtf, "f_cart")], b[state(&field, "f_body_1")], dv),
+                (a[state(&mtf, "f_pivot")], b[state(&field, "f_body_2")], dw),
+                (a[state(&mtf, "theta")], b[state(&field, "q_body_2")], w),
+                (a[state(&mtf, "x")], b[state(&field, "q_body_1")], v),
+            ];
+            for (k, (got_mtf, got_field, want)) in pairs.into_iter().enumerate() {
+                let tol = 1e-12 * (1.0 + want.abs());
+                assert!(
+                    (got_mtf - want).abs() < tol && (got_field - want).abs() < tol,
+                    "θ = {theta}, v = {v}, ω = {w}, F = {force}, rate {k}: MTF {got_mtf}, field {got_field}, hand {want}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn cart_pole_as_mtfs_has_the_mass_matrix_form_not_a_quotient() {
+    let eqs = fixture("fields/cart_pole_mtf");
+    assert_eq!(eqs.mass.len(), 1, "{:?}", eqs.mass);
+    let block = &eqs.mass[0];
+    let mut rows: Vec<&str> = block
+        .states
+        .iter()
+        .map(|&i| eqs.states[i].name.as_str())
+        .collect();
+    rows.sort_unstable();
+    assert_eq!(rows, ["f_cart", "f_pivot"]);
+    // No rate divides by anything but parameters: the configuration enters M, which is solved numerically.
+    let text = bgc::equations::to_text(&eqs);
+    for line in text.lines().filter(|l| l.contains("d/dt")) {
+        assert!(
+            !line.contains("/(l*sin")
+                && !line.contains("/(l*cos")
+                && !line.contains("/sin")
+                && !line.contains("/cos"),
+            "{line}"
+        );
+    }
+}
+
+#[test]
+fn cart_pole_as_mtfs_simulates_from_the_bottom() {
+    let eqs = fixture("fields/cart_pole_mtf");
+    let signals = vec![Signal::parse("1").unwrap_or_else(|e| panic!("{e}"))];
+    let (system, _) =
+        System::new(&eqs, eqs.default_params(), signals).unwrap_or_else(|e| panic!("{e}"));
+    let opts = RunOptions {
+        t_end: 0.5,
+        dt_out: 0.05,
+        method: Method::Tsit45,
+        rtol: 1e-10,
+        atol: 1e-12,
+        max_steps: 1_000_000,
+    };
+    let traj = run(&system, &mtf_point(&eqs, 0.0, 0.0, 0.0, 0.0), &opts)
+        .unwrap_or_else(|e| panic!("simulate from θ = 0: {e}"));
+    let col = |name: &str| {
+        traj.columns
+            .iter()
+            .position(|c| c == name || c.starts_with(&format!("{name} ")))
+            .unwrap_or_else(|| panic!("no column {name} in {:?}", traj.columns))
+    };
+    let (v, w) = (col("f_cart"), col("f_pivot"));
+    let offset = traj.columns.len() - traj.rows[1].len();
+    // At t = 0 the hand-derived accelerations under F = 1 N; the first sample follows them to first order.
+    let (dv, dw) = hand_rates(0.0, 0.0, 1.0);
+    let t1 = traj.times[1];
+    let row = &traj.rows[1];
+    assert!(
+        (row[v - offset] / t1 - dv).abs() < 0.05 * dv.abs()
+            && (row[w - offset] / t1 - dw).abs() < 0.05 * dw.abs(),
+        "{:?} at t = {t1}: want v̇ {dv}, ω̇ {dw}",
+        row
+    );
+    assert!(traj.rows.iter().flatten().all(|v| v.is_finite()));
+}
+
+#[test]
+fn cart_pole_as_mtfs_linearises_at_the_bottom_to_the_hand_derived_state_space() {
+    let eqs = fixture("fields/cart_pole_mtf");
+    let p = eqs.default_params();
+    let x0 = mtf_point(&eqs, 0.0, 0.0, 0.0, 0.0);
+    let ss = linearise(&eqs, StateSelection::All, &p, &x0, &[0.0], 0.0)
+        .unwrap_or_else(|e| panic!("{e}"));
+    // At θ = 0: det = M m l²; v̇ = (m g / M) θ + F / M, ω̇ = −(M + m) g θ / (M l) − F / (M l).
+    let (iv, iw, it, ix) = (
+        state(&eqs, "f_cart"),
+        state(&eqs, "f_pivot"),
+        state(&eqs, "theta"),
+        state(&eqs, "x"),
+    );
+    let want = [
+        (iv, it, MB * G / M),
+        (iw, it, -(M + MB) * G / (M * L)),
+        (it, iw, 1.0),
+        (ix, iv, 1.0),
+    ];
+    for (r, row) in ss.a.iter().enumerate() {
+        for (c, &got) in row.iter().enumerate() {
+            let w = want
+                .iter()
+                .find(|&&(wr, wc, _)| wr == r && wc == c)
+                .map_or(0.0, |t| t.2);
+            assert!((got - w).abs() < 1e-12, "A[{r}][{c}] = {got}, want {w}");
+        }
+    }
+    let b_want = |r: usize| match r {
+        _ if r == iv => 1.0 / M,
+        _ if r == iw => -1.0 / (M * L),
+        _ => 0.0,
+    };
+    for (r, row) in ss.b.iter().enumerate() {
+        assert!((row[0] - b_want(r)).abs() < 1e-12, "B[{r}] = {}", row[0]);
+    }
+}
+
+#[test]
+fn pendulum_of_mtfs_is_regular_when_horizontal() {
+    // bgc/tests/corpus/pendulum.bg: x = l sin θ, y = −l cos θ, pivot friction b. m l² ω̇ = −m g l sin θ − b ω.
+    let eqs = fixture("../corpus/pendulum");
+    let p = eqs.default_params();
+    let (m, l, g, b) = (1.0, 0.5, 9.81, 0.01);
+    for &theta in &[
+        std::f64::consts::FRAC_PI_2,
+        -std::f64::consts::FRAC_PI_2,
+        0.0,
+        2.0,
+    ] {
+        let w = 0.8;
+        let mut x = vec![0.0; eqs.states.len()];
+        x[state(&eqs, "theta")] = theta;
+        x[state(&eqs, "f_pivot")] = w;
+        let r = eqs
+            .rates_at(&p, &x, &[], 0.0)
+            .unwrap_or_else(|e| panic!("θ = {theta}: {e}"));
+        let want = (-m * g * l * theta.sin() - b * w) / (m * l * l);
+        let got = r[state(&eqs, "f_pivot")];
+        assert!((got - want).abs() < 1e-12, "θ = {theta}: {got} vs {want}");
+    }
+}
+
+#[test]
+fn capacitor_behind_a_modulated_gyrator_is_regular_where_the_modulus_vanishes() {
+    // L = ½ (J + c m²) ω² with m = k cos θ: (J + c m²) ω̇ + c m m' ω² = −b ω.
+    let eqs = fixture("fields/gyrator_mgy");
+    let p = eqs.default_params();
+    let (c, j, k, b) = (0.5, 2.0, 1.5, 0.1);
+    for &theta in &[std::f64::consts::FRAC_PI_2, 0.0, 1.2, -2.5] {
+        let w = -0.9;
+        let mut x = vec![0.0; eqs.states.len()];
+        x[state(&eqs, "theta")] = theta;
+        x[state(&eqs, "f_a")] = w;
+        let r = eqs
+            .rates_at(&p, &x, &[], 0.0)
+            .unwrap_or_else(|e| panic!("θ = {theta}: {e}"));
+        let (m, dm) = (k * theta.cos(), -k * theta.sin());
+        let want = (-c * m * dm * w * w - b * w) / (j + c * m * m);
+        let got = r[state(&eqs, "f_a")];
+        assert!((got - want).abs() < 1e-12, "θ = {theta}: {got} vs {want}");
+    }
+}

@@ -1,0 +1,171 @@
+//! The scaling families of `benches/equations_scaling.rs` at small sizes, against hand-derived values: a resistor
+//! ladder with chained algebraic loops, outputs defined through earlier outputs, and a chain of modulated
+//! transformers whose inertias are all rigidly coupled (one in integral causality, the rest dependent).
+
+use bgc::causality::analyse;
+use bgc::diagnostic::Diagnostic;
+use bgc::equations::{Equations, derive};
+use bgc::lower::{MemoryLoader, lower};
+use bgc::span::SourceMap;
+
+fn equations(text: &str) -> Equations {
+    let mut sources = SourceMap::new();
+    let root = sources.add("scaling.bg".to_string(), text.to_string());
+    let (models, mut diags) = lower(&mut sources, root, &mut MemoryLoader::new());
+    assert_eq!(models.len(), 1, "{diags:?}");
+    let (causality, cdiags) = analyse(&models[0]);
+    diags.extend(cdiags);
+    let (eqs, ediags) = derive(&models[0], &causality);
+    diags.extend(ediags);
+    let errors: Vec<&Diagnostic> = diags.iter().filter(|d| d.is_error()).collect();
+    assert!(errors.is_empty(), "{errors:?}");
+    eqs
+}
+
+/// `Se u -> 1 s1 (R r) -> 0 n1 (R 1·r) -> 1 s2 (R r) -> 0 n2 (R 2·r) -> … -> C c`: every rung's resistors form an
+/// algebraic loop with the next rung's.
+pub fn ladder(rungs: usize) -> String {
+    let mut s = String::from(
+        "model ladder {\n    domain electrical;\n    input u [V];\n    param r = 1 [Ohm];\n    param c = 1e-3 [F];\n    Se src = u;\n    C cap = c;\n",
+    );
+    let mut chain = String::from("src");
+    for k in 1..=rungs {
+        s += &format!("    1 s{k};\n    R rs{k} = r;\n    0 n{k};\n    R rp{k} = {k}*r;\n");
+        s += &format!("    bond s{k} -> rs{k};\n    bond n{k} -> rp{k};\n");
+        chain += &format!(" -> s{k} -> n{k}");
+    }
+    s += &format!("    bond {chain} -> cap;\n    output i1 [A] = f(rs1);\n}}\n");
+    s
+}
+
+/// A mass on a spring with outputs `y_1 = sin((q/q0)²) + cos(q/q0)`, `y_i = sin(y_{i-1}·y_{i-1}) + cos(y_{i-1})`.
+pub fn output_chain(levels: usize) -> String {
+    let mut s = String::from(
+        "model outchain {\n    domain translational;\n    param m = 1 [kg];\n    param k = 1 [N/m];\n    param q0 = 1 [m];\n    1 j;\n    I mass = m;\n    C spring = 1/k;\n    bond j -> mass;\n    bond j -> spring;\n    output y1 [1] = sin(q(spring)*q(spring)/(q0*q0)) + cos(q(spring)/q0);\n",
+    );
+    for i in 2..=levels {
+        s += &format!(
+            "    output y{i} [1] = sin(y{}*y{}) + cos(y{});\n",
+            i - 1,
+            i - 1,
+            i - 1
+        );
+    }
+    s + "}\n"
+}
+
+/// `Se tau -> 1 j0 {I J, R b} -> MTF g1 -> 1 j1 {I J} -> … -> MTF gN -> 1 jN {I J}`, every modulus
+/// `1 + 0.1 cos(theta)` with `theta = ∫ f(j0)`.
+pub fn mtf_chain(n: usize) -> String {
+    let mut s = String::from(
+        "model mtfchain {\n    domain rotational;\n    param J = 1 [kg m^2];\n    param b = 0.1 [N m s/rad];\n    input tau [N m];\n    var theta [rad] = int(f(j0));\n    Se drive = tau;\n    1 j0;\n    I i0 = J;\n    R r0 = b;\n    bond drive -> j0;\n    bond j0 -> i0;\n    bond j0 -> r0;\n",
+    );
+    for k in 1..=n {
+        s += &format!(
+            "    1 j{k};\n    I i{k} = J;\n    MTF g{k} = 1 + 0.1*cos(theta);\n    bond j{} -> g{k} -> j{k};\n    bond j{k} -> i{k};\n",
+            k - 1
+        );
+    }
+    s + "}\n"
+}
+
+fn state(eqs: &Equations, name: &str) -> usize {
+    eqs.states
+        .iter()
+        .position(|s| s.name == name)
+        .unwrap_or_else(|| panic!("no state {name} in {:?}", eqs.states))
+}
+
+#[test]
+fn ladder_of_two_rungs_is_the_hand_derived_divider() {
+    // Node voltages v1, v2 = q/c: (u − v1)/r = v1/r + (v1 − v2)/r gives v1 = (u + v2)/3; the capacitor's current
+    // is (v1 − v2)/r − v2/(2r) = (u/3 − 7 v2/6)/r, and i1 = (u − v1)/r = (2u/3 − v2/3)/r.
+    let eqs = equations(&ladder(2));
+    let p = eqs.default_params();
+    let (r, c) = (1.0, 1e-3);
+    for &(q, u) in &[(0.0, 1.0), (2e-3, -0.5), (-1e-3, 3.0)] {
+        let v2 = q / c;
+        let rates = eqs
+            .rates_at(&p, &[q], &[u], 0.0)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let want = (u / 3.0 - 7.0 * v2 / 6.0) / r;
+        assert!(
+            (rates[0] - want).abs() < 1e-12 * (1.0 + want.abs()),
+            "{rates:?} vs {want}"
+        );
+        let y = eqs
+            .outputs_at(&p, &[q], &[u], 0.0)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let want = (2.0 * u / 3.0 - v2 / 3.0) / r;
+        assert!(
+            (y[0] - want).abs() < 1e-12 * (1.0 + want.abs()),
+            "{y:?} vs {want}"
+        );
+    }
+}
+
+#[test]
+fn outputs_through_earlier_outputs_are_the_composition() {
+    let levels = 6;
+    let eqs = equations(&output_chain(levels));
+    let p = eqs.default_params();
+    let q = 0.7;
+    let mut x = vec![0.0; eqs.states.len()];
+    x[state(&eqs, "q_spring")] = q;
+    let y = eqs
+        .outputs_at(&p, &x, &[], 0.0)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut want = (q * q).sin() + q.cos();
+    for (i, got) in y.iter().enumerate() {
+        assert!((got - want).abs() < 1e-12, "y{}: {got} vs {want}", i + 1);
+        want = (want * want).sin() + want.cos();
+    }
+}
+
+/// `(ω, ω̇)` of the MTF chain by Lagrange: with `n = 1 + 0.1 cos θ` and `ω = θ̇ = f(j0)`, junction `k` turns at
+/// `ω/nᵏ` (a transformer's output flow is its input flow over its modulus), so `T = ½ m(θ) ω²` with
+/// `m = J Σ_{k=0..N} n^(−2k)`, and `m ω̇ + ½ m'(θ) ω² = τ − b ω`.
+fn mtf_chain_lagrange(n_mtf: usize, theta: f64, w: f64, tau: f64) -> f64 {
+    let (j, b) = (1.0, 0.1);
+    let n = 1.0 + 0.1 * theta.cos();
+    let dn = -0.1 * theta.sin();
+    let m: f64 = (0..=n_mtf).map(|k| j * n.powi(-2 * k as i32)).sum();
+    let dm: f64 = (0..=n_mtf)
+        .map(|k| j * (-2.0 * k as f64) * n.powi(-2 * k as i32 - 1) * dn)
+        .sum();
+    (tau - b * w - 0.5 * dm * w * w) / m
+}
+
+#[test]
+fn chain_of_modulated_transformers_follows_lagrange() {
+    for n_mtf in [3, 50] {
+        let eqs = equations(&mtf_chain(n_mtf));
+        let p = eqs.default_params();
+        // The velocity state is that of the chain's far end, whose flow the others follow as products.
+        let far = format!("f_j{n_mtf}");
+        let (iw, it) = (state(&eqs, &far), state(&eqs, "theta"));
+        for &(theta, w0, tau) in &[(0.3, 0.5, 1.0), (2.0, -1.2, 0.0), (-1.0, 0.1, -2.0)] {
+            let n = 1.0 + 0.1 * f64::cos(theta);
+            let dn = -0.1 * f64::sin(theta);
+            let mut x = vec![0.0; eqs.states.len()];
+            x[it] = theta;
+            x[iw] = w0 / n.powi(n_mtf as i32);
+            let rates = eqs
+                .rates_at(&p, &x, &[tau], 0.0)
+                .unwrap_or_else(|e| panic!("{e}"));
+            assert!(
+                (rates[it] - w0).abs() < 1e-12 * (1.0 + w0.abs()),
+                "θ̇ {rates:?}"
+            );
+            let dw0 = mtf_chain_lagrange(n_mtf, theta, w0, tau);
+            // f_jN = ω n^(−N): its rate is ω̇ n^(−N) − N ω n^(−N−1) n' θ̇.
+            let k = n_mtf as i32;
+            let want = dw0 * n.powi(-k) - f64::from(k) * w0 * n.powi(-k - 1) * dn * w0;
+            assert!(
+                (rates[iw] - want).abs() < 1e-10 * (1.0 + want.abs()),
+                "N = {n_mtf}, θ = {theta}: {} vs {want}",
+                rates[iw]
+            );
+        }
+    }
+}

@@ -3,6 +3,7 @@
 mod cli_support;
 mod codegen_support;
 mod equations_support;
+mod lsp_support;
 
 mod causality_allow;
 mod causality_models;
@@ -36,5 +37,7 @@ mod front_end_props;
 mod hostile_props;
 mod language_examples;
 mod loops_globalised;
+mod lsp_props;
+mod lsp_session;
 mod syntax_fixtures;
 mod syntax_fuzz;

@@ -39,5 +39,6 @@ mod language_examples;
 mod loops_globalised;
 mod lsp_props;
 mod lsp_session;
+mod lsp_stdio;
 mod syntax_fixtures;
 mod syntax_fuzz;

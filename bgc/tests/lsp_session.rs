@@ -333,6 +333,18 @@ fn hover_shows_parameters_elements_causality_equations_and_units() {
         "{trunk}"
     );
 
+    // The gearbox: a ratio of input over output speed gives f_out = f_in/r_g and, conserving power,
+    // e_in = e_out/r_g. Its port variables are named `gear_in`/`gear_out`, so the inertia `gear_in` shows none.
+    let gear = hover_text(&mut client, &doc, find(&text, "TF gear", 0, 3));
+    assert!(gear.contains("- `f_gear_out = f_rotor/r_g`"), "{gear}");
+    assert!(gear.contains("- `e_gear_in = e_gear_out/r_g`"), "{gear}");
+    let gear_in = hover_text(&mut client, &doc, find(&text, "I gear_in", 0, 3));
+    assert!(
+        gear_in.contains("- derivative causality (no state of its own)"),
+        "{gear_in}"
+    );
+    assert!(!gear_in.contains("e_gear_in ="), "{gear_in}");
+
     // Units in their SI form: the radian is dimensionless.
     let unit = hover_text(&mut client, &doc, find(&text, "[rad/s]", 0, 1));
     assert_eq!(unit, "unit `[rad/s]` = 1/s (SI)");

@@ -222,15 +222,32 @@ fn equation_lines(m: &ModelFacts, node: NodeIndex) -> Vec<String> {
             out.push(format!("`d/dt {} = {}`", spec.name, expr_text(eqs, rate)));
         }
     }
-    let base = m.model.graph[node].name.replace('.', "_");
+    let graph = &m.model.graph;
+    let base = graph[node].name.replace('.', "_");
+    // A transformer or gyrator `T` names the variables of its ports `T_in` and `T_out`; an element whose own name
+    // is one of those would be confused with them, so it is shown none.
+    let bases: Vec<String> = if graph[node].kind.is_two_port() {
+        vec![format!("{base}_in"), format!("{base}_out")]
+    } else if graph.node_weights().any(|n| {
+        n.kind.is_two_port() && {
+            let t = n.name.replace('.', "_");
+            base == format!("{t}_in") || base == format!("{t}_out")
+        }
+    }) {
+        Vec::new()
+    } else {
+        vec![base]
+    };
     let named_after = |n: &str| {
         ["e_", "f_"].iter().any(|p| {
             n.strip_prefix(p).is_some_and(|rest| {
-                rest == base
-                    || rest
-                        .strip_prefix(base.as_str())
-                        .and_then(|r| r.strip_prefix('_'))
-                        .is_some_and(|r| r.parse::<u32>().is_ok())
+                bases.iter().any(|base| {
+                    rest == base
+                        || rest
+                            .strip_prefix(base.as_str())
+                            .and_then(|r| r.strip_prefix('_'))
+                            .is_some_and(|r| r.parse::<u32>().is_ok())
+                })
             })
         })
     };

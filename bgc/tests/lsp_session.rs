@@ -682,3 +682,71 @@ fn bad_requests_are_answered_with_errors_and_the_session_goes_on() {
     );
     assert_eq!(client.shutdown(), Ok(()));
 }
+
+const DERIVATIVE: &str = "model d {
+    domain translational;
+    param m = 1 [kg];
+    input v_in [m/s];
+    Sf src = v_in;
+    I m0 = m;
+    bond src -> m0;
+    output force [N] = e(m0);
+}
+";
+
+fn codes(found: &[lsp_types::Diagnostic]) -> Vec<String> {
+    found.iter().map(code).collect()
+}
+
+#[test]
+fn equation_stage_errors_are_published_which_bgc_check_leaves_out() {
+    // A flow source drives an inertia: its effort is m dv/dt, so the output `force` needs the derivative of the
+    // input, which the equations stage refuses (BG0602); `bgc check` stops at causality (BG0510).
+    let mut client = Client::start();
+    let doc = uri(&unsaved("derivative.bg"));
+    client.open(&doc, DERIVATIVE);
+    let found = client.diagnostics(&doc, 1);
+    assert_eq!(codes(&found), ["BG0510", "BG0602"]);
+    assert_eq!(found[1].severity, Some(DiagnosticSeverity::ERROR));
+    assert!(
+        found[1]
+            .message
+            .starts_with("output `force` needs the time derivative of input `v_in`")
+    );
+    assert_eq!(client.shutdown(), Ok(()));
+}
+
+#[test]
+fn large_documents_get_the_front_end_first_and_the_equations_after() {
+    // Every document counts as large here: the front end's findings come first, the equation stage's with the
+    // second publication of the same version.
+    let options = bgc::lsp::Options {
+        background_above: 1,
+        ..bgc::lsp::Options::default()
+    };
+    let mut client = Client::start_with(options);
+    let doc = uri(&unsaved("derivative.bg"));
+    client.open(&doc, DERIVATIVE);
+    assert_eq!(codes(&client.diagnostics(&doc, 1)), ["BG0510"]);
+    assert_eq!(codes(&client.diagnostics(&doc, 1)), ["BG0510", "BG0602"]);
+    // Requests then see the equations: the inertia's hover shows its intermediate.
+    let m0 = hover_text(&mut client, &doc, find(DERIVATIVE, "I m0", 0, 3));
+    assert!(
+        m0.contains("- derivative causality (no state of its own)"),
+        "{m0}"
+    );
+    assert!(m0.contains("- `e_m0 = d/dt "), "{m0}");
+    // A change: again the front end first, then everything.
+    let p = find(DERIVATIVE, "param m = 1", 0, 10);
+    client.change(
+        &doc,
+        2,
+        vec![edit(
+            range(p.line, p.character, p.line, p.character + 1),
+            "2",
+        )],
+    );
+    assert_eq!(codes(&client.diagnostics(&doc, 2)), ["BG0510"]);
+    assert_eq!(codes(&client.diagnostics(&doc, 2)), ["BG0510", "BG0602"]);
+    assert_eq!(client.shutdown(), Ok(()));
+}

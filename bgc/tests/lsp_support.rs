@@ -54,8 +54,12 @@ pub struct Client {
 impl Client {
     /// Starts a server and completes `initialize` / `initialized`.
     pub fn start() -> Client {
+        Client::start_with(bgc::lsp::Options::default())
+    }
+
+    pub fn start_with(options: bgc::lsp::Options) -> Client {
         let (server_side, client_side) = Connection::memory();
-        let server = std::thread::spawn(move || bgc::lsp::serve(&server_side, Vec::new()));
+        let server = std::thread::spawn(move || bgc::lsp::serve(&server_side, options));
         let mut client = Client {
             connection: client_side,
             server: Some(server),

@@ -127,7 +127,11 @@ pub fn lsp(include: &[PathBuf]) -> Status {
         .iter()
         .map(|d| std::path::absolute(d).unwrap_or_else(|_| d.clone()))
         .collect();
-    match bgc::lsp::run_stdio(include) {
+    let options = bgc::lsp::Options {
+        include,
+        ..bgc::lsp::Options::default()
+    };
+    match bgc::lsp::run_stdio(options) {
         Ok(()) => Status::Ok,
         Err(e) => {
             stderrln(&format!("error: bgc lsp: {e}"));

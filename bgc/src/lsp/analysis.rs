@@ -2,10 +2,10 @@
 //! read from it.
 //!
 //! [`analyse`] is a pure function of the text and what the loader serves for the imports. It runs what `bgc
-//! check` runs (parse, lower with the imports, causality of each model when lowering found no error) and then the
-//! equations stage on each model whose causality has no error, so that the editor shows the equation stage's
-//! findings too; it keeps the syntax trees of every file for the index of names, and each model's causality and
-//! equations for hover.
+//! check` runs (parse, lower with the imports, causality of each model when lowering found no error;
+//! [`analyse_front`]) and then the equations stage on each model whose causality has no error
+//! ([`derive_equations`]), so that the editor shows the equation stage's findings too; it keeps the syntax trees of
+//! every file for the index of names, and each model's causality and equations for hover.
 
 use super::index::Index;
 use crate::causality::Causality;
@@ -22,7 +22,9 @@ pub struct ModelFacts {
     pub model: ir::Model,
     /// `None` when lowering found errors.
     pub causality: Option<Causality>,
-    /// `None` when an earlier stage found errors.
+    /// True when the causality has no error, so that the equations can be derived.
+    pub causal: bool,
+    /// `None` when an earlier stage found errors or the equations are not derived yet.
     pub equations: Option<Equations>,
 }
 
@@ -38,6 +40,8 @@ pub struct Analysis {
     pub diagnostics: Vec<Diagnostic>,
     pub models: Vec<ModelFacts>,
     pub index: Index,
+    /// True once [`derive_equations`] ran: `diagnostics` then hold the equation stage's findings too.
+    pub equations_done: bool,
 }
 
 impl Analysis {
@@ -57,8 +61,32 @@ impl Analysis {
     }
 }
 
-/// Analyses the text of the file named `name` (a path; imports are resolved relative to it by `loader`).
+/// Analyses the text of the file named `name` (a path; imports are resolved relative to it by `loader`): the
+/// front end ([`analyse_front`]) and then the equations ([`derive_equations`]).
 pub fn analyse(name: &str, text: &str, loader: &mut dyn SourceLoader) -> Analysis {
+    let mut analysis = analyse_front(name, text, loader);
+    derive_equations(&mut analysis);
+    analysis
+}
+
+/// The models of the root file: the equations of each model whose causality has no error, and their findings.
+/// The equations stage is the expensive one (seconds for ten thousand elements), so the server may run it apart
+/// from the rest.
+pub fn derive_equations(analysis: &mut Analysis) {
+    for facts in &mut analysis.models {
+        let Some(causality) = facts.causality.as_ref().filter(|_| facts.causal) else {
+            continue;
+        };
+        let (equations, mut found) = crate::equations::derive(&facts.model, causality);
+        crate::lower::add_instance_context(&facts.model, &mut found);
+        analysis.diagnostics.extend(found);
+        facts.equations = Some(equations);
+    }
+    analysis.equations_done = true;
+}
+
+/// Parse, lowering and causality of the text (what `bgc check` runs), and the index of names.
+pub fn analyse_front(name: &str, text: &str, loader: &mut dyn SourceLoader) -> Analysis {
     let mut sources = SourceMap::new();
     let root = sources.add(name, text);
     let (lowered, mut diagnostics) = crate::lower::lower(&mut sources, root, loader);
@@ -69,6 +97,7 @@ pub fn analyse(name: &str, text: &str, loader: &mut dyn SourceLoader) -> Analysi
             models.push(ModelFacts {
                 model,
                 causality: None,
+                causal: false,
                 equations: None,
             });
             continue;
@@ -77,16 +106,11 @@ pub fn analyse(name: &str, text: &str, loader: &mut dyn SourceLoader) -> Analysi
         crate::lower::add_instance_context(&model, &mut found);
         let causal = !has_errors(&found);
         diagnostics.extend(found);
-        let equations = causal.then(|| {
-            let (equations, mut found) = crate::equations::derive(&model, &causality);
-            crate::lower::add_instance_context(&model, &mut found);
-            diagnostics.extend(found);
-            equations
-        });
         models.push(ModelFacts {
             model,
             causality: Some(causality),
-            equations,
+            causal,
+            equations: None,
         });
     }
     let files: Vec<(FileId, ast::File)> = sources
@@ -101,5 +125,6 @@ pub fn analyse(name: &str, text: &str, loader: &mut dyn SourceLoader) -> Analysi
         diagnostics,
         models,
         index,
+        equations_done: false,
     }
 }

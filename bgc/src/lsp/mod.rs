@@ -12,6 +12,7 @@
 //! a copy of the standard library for go-to-definition); the analysis is a pure function of the texts.
 
 pub mod analysis;
+pub mod background;
 pub mod completion;
 pub mod diagnostics;
 pub mod document;
@@ -66,9 +67,27 @@ pub fn capabilities() -> ServerCapabilities {
     }
 }
 
+/// How the server runs.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// The directories imports are also looked up in (`bgc -I DIR lsp`), as for the other commands.
+    pub include: Vec<PathBuf>,
+    /// A document whose models have more elements and junctions than this gets the equation stage's findings in a
+    /// second publication, derived on a thread of its own, so that the rest of its diagnostics come at once.
+    pub background_above: usize,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options {
+            include: Vec::new(),
+            background_above: 1000,
+        }
+    }
+}
+
 /// Initialises the connection and serves it until the client says `shutdown` and `exit` (or goes away).
-/// `include` are the directories imports are also looked up in (`bgc -I DIR lsp`), as for the other commands.
-pub fn serve(connection: &Connection, include: Vec<PathBuf>) -> Result<(), String> {
+pub fn serve(connection: &Connection, options: Options) -> Result<(), String> {
     let init = serde_json::json!({
         "capabilities": capabilities(),
         "serverInfo": ServerInfo {
@@ -79,13 +98,13 @@ pub fn serve(connection: &Connection, include: Vec<PathBuf>) -> Result<(), Strin
     let fail = |e: lsp_server::ProtocolError| format!("initialisation failed: {e}");
     let (id, _params) = connection.initialize_start().map_err(fail)?;
     connection.initialize_finish(id, init).map_err(fail)?;
-    server::Server::new(include).run(connection)
+    server::Server::new(options, connection).run(connection)
 }
 
 /// Serves on standard input and output.
-pub fn run_stdio(include: Vec<PathBuf>) -> Result<(), String> {
+pub fn run_stdio(options: Options) -> Result<(), String> {
     let (connection, io) = Connection::stdio();
-    let served = serve(&connection, include);
+    let served = serve(&connection, options);
     drop(connection);
     io.join()
         .map_err(|e| format!("the connection failed: {e}"))?;

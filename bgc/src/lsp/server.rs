@@ -6,7 +6,9 @@
 //! A panic while answering a request is caught and answered as an internal error; the server keeps its state and
 //! goes on.
 
-use super::analysis::{Analysis, analyse};
+use super::Options;
+use super::analysis::{Analysis, analyse_front, derive_equations};
+use super::background::{Job, Worker};
 use super::document::Documents;
 use super::files::{OverlayLoader, document_key, uri_to_path};
 use super::{completion, diagnostics, edits, hover, navigation};
@@ -29,29 +31,45 @@ use serde_json::Value;
 use std::collections::{BTreeSet, HashMap};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
+use std::str::FromStr;
+use std::sync::Arc;
 
 /// The state of a session.
 pub struct Server {
     documents: Documents,
-    /// The latest analysis of each open document, by URI.
-    analyses: HashMap<String, Analysis>,
+    /// The latest analysis of each open document, by URI, with the version it analysed.
+    analyses: HashMap<String, (i32, Analysis)>,
     /// Open documents whose analysis is older than their text (or than a file they import).
     stale: BTreeSet<String>,
     /// Documents closed since the last refresh, whose diagnostics are to be cleared.
     closed: Vec<Uri>,
     include: Vec<PathBuf>,
+    /// Documents with more elements and junctions than this get their equations from the worker.
+    background_above: usize,
+    worker: Worker,
 }
 
 type Answer = Result<Value, (ErrorCode, String)>;
 
 impl Server {
-    pub fn new(include: Vec<PathBuf>) -> Server {
+    pub fn new(options: Options, connection: &Connection) -> Server {
+        let sender = connection.sender.clone();
+        let publish = Arc::new(move |uri: &str, version: i32, analysis: &Analysis| {
+            if let Ok(uri) = Uri::from_str(uri) {
+                let found = diagnostics::document_diagnostics(analysis);
+                let params = PublishDiagnosticsParams::new(uri, found, Some(version));
+                let n = Notification::new(PublishDiagnostics::METHOD.to_string(), params);
+                let _ = sender.send(n.into());
+            }
+        });
         Server {
             documents: Documents::default(),
             analyses: HashMap::new(),
             stale: BTreeSet::new(),
             closed: Vec::new(),
-            include,
+            include: options.include,
+            background_above: options.background_above,
+            worker: Worker::start(publish),
         }
     }
 
@@ -82,6 +100,7 @@ impl Server {
                         return Ok(());
                     }
                     self.refresh(connection);
+                    self.collect_done();
                     let response = self.respond(request);
                     send(connection, response.into());
                 }
@@ -144,8 +163,7 @@ impl Server {
             DocumentSymbolRequest::METHOD => {
                 let p: lsp_types::DocumentSymbolParams = parse(params)?;
                 let found = self
-                    .analyses
-                    .get(p.text_document.uri.as_str())
+                    .analysis(&p.text_document.uri)
                     .map(|a| DocumentSymbolResponse::Nested(navigation::document_symbols(a)));
                 to_value(found)
             }
@@ -168,8 +186,7 @@ impl Server {
                 let p: lsp_types::CodeActionParams = parse(params)?;
                 let uri = &p.text_document.uri;
                 let found = self
-                    .analyses
-                    .get(uri.as_str())
+                    .analysis(uri)
                     .map(|a| edits::code_actions(a, uri, p.range));
                 to_value(found)
             }
@@ -184,7 +201,7 @@ impl Server {
     fn at(&self, p: &TextDocumentPositionParams) -> Option<(&Analysis, usize)> {
         let uri = &p.text_document.uri;
         let document = self.documents.get(uri)?;
-        let analysis = self.analyses.get(uri.as_str())?;
+        let (_, analysis) = self.analyses.get(uri.as_str())?;
         Some((analysis, document.lines.offset(&document.text, p.position)))
     }
 
@@ -195,7 +212,21 @@ impl Server {
     }
 
     fn all_analyses(&self) -> Vec<&Analysis> {
-        self.analyses.values().collect()
+        self.analyses.values().map(|(_, a)| a).collect()
+    }
+
+    fn analysis(&self, uri: &Uri) -> Option<&Analysis> {
+        self.analyses.get(uri.as_str()).map(|(_, a)| a)
+    }
+
+    /// Takes the worker's analyses with equations that are still of the documents' current versions.
+    fn collect_done(&mut self) {
+        for (uri, version, analysis) in self.worker.take_done() {
+            let current = self.documents.iter().find(|(u, _)| u.as_str() == uri);
+            if current.is_some_and(|(_, d)| d.version == version) {
+                self.analyses.insert(uri, (version, analysis));
+            }
+        }
     }
 
     fn hover(&self, p: &TextDocumentPositionParams) -> Option<Hover> {
@@ -262,16 +293,18 @@ impl Server {
         let Some(name) = document_name(uri) else {
             return;
         };
-        for (other, analysis) in &self.analyses {
+        for (other, (_, analysis)) in &self.analyses {
             if diagnostics::imported_names(analysis).any(|n| n == name) {
                 self.stale.insert(other.clone());
             }
         }
     }
 
-    /// Analyses the stale documents and publishes their diagnostics.
+    /// Analyses the stale documents and publishes their diagnostics: all of them for a small document; for a large
+    /// one those of the front end now and all of them when the worker has derived the equations.
     fn refresh(&mut self, connection: &Connection) {
         for uri in std::mem::take(&mut self.closed) {
+            self.worker.forget(uri.as_str());
             publish(connection, uri, Vec::new(), None);
         }
         if self.stale.is_empty() {
@@ -293,14 +326,34 @@ impl Server {
                 overlay: &overlay,
             };
             let text = &doc.text;
-            let Ok(analysis) = catch_unwind(AssertUnwindSafe(|| analyse(&name, text, &mut loader)))
-            else {
+            let front = catch_unwind(AssertUnwindSafe(|| analyse_front(&name, text, &mut loader)));
+            let Ok(mut analysis) = front else {
                 eprintln!("bgc lsp: the analysis of {key} failed; its previous results stay");
                 continue;
             };
+            let size: usize = analysis
+                .models
+                .iter()
+                .map(|m| m.model.graph.node_count())
+                .sum();
+            let version = doc.version;
+            let job = if size > self.background_above {
+                Some(Job {
+                    version,
+                    analysis: analysis.clone(),
+                })
+            } else {
+                if catch_unwind(AssertUnwindSafe(|| derive_equations(&mut analysis))).is_err() {
+                    eprintln!("bgc lsp: the equations of {key} failed; the other diagnostics stay");
+                }
+                None
+            };
             let found = diagnostics::document_diagnostics(&analysis);
-            publish(connection, uri.clone(), found, Some(doc.version));
-            self.analyses.insert(key, analysis);
+            let uri = uri.clone();
+            self.worker.publish(&key, version, job, || {
+                publish(connection, uri, found, Some(version));
+            });
+            self.analyses.insert(key, (version, analysis));
         }
     }
 }

@@ -428,6 +428,12 @@ fn definitions_and_references_within_a_file_and_into_the_standard_library() {
         std::fs::read_to_string(on_disk).ok().as_deref(),
         Some(std_text)
     );
+    // The import itself leads to the file.
+    let import = definition(&mut client, &model, Position::new(0, 9));
+    assert_eq!(
+        (import.uri, import.range),
+        (component.uri.clone(), range(0, 0, 0, 0))
+    );
     // A port of an instance, and an override's parameter.
     let port = definition(&mut client, &model, find(source, "s.a", 0, 2));
     let a = find(std_text, "port a = j;", 0, 5);
@@ -460,6 +466,10 @@ fn importers_see_unsaved_text_and_rename_reaches_them() {
     client.open(&main, MAIN);
     assert_eq!(client.diagnostics(&lib, 1), vec![]);
     assert_eq!(client.diagnostics(&main, 1), vec![]);
+    assert_eq!(
+        definition(&mut client, &main, Position::new(0, 10)),
+        Location::new(lib.clone(), range(0, 0, 0, 0))
+    );
 
     // A misspelling in the library, not saved: the importer's diagnostics show it at its import.
     let k_use = find(LIB, "1 / k;", 0, 4);

@@ -10,6 +10,7 @@ use super::files::source_uri;
 use super::index::{Hit, SymbolKind};
 use crate::lower::STD_DISPLAY_NAME;
 use crate::span::{FileId, Span};
+use crate::syntax::ast::Item;
 use lsp_types::{DocumentSymbol, Location, TextEdit, Uri, WorkspaceEdit};
 use std::collections::HashMap;
 
@@ -47,11 +48,41 @@ fn find(analysis: &Analysis, key: &SymbolKey) -> Option<usize> {
     })
 }
 
-/// Where the name at an offset is declared.
+/// Where the name at an offset is declared; on an import, the start of the imported file.
 pub fn definition(analysis: &Analysis, file: FileId, offset: usize) -> Option<Location> {
+    if let Some(location) = imported_file(analysis, file, offset) {
+        return Some(location);
+    }
     let (id, _) = symbol_at(analysis, file, offset)?;
     let s = analysis.index.symbols.get(id)?;
     Lines::new(analysis).location(s.name_span)
+}
+
+/// The file an import at the offset loaded (the standard library for `"std.bg"`).
+fn imported_file(analysis: &Analysis, file: FileId, offset: usize) -> Option<Location> {
+    let (_, tree) = analysis.files.iter().find(|(id, _)| *id == file)?;
+    let import = tree.items.iter().find_map(|item| match item {
+        Item::Import(imp)
+            if (imp.span.start as usize) <= offset && offset <= imp.span.end as usize =>
+        {
+            Some(imp)
+        }
+        _ => None,
+    })?;
+    let wanted = if import.path == crate::lower::STD_NAME {
+        STD_DISPLAY_NAME.to_string()
+    } else {
+        let importer = analysis.sources.get(file)?.name.clone();
+        let dir = std::path::Path::new(&importer).parent()?.to_path_buf();
+        crate::lower::normalize(&dir.join(&import.path))
+            .display()
+            .to_string()
+    };
+    let target = analysis.sources.files().find(|(_, f)| f.name == wanted)?;
+    Some(Location::new(
+        source_uri(&target.1.name)?,
+        lsp_types::Range::default(),
+    ))
 }
 
 /// The spans naming the declaration in one analysis: its declaration (when asked for) and every reference.

@@ -7,7 +7,7 @@ use proptest::prelude::*;
 
 /// Pieces to insert: names, punctuation that breaks statements, line breaks, and characters of one and two
 /// UTF-16 units.
-const PIECES: [&str; 12] = [
+const PIECES: [&str; 14] = [
     "J_m",
     "k",
     ";",
@@ -17,6 +17,8 @@ const PIECES: [&str; 12] = [
     " ",
     "µ",
     "𝜔",
+    "𝜔µ",
+    "Ω𝜔 x",
     "bond a -> b;",
     "//",
     "= 1 [N m]",
@@ -25,6 +27,9 @@ const PIECES: [&str; 12] = [
 #[derive(Clone, Debug)]
 struct Edit {
     at: prop::sample::Index,
+    /// Instead of `at`: this many characters after the end of the previous insertion, so that edits land on the
+    /// same line behind characters of two UTF-16 units, where byte, character and UTF-16 columns all differ.
+    near: Option<usize>,
     delete: usize,
     insert: &'static str,
     /// Sent in the same notification as the previous edit.
@@ -34,12 +39,14 @@ struct Edit {
 fn edit_strategy() -> impl Strategy<Value = Edit> {
     (
         any::<prop::sample::Index>(),
+        prop::option::weighted(0.6, 0usize..4),
         0usize..6,
         prop::sample::select(&PIECES[..]),
         any::<bool>(),
     )
-        .prop_map(|(at, delete, insert, batched)| Edit {
+        .prop_map(|(at, near, delete, insert, batched)| Edit {
             at,
+            near,
             delete,
             insert,
             batched,
@@ -55,7 +62,7 @@ fn position(text: &str, offset: usize) -> Position {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 
     #[test]
     fn diagnostics_after_random_edits_are_those_of_a_fresh_analysis(
@@ -68,13 +75,21 @@ proptest! {
         client.open(&doc, &text);
         let mut version = 1;
         let mut batch = Vec::new();
+        let mut previous_end = 0usize;
         for e in &edits {
             let boundaries: Vec<usize> = text.char_indices().map(|(i, _)| i).chain([text.len()]).collect();
-            let start_index = e.at.index(boundaries.len());
+            let start_index = match e.near {
+                Some(d) => {
+                    let after = boundaries.iter().position(|&b| b >= previous_end).unwrap_or(0);
+                    (after + d).min(boundaries.len() - 1)
+                }
+                None => e.at.index(boundaries.len()),
+            };
             let start = boundaries[start_index];
             let end = boundaries[(start_index + e.delete).min(boundaries.len() - 1)];
             let range = lsp_types::Range::new(position(&text, start), position(&text, end));
             text.replace_range(start..end, e.insert);
+            previous_end = start + e.insert.len();
             if !e.batched && !batch.is_empty() {
                 version += 1;
                 client.change(&doc, version, std::mem::take(&mut batch));

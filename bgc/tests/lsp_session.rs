@@ -345,6 +345,11 @@ fn hover_shows_parameters_elements_causality_equations_and_units() {
     );
     assert!(!gear_in.contains("e_gear_in ="), "{gear_in}");
 
+    // An integrated flow: the motor angle integrates the flow of `j_m`, which is the rotor's.
+    let theta = hover_text(&mut client, &doc, find(&text, "var theta_m", 0, 5));
+    assert!(theta.contains("- unit [rad] = 1 in SI"), "{theta}");
+    assert!(theta.contains("- `d/dt theta_m = f_rotor`"), "{theta}");
+
     // Units in their SI form: the radian is dimensionless.
     let unit = hover_text(&mut client, &doc, find(&text, "[rad/s]", 0, 1));
     assert_eq!(unit, "unit `[rad/s]` = 1/s (SI)");

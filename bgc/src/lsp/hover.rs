@@ -50,7 +50,8 @@ fn symbol(analysis: &Analysis, id: usize) -> String {
         SymbolKind::Element => element_facts(analysis, s),
         SymbolKind::Instance => instance_facts(analysis, s),
         SymbolKind::Model | SymbolKind::Component => model_facts(analysis, id, s),
-        SymbolKind::Var | SymbolKind::Port => Vec::new(),
+        SymbolKind::Var => var_facts(analysis, s),
+        SymbolKind::Port => Vec::new(),
     };
     if !facts.is_empty() {
         out.push('\n');
@@ -124,6 +125,26 @@ fn signal_facts(analysis: &Analysis, s: &Symbol) -> Vec<String> {
         }
     }
     out.dedup();
+    out
+}
+
+/// An integrated flow: its unit and the rate of its state.
+fn var_facts(analysis: &Analysis, s: &Symbol) -> Vec<String> {
+    let mut out = Vec::new();
+    for m in &analysis.models {
+        for (i, (var, span)) in m.model.vars.iter().zip(&m.model.spans.vars).enumerate() {
+            if !contains(*span, s.name_span) {
+                continue;
+            }
+            out.push(format!("unit [{}] = {} in SI", var.unit_text, var.unit));
+            let Some(eqs) = &m.equations else { continue };
+            for (spec, rate) in eqs.states.iter().zip(&eqs.rates) {
+                if spec.var == Some(i) {
+                    out.push(format!("`d/dt {} = {}`", spec.name, expr_text(eqs, rate)));
+                }
+            }
+        }
+    }
     out
 }
 

@@ -201,6 +201,14 @@ enum Command {
         #[arg(long)]
         no_runtime: bool,
     },
+    /// Run the language server for editors: the Language Server Protocol on standard input and output
+    /// (diagnostics as you type, hover, go to definition, references, rename, outline, formatting, completion,
+    /// quick fixes). Editors start it; see editors/README.md.
+    Lsp {
+        /// Speak on standard input and output (the only transport; accepted because editors pass it).
+        #[arg(long)]
+        stdio: bool,
+    },
     /// Print .bg files in the canonical layout (in place), or with --check report the files that differ.
     Fmt {
         #[arg(required = true)]
@@ -238,6 +246,7 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
         Command::Check { files, format } => commands::check(&files, format, color),
         Command::Rust { file, no_runtime } => commands::rust(&file, !no_runtime, color),
         Command::Fmt { files, check } => commands::fmt(&files, check, color),
+        Command::Lsp { stdio: _ } => commands::lsp(&cli.include),
         Command::Causality {
             file,
             model,

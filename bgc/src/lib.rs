@@ -13,6 +13,8 @@ pub mod draw;
 pub mod equations;
 pub mod ir;
 pub mod lower;
+#[cfg(feature = "lsp")]
+pub mod lsp;
 pub mod simulate;
 pub mod span;
 pub mod symbolic;

@@ -237,6 +237,11 @@ pub fn parse_symbol(symbol: &str) -> Option<Unit> {
     None
 }
 
+/// Every unit symbol, with its unit (the prefixable ones also take the SI prefixes `p n µ m c d k M G`).
+pub fn symbols() -> impl Iterator<Item = (&'static str, Unit)> {
+    EXACT.iter().chain(PREFIXABLE.iter()).copied()
+}
+
 /// Parses a bracketed unit of the AST (`[N m/rad]`, `[kg m^2]`, `[1]`).
 pub fn parse_unit(u: &UnitExpr) -> Result<Unit, UnitError> {
     let mut out = Unit::ONE;

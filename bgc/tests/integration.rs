@@ -3,6 +3,7 @@
 mod cli_support;
 mod codegen_support;
 mod equations_support;
+mod lsp_support;
 
 mod causality_allow;
 mod causality_models;
@@ -42,5 +43,8 @@ mod language_examples;
 mod loops_globalised;
 mod loops_warm_start;
 mod pipeline_props;
+mod lsp_props;
+mod lsp_session;
+mod lsp_stdio;
 mod syntax_fixtures;
 mod syntax_fuzz;

@@ -119,6 +119,27 @@ fn fmt_one(path: &Path, check_only: bool, color: bool) -> std::io::Result<bool> 
     Ok(true)
 }
 
+/// `bgc lsp`: serves until the editor ends the session.
+pub fn lsp(include: &[PathBuf]) -> Status {
+    // The server outlives the working directory it was started in, as far as the editor is concerned: the
+    // include directories are made absolute once.
+    let include = include
+        .iter()
+        .map(|d| std::path::absolute(d).unwrap_or_else(|_| d.clone()))
+        .collect();
+    let options = bgc::lsp::Options {
+        include,
+        ..bgc::lsp::Options::default()
+    };
+    match bgc::lsp::run_stdio(options) {
+        Ok(()) => Status::Ok,
+        Err(e) => {
+            stderrln(&format!("error: bgc lsp: {e}"));
+            Status::UsageOrIo
+        }
+    }
+}
+
 fn emit(sources: &SourceMap, diags: &[Diagnostic], format: DiagFormat, color: bool) {
     match format {
         DiagFormat::Text => stderr(&render::to_text(sources, diags, color)),

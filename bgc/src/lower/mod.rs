@@ -41,7 +41,7 @@ use petgraph::Direction;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-pub use imports::{STD_NAME, STD_SOURCE, normalize};
+pub use imports::{STD_DISPLAY_NAME, STD_NAME, STD_SOURCE, normalize};
 pub use instances::add_instance_context;
 
 /// Where lowering gets the text of imported files. The loader decides which file an import names and what

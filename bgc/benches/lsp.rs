@@ -1,0 +1,174 @@
+//! The language server's answer to a keystroke: from a `didChange` to the `publishDiagnostics` of that version
+//! (parse, lower, causality and equations of the document, and the conversion of the findings), over an
+//! in-memory connection. Two documents: models/back_support.bg, and a generated chain of 10,001 elements and
+//! junctions (`Se -> 1 -> {I, R} -> 0 -> C -> 1 -> ...`, 2,000 stages).
+//!
+//! Each iteration changes a parameter's default (`1` <-> `2`), so every analysis is a full one. The time is that of
+//! the first publication for the new version: for back_support all its diagnostics; for the chain, which is above
+//! the server's size for deriving equations on the loop (`Options::background_above`), those of parse, lowering
+//! and causality, while the equations follow from the worker thread.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use lsp_server::{Connection, Message, Notification, Request, RequestId};
+use lsp_types::notification::{
+    DidChangeTextDocument, DidOpenTextDocument, Exit, Initialized, Notification as _,
+    PublishDiagnostics,
+};
+use lsp_types::{Position, Range, TextDocumentContentChangeEvent, Uri};
+use std::time::Duration;
+
+const STAGES: usize = 2000;
+
+fn chain() -> String {
+    let mut out = String::from(
+        "model chain {\n    domain translational;\n    param m = 1 [kg] \"mass of each stage\";\n    \
+         param d = 1 [N s/m] \"damping of each stage\";\n    param k = 100 [N/m] \"stiffness of each stage\";\n    \
+         input force [N] \"drive\";\n    Se src = force;\n",
+    );
+    let mut prev = "src".to_string();
+    for i in 0..STAGES {
+        out.push_str(&format!(
+            "    1 v{i};\n    I m{i} = m;\n    R d{i} = d;\n    0 f{i};\n    C k{i} = 1 / k;\n    \
+             bond {prev} -> v{i} -> m{i}, d{i}, f{i};\n    bond f{i} -> k{i};\n"
+        ));
+        prev = format!("f{i}");
+    }
+    out.push_str("}\n");
+    out
+}
+
+struct Session {
+    client: Connection,
+    server: Option<std::thread::JoinHandle<Result<(), String>>>,
+    uri: Uri,
+    version: i32,
+}
+
+impl Session {
+    fn start(name: &str, text: &str) -> Session {
+        let (server_side, client) = Connection::memory();
+        let server =
+            std::thread::spawn(move || bgc::lsp::serve(&server_side, bgc::lsp::Options::default()));
+        let init = Request::new(
+            RequestId::from(1),
+            "initialize".into(),
+            serde_json::json!({ "processId": null, "rootUri": null, "capabilities": {} }),
+        );
+        client.sender.send(init.into()).expect("server running");
+        client.receiver.recv().expect("initialize answered");
+        let n = Notification::new(Initialized::METHOD.into(), serde_json::json!({}));
+        client.sender.send(n.into()).expect("server running");
+        let path = std::env::temp_dir().join("bgc-lsp-bench").join(name);
+        let uri = bgc::lsp::files::path_to_uri(&path).expect("a file URI");
+        let open = Notification::new(
+            DidOpenTextDocument::METHOD.into(),
+            serde_json::json!({ "textDocument": { "uri": uri, "languageId": "bg", "version": 1, "text": text } }),
+        );
+        client.sender.send(open.into()).expect("server running");
+        let mut s = Session {
+            client,
+            server: Some(server),
+            uri,
+            version: 1,
+        };
+        s.wait(1);
+        s
+    }
+
+    /// Waits for the diagnostics of a version; returns how many there are.
+    fn wait(&mut self, version: i32) -> usize {
+        loop {
+            let Ok(Message::Notification(n)) = self.client.receiver.recv() else {
+                panic!("the server answers with notifications only here");
+            };
+            if n.method != PublishDiagnostics::METHOD {
+                continue;
+            }
+            let p: lsp_types::PublishDiagnosticsParams =
+                serde_json::from_value(n.params).expect("publishDiagnostics");
+            if p.version == Some(version) {
+                return p.diagnostics.len();
+            }
+        }
+    }
+
+    /// Replaces one character at `at` and waits for the new diagnostics.
+    fn change(&mut self, at: Position, text: &str) -> usize {
+        self.version += 1;
+        let change = TextDocumentContentChangeEvent {
+            range: Some(Range::new(at, Position::new(at.line, at.character + 1))),
+            range_length: None,
+            text: text.to_string(),
+        };
+        let n = Notification::new(
+            DidChangeTextDocument::METHOD.into(),
+            serde_json::json!({
+                "textDocument": { "uri": self.uri, "version": self.version },
+                "contentChanges": [change],
+            }),
+        );
+        self.client.sender.send(n.into()).expect("server running");
+        self.wait(self.version)
+    }
+}
+
+impl Drop for Session {
+    fn drop(&mut self) {
+        let shutdown = Request::new(
+            RequestId::from(2),
+            "shutdown".into(),
+            serde_json::Value::Null,
+        );
+        let _ = self.client.sender.send(shutdown.into());
+        let _ = self.client.receiver.recv();
+        let _ = self
+            .client
+            .sender
+            .send(Notification::new(Exit::METHOD.into(), ()).into());
+        if let Some(h) = self.server.take() {
+            let _ = h.join();
+        }
+    }
+}
+
+/// The position of the first digit after `needle`.
+fn digit_after(text: &str, needle: &str) -> Position {
+    let at = text.find(needle).expect("needle") + needle.len();
+    let line = text[..at].matches('\n').count() as u32;
+    let start = text[..at].rfind('\n').map_or(0, |i| i + 1);
+    Position::new(line, text[start..at].encode_utf16().count() as u32)
+}
+
+fn bench(c: &mut Criterion) {
+    let back_support = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../models/back_support.bg"
+    ))
+    .expect("models/back_support.bg");
+    let chain = chain();
+    let mut group = c.benchmark_group("lsp_diagnostics_after_change");
+    group.sample_size(20);
+    group.measurement_time(Duration::from_secs(10));
+    for (name, text, needle) in [
+        ("back_support", back_support.as_str(), "param r_g = 16"),
+        ("chain_10001_elements", chain.as_str(), "param d = "),
+    ] {
+        let mut session = Session::start(&format!("{name}.bg"), text);
+        let at = digit_after(text, needle);
+        let mut flip = false;
+        // The original digit is restored every second iteration; the findings stay those of a valid model.
+        let original = &text[text.find(needle).expect("needle") + needle.len()..][..1];
+        let expected = session.change(at, original);
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                flip = !flip;
+                let found = session.change(at, if flip { "2" } else { original });
+                assert_eq!(found, expected);
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,112 @@
+//! Positions: byte offsets of bgc's spans and the LSP's (line, UTF-16 code unit) positions.
+//!
+//! The protocol counts columns in UTF-16 code units by default (the client may offer others; this server always
+//! asks for UTF-16, which every client supports), so a line with `µ` or `Ω` has columns that differ from both its
+//! byte and its character offsets. A position past the end of its line is clamped to the line's end, and one
+//! inside a character that takes two UTF-16 units is moved to the start of that character, as the protocol asks.
+
+use lsp_types::{Position, Range};
+
+/// The starts of the lines of one text, for conversions in both directions.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct LineIndex {
+    /// Byte offset of the start of each line (the first is 0).
+    starts: Vec<usize>,
+    len: usize,
+}
+
+impl LineIndex {
+    pub fn new(text: &str) -> LineIndex {
+        let starts = std::iter::once(0)
+            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
+        LineIndex {
+            starts,
+            len: text.len(),
+        }
+    }
+
+    /// The position of a byte offset (clamped to the text, and moved back to a character boundary).
+    pub fn position(&self, text: &str, offset: usize) -> Position {
+        let mut offset = offset.min(text.len());
+        while !text.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        let line = match self.starts.binary_search(&offset) {
+            Ok(l) => l,
+            Err(l) => l.saturating_sub(1),
+        };
+        let start = self.starts.get(line).copied().unwrap_or(0);
+        let column: usize = text
+            .get(start..offset)
+            .map(|s| s.chars().map(char::len_utf16).sum())
+            .unwrap_or(0);
+        Position::new(line as u32, column as u32)
+    }
+
+    /// The byte offset of a position: a line past the end is the end of the text, a column past the end of its
+    /// line is the line's end (before its line break).
+    pub fn offset(&self, text: &str, position: Position) -> usize {
+        let Some(&start) = self.starts.get(position.line as usize) else {
+            return self.len.min(text.len());
+        };
+        let end = self
+            .starts
+            .get(position.line as usize + 1)
+            .map(|&next| next - 1)
+            .unwrap_or(text.len());
+        let line = text.get(start..end).unwrap_or("");
+        let line = line.strip_suffix('\r').unwrap_or(line);
+        let mut units = 0usize;
+        for (i, c) in line.char_indices() {
+            let width = c.len_utf16();
+            if units + width > position.character as usize {
+                return start + i;
+            }
+            units += width;
+        }
+        start + line.len()
+    }
+
+    /// The range of a byte range.
+    pub fn range(&self, text: &str, bytes: std::ops::Range<usize>) -> Range {
+        Range::new(
+            self.position(text, bytes.start),
+            self.position(text, bytes.end.max(bytes.start)),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn columns_count_utf16_units() {
+        // `µ` is 2 bytes and 1 UTF-16 unit; `𝜔` (U+1D714) is 4 bytes and 2 units.
+        let text = "a µ𝜔 b\nsecond\n";
+        let index = LineIndex::new(text);
+        let b = text.find('b').unwrap_or(0);
+        assert_eq!(index.position(text, b), Position::new(0, 6));
+        assert_eq!(index.offset(text, Position::new(0, 6)), b);
+        let second = text.find("second").unwrap_or(0);
+        assert_eq!(index.position(text, second + 3), Position::new(1, 3));
+        assert_eq!(index.offset(text, Position::new(1, 3)), second + 3);
+    }
+
+    #[test]
+    fn positions_out_of_range_are_clamped() {
+        let text = "ab\r\ncd";
+        let index = LineIndex::new(text);
+        // Past the end of line 0: before its `\r\n`.
+        assert_eq!(index.offset(text, Position::new(0, 99)), 2);
+        // Past the last line: the end of the text.
+        assert_eq!(index.offset(text, Position::new(7, 0)), text.len());
+        // Inside the surrogate pair of `𝜔`: the start of the character.
+        let text = "𝜔x";
+        let index = LineIndex::new(text);
+        assert_eq!(index.offset(text, Position::new(0, 1)), 0);
+        assert_eq!(index.offset(text, Position::new(0, 2)), 4);
+        assert_eq!(index.position(text, 2), Position::new(0, 0));
+    }
+}

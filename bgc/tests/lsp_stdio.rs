@@ -1,0 +1,93 @@
+//! `bgc lsp` as editors run it: a child process speaking JSON-RPC with `Content-Length` framing on its standard
+//! input and output.
+
+use crate::lsp_support::{back_support_path, back_support_text, uri};
+use std::io::Write;
+use std::process::{Command, Stdio};
+
+fn frame(message: &serde_json::Value) -> Vec<u8> {
+    let body = message.to_string();
+    format!("Content-Length: {}\r\n\r\n{body}", body.len()).into_bytes()
+}
+
+/// Splits the framed output into messages.
+fn messages(mut out: &[u8]) -> Vec<serde_json::Value> {
+    let mut found = Vec::new();
+    while let Some(end) = out.windows(4).position(|w| w == b"\r\n\r\n") {
+        let header = String::from_utf8_lossy(&out[..end]).to_string();
+        let length: usize = header
+            .trim()
+            .strip_prefix("Content-Length: ")
+            .and_then(|n| n.parse().ok())
+            .expect("a Content-Length header");
+        let body = &out[end + 4..end + 4 + length];
+        found.push(serde_json::from_slice(body).expect("a JSON body"));
+        out = &out[end + 4 + length..];
+    }
+    found
+}
+
+#[test]
+fn a_session_over_stdio_ends_with_status_zero() {
+    let doc = uri(&back_support_path());
+    let session = [
+        serde_json::json!({"jsonrpc": "2.0", "id": 1, "method": "initialize",
+            "params": {"processId": null, "rootUri": null, "capabilities": {}}}),
+        serde_json::json!({"jsonrpc": "2.0", "method": "initialized", "params": {}}),
+        serde_json::json!({"jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {"textDocument":
+            {"uri": doc, "languageId": "bg", "version": 1, "text": back_support_text()}}}),
+        serde_json::json!({"jsonrpc": "2.0", "id": 2, "method": "textDocument/hover", "params":
+            {"textDocument": {"uri": doc}, "position": {"line": 21, "character": 11}}}),
+        serde_json::json!({"jsonrpc": "2.0", "id": 3, "method": "shutdown", "params": null}),
+        serde_json::json!({"jsonrpc": "2.0", "method": "exit", "params": null}),
+    ];
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bgc"))
+        .args(["lsp", "--stdio"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("bgc lsp starts");
+    let mut stdin = child.stdin.take().expect("stdin");
+    for m in &session {
+        stdin.write_all(&frame(m)).expect("the server reads");
+    }
+    drop(stdin);
+    let out = child.wait_with_output().expect("bgc lsp ends");
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let received = messages(&out.stdout);
+    let by_id = |id: i64| {
+        received
+            .iter()
+            .find(|m| m["id"] == id)
+            .unwrap_or_else(|| panic!("response {id} in {received:#?}"))
+    };
+    assert_eq!(by_id(1)["result"]["serverInfo"]["name"], "bgc");
+    let hover = by_id(2)["result"]["contents"]["value"]
+        .as_str()
+        .unwrap_or("");
+    assert!(
+        hover.contains("parameter `k_g` of model `back_support`: gearbox stiffness (C1 = 1/k_g)"),
+        "{hover}"
+    );
+    assert!(
+        hover.contains("`k_g` = 26400 N m (SI; declared in [N m/rad])"),
+        "{hover}"
+    );
+    assert_eq!(by_id(3)["result"], serde_json::Value::Null);
+    let published: Vec<&serde_json::Value> = received
+        .iter()
+        .filter(|m| m["method"] == "textDocument/publishDiagnostics")
+        .collect();
+    assert_eq!(published.len(), 1);
+    let codes: Vec<&str> = published[0]["params"]["diagnostics"]
+        .as_array()
+        .map(|a| a.iter().filter_map(|d| d["code"].as_str()).collect())
+        .unwrap_or_default();
+    assert_eq!(codes, ["BG0510", "BG0510"]);
+}

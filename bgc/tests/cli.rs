@@ -98,19 +98,15 @@ fn back_support_model_checks_clean() {
     let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models");
     let run = bgc(&models, &["check", "--color", "never", "back_support.bg"]);
     assert_eq!(run.status, 0, "{}", run.transcript());
-    // Exactly the two derivative-causality warnings of the paper's graph: J_g behind J_m on the motor junction, and
-    // the trunk inertia driven by the trunk-velocity source.
+    // The paper's graph has two derivative-causality findings (J_g behind J_m on the motor junction, the trunk
+    // inertia driven by the trunk-velocity source); the model acknowledges both with `allow`, so none is printed.
     assert_eq!(
         run.stderr.matches("warning[BG0510]").count(),
-        2,
+        0,
         "{}",
         run.transcript()
     );
-    assert!(
-        run.stderr.contains("0 errors, 2 warnings"),
-        "{}",
-        run.transcript()
-    );
+    assert!(!run.stderr.contains("warning"), "{}", run.transcript());
     insta::assert_snapshot!(run.transcript());
 }
 

@@ -16,7 +16,7 @@ use crate::cli_support;
 use crate::codegen_support;
 
 use cli_support::{bgc, corpus};
-use codegen_support::rustc::{NALGEBRA, rustc};
+use codegen_support::rustc::build_and_run;
 use codegen_support::{generate_text, scratch};
 
 pub(crate) const ROOTS: [(f64, f64); 4] = [
@@ -103,53 +103,7 @@ fn the_generated_solve_loops_solves_the_steep_diode_loop() {
         &text,
         bgc::codegen::rust::Options { runtime: false },
     );
-    for (name, source) in [("nalgebra", NALGEBRA), ("libm", LIBM_STD)] {
-        std::fs::write(dir.join(format!("{name}.rs")), source).unwrap_or_else(|e| panic!("{e}"));
-        let out = rustc(
-            &dir,
-            &[
-                "--crate-type",
-                "rlib",
-                "--crate-name",
-                name,
-                &format!("{name}.rs"),
-            ],
-        );
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-    }
-    std::fs::write(dir.join("diode.module"), &code).unwrap_or_else(|e| panic!("{e}"));
-    std::fs::write(dir.join("main.rs"), MAIN).unwrap_or_else(|e| panic!("{e}"));
-    let out = rustc(
-        &dir,
-        &[
-            "--crate-type",
-            "bin",
-            "--crate-name",
-            "diode",
-            "--extern",
-            "nalgebra=libnalgebra.rlib",
-            "--extern",
-            "libm=liblibm.rlib",
-            "-L",
-            ".",
-            "-o",
-            "diode",
-            "main.rs",
-        ],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let run = std::process::Command::new(dir.join("diode"))
-        .output()
-        .unwrap_or_else(|e| panic!("{e}"));
-    let printed = String::from_utf8_lossy(&run.stdout).into_owned();
+    let printed = build_and_run(&dir, "diode", &code, MAIN, LIBM_STD);
     let _ = std::fs::remove_dir_all(&dir);
     let lines: Vec<&str> = printed.lines().collect();
     assert_eq!(lines.len(), ROOTS.len(), "{printed}");

@@ -5,7 +5,7 @@
 //! starts that are useless (NaN, far off), and the residual is checked against the diode law.
 
 use crate::cli_support::{Csv, corpus, simulate};
-use crate::codegen_support::rustc::{NALGEBRA, rustc};
+use crate::codegen_support::rustc::build_and_run;
 use crate::codegen_support::{generate_text, scratch};
 use crate::loops_globalised::{LIBM_STD, ROOTS};
 
@@ -67,45 +67,7 @@ fn the_generated_solve_loops_from_follows_the_diode_loop_from_the_last_solution(
         &text,
         bgc::codegen::rust::Options { runtime: false },
     );
-    for (name, source) in [("nalgebra", NALGEBRA), ("libm", LIBM_STD)] {
-        std::fs::write(dir.join(format!("{name}.rs")), source).unwrap_or_else(|e| panic!("{e}"));
-        let lib = format!("{name}.rs");
-        let out = rustc(&dir, &["--crate-type", "rlib", "--crate-name", name, &lib]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-    }
-    std::fs::write(dir.join("diode.module"), &code).unwrap_or_else(|e| panic!("{e}"));
-    std::fs::write(dir.join("main.rs"), MAIN).unwrap_or_else(|e| panic!("{e}"));
-    let out = rustc(
-        &dir,
-        &[
-            "--crate-type",
-            "bin",
-            "--crate-name",
-            "diode",
-            "--extern",
-            "nalgebra=libnalgebra.rlib",
-            "--extern",
-            "libm=liblibm.rlib",
-            "-L",
-            ".",
-            "-o",
-            "diode",
-            "main.rs",
-        ],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let run = std::process::Command::new(dir.join("diode"))
-        .output()
-        .unwrap_or_else(|e| panic!("{e}"));
-    let printed = String::from_utf8_lossy(&run.stdout).into_owned();
+    let printed = build_and_run(&dir, "diode", &code, MAIN, LIBM_STD);
     let _ = std::fs::remove_dir_all(&dir);
     let solved: Vec<(String, f64, f64)> = printed
         .lines()

@@ -1,7 +1,7 @@
 //! `bgc lsp` as editors run it: a child process speaking JSON-RPC with `Content-Length` framing on its standard
 //! input and output.
 
-use crate::lsp_support::{back_support_path, back_support_text, uri};
+use crate::lsp_support::{back_support_path, back_support_unacknowledged, uri};
 use std::io::Write;
 use std::process::{Command, Stdio};
 
@@ -35,7 +35,7 @@ fn a_session_over_stdio_ends_with_status_zero() {
             "params": {"processId": null, "rootUri": null, "capabilities": {}}}),
         serde_json::json!({"jsonrpc": "2.0", "method": "initialized", "params": {}}),
         serde_json::json!({"jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {"textDocument":
-            {"uri": doc, "languageId": "bg", "version": 1, "text": back_support_text()}}}),
+            {"uri": doc, "languageId": "bg", "version": 1, "text": back_support_unacknowledged()}}}),
         serde_json::json!({"jsonrpc": "2.0", "id": 2, "method": "textDocument/hover", "params":
             {"textDocument": {"uri": doc}, "position": {"line": 21, "character": 11}}}),
         serde_json::json!({"jsonrpc": "2.0", "id": 3, "method": "shutdown", "params": null}),

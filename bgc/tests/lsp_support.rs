@@ -31,6 +31,21 @@ pub fn back_support_text() -> String {
     std::fs::read_to_string(back_support_path()).expect("models/back_support.bg is readable")
 }
 
+/// `models/back_support.bg` without its two `allow BG0510` lines, so that both derivative-causality findings are
+/// reported.
+pub fn back_support_unacknowledged() -> String {
+    let text: String = back_support_text()
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("allow "))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert_eq!(
+        back_support_text().lines().count() - text.lines().count(),
+        2
+    );
+    text
+}
+
 pub fn uri(path: &std::path::Path) -> Uri {
     bgc::lsp::files::path_to_uri(path).expect("an absolute UTF-8 path")
 }

@@ -5,7 +5,7 @@
 //! generates code. A deterministic sample of 8 accepted mutants is compiled by rustc, in one invocation, as
 //! `#![no_std]` modules: bgc never generates code that rustc rejects.
 
-use crate::codegen_support::rustc::{rustc, stand_ins};
+use crate::codegen_support::rustc::{compile_against_stand_ins, stand_ins};
 use crate::codegen_support::scratch;
 use crate::front_end_props::{Mutation, apply, mutation, seeds};
 
@@ -172,23 +172,9 @@ fn a_sample_of_accepted_mutants_compiles_with_rustc() {
         ));
     }
     std::fs::write(dir.join("mutants.rs"), root).unwrap_or_else(|e| panic!("{e}"));
-    let out = rustc(
-        &dir,
-        &[
-            "--crate-type",
-            "rlib",
-            "--crate-name",
-            "mutants",
-            "--extern",
-            "nalgebra=libnalgebra.rlib",
-            "--extern",
-            "libm=liblibm.rlib",
-            "-L",
-            ".",
-            "mutants.rs",
-        ],
-    );
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    let compiled = compile_against_stand_ins(&dir, "rlib", "mutants", "mutants.rs", &[]);
     let _ = std::fs::remove_dir_all(&dir);
-    assert!(out.status.success(), "{stderr}");
+    if let Err(stderr) = compiled {
+        panic!("{stderr}");
+    }
 }

@@ -82,7 +82,13 @@ pub fn rustc(dir: &Path, args: &[&str]) -> std::process::Output {
 
 /// Builds the two stand-ins in `dir`.
 pub fn stand_ins(dir: &Path) {
-    for (name, source) in [("nalgebra", NALGEBRA), ("libm", LIBM)] {
+    stand_ins_with(dir, LIBM);
+}
+
+/// Builds the nalgebra stand-in and `libm_source` as `libm` in `dir` (the real functions where a test runs
+/// the code and checks its numbers).
+pub fn stand_ins_with(dir: &Path, libm_source: &str) {
+    for (name, source) in [("nalgebra", NALGEBRA), ("libm", libm_source)] {
         std::fs::write(dir.join(format!("{name}.rs")), source).unwrap_or_else(|e| panic!("{e}"));
         let out = rustc(
             dir,
@@ -102,6 +108,57 @@ pub fn stand_ins(dir: &Path) {
     }
 }
 
+/// Compiles `root` in `dir` as a crate of `crate_type` named `crate_name` against the stand-ins, with `extra`
+/// arguments; rustc's errors on failure.
+pub fn compile_against_stand_ins(
+    dir: &Path,
+    crate_type: &str,
+    crate_name: &str,
+    root: &str,
+    extra: &[&str],
+) -> Result<(), String> {
+    let args = [
+        "--crate-type",
+        crate_type,
+        "--crate-name",
+        crate_name,
+        "--extern",
+        "nalgebra=libnalgebra.rlib",
+        "--extern",
+        "libm=liblibm.rlib",
+        "-L",
+        ".",
+        root,
+    ];
+    let out = rustc(
+        dir,
+        &args
+            .into_iter()
+            .chain(extra.iter().copied())
+            .collect::<Vec<_>>(),
+    );
+    if out.status.success() {
+        Ok(())
+    } else {
+        Err(String::from_utf8_lossy(&out.stderr).into_owned())
+    }
+}
+
+/// Builds the program `main` (which includes `NAME.module`, here `code`) against the stand-ins with the real
+/// `libm_source`, runs it and returns what it printed.
+pub fn build_and_run(dir: &Path, name: &str, code: &str, main: &str, libm_source: &str) -> String {
+    stand_ins_with(dir, libm_source);
+    std::fs::write(dir.join(format!("{name}.module")), code).unwrap_or_else(|e| panic!("{e}"));
+    std::fs::write(dir.join("main.rs"), main).unwrap_or_else(|e| panic!("{e}"));
+    if let Err(e) = compile_against_stand_ins(dir, "bin", name, "main.rs", &["-o", name]) {
+        panic!("{e}");
+    }
+    let run = Command::new(dir.join(name))
+        .output()
+        .unwrap_or_else(|e| panic!("{e}"));
+    String::from_utf8_lossy(&run.stdout).into_owned()
+}
+
 /// Compiles `module` as a `#![no_std]` library against the stand-ins; rustc's errors on failure.
 pub fn compile_no_std(dir: &Path, file: &str, module: &str) -> Result<(), String> {
     compile_no_std_with(dir, file, module, &[])
@@ -119,28 +176,5 @@ pub fn compile_no_std_with(
     );
     std::fs::write(dir.join(format!("{file}.module")), module).map_err(|e| e.to_string())?;
     std::fs::write(dir.join(format!("{file}.rs")), root).map_err(|e| e.to_string())?;
-    let out = rustc(
-        dir,
-        &[
-            "--crate-type",
-            "rlib",
-            "--crate-name",
-            file,
-            "--extern",
-            "nalgebra=libnalgebra.rlib",
-            "--extern",
-            "libm=liblibm.rlib",
-            "-L",
-            ".",
-            &format!("{file}.rs"),
-        ]
-        .into_iter()
-        .chain(extra.iter().copied())
-        .collect::<Vec<_>>(),
-    );
-    if out.status.success() {
-        Ok(())
-    } else {
-        Err(String::from_utf8_lossy(&out.stderr).into_owned())
-    }
+    compile_against_stand_ins(dir, "rlib", file, &format!("{file}.rs"), extra)
 }

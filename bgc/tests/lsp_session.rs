@@ -7,7 +7,7 @@ use crate::lsp_support::{
 };
 use lsp_types::request::{
     CodeActionRequest, Completion, DocumentSymbolRequest, Formatting, GotoDefinition, HoverRequest,
-    References, Rename,
+    RangeFormatting, References, Rename,
 };
 use lsp_types::{
     CodeActionOrCommand, CompletionResponse, DiagnosticSeverity, DocumentSymbolResponse,
@@ -587,6 +587,45 @@ fn formatting_returns_the_edits_of_bgc_fmt() {
     assert_eq!(format(&mut client), Some(vec![]));
     client.change(&doc, 3, vec![edit(range(0, 0, 99, 0), "model m {\n")]);
     assert_eq!(format(&mut client), None);
+    assert_eq!(client.shutdown(), Ok(()));
+}
+
+#[test]
+fn range_formatting_changes_only_the_selected_lines() {
+    let mut client = Client::start();
+    let doc = uri(&unsaved("messy_range.bg"));
+    // Messy lines 1 and 3 between lines already in the canonical layout.
+    let messy = "model m {\ndomain rotational;\n    param k = 1 [N m/rad];\n  Se s = 1; 1 j; C c = 1/k;\n    bond s -> j -> c;\n}\n";
+    client.open(&doc, messy);
+    client.diagnostics(&doc, 1);
+    let format = |client: &mut Client, lines: lsp_types::Range| {
+        client
+            .request::<RangeFormatting>(lsp_types::DocumentRangeFormattingParams {
+                text_document: TextDocumentIdentifier::new(doc.clone()),
+                range: lines,
+                options: Default::default(),
+                work_done_progress_params: Default::default(),
+            })
+            .expect("range formatting answers")
+    };
+    // Line 3 (`Se s = 1; 1 j; C c = 1/k;`) alone: split and spaced; the messy line 1 stays as written.
+    let edits = format(&mut client, range(3, 0, 3, 5)).expect("edits");
+    assert_eq!(
+        apply(messy, &edits),
+        "model m {\ndomain rotational;\n    param k = 1 [N m/rad];\n    Se s = 1;\n    1 j;\n    C c = 1 / k;\n    bond s -> j -> c;\n}\n"
+    );
+    // Line 1 alone: the other way round.
+    let edits = format(&mut client, range(1, 0, 1, 0)).expect("edits");
+    assert_eq!(
+        apply(messy, &edits),
+        "model m {\n    domain rotational;\n    param k = 1 [N m/rad];\n  Se s = 1; 1 j; C c = 1/k;\n    bond s -> j -> c;\n}\n"
+    );
+    // The whole file as the range gives what whole-document formatting gives.
+    let all = format(&mut client, range(0, 0, 6, 0)).expect("edits");
+    assert_eq!(
+        apply(messy, &all),
+        "model m {\n    domain rotational;\n    param k = 1 [N m/rad];\n    Se s = 1;\n    1 j;\n    C c = 1 / k;\n    bond s -> j -> c;\n}\n"
+    );
     assert_eq!(client.shutdown(), Ok(()));
 }
 

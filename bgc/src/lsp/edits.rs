@@ -26,6 +26,49 @@ pub fn format(text: &str) -> Option<Vec<TextEdit>> {
     Some(vec![TextEdit::new(range, new_text)])
 }
 
+/// The edits of [`format`] that touch the lines of `range`: the canonical layout's line changes, each hunk of a
+/// line diff of the old and the formatted text kept when it overlaps (or, for an insertion, borders) those lines,
+/// so a run of adjacent changed lines is formatted whole; the rest of the file stays as written. `None` when the
+/// text has syntax errors.
+pub fn format_range(text: &str, range: Range) -> Option<Vec<TextEdit>> {
+    let formatted = crate::syntax::format_source(crate::span::FileId(0), text).ok()?;
+    let starts = line_starts(text);
+    let new_lines: Vec<&str> = formatted.split_inclusive('\n').collect();
+    let (first, last) = (range.start.line as usize, range.end.line as usize);
+    let lines = LineIndex::new(text);
+    let mut edits = Vec::new();
+    for op in similar::TextDiff::from_lines(text, &formatted).ops() {
+        let (tag, old, new) = op.as_tag_tuple();
+        if tag == similar::DiffTag::Equal {
+            continue;
+        }
+        let touches = if old.is_empty() {
+            (first..=last + 1).contains(&old.start)
+        } else {
+            old.start <= last && first < old.end
+        };
+        if touches {
+            let bytes = starts[old.start]..starts[old.end];
+            edits.push(TextEdit::new(
+                lines.range(text, bytes),
+                new_lines[new].concat(),
+            ));
+        }
+    }
+    Some(edits)
+}
+
+/// The byte offset of the start of each line of `text`, and its length last (`starts[k]..starts[k + 1]` is line
+/// `k` with its line break).
+fn line_starts(text: &str) -> Vec<usize> {
+    let mut starts = vec![0];
+    starts.extend(text.match_indices('\n').map(|(i, _)| i + 1));
+    if starts.last() != Some(&text.len()) {
+        starts.push(text.len());
+    }
+    starts
+}
+
 fn common_prefix(a: &str, b: &str) -> usize {
     let mut n = a.bytes().zip(b.bytes()).take_while(|(x, y)| x == y).count();
     while !a.is_char_boundary(n) || !b.is_char_boundary(n) {

@@ -20,7 +20,7 @@ use lsp_types::notification::{
 };
 use lsp_types::request::{
     CodeActionRequest, Completion, DocumentSymbolRequest, Formatting, GotoDefinition, HoverRequest,
-    PrepareRenameRequest, References, Rename, Request as _,
+    PrepareRenameRequest, RangeFormatting, References, Rename, Request as _,
 };
 use lsp_types::{
     CompletionResponse, DocumentSymbolResponse, GotoDefinitionResponse, Hover, HoverContents,
@@ -173,6 +173,14 @@ impl Server {
                     .documents
                     .get(&p.text_document.uri)
                     .and_then(|d| edits::format(&d.text));
+                to_value(found)
+            }
+            RangeFormatting::METHOD => {
+                let p: lsp_types::DocumentRangeFormattingParams = parse(params)?;
+                let found = self
+                    .documents
+                    .get(&p.text_document.uri)
+                    .and_then(|d| edits::format_range(&d.text, p.range));
                 to_value(found)
             }
             Completion::METHOD => {

@@ -333,8 +333,14 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         self.loop_correction(&mut d, g_z, r_v, size);
         match name {
             "jac_x_into" => self.mass_solve_in_jacobian(&mut d, true, "N_STATES"),
-            "jac_u_into" => self.mass_solve_in_jacobian(&mut d, false, "N_INPUTS"),
+            // Without inputs `∂f/∂u` has no columns to solve for (and an empty loop fails `clippy`).
+            "jac_u_into" if !self.plan.inputs.is_empty() => {
+                self.mass_solve_in_jacobian(&mut d, false, "N_INPUTS")
+            }
             _ => {}
+        }
+        if !(d.uses.t || d.uses.x || d.uses.u) {
+            self.constant_jacobian(name, ty);
         }
         let mut args = Self::model_args(d.uses);
         args.push(Arg::new("jac", ty, true));

@@ -271,6 +271,9 @@ pub(in crate::codegen) struct Writer<'a> {
     all_fields: Vec<String>,
     /// The columns of a line.
     width: usize,
+    /// The Jacobians whose bodies read neither `t`, `x` nor `u` (those of a linear model): `Model` computes them
+    /// once per parameter set.
+    constant_jacobians: Vec<model::ConstantJacobian>,
     pub(in crate::codegen) out: String,
 }
 
@@ -320,6 +323,7 @@ impl<'a> Writer<'a> {
             free,
             all_fields,
             width,
+            constant_jacobians: Vec::new(),
             out: String::new(),
         }
     }

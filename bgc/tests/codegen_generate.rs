@@ -388,3 +388,40 @@ fn a_large_model_keeps_no_jacobian_in_its_model() {
     );
     assert!(large.contains("pub struct Model {\n    params: Params,\n}\n"));
 }
+
+#[test]
+fn a_large_model_gets_its_state_jacobian_as_triplets() {
+    // 100 masses: 199 states `p_mass0, q_spring0, p_mass1, ...`, a `JacX` of 199² · 8 bytes = 310 KiB. By hand,
+    // `ṗ_i = q_{i-1} k_{i-1} − q_i k_i + 0.5 (p_{i-1}/m_{i-1} − 2 p_i/m_i + p_{i+1}/m_{i+1})` (ends without the
+    // missing terms) and `q̇_i = p_i/m_i − p_{i+1}/m_{i+1}`: the column of `p_mass_i` has 5 entries (3 at either
+    // end of the chain), that of `q_spring_i` 2, so 98·5 + 2·3 + 99·2 = 694.
+    let large = generate_with(&codegen_support::chain(100), Options { runtime: false });
+    assert!(large.contains("pub const N_STATES: usize = 199;"));
+    assert!(
+        large.contains("pub const JAC_X_NNZ: usize = 694;"),
+        "{large}"
+    );
+    // Column by column: `p_mass0` (rows p_mass0, q_spring0, p_mass1), then `q_spring0` (rows p_mass0, p_mass1).
+    assert!(large.contains(
+        "pub const JAC_X_ROWS: [usize; JAC_X_NNZ] = [\n    0, 1, 2, 0, 2, 0, 1, 2, 3, 4,"
+    ));
+    assert!(large.contains(
+        "pub const JAC_X_COLS: [usize; JAC_X_NNZ] = [\n    0, 0, 0, 1, 1, 2, 2, 2, 2, 2,"
+    ));
+    for entry in [
+        "    values[0] = -0.5 / p.m0;\n",
+        "    values[1] = 1.0 / p.m0;\n",
+        "    values[2] = 0.5 / p.m0;\n",
+        "    values[3] = -p.k0;\n",
+        "    values[4] = p.k0;\n",
+    ] {
+        assert!(large.contains(entry), "{entry}");
+    }
+    let dir = codegen_support::scratch("sparse-jacobian");
+    codegen_support::rustc::stand_ins(&dir);
+    if let Err(errors) = codegen_support::rustc::compile_no_std(&dir, "chain100", &large) {
+        panic!("{errors}");
+    }
+    // A small model keeps the matrix alone.
+    assert!(!generate(&codegen_support::chain(10)).contains("jac_x_sparse_into"));
+}

@@ -319,3 +319,109 @@ fn energy_is_a_sum_of_named_terms_or_a_running_total_for_many_terms() {
     assert_eq!(large.matches("    total += ").count(), 258);
     assert!(large.ends_with("    total"), "{large}");
 }
+
+/// The `ContinuousModel` method `name` of `code`, up to its closing brace.
+fn trait_method(code: &str, name: &str) -> String {
+    let start = code.find(&format!("    fn {name}(")).unwrap_or_default();
+    let end = code[start..]
+        .find("\n    }\n")
+        .map_or(code.len(), |e| start + e);
+    code[start..end].to_string()
+}
+
+#[test]
+fn a_jacobian_of_the_parameters_only_is_computed_once_per_parameter_set() {
+    // Ten masses, springs and dampers: linear, every Jacobian is a function of the parameters.
+    let linear = generate(&codegen_support::chain(10));
+    assert!(
+        linear.contains("    constant: ConstantJacobians,\n"),
+        "{linear}"
+    );
+    for method in ["jac_x", "jac_u", "output_jac_x", "output_jac_u"] {
+        let body = trait_method(&linear, method);
+        assert!(
+            body.ends_with(&format!("        *jac = self.constant.{method};")),
+            "{body}"
+        );
+    }
+    // `set_param` recomputes them.
+    let set_param = trait_method(&linear, "set_param");
+    assert!(
+        set_param.contains("self.constant = ConstantJacobians::at(&self.params);"),
+        "{set_param}"
+    );
+    // A pendulum: `∂f/∂x` reads the angle, the output Jacobians do not.
+    let pendulum =
+        std::fs::read_to_string(codegen_support::workspace().join("bgc/tests/corpus/pendulum.bg"))
+            .unwrap_or_default();
+    let nonlinear = generate(&pendulum);
+    assert!(
+        trait_method(&nonlinear, "jac_x").ends_with("jac_x_into(&self.params, t, x, u, jac);"),
+        "{nonlinear}"
+    );
+    // It has no inputs: `∂f/∂u` has no columns, nothing to solve with its mass matrix, and is constant.
+    assert!(
+        trait_method(&nonlinear, "jac_u").ends_with("*jac = self.constant.jac_u;"),
+        "{nonlinear}"
+    );
+    assert!(!nonlinear.contains("for c in 0..N_INPUTS"), "{nonlinear}");
+    assert!(
+        trait_method(&nonlinear, "output_jac_x").ends_with("*jac = self.constant.output_jac_x;"),
+        "{nonlinear}"
+    );
+    // Without the runtime's traits nothing reads them: `Model` holds the parameters only.
+    let no_runtime = generate_with(&codegen_support::chain(10), Options { runtime: false });
+    assert!(!no_runtime.contains("ConstantJacobians"), "{no_runtime}");
+}
+
+#[test]
+fn a_large_model_keeps_no_jacobian_in_its_model() {
+    // 130 masses: 259 states, a `JacX` of 259² · 8 bytes = 524 KiB, more than the 256 KiB a `Model` (which is
+    // `Copy` and lives on the stack) may hold: its Jacobians are computed at each call.
+    let large = generate(&codegen_support::chain(130));
+    assert!(large.contains("pub const N_STATES: usize = 259;"));
+    assert!(!large.contains("ConstantJacobians"));
+    assert!(
+        trait_method(&large, "jac_x").ends_with("jac_x_into(&self.params, t, x, u, jac);"),
+        "{}",
+        trait_method(&large, "jac_x")
+    );
+    assert!(large.contains("pub struct Model {\n    params: Params,\n}\n"));
+}
+
+#[test]
+fn a_large_model_gets_its_state_jacobian_as_triplets() {
+    // 100 masses: 199 states `p_mass0, q_spring0, p_mass1, ...`, a `JacX` of 199² · 8 bytes = 310 KiB. By hand,
+    // `ṗ_i = q_{i-1} k_{i-1} − q_i k_i + 0.5 (p_{i-1}/m_{i-1} − 2 p_i/m_i + p_{i+1}/m_{i+1})` (ends without the
+    // missing terms) and `q̇_i = p_i/m_i − p_{i+1}/m_{i+1}`: the column of `p_mass_i` has 5 entries (3 at either
+    // end of the chain), that of `q_spring_i` 2, so 98·5 + 2·3 + 99·2 = 694.
+    let large = generate_with(&codegen_support::chain(100), Options { runtime: false });
+    assert!(large.contains("pub const N_STATES: usize = 199;"));
+    assert!(
+        large.contains("pub const JAC_X_NNZ: usize = 694;"),
+        "{large}"
+    );
+    // Column by column: `p_mass0` (rows p_mass0, q_spring0, p_mass1), then `q_spring0` (rows p_mass0, p_mass1).
+    assert!(large.contains(
+        "pub const JAC_X_ROWS: [usize; JAC_X_NNZ] = [\n    0, 1, 2, 0, 2, 0, 1, 2, 3, 4,"
+    ));
+    assert!(large.contains(
+        "pub const JAC_X_COLS: [usize; JAC_X_NNZ] = [\n    0, 0, 0, 1, 1, 2, 2, 2, 2, 2,"
+    ));
+    for entry in [
+        "    values[0] = -0.5 / p.m0;\n",
+        "    values[1] = 1.0 / p.m0;\n",
+        "    values[2] = 0.5 / p.m0;\n",
+        "    values[3] = -p.k0;\n",
+        "    values[4] = p.k0;\n",
+    ] {
+        assert!(large.contains(entry), "{entry}");
+    }
+    let dir = codegen_support::scratch("sparse-jacobian");
+    codegen_support::rustc::stand_ins(&dir);
+    if let Err(errors) = codegen_support::rustc::compile_no_std(&dir, "chain100", &large) {
+        panic!("{errors}");
+    }
+    // A small model keeps the matrix alone.
+    assert!(!generate(&codegen_support::chain(10)).contains("jac_x_sparse_into"));
+}

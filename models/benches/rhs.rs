@@ -3,6 +3,7 @@
 //! states plus the four angles (10 states) and computes the bond-graph equations directly.
 
 use bgc_models::back_support as m;
+use bgc_runtime::model::ContinuousModel;
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::SVector;
 use std::hint::black_box;
@@ -35,6 +36,15 @@ fn rhs(c: &mut Criterion) {
     group.bench_function("generated_jac_x", |b| {
         b.iter(|| {
             m::jac_x_into(black_box(&p), 0.0, black_box(&x), black_box(&u), &mut jac);
+            black_box(&jac);
+        })
+    });
+    // What the runtime calls (Kalman filters, linearisation, implicit solvers): a linear model's Jacobian is
+    // the same at every point, so `Model` holds it.
+    let model = m::Model::default();
+    group.bench_function("model_jac_x", |b| {
+        b.iter(|| {
+            black_box(&model).jac_x(0.0, black_box(&x), black_box(&u), &mut jac);
             black_box(&jac);
         })
     });

@@ -333,14 +333,105 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         self.loop_correction(&mut d, g_z, r_v, size);
         match name {
             "jac_x_into" => self.mass_solve_in_jacobian(&mut d, true, "N_STATES"),
-            "jac_u_into" => self.mass_solve_in_jacobian(&mut d, false, "N_INPUTS"),
+            // Without inputs `∂f/∂u` has no columns to solve for (and an empty loop fails `clippy`).
+            "jac_u_into" if !self.plan.inputs.is_empty() => {
+                self.mass_solve_in_jacobian(&mut d, false, "N_INPUTS")
+            }
             _ => {}
         }
+        if !(d.uses.t || d.uses.x || d.uses.u) {
+            self.constant_jacobian(name, ty);
+        }
+        let sparse = name == "jac_x_into" && self.wants_sparse_jac_x();
         let mut args = Self::model_args(d.uses);
         args.push(Arg::new("jac", ty, true));
         self.function(Function {
             doc: doc.to_string(),
             name: name.to_string(),
+            args,
+            ret: String::new(),
+            body: Self::body_text(&d.lines),
+            locals: d.locals,
+        });
+        if sparse {
+            self.sparse_jac_x(m, rows, cols, row_prefix);
+        }
+    }
+
+    /// Whether `∂f/∂x` also gets its sparse form: when a `JacX` takes more than
+    /// [`super::model::MAX_CONSTANT_JACOBIAN_BYTES`] (a thread's stack holds few of them) and every entry is an
+    /// expression of its own (no loop or mass-matrix correction writes to the matrix as a whole).
+    fn wants_sparse_jac_x(&self) -> bool {
+        let n = self.plan.states.len();
+        n.saturating_mul(n).saturating_mul(8) > super::model::MAX_CONSTANT_JACOBIAN_BYTES
+            && self.plan.loops.is_none()
+            && self.plan.mass.is_empty()
+    }
+
+    /// `JAC_X_NNZ`, `JAC_X_ROWS`, `JAC_X_COLS` and `jac_x_sparse_into`: the entries of `∂f/∂x` that are not
+    /// identically zero, column by column, without an `N_STATES × N_STATES` matrix.
+    fn sparse_jac_x(
+        &mut self,
+        m: &[Vec<Expr>],
+        rows: &[String],
+        cols: &[String],
+        row_prefix: &str,
+    ) {
+        let mut entries: Vec<(usize, usize, &Expr)> = Vec::new();
+        for c in 0..cols.len() {
+            for (r, row) in m.iter().enumerate() {
+                if let Some(e) = row.get(c).filter(|e| !e.is_zero()) {
+                    entries.push((r, c, e));
+                }
+            }
+        }
+        self.out.push('\n');
+        self.doc(
+            0,
+            "The number of entries of `∂f/∂x` that are not identically zero.",
+        );
+        self.out.push_str(&format!(
+            "pub const JAC_X_NNZ: usize = {};\n",
+            entries.len()
+        ));
+        for (konst, what, pick) in [("JAC_X_ROWS", "row", 0usize), ("JAC_X_COLS", "column", 1)] {
+            let list: Vec<String> = entries
+                .iter()
+                .map(|&(r, c, _)| if pick == 0 { r } else { c }.to_string())
+                .collect();
+            self.out.push('\n');
+            self.doc(
+                0,
+                &format!("The {what} of each entry of `jac_x_sparse_into`."),
+            );
+            let head = format!("pub const {konst}: [usize; JAC_X_NNZ] = ");
+            self.out.push_str(&super::super::format::array(
+                &head, &list, ";", 0, self.width,
+            ));
+            self.out.push('\n');
+        }
+        let exprs: Vec<&Expr> = entries.iter().map(|e| e.2).collect();
+        let mut d = self.draft(&exprs);
+        for (k, &(r, c, e)) in entries.iter().enumerate() {
+            let lhs = format!(
+                "∂({row_prefix}{})/∂{} = ",
+                rows.get(r).cloned().unwrap_or_default(),
+                cols.get(c).cloned().unwrap_or_default()
+            );
+            self.statement(&mut d, &lhs, e, &format!("values[{k}] = "), ";");
+        }
+        let mut args = Self::model_args(d.uses);
+        args.push(Arg::new(
+            "values",
+            "&mut [f64; JAC_X_NNZ]",
+            !entries.is_empty(),
+        ));
+        self.function(Function {
+            doc: "Writes the entries of `∂f/∂x` that are not identically zero into `values`, at the rows \
+                  `JAC_X_ROWS` and columns `JAC_X_COLS`: the Jacobian of a large model without the \
+                  `N_STATES × N_STATES` matrix a `JacX` takes on the stack."
+                .to_string(),
+            name: "jac_x_sparse_into".to_string(),
             args,
             ret: String::new(),
             body: Self::body_text(&d.lines),

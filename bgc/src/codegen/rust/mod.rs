@@ -8,7 +8,9 @@
 //! - `ParamError` and `Params` (one documented field per free parameter, `Default` from the file, `validate`,
 //!   `get`, `set`; a derived parameter, defined from others in the file, is a method that follows them);
 //! - `rhs`/`rhs_into` (`ẋ = f(t, x, u)`), `outputs`/`outputs_into` (`y = h(t, x, u)`) and the Jacobians
-//!   `jac_x_into`, `jac_u_into`, `output_jac_x_into`, `output_jac_u_into` from symbolic derivatives;
+//!   `jac_x_into`, `jac_u_into`, `output_jac_x_into`, `output_jac_u_into` from symbolic derivatives; when a
+//!   `JacX` takes more than 256 KiB (above 181 states) and no loop or mass matrix corrects it, also the triplets
+//!   `JAC_X_NNZ`, `JAC_X_ROWS`, `JAC_X_COLS` and `jac_x_sparse_into`, which need no `N_STATES²` matrix;
 //! - for a linear model `state_space(&Params) -> (A, B, C, D)` whenever `bgc statespace` prints one: in the energy
 //!   states (type `EnergyStateSpace`), or, when the outputs or rates read an integrated flow (`var`), in all states,
 //!   energy states then integrated flows (type `FullStateSpace`); and, when the model declares coordinates,
@@ -271,6 +273,9 @@ pub(in crate::codegen) struct Writer<'a> {
     all_fields: Vec<String>,
     /// The columns of a line.
     width: usize,
+    /// The Jacobians whose bodies read neither `t`, `x` nor `u` (those of a linear model): `Model` computes them
+    /// once per parameter set.
+    constant_jacobians: Vec<model::ConstantJacobian>,
     pub(in crate::codegen) out: String,
 }
 
@@ -320,6 +325,7 @@ impl<'a> Writer<'a> {
             free,
             all_fields,
             width,
+            constant_jacobians: Vec::new(),
             out: String::new(),
         }
     }

@@ -1,9 +1,37 @@
 //! `Model`: the parameters of a generated model, validated, and its implementations of the runtime's traits.
+//!
+//! A Jacobian that depends on the parameters only (every Jacobian of a linear model) is computed once per
+//! parameter set, in `Model::new`, `set_params` and `set_param`, and the runtime's `jac_x`, ... copy it: the
+//! back-support `jac_x` would otherwise divide by parameters 22 times and fill 100 entries at each call. The cache
+//! lives in `Model`, which is `Copy` and on the stack, so it is kept only while its matrices fit in
+//! [`MAX_CONSTANT_JACOBIAN_BYTES`]; a larger model computes its Jacobians at each call, as the free functions do.
 
 use super::super::names::comment;
 use super::Writer;
+use std::fmt::Write;
 
-/// `Model` and its inherent methods.
+/// The most bytes of constant Jacobians a `Model` holds (256 KiB: a `JacX` of 181 states).
+pub(in crate::codegen) const MAX_CONSTANT_JACOBIAN_BYTES: usize = 256 * 1024;
+
+/// A Jacobian function whose body reads neither `t`, `x` nor `u`.
+#[derive(Clone, Debug)]
+pub(in crate::codegen) struct ConstantJacobian {
+    /// The free function (`jac_x_into`).
+    function: String,
+    /// The matrix type (`JacX`).
+    ty: String,
+}
+
+impl ConstantJacobian {
+    /// The field of `ConstantJacobians` and the method of the runtime's trait (`jac_x`).
+    fn field(&self) -> &str {
+        self.function
+            .strip_suffix("_into")
+            .unwrap_or(&self.function)
+    }
+}
+
+/// `Model` and its inherent methods, without constant Jacobians.
 const MODEL: &str = "#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Model {
     params: Params,
@@ -30,34 +58,50 @@ impl Model {
 }
 ";
 
-/// The implementations of `bgc_runtime`'s traits.
-const RUNTIME_IMPLS: &str = "
-impl bgc_runtime::model::ContinuousModel<N_STATES, N_INPUTS, N_OUTPUTS> for Model {
-    fn rhs(&self, t: f64, x: &State, u: &Inputs, dx: &mut State) {
-        rhs_into(&self.params, t, x, u, dx);
+/// `Model` and its inherent methods, with the constant Jacobians `ConstantJacobians::at(&params)`.
+const MODEL_WITH_CONSTANTS: &str = "#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Model {
+    params: Params,
+    constant: ConstantJacobians,
+}
+
+impl Model {
+    /// The model with parameters `params`, refused when they are not physical.
+    pub fn new(params: Params) -> Result<Model, ParamError> {
+        params.validate()?;
+        Ok(Model::at(params))
     }
 
-    fn outputs(&self, t: f64, x: &State, u: &Inputs, y: &mut Outputs) {
-        outputs_into(&self.params, t, x, u, y);
+    /// The model at `params` (validated or the defaults), with its constant Jacobians.
+    fn at(params: Params) -> Model {
+        Model {
+            params,
+            constant: ConstantJacobians::at(&params),
+        }
     }
 
-    fn jac_x(&self, t: f64, x: &State, u: &Inputs, jac: &mut JacX) {
-        jac_x_into(&self.params, t, x, u, jac);
+    /// The parameters.
+    pub fn params(&self) -> &Params {
+        &self.params
     }
 
-    fn jac_u(&self, t: f64, x: &State, u: &Inputs, jac: &mut JacU) {
-        jac_u_into(&self.params, t, x, u, jac);
-    }
-
-    fn output_jac_x(&self, t: f64, x: &State, u: &Inputs, jac: &mut OutJacX) {
-        output_jac_x_into(&self.params, t, x, u, jac);
-    }
-
-    fn output_jac_u(&self, t: f64, x: &State, u: &Inputs, jac: &mut OutJacU) {
-        output_jac_u_into(&self.params, t, x, u, jac);
+    /// Replaces the parameters; non-physical ones are refused and leave the model unchanged.
+    pub fn set_params(&mut self, params: Params) -> Result<(), ParamError> {
+        params.validate()?;
+        *self = Model::at(params);
+        Ok(())
     }
 }
 
+impl Default for Model {
+    fn default() -> Self {
+        Model::at(Params::default())
+    }
+}
+";
+
+/// The implementations of `bgc_runtime`'s traits.
+const RUNTIME_IMPLS: &str = "
 impl bgc_runtime::model::Parametric for Model {
     fn param_names(&self) -> &'static [&'static str] {
         &PARAM_NAMES
@@ -68,10 +112,23 @@ impl bgc_runtime::model::Parametric for Model {
     }
 
     fn set_param(&mut self, index: usize, value: f64) -> Result<(), ParamError> {
-        self.params.set(index, value)
+        {set_param}
     }
 }
 ";
+
+/// The body of `set_param` when `Model` holds constant Jacobians.
+const SET_PARAM_WITH_CONSTANTS: &str = "self.params.set(index, value)?;
+        self.constant = ConstantJacobians::at(&self.params);
+        Ok(())";
+
+/// The runtime's Jacobian methods, in trait order: method, free function, matrix type.
+const JACOBIANS: [(&str, &str, &str); 4] = [
+    ("jac_x", "jac_x_into", "JacX"),
+    ("jac_u", "jac_u_into", "JacU"),
+    ("output_jac_x", "output_jac_x_into", "OutJacX"),
+    ("output_jac_u", "output_jac_u_into", "OutJacU"),
+];
 
 impl Writer<'_> {
     pub(super) fn model(&mut self) {
@@ -88,9 +145,144 @@ impl Writer<'_> {
         };
         let name = comment(&self.m.model.name);
         self.doc(0, &format!("Model `{name}` with its parameters: {what}"));
-        self.out.push_str(MODEL);
-        if self.options.runtime {
-            self.out.push_str(RUNTIME_IMPLS);
+        let constants = self.cached_jacobians();
+        if constants.is_empty() {
+            self.out.push_str(MODEL);
+        } else {
+            self.out.push_str(MODEL_WITH_CONSTANTS);
         }
+        if self.options.runtime {
+            self.continuous_model(&constants);
+            let set_param = if constants.is_empty() {
+                "self.params.set(index, value)"
+            } else {
+                SET_PARAM_WITH_CONSTANTS
+            };
+            self.out
+                .push_str(&RUNTIME_IMPLS.replace("{set_param}", set_param));
+        }
+        if !constants.is_empty() {
+            self.constant_jacobians_struct(&constants);
+        }
+    }
+
+    /// Records that the Jacobian function `function` (with argument type `&mut JacX`, ...) is constant.
+    pub(super) fn constant_jacobian(&mut self, function: &str, arg_ty: &str) {
+        self.constant_jacobians.push(ConstantJacobian {
+            function: function.to_string(),
+            ty: arg_ty.trim_start_matches("&mut ").to_string(),
+        });
+    }
+
+    /// The constant Jacobians `Model` holds: none without the runtime's traits (nothing would read them) or when
+    /// they take more than [`MAX_CONSTANT_JACOBIAN_BYTES`].
+    fn cached_jacobians(&self) -> Vec<ConstantJacobian> {
+        let (nx, nu, ny) = (
+            self.plan.states.len(),
+            self.plan.inputs.len(),
+            self.m.equations.outputs.len(),
+        );
+        let bytes = |ty: &str| {
+            let (r, c) = match ty {
+                "JacX" => (nx, nx),
+                "JacU" => (nx, nu),
+                "OutJacX" => (ny, nx),
+                _ => (ny, nu),
+            };
+            r.saturating_mul(c).saturating_mul(8)
+        };
+        let total: usize = self.constant_jacobians.iter().map(|j| bytes(&j.ty)).sum();
+        if !self.options.runtime || total > MAX_CONSTANT_JACOBIAN_BYTES {
+            return Vec::new();
+        }
+        self.constant_jacobians.clone()
+    }
+
+    /// `ContinuousModel` for `Model`: a constant Jacobian is copied, the others are computed.
+    fn continuous_model(&mut self, constants: &[ConstantJacobian]) {
+        let mut text = String::from(
+            "
+impl bgc_runtime::model::ContinuousModel<N_STATES, N_INPUTS, N_OUTPUTS> for Model {
+    fn rhs(&self, t: f64, x: &State, u: &Inputs, dx: &mut State) {
+        rhs_into(&self.params, t, x, u, dx);
+    }
+
+    fn outputs(&self, t: f64, x: &State, u: &Inputs, y: &mut Outputs) {
+        outputs_into(&self.params, t, x, u, y);
+    }
+",
+        );
+        for (method, function, ty) in JACOBIANS {
+            if constants.iter().any(|c| c.function == function) {
+                let _ = write!(
+                    text,
+                    "
+    fn {method}(&self, _t: f64, _x: &State, _u: &Inputs, jac: &mut {ty}) {{
+        *jac = self.constant.{method};
+    }}
+"
+                );
+            } else {
+                let _ = write!(
+                    text,
+                    "
+    fn {method}(&self, t: f64, x: &State, u: &Inputs, jac: &mut {ty}) {{
+        {function}(&self.params, t, x, u, jac);
+    }}
+"
+                );
+            }
+        }
+        text.push_str(
+            "}
+",
+        );
+        self.out.push_str(&text);
+    }
+
+    /// `ConstantJacobians`: the Jacobians that depend on the parameters only, and `at(p)`.
+    fn constant_jacobians_struct(&mut self, constants: &[ConstantJacobian]) {
+        let mut text = String::from(
+            "
+/// The Jacobians that depend on the parameters only, computed once for them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ConstantJacobians {
+",
+        );
+        for c in constants {
+            let _ = writeln!(text, "    {}: {},", c.field(), c.ty);
+        }
+        text.push_str(
+            "}
+
+impl ConstantJacobians {
+    /// The Jacobians at the parameters `p` (at any `t`, `x`, `u`: they read none).
+    fn at(p: &Params) -> ConstantJacobians {
+        let (x, u) = (State::zeros(), Inputs::zeros());
+",
+        );
+        for c in constants {
+            let _ = write!(
+                text,
+                "        let mut {field} = {ty}::zeros();\n        {function}(p, 0.0, &x, &u, &mut {field});\n",
+                field = c.field(),
+                ty = c.ty,
+                function = c.function,
+            );
+        }
+        let fields: Vec<&str> = constants.iter().map(|c| c.field()).collect();
+        let list = fields.join(", ");
+        // rustfmt keeps a struct literal on one line while its fields take at most 18 columns.
+        if list.len() <= 18 {
+            let _ = writeln!(text, "        ConstantJacobians {{ {list} }}");
+        } else {
+            text.push_str("        ConstantJacobians {\n");
+            for f in fields {
+                let _ = writeln!(text, "            {f},");
+            }
+            text.push_str("        }\n");
+        }
+        text.push_str("    }\n}\n");
+        self.out.push_str(&text);
     }
 }

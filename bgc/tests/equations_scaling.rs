@@ -3,9 +3,12 @@
 //! transformers whose inertias are all rigidly coupled (one in integral causality, the rest dependent).
 
 use bgc::causality::analyse;
+use bgc::codegen::explicit_outputs;
 use bgc::diagnostic::Diagnostic;
-use bgc::equations::{Equations, derive};
+use bgc::equations::sym::Sym;
+use bgc::equations::{Equations, derive, expr_text};
 use bgc::lower::{MemoryLoader, lower};
+use bgc::simulate::System;
 use bgc::span::SourceMap;
 
 fn equations(text: &str) -> Equations {
@@ -119,6 +122,85 @@ fn outputs_through_earlier_outputs_are_the_composition() {
     for (i, got) in y.iter().enumerate() {
         assert!((got - want).abs() < 1e-12, "y{}: {got} vs {want}", i + 1);
         want = (want * want).sin() + want.cos();
+    }
+}
+
+/// `y_1 … y_levels` at `q_spring = q` by the recurrence itself.
+fn output_chain_values(levels: usize, q: f64) -> Vec<f64> {
+    let mut y = vec![(q * q).sin() + q.cos()];
+    while y.len() < levels {
+        let p = y[y.len() - 1];
+        y.push((p * p).sin() + p.cos());
+    }
+    y
+}
+
+/// Outputs defined through earlier outputs refer to them instead of copying them: each explicit output is as long
+/// as its own definition, however deep the chain (copying doubles it at every level, 2⁴⁰ copies here).
+#[test]
+fn outputs_through_earlier_outputs_are_shared_not_copied() {
+    let levels = 40;
+    let eqs = equations(&output_chain(levels));
+    for k in 1..levels {
+        let e = eqs.outputs[k]
+            .explicit
+            .as_ref()
+            .unwrap_or_else(|| panic!("y{} not derived", k + 1));
+        let mut refs = Vec::new();
+        e.for_each_sym(&mut |s| refs.push(s));
+        refs.sort();
+        refs.dedup();
+        assert_eq!(refs, vec![Sym::Output(k - 1)], "y{}", k + 1);
+        assert_eq!(
+            expr_text(&eqs, e),
+            format!("cos(y{k}) + sin(y{k}^2)"),
+            "y{}",
+            k + 1
+        );
+    }
+    let q = -0.4;
+    let want = output_chain_values(levels, q);
+    let mut x = vec![0.0; eqs.states.len()];
+    x[state(&eqs, "q_spring")] = q;
+    let p = eqs.default_params();
+    let y = eqs
+        .outputs_at(&p, &x, &[], 0.0)
+        .unwrap_or_else(|e| panic!("{e}"));
+    // The generated code's outputs: one shared node per output.
+    let generated = explicit_outputs(&eqs).unwrap_or_else(|e| panic!("{e}"));
+    // The simulation's output columns at t = 0.
+    let (system, _) = System::new(&eqs, p.clone(), Vec::new()).unwrap_or_else(|e| panic!("{e}"));
+    let mut y0 = x.clone();
+    y0.extend([0.0, 0.0]);
+    let row = system
+        .row(&y0, 0.0, &mut Vec::new(), &mut Vec::new())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let names: Vec<(String, f64)> = eqs
+        .params
+        .iter()
+        .cloned()
+        .chain([("q_spring".to_string(), q), ("p_mass".to_string(), 0.0)])
+        .collect();
+    for k in 0..levels {
+        assert!(
+            (y[k] - want[k]).abs() < 1e-12,
+            "y{}: {} vs {}",
+            k + 1,
+            y[k],
+            want[k]
+        );
+        let column = row[eqs.states.len() + k];
+        assert!(
+            (column - want[k]).abs() < 1e-12,
+            "simulated y{}: {column}",
+            k + 1
+        );
+        let g = generated[k]
+            .as_ref()
+            .unwrap_or_else(|| panic!("generated y{}", k + 1))
+            .eval(|s| names.iter().find(|(n, _)| n == s.name()).map(|(_, v)| *v))
+            .unwrap_or_else(|e| panic!("generated y{}: {e}", k + 1));
+        assert!((g - want[k]).abs() < 1e-12, "generated y{}: {g}", k + 1);
     }
 }
 

@@ -6,8 +6,10 @@
 //!    integrated flows (`var`s, named as declared); their rates are `ṗ = e`, `q̇ = f`, `θ̇ = integrand`.
 //! 2. Every node writes the causal equation of each bond variable it computes (`build.rs`).
 //! 3. The rates and outputs are expressed in states, inputs, parameters and `t` by substitution in dependency order
-//!    (`resolve.rs`); algebraic loops are torn and solved exactly when affine, storages in derivative causality
-//!    contribute `ẋ` terms, solved for by a symbolic linear solve (`solve.rs`). Multiport fields are in `field`:
+//!    (`resolve.rs`; each resolved value is multiplied out when that makes it no larger, so that the solutions of
+//!    chained algebraic loops do not nest); algebraic loops are torn and solved exactly when affine, storages in
+//!    derivative causality contribute `ẋ` terms, solved for by a symbolic linear solve (`solve.rs`). An output
+//!    defined through earlier outputs refers to them ([`Sym::Output`]) rather than copying them. Multiport fields are in `field`:
 //!    an I-field gives the mass-matrix form `M(q) ẋ = F` for its flow states ([`Equations::mass`]), solved
 //!    numerically by its consumers ([`Equations::rates_at`]).
 //! 4. A nonlinear algebraic loop stays implicit (`tear.rs`): its tear variable `z` (`Sym::Tear`, printed

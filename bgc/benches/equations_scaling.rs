@@ -98,8 +98,8 @@ fn family(c: &mut Criterion, name: &str, sizes: &[usize], generate: fn(usize) ->
 }
 
 fn bench(c: &mut Criterion) {
-    family(c, "ladder", &[3, 4, 5], ladder);
-    family(c, "output_chain", &[6, 8, 10], output_chain);
+    family(c, "ladder", &[3, 6, 12], ladder);
+    family(c, "output_chain", &[6, 12, 24], output_chain);
     family(c, "mtf_chain", &[10, 25, 50], mtf_chain);
     family(c, "benchmark_chain", &[100, 300, 1000], benchmark_chain);
 }

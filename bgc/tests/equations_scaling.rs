@@ -3,9 +3,12 @@
 //! transformers whose inertias are all rigidly coupled (one in integral causality, the rest dependent).
 
 use bgc::causality::analyse;
+use bgc::codegen::explicit_outputs;
 use bgc::diagnostic::Diagnostic;
-use bgc::equations::{Equations, derive};
+use bgc::equations::sym::Sym;
+use bgc::equations::{Equations, derive, expr_text};
 use bgc::lower::{MemoryLoader, lower};
+use bgc::simulate::System;
 use bgc::span::SourceMap;
 
 fn equations(text: &str) -> Equations {
@@ -119,6 +122,145 @@ fn outputs_through_earlier_outputs_are_the_composition() {
     for (i, got) in y.iter().enumerate() {
         assert!((got - want).abs() < 1e-12, "y{}: {got} vs {want}", i + 1);
         want = (want * want).sin() + want.cos();
+    }
+}
+
+/// The node voltages `V_0 = u, V_1 … V_N = q/c` of the ladder by nodal analysis: at node `k < N`,
+/// `(V_{k−1} − V_k)/r = V_k/(k r) + (V_k − V_{k+1})/r`, a tridiagonal system solved by elimination. Returns the
+/// capacitor's current `(V_{N−1} − V_N)/r − V_N/(N r)` and the source's `(u − V_1)/r`.
+fn ladder_currents(rungs: usize, r: f64, vc: f64, u: f64) -> (f64, f64) {
+    let n = rungs;
+    // Unknowns V_1 … V_{N−1}: row k: −V_{k−1} + (2 + 1/k) V_k − V_{k+1} = 0, known ends moved to the right.
+    let m = n - 1;
+    let mut diag: Vec<f64> = (1..=m).map(|k| 2.0 + 1.0 / k as f64).collect();
+    let mut rhs = vec![0.0; m];
+    rhs[0] += u;
+    rhs[m - 1] += vc;
+    for k in 1..m {
+        let w = -1.0 / diag[k - 1];
+        diag[k] += w;
+        rhs[k] -= w * rhs[k - 1];
+    }
+    let mut v = vec![0.0; m];
+    v[m - 1] = rhs[m - 1] / diag[m - 1];
+    for k in (0..m - 1).rev() {
+        v[k] = (rhs[k] + v[k + 1]) / diag[k];
+    }
+    let i_cap = (v[m - 1] - vc) / r - vc / (n as f64 * r);
+    (i_cap, (u - v[0]) / r)
+}
+
+/// A ladder whose rungs form a chain of algebraic loops: every solved loop is multiplied out, so the explicit rate
+/// stays a few terms in `q_cap` and `u` (nested, it grows about fivefold per rung), with the values of nodal
+/// analysis.
+#[test]
+fn long_ladder_stays_small_and_matches_nodal_analysis() {
+    let rungs = 12;
+    let eqs = equations(&ladder(rungs));
+    let p = eqs.default_params();
+    let (r, c) = (1.0, 1e-3);
+    let rate = eqs.f[0].as_ref().unwrap_or_else(|| panic!("no rate"));
+    let text = expr_text(&eqs, rate);
+    assert!(text.len() < 100, "{text}");
+    for &(q, u) in &[(0.0, 1.0), (2e-3, -0.5), (-1e-3, 3.0)] {
+        let (i_cap, i_src) = ladder_currents(rungs, r, q / c, u);
+        let rates = eqs
+            .rates_at(&p, &[q], &[u], 0.0)
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            (rates[0] - i_cap).abs() < 1e-12 * (1.0 + i_cap.abs()),
+            "{rates:?} vs {i_cap}"
+        );
+        let y = eqs
+            .outputs_at(&p, &[q], &[u], 0.0)
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            (y[0] - i_src).abs() < 1e-12 * (1.0 + i_src.abs()),
+            "{y:?} vs {i_src}"
+        );
+    }
+    // The nodal analysis itself, on the two-rung ladder derived by hand above.
+    let (i_cap, i_src) = ladder_currents(2, 1.0, 0.6, 1.5);
+    assert!((i_cap - (1.5 / 3.0 - 7.0 * 0.6 / 6.0)).abs() < 1e-15);
+    assert!((i_src - (2.0 * 1.5 / 3.0 - 0.6 / 3.0)).abs() < 1e-15);
+}
+
+/// `y_1 … y_levels` at `q_spring = q` by the recurrence itself.
+fn output_chain_values(levels: usize, q: f64) -> Vec<f64> {
+    let mut y = vec![(q * q).sin() + q.cos()];
+    while y.len() < levels {
+        let p = y[y.len() - 1];
+        y.push((p * p).sin() + p.cos());
+    }
+    y
+}
+
+/// Outputs defined through earlier outputs refer to them instead of copying them: each explicit output is as long
+/// as its own definition, however deep the chain (copying doubles it at every level, 2⁴⁰ copies here).
+#[test]
+fn outputs_through_earlier_outputs_are_shared_not_copied() {
+    let levels = 40;
+    let eqs = equations(&output_chain(levels));
+    for k in 1..levels {
+        let e = eqs.outputs[k]
+            .explicit
+            .as_ref()
+            .unwrap_or_else(|| panic!("y{} not derived", k + 1));
+        let mut refs = Vec::new();
+        e.for_each_sym(&mut |s| refs.push(s));
+        refs.sort();
+        refs.dedup();
+        assert_eq!(refs, vec![Sym::Output(k - 1)], "y{}", k + 1);
+        assert_eq!(
+            expr_text(&eqs, e),
+            format!("cos(y{k}) + sin(y{k}^2)"),
+            "y{}",
+            k + 1
+        );
+    }
+    let q = -0.4;
+    let want = output_chain_values(levels, q);
+    let mut x = vec![0.0; eqs.states.len()];
+    x[state(&eqs, "q_spring")] = q;
+    let p = eqs.default_params();
+    let y = eqs
+        .outputs_at(&p, &x, &[], 0.0)
+        .unwrap_or_else(|e| panic!("{e}"));
+    // The generated code's outputs: one shared node per output.
+    let generated = explicit_outputs(&eqs).unwrap_or_else(|e| panic!("{e}"));
+    // The simulation's output columns at t = 0.
+    let (system, _) = System::new(&eqs, p.clone(), Vec::new()).unwrap_or_else(|e| panic!("{e}"));
+    let mut y0 = x.clone();
+    y0.extend([0.0, 0.0]);
+    let row = system
+        .row(&y0, 0.0, &mut Vec::new(), &mut Vec::new())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let names: Vec<(String, f64)> = eqs
+        .params
+        .iter()
+        .cloned()
+        .chain([("q_spring".to_string(), q), ("p_mass".to_string(), 0.0)])
+        .collect();
+    for k in 0..levels {
+        assert!(
+            (y[k] - want[k]).abs() < 1e-12,
+            "y{}: {} vs {}",
+            k + 1,
+            y[k],
+            want[k]
+        );
+        let column = row[eqs.states.len() + k];
+        assert!(
+            (column - want[k]).abs() < 1e-12,
+            "simulated y{}: {column}",
+            k + 1
+        );
+        let g = generated[k]
+            .as_ref()
+            .unwrap_or_else(|| panic!("generated y{}", k + 1))
+            .eval(|s| names.iter().find(|(n, _)| n == s.name()).map(|(_, v)| *v))
+            .unwrap_or_else(|e| panic!("generated y{}: {e}", k + 1));
+        assert!((g - want[k]).abs() < 1e-12, "generated y{}: {g}", k + 1);
     }
 }
 

@@ -10,7 +10,7 @@
 
 use crate::equations::Equations;
 use crate::equations::sym::{Ex, Sym};
-use crate::symbolic::{Expr, Symbol};
+use crate::symbolic::{Expr, Symbol, SymbolKind};
 
 /// An expression that cannot be generated.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -30,6 +30,8 @@ pub fn symbol(eqs: &Equations, s: Sym) -> Result<Symbol, AdaptError> {
         // A tear (`loop_<variable>`) is a local of the generated functions, bound from the loops' solution.
         Sym::Var(_) | Sym::Tear(_) => Ok(Symbol::intermediate(eqs.sym_name(s))),
         Sym::Time => Ok(Symbol::time()),
+        // An earlier output in a readable output (explicit outputs are converted by `explicit_outputs`).
+        Sym::Output(_) => Ok(Symbol::new(eqs.sym_name(s), SymbolKind::Output)),
         Sym::InputDot(_) | Sym::StateDot(_) => Err(AdaptError::Unsupported {
             symbol: eqs.sym_name(s),
         }),
@@ -38,24 +40,58 @@ pub fn symbol(eqs: &Equations, s: Sym) -> Result<Symbol, AdaptError> {
 
 /// `e` as a symbolic-engine expression.
 pub fn to_symbolic(eqs: &Equations, e: &Ex) -> Result<Expr, AdaptError> {
+    convert(eqs, e, &[])
+}
+
+/// The explicit outputs `h(x, u, p, t)`, in order: a reference to an earlier output ([`Sym::Output`]) becomes that
+/// output's expression, one shared node of the engine however often it is used. `None` for an output that was not
+/// derived (and for the outputs defined through it).
+pub fn explicit_outputs(eqs: &Equations) -> Result<Vec<Option<Expr>>, AdaptError> {
+    let mut done: Vec<Option<Expr>> = Vec::with_capacity(eqs.outputs.len());
+    for o in &eqs.outputs {
+        let refs_ok = o.explicit.as_ref().is_some_and(|e| {
+            !e.any_sym(&|s| matches!(s, Sym::Output(j) if done.get(j).is_none_or(Option::is_none)))
+        });
+        let value = match (&o.explicit, refs_ok) {
+            (Some(e), true) => Some(convert(eqs, e, &done)?),
+            _ => None,
+        };
+        done.push(value);
+    }
+    Ok(done)
+}
+
+/// The given expression of output `s`, if `s` is one.
+fn s_output(outputs: &[Option<Expr>], s: Sym) -> Option<&Expr> {
+    match s {
+        Sym::Output(j) => outputs.get(j).and_then(Option::as_ref),
+        _ => None,
+    }
+}
+
+/// `e` with the earlier outputs `outputs[j]` in place of [`Sym::Output`]`(j)` where they are given.
+fn convert(eqs: &Equations, e: &Ex, outputs: &[Option<Expr>]) -> Result<Expr, AdaptError> {
     Ok(match e {
         Ex::Num(v) => Expr::constant(*v),
-        Ex::S(s) => Expr::symbol(symbol(eqs, *s)?),
+        Ex::S(s) => match s_output(outputs, *s) {
+            Some(shared) => shared.clone(),
+            None => Expr::symbol(symbol(eqs, *s)?),
+        },
         Ex::Add(ts) => Expr::sum(
             ts.iter()
-                .map(|t| to_symbolic(eqs, t))
+                .map(|t| convert(eqs, t, outputs))
                 .collect::<Result<Vec<_>, _>>()?,
         ),
         Ex::Mul(fs) => Expr::product(
             fs.iter()
-                .map(|f| to_symbolic(eqs, f))
+                .map(|f| convert(eqs, f, outputs))
                 .collect::<Result<Vec<_>, _>>()?,
         ),
-        Ex::Pow(b, x) => to_symbolic(eqs, b)?.pow(&to_symbolic(eqs, x)?),
+        Ex::Pow(b, x) => convert(eqs, b, outputs)?.pow(&convert(eqs, x, outputs)?),
         Ex::Call(f, args) => {
             let args = args
                 .iter()
-                .map(|a| to_symbolic(eqs, a))
+                .map(|a| convert(eqs, a, outputs))
                 .collect::<Result<Vec<_>, _>>()?;
             Expr::call(*f, &args).ok_or(AdaptError::Arity { func: f.name() })?
         }

@@ -11,7 +11,7 @@
 //! stage always provides for a complete model, and also when it would need more than [`MAX_LETS`] intermediates. Both are the same function; the tests check the generated code
 //! against the stage's own evaluation of `f`.
 
-use super::adapter::{AdaptError, to_symbolic};
+use super::adapter::{AdaptError, explicit_outputs, to_symbolic};
 use crate::equations::sym::Ex;
 use crate::equations::{
     EnergyKind, Equations, LinearError, StateSelection, declared_state_space_symbolic, jacobians,
@@ -90,16 +90,12 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
                 .ok_or_else(|| format!("the rate of `{name}` was not derived"))?,
         );
     }
-    let mut h_ex = Vec::with_capacity(eqs.outputs.len());
-    for o in &eqs.outputs {
-        h_ex.push(
-            o.explicit
-                .clone()
-                .ok_or_else(|| format!("output `{}` was not derived", o.name))?,
-        );
+    let mut h = Vec::with_capacity(eqs.outputs.len());
+    let explicit = explicit_outputs(eqs).map_err(|e| e.to_string())?;
+    for (o, e) in eqs.outputs.iter().zip(explicit) {
+        h.push(e.ok_or_else(|| format!("output `{}` was not derived", o.name))?);
     }
     let f = convert_all(eqs, &f_ex).map_err(|e| e.to_string())?;
-    let h = convert_all(eqs, &h_ex).map_err(|e| e.to_string())?;
     let states: Vec<Symbol> = eqs
         .states
         .iter()

@@ -27,7 +27,7 @@ pub mod rust;
 #[cfg(test)]
 mod test_support;
 
-pub use adapter::{AdaptError, to_symbolic};
+pub use adapter::{AdaptError, explicit_outputs, to_symbolic};
 
 use crate::diagnostic::{Diagnostic, has_errors};
 use crate::equations::Equations;

@@ -17,6 +17,7 @@ pub fn symbol(eqs: &Equations, s: Sym) -> Symbol {
         Sym::Input(_) => SymbolKind::Input,
         Sym::State(_) => SymbolKind::State,
         Sym::Time => SymbolKind::Time,
+        Sym::Output(_) => SymbolKind::Output,
         Sym::Var(_) | Sym::StateDot(_) | Sym::InputDot(_) | Sym::Tear(_) => {
             SymbolKind::Intermediate
         }

@@ -233,15 +233,28 @@ impl Ctx<'_> {
 
     /// Converts an IR expression; `outputs_seen` guards against outputs defined through each other.
     pub fn convert(&self, e: &Expr) -> Result<Ex, ConvertError> {
-        self.convert_guarded(e, &mut Vec::new())
+        self.convert_guarded(e, &mut Vec::new(), 0)
     }
 
-    fn convert_guarded(&self, e: &Expr, outputs_seen: &mut Vec<usize>) -> Result<Ex, ConvertError> {
+    /// Converts the value of output `k`: earlier outputs stay references ([`Sym::Output`]), evaluated once before
+    /// it, so that a chain of outputs defined through each other is shared, not copied into every use.
+    pub fn convert_output(&self, e: &Expr, k: usize) -> Result<Ex, ConvertError> {
+        self.convert_guarded(e, &mut vec![k], k)
+    }
+
+    /// `shared_below`: outputs with a smaller index are kept as references.
+    fn convert_guarded(
+        &self,
+        e: &Expr,
+        outputs_seen: &mut Vec<usize>,
+        shared_below: usize,
+    ) -> Result<Ex, ConvertError> {
         Ok(match e {
             Expr::Const(v) => Ex::Num(*v),
             Expr::Time => Ex::S(Sym::Time),
             Expr::Param(p) => Ex::S(Sym::Param(*p)),
             Expr::Input(i) => Ex::S(Sym::Input(*i)),
+            Expr::Output(o) if *o < shared_below => Ex::S(Sym::Output(*o)),
             Expr::Output(o) => {
                 if outputs_seen.contains(o) {
                     return Err(ConvertError::Unsupported(
@@ -254,7 +267,7 @@ impl Ctx<'_> {
                     .get(*o)
                     .ok_or_else(|| ConvertError::Unsupported(format!("output #{o}")))?;
                 outputs_seen.push(*o);
-                let v = self.convert_guarded(&out.value, outputs_seen)?;
+                let v = self.convert_guarded(&out.value, outputs_seen, shared_below)?;
                 outputs_seen.pop();
                 v
             }
@@ -268,10 +281,10 @@ impl Ctx<'_> {
             Expr::Momentum(n) => self.energy_of(*n, "p")?,
             Expr::Displacement(n) => self.energy_of(*n, "q")?,
             Expr::FieldPort { node, var, port } => self.field_port(*node, *var, *port)?,
-            Expr::Neg(a) => neg(self.convert_guarded(a, outputs_seen)?),
+            Expr::Neg(a) => neg(self.convert_guarded(a, outputs_seen, shared_below)?),
             Expr::Binary(op, a, b) => {
-                let a = self.convert_guarded(a, outputs_seen)?;
-                let b = self.convert_guarded(b, outputs_seen)?;
+                let a = self.convert_guarded(a, outputs_seen, shared_below)?;
+                let b = self.convert_guarded(b, outputs_seen, shared_below)?;
                 match op {
                     BinOp::Add => add(vec![a, b]),
                     BinOp::Sub => sym::sub(a, b),
@@ -283,7 +296,7 @@ impl Ctx<'_> {
             Expr::Call(f, args) => sym::call(
                 *f,
                 args.iter()
-                    .map(|a| self.convert_guarded(a, outputs_seen))
+                    .map(|a| self.convert_guarded(a, outputs_seen, shared_below))
                     .collect::<Result<_, _>>()?,
             ),
         })

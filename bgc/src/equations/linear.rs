@@ -175,8 +175,8 @@ fn selected(eqs: &Equations, selection: StateSelection) -> Result<(Vec<Ex>, Vec<
         f.push(e);
     }
     let mut h = Vec::with_capacity(eqs.outputs.len());
-    for o in &eqs.outputs {
-        h.push(o.explicit.clone().ok_or_else(|| LinearError::Incomplete {
+    for (o, e) in eqs.outputs.iter().zip(eqs.outputs_inlined()) {
+        h.push(e.ok_or_else(|| LinearError::Incomplete {
             what: format!("output `{}`", o.name),
         })?);
     }

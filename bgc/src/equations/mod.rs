@@ -6,8 +6,10 @@
 //!    integrated flows (`var`s, named as declared); their rates are `ṗ = e`, `q̇ = f`, `θ̇ = integrand`.
 //! 2. Every node writes the causal equation of each bond variable it computes (`build.rs`).
 //! 3. The rates and outputs are expressed in states, inputs, parameters and `t` by substitution in dependency order
-//!    (`resolve.rs`); algebraic loops are torn and solved exactly when affine, storages in derivative causality
-//!    contribute `ẋ` terms, solved for by a symbolic linear solve (`solve.rs`). Multiport fields are in `field`:
+//!    (`resolve.rs`; each resolved value is multiplied out when that makes it no larger, so that the solutions of
+//!    chained algebraic loops do not nest); algebraic loops are torn and solved exactly when affine, storages in
+//!    derivative causality contribute `ẋ` terms, solved for by a symbolic linear solve (`solve.rs`). An output
+//!    defined through earlier outputs refers to them ([`Sym::Output`]) rather than copying them. Multiport fields are in `field`:
 //!    an I-field gives the mass-matrix form `M(q) ẋ = F` for its flow states ([`Equations::mass`]), solved
 //!    numerically by its consumers ([`Equations::rates_at`]).
 //! 4. A nonlinear algebraic loop stays implicit (`tear.rs`): its tear variable `z` (`Sym::Tear`, printed
@@ -145,8 +147,9 @@ pub struct OutputEq {
     pub name: String,
     /// In states, inputs, parameters, `t` and intermediates.
     pub value: Ex,
-    /// In states, inputs, parameters and `t` only: `h(x, u, p, t)`. `None` when it could not be derived (a
-    /// diagnostic says why).
+    /// In states, inputs, parameters, `t`, tear variables and earlier outputs ([`Sym::Output`]`(j)`, `j` less
+    /// than this output's index, whose values are computed first): `h(x, u, p, t)`. `None` when it could not be
+    /// derived (a diagnostic says why, at this output or at the output it is defined through).
     pub explicit: Option<Ex>,
 }
 
@@ -219,7 +222,35 @@ impl Equations {
                 .unwrap_or_else(|| format!("v{i}")),
             Sym::Tear(i) => format!("loop_{}", self.sym_name(Sym::Var(i))),
             Sym::Time => "t".to_string(),
+            Sym::Output(k) => self
+                .outputs
+                .get(k)
+                .map(|o| o.name.clone())
+                .unwrap_or_else(|| format!("output{k}")),
         }
+    }
+
+    /// The explicit outputs with the references to earlier outputs ([`Sym::Output`]) substituted, each in
+    /// states, inputs, parameters, `t` and tears only (`None` where an output was not derived). A chain of outputs
+    /// defined through each other grows here with every level; evaluating the outputs in order does not.
+    pub fn outputs_inlined(&self) -> Vec<Option<Ex>> {
+        let mut done: Vec<Option<Ex>> = Vec::with_capacity(self.outputs.len());
+        for o in &self.outputs {
+            let e = o.explicit.as_ref().and_then(|e| {
+                let mut missing = false;
+                let v = sym::subst(e, &mut |s| match s {
+                    Sym::Output(j) => {
+                        let r = done.get(j).cloned().flatten();
+                        missing |= r.is_none();
+                        r
+                    }
+                    _ => None,
+                });
+                (!missing).then_some(v)
+            });
+            done.push(e);
+        }
+        done
     }
 
     /// True when every explicit rate and output was derived.
@@ -448,7 +479,7 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
 
     // Outputs.
     for (k, out) in model.outputs.iter().enumerate() {
-        let value = match ctx.convert(&out.value) {
+        let value = match ctx.convert_output(&out.value, k) {
             Ok(v) => v,
             Err(build::ConvertError::Unsupported(what)) => {
                 let d = Diagnostic::error(
@@ -464,7 +495,12 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
                 continue;
             }
         };
+        let underived = |e: &Ex| {
+            e.any_sym(&|s| matches!(s, Sym::Output(j) if eqs.outputs.get(j).is_none_or(|o| o.explicit.is_none())))
+        };
         let explicit = match resolver.expr(&value) {
+            // The output it is defined through has a diagnostic already.
+            Ok(e) if underived(&e) => None,
             Ok(e) if e.any_sym(&|s| matches!(s, Sym::InputDot(_))) => {
                 let names: Vec<String> = (0..model.inputs.len())
                     .filter(|&j| e.contains(Sym::InputDot(j)))

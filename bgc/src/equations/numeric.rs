@@ -126,18 +126,22 @@ impl Equations {
     ) -> Result<Vec<f64>, LinearError> {
         self.check_point(params, x, u)?;
         let tears = self.tears_at(params, x, u, t)?;
-        let value = |s: Sym| point_with_tears(s, params, x, u, t, &tears);
-        self.outputs
-            .iter()
-            .map(|o| {
-                let what = || format!("output `{}`", o.name);
-                let e = o
-                    .explicit
-                    .as_ref()
-                    .ok_or_else(|| LinearError::Incomplete { what: what() })?;
-                value_of(self, e, &what, &value)
-            })
-            .collect()
+        // In order: an output defined through earlier outputs reads their values.
+        let mut done: Vec<f64> = Vec::with_capacity(self.outputs.len());
+        for o in &self.outputs {
+            let what = || format!("output `{}`", o.name);
+            let e = o
+                .explicit
+                .as_ref()
+                .ok_or_else(|| LinearError::Incomplete { what: what() })?;
+            let value = |s: Sym| match s {
+                Sym::Output(j) => done.get(j).copied(),
+                _ => point_with_tears(s, params, x, u, t, &tears),
+            };
+            let v = value_of(self, e, &what, &value)?;
+            done.push(v);
+        }
+        Ok(done)
     }
 }
 

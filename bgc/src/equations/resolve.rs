@@ -104,7 +104,7 @@ impl<'a> Resolver<'a> {
         let result = self.compute(v);
         self.depth -= 1;
         let value = match result.and_then(|value| self.close_loop(v, value)) {
-            Ok(value) => value,
+            Ok(value) => compact(value),
             Err(e) => {
                 self.forget(v);
                 return Err(e);
@@ -134,12 +134,12 @@ impl<'a> Resolver<'a> {
         if gain.is_zero() {
             return Err(ResolveError::SingularLoop(v));
         }
-        let solved = div(b, gain);
+        let solved = compact(div(b, gain));
         // Values computed inside the loop, and the residuals of implicit loops inside it, hold the tear: replace it
         // everywhere.
         let mut replace = |e: &mut Ex| {
             if e.contains(tear) {
-                *e = sym::subst(e, &mut |s| (s == tear).then(|| solved.clone()));
+                *e = compact(sym::subst(e, &mut |s| (s == tear).then(|| solved.clone())));
             }
         };
         self.cache.iter_mut().flatten().for_each(&mut replace);
@@ -233,5 +233,17 @@ impl<'a> Resolver<'a> {
             terms.push(d(Sym::Time)?);
         }
         Ok(add(terms))
+    }
+}
+
+/// `e` multiplied out when that makes it no larger. A value is copied into every variable that uses it: in a chain
+/// of algebraic loops each rung's solution `b / (1 − a)` holds the previous ones as nested products of sums, which
+/// grow geometrically; multiplied out, the like terms collect and the size stays that of the model's symbols.
+fn compact(e: Ex) -> Ex {
+    let expanded = sym::expand(&e);
+    if expanded.key().len() <= e.key().len() {
+        expanded
+    } else {
+        e
     }
 }

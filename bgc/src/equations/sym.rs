@@ -31,6 +31,9 @@ pub enum Sym {
     Tear(usize),
     /// Time.
     Time,
+    /// The value of an earlier output (index into the equations' outputs): an output defined through earlier
+    /// outputs refers to them instead of copying their expressions, and consumers evaluate outputs in order.
+    Output(usize),
 }
 
 /// A symbolic expression.

@@ -134,7 +134,9 @@ impl System {
     /// input. Returns the system and the warnings about energy terms left out of the energy columns.
     ///
     /// The programs read the inputs as `[u, u̇, z]`: [`Sym::InputDot`]`(j)` is compiled as input `n_inputs + j`,
-    /// the `k`-th tear variable of the loops (in block order) as input `2 n_inputs + k`.
+    /// the `k`-th tear variable of the loops (in block order) as input `2 n_inputs + k`; the outputs read an
+    /// earlier output `j` ([`Sym::Output`]) as input `2 n_inputs + n_tears + j`, written there by [`System::row`]
+    /// in output order.
     pub fn new(
         eqs: &Equations,
         params: Vec<f64>,
@@ -155,7 +157,12 @@ impl System {
             states: n,
             inputs: ext_len,
         };
+        let output_layout = Layout {
+            inputs: ext_len + eqs.outputs.len(),
+            ..layout
+        };
         let name = |s: Sym| match s {
+            Sym::Input(j) if j >= ext_len => eqs.sym_name(Sym::Output(j - ext_len)),
             Sym::Input(j) if j >= 2 * n_inputs => tears
                 .get(j - 2 * n_inputs)
                 .map_or_else(|| format!("input{j}"), |&z| eqs.sym_name(z)),
@@ -235,7 +242,16 @@ impl System {
                 .explicit
                 .as_ref()
                 .ok_or_else(|| SimError::Incomplete { what: what.clone() })?;
-            outputs_h.push(compile(e, &what)?);
+            let e = sym::subst(e, &mut |s| match s {
+                Sym::Output(j) => Some(Ex::S(Sym::Input(ext_len + j))),
+                _ => None,
+            });
+            let program = Program::compile(&exogenous(&e, n_inputs, &tears), output_layout, &name)
+                .map_err(|reason| SimError::Compile {
+                    what: what.clone(),
+                    reason,
+                })?;
+            outputs_h.push(program);
         }
         let system = System {
             states: (0..n).map(|i| eqs.sym_name(Sym::State(i))).collect(),
@@ -415,10 +431,18 @@ impl System {
         self.inputs_at(t, u);
         self.solve_loops(y, u, t, stack)?;
         let n = self.states.len();
-        let v = self.values(y, u, t);
         let mut row = Vec::with_capacity(n + self.outputs_h.len() + 3);
         row.extend(y.iter().take(n));
-        row.extend(self.outputs_h.iter().map(|p| p.eval(&v, stack)));
+        // Each output is written after the inputs before the next is evaluated (outputs defined through earlier
+        // outputs read them there).
+        u.truncate(self.ext_len);
+        for p in &self.outputs_h {
+            let value = p.eval(&self.values(y, u, t), stack);
+            u.push(value);
+            row.push(value);
+        }
+        u.truncate(self.ext_len);
+        let v = self.values(y, u, t);
         row.push(self.stored.eval(&v, stack));
         row.extend(y.iter().skip(n).take(2));
         Ok(row)

@@ -26,7 +26,7 @@ pub fn format(text: &str) -> Option<Vec<TextEdit>> {
     Some(vec![TextEdit::new(range, new_text)])
 }
 
-/// The edits of [`format`] that touch the lines of `range`: the canonical layout's line changes, each hunk of a
+/// The edits of [`format()`] that touch the lines of `range`: the canonical layout's line changes, each hunk of a
 /// line diff of the old and the formatted text kept when it overlaps (or, for an insertion, borders) those lines,
 /// so a run of adjacent changed lines is formatted whole; the rest of the file stays as written. `None` when the
 /// text has syntax errors.

@@ -7,6 +7,7 @@ mod model;
 mod params;
 mod quantities;
 mod simulate;
+mod sparse;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::ffi::OsString;
@@ -154,6 +155,10 @@ enum Command {
         /// Print the effective parameter values (declared unit and SI) and the operating point on standard error.
         #[arg(long, short)]
         verbose: bool,
+        /// Each matrix as coordinate triplets `[row, column, value]` of its nonzero entries (0-based), with its
+        /// size, instead of dense rows: the form for large models.
+        #[arg(long)]
+        sparse: bool,
     },
     /// Simulate a model and print CSV: t, the states, the outputs, energy (stored), dissipated (in the resistors
     /// since t = 0) and supplied (by the sources since t = 0).
@@ -272,6 +277,7 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
             format,
             at,
             verbose,
+            sparse,
         } => {
             let args = model::StateSpaceArgs {
                 params: &params,
@@ -280,6 +286,7 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
                 format,
                 at: &at,
                 verbose,
+                sparse,
             };
             model::statespace(&file, model.as_deref(), &args, color)
         }

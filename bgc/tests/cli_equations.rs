@@ -161,6 +161,57 @@ fn symbolic_state_space_is_in_the_parameters() {
 }
 
 #[test]
+fn sparse_state_space_lists_the_nonzero_entries() {
+    // The oscillator: p' = F - d p/m - k q, q' = p/m; the structural zero A[1][1] and B[1][0] are left out.
+    let v = ok_json(&[
+        "statespace",
+        &corpus("oscillator.bg"),
+        "--symbolic",
+        "--sparse",
+    ]);
+    assert_eq!(names(&v, "states"), ["p_mass", "q_spring"]);
+    assert_eq!(
+        v["A"],
+        serde_json::json!({"rows": 2, "cols": 2, "entries": [[0, 0, "-d/m"], [0, 1, "-k"], [1, 0, "1/m"]]})
+    );
+    assert_eq!(
+        v["B"],
+        serde_json::json!({"rows": 2, "cols": 1, "entries": [[0, 0, "1"]]})
+    );
+    // The numeric triplets are the dense form's nonzeros, in row-major order.
+    let dense = ok_json(&["statespace", &corpus("oscillator.bg")]);
+    let sparse = ok_json(&["statespace", &corpus("oscillator.bg"), "--sparse"]);
+    for m in ["A", "B", "C", "D"] {
+        let rows = dense[m].as_array().cloned().unwrap_or_default();
+        let mut nonzeros = Vec::new();
+        for (i, row) in rows.iter().enumerate() {
+            for (j, x) in row
+                .as_array()
+                .cloned()
+                .unwrap_or_default()
+                .iter()
+                .enumerate()
+            {
+                if x.as_f64() != Some(0.0) {
+                    nonzeros.push(serde_json::json!([i, j, x]));
+                }
+            }
+        }
+        assert_eq!(sparse[m]["entries"], Value::Array(nonzeros), "{m}");
+        assert_eq!(sparse[m]["rows"], rows.len());
+    }
+    let (code, out, _) = bgc(&[
+        "statespace",
+        &corpus("oscillator.bg"),
+        "--sparse",
+        "--format",
+        "text",
+    ]);
+    assert_eq!(code, 0);
+    assert!(out.contains("\nA: 2 x 2, 3 nonzero\n"), "{out}");
+}
+
+#[test]
 fn state_space_text_and_json_forms_are_stable() {
     let (code, out, _) = bgc(&["statespace", &corpus("oscillator.bg"), "--format", "text"]);
     assert_eq!(code, 0);

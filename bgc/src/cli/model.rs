@@ -5,6 +5,7 @@ use super::io::{stderr, stderrln, stdout, stdoutln};
 use super::matrix_text;
 use super::params::{Assignment, param_values, values_or_zero};
 use super::quantities::{self, Declared};
+use super::sparse;
 use super::{Coords, EquationsFormat, ReportFormat, Status};
 use bgc::diagnostic::{has_errors, render};
 use bgc::equations::sym::{self, Ex, Sym};
@@ -82,6 +83,8 @@ pub struct StateSpaceArgs<'a> {
     pub at: &'a [Assignment],
     /// Print the effective parameter values and the operating point on standard error.
     pub verbose: bool,
+    /// Coordinate triplets of the nonzero entries instead of dense rows.
+    pub sparse: bool,
 }
 
 /// `bgc statespace FILE`
@@ -97,9 +100,11 @@ pub fn statespace(
     };
     match state_space(&d, args) {
         Ok(v) => {
-            match args.format {
-                ReportFormat::Json => stdout(&json_rows(&v)),
-                ReportFormat::Text => stdout(&text(&v)),
+            match (args.format, args.sparse) {
+                (ReportFormat::Json, false) => stdout(&json_rows(&v)),
+                (ReportFormat::Text, false) => stdout(&text(&v)),
+                (ReportFormat::Json, true) => stdout(&sparse::json(&v)),
+                (ReportFormat::Text, true) => stdout(&sparse::text(&v)),
             }
             Status::Ok
         }

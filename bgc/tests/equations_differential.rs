@@ -27,34 +27,6 @@ use petgraph::Direction;
 use petgraph::visit::EdgeRef;
 use proptest::prelude::*;
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Cx(f64, f64);
-
-impl Cx {
-    fn add(self, o: Cx) -> Cx {
-        Cx(self.0 + o.0, self.1 + o.1)
-    }
-    fn sub(self, o: Cx) -> Cx {
-        Cx(self.0 - o.0, self.1 - o.1)
-    }
-    fn mul(self, o: Cx) -> Cx {
-        Cx(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
-    }
-    fn div(self, o: Cx) -> Cx {
-        let d = o.0 * o.0 + o.1 * o.1;
-        Cx(
-            (self.0 * o.0 + self.1 * o.1) / d,
-            (self.1 * o.0 - self.0 * o.1) / d,
-        )
-    }
-    fn abs(self) -> f64 {
-        self.0.hypot(self.1)
-    }
-    fn re(v: f64) -> Cx {
-        Cx(v, 0.0)
-    }
-}
-
 /// Solves `a x = b` by Gaussian elimination with partial pivoting; `None` when singular.
 fn solve(mut a: Vec<Vec<Cx>>, mut b: Vec<Cx>) -> Option<Vec<Cx>> {
     let n = b.len();

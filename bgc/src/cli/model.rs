@@ -411,8 +411,8 @@ fn json_rows(v: &Value) -> String {
     out
 }
 
-/// The text form: the names, then each matrix with one row per line.
-fn text(v: &Value) -> String {
+/// The head of the text forms: the states, inputs and outputs of a state-space value, one line each.
+pub(super) fn names_text(v: &Value) -> String {
     let names = |k: &str| {
         let list: Vec<&str> = v
             .get(k)
@@ -427,12 +427,17 @@ fn text(v: &Value) -> String {
             list.join(", ")
         }
     };
-    let mut out = format!(
+    format!(
         "states: {}\ninputs: {}\noutputs: {}\n",
         names("states"),
         names("inputs"),
         names("outputs")
-    );
+    )
+}
+
+/// The text form: the names, then each matrix with one row per line.
+fn text(v: &Value) -> String {
+    let mut out = names_text(v);
     for m in ["A", "B", "C", "D"] {
         out.push_str(&format!("\n{m} =\n"));
         let rows: Vec<&Vec<Value>> = v

@@ -78,25 +78,7 @@ pub fn json(v: &Value) -> String {
 /// The text form: the names, then each matrix's size and one `row column value` line per nonzero entry.
 pub fn text(v: &Value) -> String {
     let t = triplets(v);
-    let names = |k: &str| {
-        let list: Vec<&str> = t[k]
-            .as_array()
-            .into_iter()
-            .flatten()
-            .filter_map(Value::as_str)
-            .collect();
-        if list.is_empty() {
-            "(none)".to_string()
-        } else {
-            list.join(", ")
-        }
-    };
-    let mut out = format!(
-        "states: {}\ninputs: {}\noutputs: {}\n",
-        names("states"),
-        names("inputs"),
-        names("outputs")
-    );
+    let mut out = super::model::names_text(&t);
     for m in ["A", "B", "C", "D"] {
         let entries = t[m]["entries"].as_array().cloned().unwrap_or_default();
         out.push_str(&format!(

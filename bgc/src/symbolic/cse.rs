@@ -67,30 +67,31 @@ pub fn cse(exprs: &[Expr]) -> (Vec<(Symbol, Expr)>, Vec<Expr>) {
 /// The expressions as text with their common subexpressions named: one line `name = expression` per definition,
 /// then one line per expression, each symbol printed as `names` says (the names of definitions as they are).
 pub fn to_text_cse(exprs: &[Expr], names: &dyn Fn(&Symbol) -> String) -> String {
-    let (definitions, outputs) = cse(exprs);
-    let defined: BTreeSet<&Symbol> = definitions.iter().map(|(s, _)| s).collect();
-    let name = |s: &Symbol| {
-        if defined.contains(s) {
-            s.name().to_string()
-        } else {
-            names(s)
-        }
-    };
-    let mut out = String::new();
-    for (s, body) in &definitions {
-        out.push_str(&format!("{} = {}\n", s.name(), to_text_with(body, &name)));
-    }
-    for e in &outputs {
-        out.push_str(&to_text_with(e, &name));
-        out.push('\n');
-    }
-    out
+    cse_lines(exprs, names, to_text_with, |name, body| {
+        format!("{name} = {body}")
+    })
 }
 
 /// The expressions as Rust with their common subexpressions bound first: one `let name = expression;` line per
 /// definition, then one line per expression, each symbol printed as `names` says (the names of definitions as
 /// they are).
 pub fn to_rust_cse(exprs: &[Expr], names: &dyn Fn(&Symbol) -> String) -> String {
+    cse_lines(exprs, names, to_rust, |name, body| {
+        format!("let {name} = {body};")
+    })
+}
+
+/// A printer of one expression with the symbols named by a function (`to_text_with`, `to_rust`).
+type Printer = fn(&Expr, &dyn Fn(&Symbol) -> String) -> String;
+
+/// The lines of [`to_text_cse`] and [`to_rust_cse`]: each definition as `define` writes it, then each expression,
+/// printed by `print` with the definitions' own names.
+fn cse_lines(
+    exprs: &[Expr],
+    names: &dyn Fn(&Symbol) -> String,
+    print: Printer,
+    define: fn(&str, &str) -> String,
+) -> String {
     let (definitions, outputs) = cse(exprs);
     let defined: BTreeSet<&Symbol> = definitions.iter().map(|(s, _)| s).collect();
     let name = |s: &Symbol| {
@@ -102,10 +103,11 @@ pub fn to_rust_cse(exprs: &[Expr], names: &dyn Fn(&Symbol) -> String) -> String 
     };
     let mut out = String::new();
     for (s, body) in &definitions {
-        out.push_str(&format!("let {} = {};\n", s.name(), to_rust(body, &name)));
+        out.push_str(&define(s.name(), &print(body, &name)));
+        out.push('\n');
     }
     for e in &outputs {
-        out.push_str(&to_rust(e, &name));
+        out.push_str(&print(e, &name));
         out.push('\n');
     }
     out

@@ -248,16 +248,16 @@ impl Rng {
 pub struct Cx(pub f64, pub f64);
 
 impl Cx {
-    fn add(self, o: Cx) -> Cx {
+    pub fn add(self, o: Cx) -> Cx {
         Cx(self.0 + o.0, self.1 + o.1)
     }
-    fn sub(self, o: Cx) -> Cx {
+    pub fn sub(self, o: Cx) -> Cx {
         Cx(self.0 - o.0, self.1 - o.1)
     }
-    fn mul(self, o: Cx) -> Cx {
+    pub fn mul(self, o: Cx) -> Cx {
         Cx(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
     }
-    fn div(self, o: Cx) -> Cx {
+    pub fn div(self, o: Cx) -> Cx {
         let d = o.0 * o.0 + o.1 * o.1;
         Cx(
             (self.0 * o.0 + self.1 * o.1) / d,
@@ -266,6 +266,11 @@ impl Cx {
     }
     pub fn abs(self) -> f64 {
         self.0.hypot(self.1)
+    }
+
+    /// The real number `v`.
+    pub fn re(v: f64) -> Cx {
+        Cx(v, 0.0)
     }
 }
 

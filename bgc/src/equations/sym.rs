@@ -305,46 +305,12 @@ pub fn recip(a: Ex) -> Ex {
 /// A function call, folded when its arguments are numbers.
 pub fn call(f: Func, args: Vec<Ex>) -> Ex {
     let nums: Option<Vec<f64>> = args.iter().map(Ex::num).collect();
-    if let Some(v) = nums.and_then(|n| eval_func(f, &n))
+    if let Some(v) = nums.and_then(|n| f.eval(&n))
         && v.is_finite()
     {
         return Ex::Num(v);
     }
     Ex::Call(f, args)
-}
-
-/// Evaluates a function on numbers (`None` on an arity mismatch).
-pub fn eval_func(f: Func, a: &[f64]) -> Option<f64> {
-    let x = *a.first()?;
-    let y = a.get(1).copied();
-    Some(match f {
-        Func::Sin => x.sin(),
-        Func::Cos => x.cos(),
-        Func::Tan => x.tan(),
-        Func::Asin => x.asin(),
-        Func::Acos => x.acos(),
-        Func::Atan => x.atan(),
-        Func::Atan2 => x.atan2(y?),
-        Func::Exp => x.exp(),
-        Func::Ln => x.ln(),
-        Func::Log10 => x.log10(),
-        Func::Sqrt => x.sqrt(),
-        Func::Abs => x.abs(),
-        Func::Sign => {
-            if x > 0.0 {
-                1.0
-            } else if x < 0.0 {
-                -1.0
-            } else {
-                0.0
-            }
-        }
-        Func::Min => x.min(y?),
-        Func::Max => x.max(y?),
-        Func::Tanh => x.tanh(),
-        Func::Sinh => x.sinh(),
-        Func::Cosh => x.cosh(),
-    })
 }
 
 /// Products of sums multiplied out (`a (b + c)` → `a b + a c`), unless that would make more than 64 terms, in
@@ -528,7 +494,7 @@ pub fn eval(e: &Ex, value: &dyn Fn(Sym) -> Option<f64>) -> Result<f64, EvalError
                 .iter()
                 .map(|a| eval(a, value))
                 .collect::<Result<Vec<_>, _>>()?;
-            eval_func(*f, &vals).ok_or(EvalError::Arity(*f))?
+            f.eval(&vals).ok_or(EvalError::Arity(*f))?
         }
     })
 }

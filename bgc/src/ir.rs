@@ -137,6 +137,41 @@ impl Func {
             _ => 1,
         }
     }
+
+    /// The function applied to numbers (`None` when an argument is missing). The plain `f64` functions of the
+    /// standard library: constant folding of the IR and the equations stage share this one definition.
+    pub fn eval(self, a: &[f64]) -> Option<f64> {
+        let x = *a.first()?;
+        let y = a.get(1).copied();
+        Some(match self {
+            Func::Sin => x.sin(),
+            Func::Cos => x.cos(),
+            Func::Tan => x.tan(),
+            Func::Asin => x.asin(),
+            Func::Acos => x.acos(),
+            Func::Atan => x.atan(),
+            Func::Atan2 => x.atan2(y?),
+            Func::Exp => x.exp(),
+            Func::Ln => x.ln(),
+            Func::Log10 => x.log10(),
+            Func::Sqrt => x.sqrt(),
+            Func::Abs => x.abs(),
+            Func::Sign => {
+                if x > 0.0 {
+                    1.0
+                } else if x < 0.0 {
+                    -1.0
+                } else {
+                    0.0
+                }
+            }
+            Func::Min => x.min(y?),
+            Func::Max => x.max(y?),
+            Func::Tanh => x.tanh(),
+            Func::Sinh => x.sinh(),
+            Func::Cosh => x.cosh(),
+        })
+    }
 }
 
 /// What an effort or flow reference points at.
@@ -344,7 +379,7 @@ impl Expr {
                     .iter()
                     .map(|a| a.eval_const(param))
                     .collect::<Option<Vec<_>>>()?;
-                crate::equations::sym::eval_func(*f, &vals)?
+                f.eval(&vals)?
             }
             _ => return None,
         })

@@ -72,6 +72,8 @@ fn s_output(outputs: &[Option<Expr>], s: Sym) -> Option<&Expr> {
 /// `e` with the earlier outputs `outputs[j]` in place of [`Sym::Output`]`(j)` where they are given.
 fn convert(eqs: &Equations, e: &Ex, outputs: &[Option<Expr>]) -> Result<Expr, AdaptError> {
     Ok(match e {
+        // The zeros of dense matrices skip the interning table.
+        Ex::Num(v) if *v == 0.0 => Expr::zero(),
         Ex::Num(v) => Expr::constant(*v),
         Ex::S(s) => match s_output(outputs, *s) {
             Some(shared) => shared.clone(),

@@ -7,6 +7,7 @@
 
 use super::Equations;
 use super::sym::{self, Ex, Sym};
+use std::collections::{BTreeSet, HashMap};
 
 /// Which states make up the state vector.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -193,15 +194,23 @@ fn selected(eqs: &Equations, selection: StateSelection) -> Result<(Vec<Ex>, Vec<
         )
     };
     let check = |e: &Ex, what: String| -> Result<(), LinearError> {
-        for j in n..eqs.states.len() {
-            if e.contains(Sym::State(j)) {
-                return Err(LinearError::NeedsIntegratedState {
-                    what,
-                    state: eqs.sym_name(Sym::State(j)),
-                });
+        // The first left-out state the expression reads, found in one walk.
+        let mut first: Option<usize> = None;
+        e.for_each_sym(&mut |s| {
+            if let Sym::State(j) = s
+                && j >= n
+                && j < eqs.states.len()
+            {
+                first = Some(first.map_or(j, |f| f.min(j)));
             }
+        });
+        match first {
+            Some(j) => Err(LinearError::NeedsIntegratedState {
+                what,
+                state: eqs.sym_name(Sym::State(j)),
+            }),
+            None => Ok(()),
         }
-        Ok(())
     };
     for (i, e) in f.iter().enumerate() {
         check(e, what_f(i))?;
@@ -217,19 +226,29 @@ fn jacobian(
     vars: &[Sym],
     what: &dyn Fn(usize) -> String,
 ) -> Result<Vec<Vec<Ex>>, LinearError> {
+    let column: HashMap<Sym, usize> = vars.iter().enumerate().map(|(j, &v)| (v, j)).collect();
     rows.iter()
         .enumerate()
         .map(|(i, r)| {
-            vars.iter()
-                .map(|&v| {
-                    sym::diff(r, v).map_err(|sym::NotDifferentiable(f)| {
-                        LinearError::NotDifferentiable {
-                            what: what(i),
-                            func: f.name(),
-                        }
-                    })
-                })
-                .collect()
+            // Only the columns of the symbols the row reads (one walk) are differentiated, in column order; every
+            // other entry is zero.
+            let mut read = BTreeSet::new();
+            r.for_each_sym(&mut |s| {
+                if let Some(&j) = column.get(&s) {
+                    read.insert(j);
+                }
+            });
+            let mut row = vec![Ex::zero(); vars.len()];
+            for j in read {
+                let d = sym::diff(r, vars[j]).map_err(|sym::NotDifferentiable(f)| {
+                    LinearError::NotDifferentiable {
+                        what: what(i),
+                        func: f.name(),
+                    }
+                })?;
+                row[j] = d;
+            }
+            Ok(row)
         })
         .collect()
 }

@@ -218,19 +218,23 @@ impl<'a> Resolver<'a> {
             sym::diff(e, s)
                 .map_err(|sym::NotDifferentiable(f)| ResolveError::NotDifferentiable(v, f))
         };
+        // The symbols `e` reads, in one walk (not one walk per state of the model), in the order of the sum.
+        let mut read = std::collections::BTreeSet::new();
+        e.for_each_sym(&mut |s| {
+            if matches!(s, Sym::State(i) if i < self.nstates)
+                || matches!(s, Sym::Input(j) if j < self.ninputs)
+                || s == Sym::Time
+            {
+                read.insert(s);
+            }
+        });
         let mut terms = Vec::new();
-        for i in 0..self.nstates {
-            if e.contains(Sym::State(i)) {
-                terms.push(mul(vec![d(Sym::State(i))?, Ex::S(Sym::StateDot(i))]));
-            }
-        }
-        for j in 0..self.ninputs {
-            if e.contains(Sym::Input(j)) {
-                terms.push(mul(vec![d(Sym::Input(j))?, Ex::S(Sym::InputDot(j))]));
-            }
-        }
-        if e.contains(Sym::Time) {
-            terms.push(d(Sym::Time)?);
+        for s in read {
+            terms.push(match s {
+                Sym::State(i) => mul(vec![d(s)?, Ex::S(Sym::StateDot(i))]),
+                Sym::Input(j) => mul(vec![d(s)?, Ex::S(Sym::InputDot(j))]),
+                _ => d(s)?,
+            });
         }
         Ok(add(terms))
     }
@@ -241,7 +245,10 @@ impl<'a> Resolver<'a> {
 /// grow geometrically; multiplied out, the like terms collect and the size stays that of the model's symbols.
 fn compact(e: Ex) -> Ex {
     let expanded = sym::expand(&e);
-    if expanded.key().len() <= e.key().len() {
+    if expanded == e {
+        return e;
+    }
+    if expanded.key_len() <= e.key_len() {
         expanded
     } else {
         e

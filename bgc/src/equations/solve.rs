@@ -181,7 +181,7 @@ pub(crate) fn gauss(a: &mut [Vec<Ex>], b: &mut [Ex]) -> Option<Vec<Ex>> {
         let pivot = candidates
             .clone()
             .find(|&r| a[r][col].num().is_some())
-            .or_else(|| candidates.min_by_key(|&r| a[r][col].key().len()))?;
+            .or_else(|| candidates.min_by_key(|&r| a[r][col].key_len()))?;
         a.swap(col, pivot);
         b.swap(col, pivot);
         for r in col + 1..m {

@@ -10,6 +10,7 @@
 
 use crate::ir::Func;
 use std::collections::BTreeMap;
+use std::fmt::Write;
 
 /// A leaf symbol.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -34,6 +35,28 @@ pub enum Sym {
     /// The value of an earlier output (index into the equations' outputs): an output defined through earlier
     /// outputs refers to them instead of copying their expressions, and consumers evaluate outputs in order.
     Output(usize),
+}
+
+impl Sym {
+    /// Writes the symbol as its `Debug` form (`Param(3)`, `Time`), which keys and so the order of terms are made
+    /// of, without the formatter's machinery.
+    fn write_key(self, s: &mut impl Write) {
+        let (name, index) = match self {
+            Sym::Param(i) => ("Param", i),
+            Sym::Input(i) => ("Input", i),
+            Sym::InputDot(i) => ("InputDot", i),
+            Sym::State(i) => ("State", i),
+            Sym::StateDot(i) => ("StateDot", i),
+            Sym::Var(i) => ("Var", i),
+            Sym::Tear(i) => ("Tear", i),
+            Sym::Output(i) => ("Output", i),
+            Sym::Time => {
+                let _ = s.write_str("Time");
+                return;
+            }
+        };
+        let _ = write!(s, "{name}({index})");
+    }
 }
 
 /// A symbolic expression.
@@ -78,42 +101,52 @@ impl Ex {
         s
     }
 
-    fn write_key(&self, s: &mut String) {
+    /// The length of [`Ex::key`], without building it.
+    pub fn key_len(&self) -> usize {
+        let mut counter = KeyLength(0);
+        self.write_key(&mut counter);
+        counter.0
+    }
+
+    fn write_key(&self, s: &mut impl Write) {
         match self {
             // Numbers sort first; their bit pattern makes the key exact.
-            Ex::Num(v) => s.push_str(&format!("#{v:e}")),
-            Ex::S(sym) => s.push_str(&format!("{sym:?}")),
+            // Written in place: a key is built for every term of every sum and product, so no temporary strings.
+            Ex::Num(v) => {
+                let _ = write!(s, "#{v:e}");
+            }
+            Ex::S(sym) => sym.write_key(s),
             Ex::Add(ts) => {
-                s.push_str("+(");
+                let _ = s.write_str("+(");
                 for t in ts {
                     t.write_key(s);
-                    s.push(',');
+                    let _ = s.write_char(',');
                 }
-                s.push(')');
+                let _ = s.write_char(')');
             }
             Ex::Mul(fs) => {
-                s.push_str("*(");
+                let _ = s.write_str("*(");
                 for f in fs {
                     f.write_key(s);
-                    s.push(',');
+                    let _ = s.write_char(',');
                 }
-                s.push(')');
+                let _ = s.write_char(')');
             }
             Ex::Pow(b, e) => {
-                s.push_str("^(");
+                let _ = s.write_str("^(");
                 b.write_key(s);
-                s.push(',');
+                let _ = s.write_char(',');
                 e.write_key(s);
-                s.push(')');
+                let _ = s.write_char(')');
             }
             Ex::Call(f, args) => {
-                s.push_str(f.name());
-                s.push('(');
+                let _ = s.write_str(f.name());
+                let _ = s.write_char('(');
                 for a in args {
                     a.write_key(s);
-                    s.push(',');
+                    let _ = s.write_char(',');
                 }
-                s.push(')');
+                let _ = s.write_char(')');
             }
         }
     }
@@ -140,6 +173,16 @@ impl Ex {
 
     pub fn contains(&self, s: Sym) -> bool {
         self.any_sym(&|t| t == s)
+    }
+}
+
+/// Counts the bytes of a key as it is written.
+struct KeyLength(usize);
+
+impl Write for KeyLength {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        self.0 += s.len();
+        Ok(())
     }
 }
 
@@ -248,7 +291,8 @@ pub fn mul(factors: Vec<Ex>) -> Ex {
     if constant == 0.0 {
         return Ex::zero();
     }
-    out.sort_by_key(Ex::key);
+    // One key per factor (a comparison-based sort would build each key many times).
+    out.sort_by_cached_key(Ex::key);
     if constant != 1.0 {
         out.insert(0, Ex::Num(constant));
     }
@@ -305,7 +349,7 @@ pub fn recip(a: Ex) -> Ex {
 /// A function call, folded when its arguments are numbers.
 pub fn call(f: Func, args: Vec<Ex>) -> Ex {
     let nums: Option<Vec<f64>> = args.iter().map(Ex::num).collect();
-    if let Some(v) = nums.and_then(|n| eval_func(f, &n))
+    if let Some(v) = nums.and_then(|n| f.eval(&n))
         && v.is_finite()
     {
         return Ex::Num(v);
@@ -313,44 +357,14 @@ pub fn call(f: Func, args: Vec<Ex>) -> Ex {
     Ex::Call(f, args)
 }
 
-/// Evaluates a function on numbers (`None` on an arity mismatch).
-pub fn eval_func(f: Func, a: &[f64]) -> Option<f64> {
-    let x = *a.first()?;
-    let y = a.get(1).copied();
-    Some(match f {
-        Func::Sin => x.sin(),
-        Func::Cos => x.cos(),
-        Func::Tan => x.tan(),
-        Func::Asin => x.asin(),
-        Func::Acos => x.acos(),
-        Func::Atan => x.atan(),
-        Func::Atan2 => x.atan2(y?),
-        Func::Exp => x.exp(),
-        Func::Ln => x.ln(),
-        Func::Log10 => x.log10(),
-        Func::Sqrt => x.sqrt(),
-        Func::Abs => x.abs(),
-        Func::Sign => {
-            if x > 0.0 {
-                1.0
-            } else if x < 0.0 {
-                -1.0
-            } else {
-                0.0
-            }
-        }
-        Func::Min => x.min(y?),
-        Func::Max => x.max(y?),
-        Func::Tanh => x.tanh(),
-        Func::Sinh => x.sinh(),
-        Func::Cosh => x.cosh(),
-    })
-}
-
 /// Products of sums multiplied out (`a (b + c)` → `a b + a c`), unless that would make more than 64 terms, in
 /// which case the expression is returned as it is.
 pub fn expand(e: &Ex) -> Ex {
     const MAX_TERMS: usize = 64;
+    if !has_product_of_sum(e) {
+        // Nothing to multiply out: the expression is already in canonical form (most resolved values are).
+        return e.clone();
+    }
     match e {
         Ex::Add(ts) => add(ts.iter().map(expand).collect()),
         Ex::Mul(fs) => {
@@ -376,6 +390,18 @@ pub fn expand(e: &Ex) -> Ex {
             add(terms)
         }
         _ => e.clone(),
+    }
+}
+
+/// True when a product with a sum among its factors is reachable through sums and products (what [`expand`]
+/// multiplies out).
+fn has_product_of_sum(e: &Ex) -> bool {
+    match e {
+        Ex::Add(ts) => ts.iter().any(has_product_of_sum),
+        Ex::Mul(fs) => fs
+            .iter()
+            .any(|f| matches!(f, Ex::Add(_)) || has_product_of_sum(f)),
+        _ => false,
     }
 }
 
@@ -528,7 +554,7 @@ pub fn eval(e: &Ex, value: &dyn Fn(Sym) -> Option<f64>) -> Result<f64, EvalError
                 .iter()
                 .map(|a| eval(a, value))
                 .collect::<Result<Vec<_>, _>>()?;
-            eval_func(*f, &vals).ok_or(EvalError::Arity(*f))?
+            f.eval(&vals).ok_or(EvalError::Arity(*f))?
         }
     })
 }
@@ -612,6 +638,24 @@ mod tests {
             (fd - exact).abs() < 1e-6 * exact.abs().max(1.0),
             "{fd} vs {exact}"
         );
+    }
+
+    #[test]
+    fn symbol_keys_are_their_debug_form() {
+        for s in [
+            Sym::Param(0),
+            Sym::Input(12),
+            Sym::InputDot(3),
+            Sym::State(105),
+            Sym::StateDot(7),
+            Sym::Var(40),
+            Sym::Tear(2),
+            Sym::Output(9),
+            Sym::Time,
+        ] {
+            assert_eq!(Ex::S(s).key(), format!("{s:?}"));
+            assert_eq!(Ex::S(s).key_len(), format!("{s:?}").len());
+        }
     }
 
     #[test]

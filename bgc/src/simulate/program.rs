@@ -6,7 +6,7 @@
 //! program is compiled, and evaluation uses checked access anyway, so a program never panics: a missing value reads
 //! as NaN, which the integrator reports as a non-finite derivative.
 
-use crate::equations::sym::{self, Ex, Sym};
+use crate::equations::sym::{Ex, Sym};
 use crate::ir::Func;
 
 /// One instruction of a program.
@@ -121,7 +121,7 @@ impl Program {
                     stack.truncate(start);
                     let value = args
                         .get(..n.min(2))
-                        .and_then(|a| sym::eval_func(f, a))
+                        .and_then(|a| f.eval(a))
                         .unwrap_or(f64::NAN);
                     stack.push(value);
                 }
@@ -201,7 +201,7 @@ fn emit(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::equations::sym::{add, call, div, mul, pow};
+    use crate::equations::sym::{self, add, call, div, mul, pow};
 
     fn name(s: Sym) -> String {
         format!("{s:?}")

@@ -34,6 +34,7 @@ use super::expr::{Expr, Node, Symbol};
 use crate::ir::Func;
 use std::collections::BTreeMap;
 use std::ops;
+use std::sync::OnceLock;
 
 impl Expr {
     /// A numeric constant.
@@ -41,12 +42,16 @@ impl Expr {
         Expr::from_canonical(Node::Const(value))
     }
 
+    /// `0`, interned once per process: dense matrices of mostly zeros take it millions of times.
     pub fn zero() -> Expr {
-        Expr::constant(0.0)
+        static ZERO: OnceLock<Expr> = OnceLock::new();
+        ZERO.get_or_init(|| Expr::constant(0.0)).clone()
     }
 
+    /// `1`, interned once per process.
     pub fn one() -> Expr {
-        Expr::constant(1.0)
+        static ONE: OnceLock<Expr> = OnceLock::new();
+        ONE.get_or_init(|| Expr::constant(1.0)).clone()
     }
 
     /// A bare symbol.

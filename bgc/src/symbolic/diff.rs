@@ -25,18 +25,16 @@ impl Expr {
             .unwrap_or_else(Expr::zero)
     }
 
-    /// The Jacobian `∂ exprsᵢ / ∂ varsⱼ`, row by row. Each variable is one walk over all rows together, so a
-    /// subexpression the rows share is differentiated once.
+    /// The Jacobian `∂ exprsᵢ / ∂ varsⱼ`, row by row: the entries of [`Expr::sparse_jacobian`] with zeros
+    /// elsewhere, so the work follows the non-zeros (only the zeros are written `rows × columns` times).
     pub fn jacobian(exprs: &[Expr], vars: &[Symbol]) -> Vec<Vec<Expr>> {
-        let columns: Vec<Vec<Expr>> = vars.iter().map(|v| diff_all(exprs, v)).collect();
-        (0..exprs.len())
-            .map(|i| {
-                columns
-                    .iter()
-                    .map(|col| col.get(i).cloned().unwrap_or_else(Expr::zero))
-                    .collect()
-            })
-            .collect()
+        let mut dense = vec![vec![Expr::zero(); vars.len()]; exprs.len()];
+        for (i, j, entry) in Expr::sparse_jacobian(exprs, vars) {
+            if let Some(slot) = dense.get_mut(i).and_then(|row| row.get_mut(j)) {
+                *slot = entry;
+            }
+        }
+        dense
     }
 
     /// The entries of the Jacobian `∂ exprsᵢ / ∂ varsⱼ` that are not the constant 0, as `(i, j, entry)` sorted by

@@ -1,0 +1,122 @@
+//! FMUs of `bgc fmu` in FMPy, a real importer: `fmpy validate` accepts the FMU of every model in `models/`, and
+//! the simulations of the back-support plant, the walking leg (mass matrix) and the diode loop (nonlinear
+//! algebraic loop), through Model Exchange (FMPy's CVode) and Co-Simulation (the FMU's own integrator), give the
+//! outputs of `bgc simulate` to 1e-6 of each output's range; the directional derivatives equal central
+//! differences of the derivatives and outputs.
+
+use crate::fmu_support::{
+    Scenario, bgc_simulate, compare, fmpy_jacobian, fmpy_simulate, fmu, validate, workspace,
+};
+
+const BACK_SUPPORT: Scenario = Scenario {
+    model: "models/back_support.bg",
+    t_end: 0.2,
+    dt: 1e-3,
+    inputs: &[("tau_m", "0.2*step(0.01)"), ("omega_h", "0.5*step(0.02)")],
+    rows: &[
+        &[0.0, 0.0, 0.0],
+        &[0.01, 0.0, 0.0],
+        &[0.01, 0.2, 0.0],
+        &[0.02, 0.2, 0.0],
+        &[0.02, 0.2, 0.5],
+        &[0.2, 0.2, 0.5],
+    ],
+    x0: &[],
+    jumps: &[0.01, 0.02],
+};
+
+const WALKING_LEG: Scenario = Scenario {
+    model: "models/walking_leg.bg",
+    t_end: 1.0,
+    dt: 1e-2,
+    inputs: &[("tau_a3", "2*step(0.1)")],
+    rows: &[&[0.0, 0.0], &[0.1, 0.0], &[0.1, 2.0], &[1.0, 2.0]],
+    x0: &[("q_leg_1", 0.2)],
+    jumps: &[0.1],
+};
+
+const DIODE: Scenario = Scenario {
+    model: "bgc/tests/corpus/diode_rc.bg",
+    t_end: 0.5,
+    dt: 5e-3,
+    inputs: &[("u", "5-8*step(0.25)")],
+    rows: &[&[0.0, 5.0], &[0.25, 5.0], &[0.25, -3.0], &[0.5, -3.0]],
+    x0: &[],
+    jumps: &[0.25],
+};
+
+/// The required agreement with `bgc simulate`, relative to each output's range.
+const AGREEMENT: f64 = 1e-6;
+
+fn agrees(s: &Scenario, version: u8) {
+    let path = fmu(s.model, version);
+    let reference = bgc_simulate(s);
+    for (kind, rtol) in [("ModelExchange", 1e-11), ("CoSimulation", 1e-10)] {
+        let run = fmpy_simulate(&path, kind, s, rtol);
+        for (name, worst) in compare(&reference, &run, s) {
+            eprintln!(
+                "{} FMI {version} {kind}: {name} within {worst:.2e} of its range",
+                s.model
+            );
+            assert!(
+                worst <= AGREEMENT,
+                "{} FMI {version} {kind}: `{name}` differs from bgc simulate by {worst:e} of its range",
+                s.model
+            );
+        }
+    }
+}
+
+fn jacobian_matches_differences(s: &Scenario, version: u8) {
+    let (dd, fd) = fmpy_jacobian(&fmu(s.model, version), s);
+    assert!(!dd.is_empty() && dd.len() == fd.len(), "{dd:?} {fd:?}");
+    let scale = fd.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    for (c, (a, b)) in dd.iter().zip(&fd).enumerate() {
+        assert_eq!(a.len(), b.len());
+        for (r, (x, y)) in a.iter().zip(b).enumerate() {
+            assert!(
+                (x - y).abs() <= 1e-6 * (y.abs() + 1e-6 * scale),
+                "{} column {c} row {r}: directional derivative {x}, central difference {y}",
+                s.model
+            );
+        }
+    }
+}
+
+#[test]
+fn fmpy_validates_the_fmu_of_every_model() {
+    let mut models: Vec<String> = std::fs::read_dir(workspace().join("models"))
+        .unwrap_or_else(|e| panic!("models/: {e}"))
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".bg"))
+        .collect();
+    models.sort();
+    assert!(models.len() >= 4, "{models:?}");
+    for m in models {
+        validate(&fmu(&format!("models/{m}"), 2));
+    }
+    validate(&fmu(DIODE.model, 2));
+}
+
+#[test]
+fn back_support_fmu_follows_bgc_simulate() {
+    agrees(&BACK_SUPPORT, 2);
+}
+
+#[test]
+fn walking_leg_fmu_follows_bgc_simulate() {
+    agrees(&WALKING_LEG, 2);
+}
+
+#[test]
+fn diode_loop_fmu_follows_bgc_simulate() {
+    agrees(&DIODE, 2);
+}
+
+#[test]
+fn directional_derivatives_equal_central_differences() {
+    jacobian_matches_differences(&BACK_SUPPORT, 2);
+    jacobian_matches_differences(&WALKING_LEG, 2);
+    jacobian_matches_differences(&DIODE, 2);
+}

@@ -1,0 +1,108 @@
+"""Drives a bgc FMU with FMPy, the importer the FMU tests check against (run by bgc/tests/fmu_fmpy.rs).
+
+simulate FMU KIND STOP DT RTOL SCENARIO.json
+    Simulates with FMPy's simulate_fmu (KIND ModelExchange: CVode; CoSimulation: the FMU's own integrator) and
+    prints CSV: `time` and the outputs, every number in Python's round-trip form. SCENARIO holds
+    {"inputs": [names], "rows": [[t, values...], ...], "start": {name: value}}; a step is two rows at one time.
+
+jacobian FMU SCENARIO.json
+    Instantiates the Model Exchange interface, sets the states and inputs of SCENARIO ("start" and the first row)
+    and prints JSON {"dd": ..., "fd": ...}: for each state and input (columns), the directional derivatives of
+    the state derivatives and outputs (rows) from fmi2GetDirectionalDerivative, and the same by central
+    differences of fmi2GetDerivatives and fmi2GetReal.
+"""
+import ctypes
+import json
+import sys
+
+import numpy as np
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi2 import FMU2Model
+
+
+def scenario(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def simulate(fmu, kind, stop, dt, rtol, path):
+    s = scenario(path)
+    md = read_model_description(fmu)
+    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+    # Every input in the table (those the scenario leaves out at 0, as `bgc simulate` holds them).
+    names = s["inputs"]
+    given = [v.name for v in md.modelVariables if v.causality == "input"]
+    rows = s["rows"] or [[0.0]]
+    columns = [[r[0] for r in rows]] + [
+        [r[1 + names.index(n)] if n in names else 0.0 for r in rows] for n in given]
+    signals = None
+    if given:
+        signals = np.array(list(zip(*columns)),
+                           dtype=[("time", np.float64)] + [(n, np.float64) for n in given])
+    result = simulate_fmu(fmu, fmi_type=kind, stop_time=float(stop), output_interval=float(dt),
+                          relative_tolerance=float(rtol), input=signals, start_values=s["start"],
+                          output=outputs)
+    print(",".join(["time"] + outputs))
+    for row in result:
+        print(",".join(repr(float(v)) for v in row))
+
+
+def jacobian(fmu, path):
+    s = scenario(path)
+    md = read_model_description(fmu)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    states = [v for v in md.modelVariables if v.derivative is not None]
+    state_vrs = [v.derivative.valueReference for v in states]
+    deriv_vrs = [v.valueReference for v in states]
+    output_vrs = [v.valueReference for v in md.modelVariables if v.causality == "output"]
+    input_vrs = [v.valueReference for v in md.modelVariables if v.causality == "input"]
+    m = FMU2Model(guid=md.guid, unzipDirectory=extract(fmu),
+                  modelIdentifier=md.modelExchange.modelIdentifier, instanceName="jacobian")
+    m.instantiate()
+    m.setupExperiment(startTime=0.0)
+    m.enterInitializationMode()
+    m.exitInitializationMode()
+    m.newDiscreteStates()
+    m.enterContinuousTimeMode()
+    nx = len(states)
+    x0 = np.zeros(nx)
+    for k, sv in enumerate(state_vrs):
+        for name, value in s["start"].items():
+            if vr[name] == sv:
+                x0[k] = value
+    row = s["rows"][0] if s["rows"] else []
+    u0 = {vr[n]: v for n, v in zip(s["inputs"], row[1:])}
+    u = np.array([u0.get(r, 0.0) for r in input_vrs])
+
+    def evaluate(x, uu):
+        xs = np.ascontiguousarray(x, dtype=np.float64)
+        m.setContinuousStates(xs.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), nx)
+        if input_vrs:
+            m.setReal(input_vrs, list(uu))
+        return np.array(m.getReal(deriv_vrs + output_vrs))
+
+    unknowns = deriv_vrs + output_vrs
+    dd, fd = [], []
+    evaluate(x0, u)
+    for col, known in enumerate(state_vrs + input_vrs):
+        dd.append(m.getDirectionalDerivative(unknowns, [known], [1.0]))
+        dx, du = np.zeros(nx), np.zeros(len(input_vrs))
+        base = x0[col] if col < nx else u[col - nx]
+        h = 1e-6 * max(abs(base), 1e-3)
+        if col < nx:
+            dx[col] = h
+        else:
+            du[col - nx] = h
+        plus, minus = evaluate(x0 + dx, u + du), evaluate(x0 - dx, u - du)
+        fd.append(list((plus - minus) / (2 * h)))
+        evaluate(x0, u)
+    m.terminate()
+    m.freeInstance()
+    print(json.dumps({"dd": dd, "fd": fd}))
+
+
+if __name__ == "__main__":
+    if sys.argv[1] == "simulate":
+        simulate(*sys.argv[2:8])
+    else:
+        jacobian(*sys.argv[2:4])

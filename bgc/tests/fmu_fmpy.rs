@@ -120,3 +120,36 @@ fn directional_derivatives_equal_central_differences() {
     jacobian_matches_differences(&WALKING_LEG, 2);
     jacobian_matches_differences(&DIODE, 2);
 }
+
+#[test]
+fn the_c_interface_refuses_misuse_and_keeps_instances_apart() {
+    let v = crate::fmu_support::fmpy_interface(&fmu(BACK_SUPPORT.model, 2));
+    let error = serde_json::json!(3);
+    // Another model's GUID and a null name give no instance; the first is logged.
+    assert_eq!(v["wrong_guid_is_null"], true, "{v}");
+    assert_eq!(v["wrong_guid_logged"], true, "{v}");
+    assert_eq!(v["null_name_is_null"], true, "{v}");
+    // A null component, a step before initialisation, a null value array, a parameter after initialisation:
+    // fmi2Error, and the step's refusal is logged.
+    for key in [
+        "null_component",
+        "step_before_init",
+        "null_values",
+        "param_after_init",
+    ] {
+        assert_eq!(v[key], error, "{key}: {v}");
+    }
+    assert_eq!(v["step_before_init_logged"], true, "{v}");
+    // Instance a is driven by a motor torque, b is not: b stays at rest.
+    let a: Vec<f64> = serde_json::from_value(v["a"].clone()).unwrap_or_default();
+    let b: Vec<f64> = serde_json::from_value(v["b"].clone()).unwrap_or_default();
+    assert!(a.len() == 3 && a.iter().all(|x| x.abs() > 1e-3), "{v}");
+    assert_eq!(b, vec![0.0; 3], "{v}");
+    // Restoring a saved state repeats the steps from it exactly; Reset returns to the start (input 0: rest).
+    assert_eq!(v["get_state"], 0);
+    assert_eq!(v["set_state"], 0);
+    assert_eq!(v["a_on"], v["a_again"], "{v}");
+    assert_ne!(v["a_on"], v["a"], "{v}");
+    assert_eq!(v["reset"], 0);
+    assert_eq!(v["after_reset"], v["b"], "{v}");
+}

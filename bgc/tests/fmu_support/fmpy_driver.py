@@ -101,8 +101,96 @@ def jacobian(fmu, path):
     print(json.dumps({"dd": dd, "fd": fd}))
 
 
+def interface(fmu):
+    """Calls the C interface directly, against the standard's rules too, and prints JSON of what it answered."""
+    md = read_model_description(fmu)
+    ident = md.coSimulation.modelIdentifier
+    lib = ctypes.CDLL(f"{extract(fmu)}/binaries/linux64/{ident}.so")
+    messages = []
+    LOGGER = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p,
+                              ctypes.c_char_p, ctypes.c_char_p)
+
+    def log(env, name, status, category, fmt, arg):
+        messages.append((status, (arg or b"").decode()))
+
+    logger = LOGGER(log)
+
+    class Callbacks(ctypes.Structure):
+        _fields_ = [("logger", LOGGER), ("allocate", ctypes.c_void_p), ("free", ctypes.c_void_p),
+                    ("step_finished", ctypes.c_void_p), ("env", ctypes.c_void_p)]
+
+    callbacks = Callbacks(logger, None, None, None, None)
+    lib.fmi2Instantiate.restype = ctypes.c_void_p
+    lib.fmi2Instantiate.argtypes = [ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_char_p,
+                                    ctypes.POINTER(Callbacks), ctypes.c_int, ctypes.c_int]
+    for f in ["fmi2SetupExperiment", "fmi2EnterInitializationMode", "fmi2ExitInitializationMode",
+              "fmi2DoStep", "fmi2GetReal", "fmi2SetReal", "fmi2Reset", "fmi2FreeInstance", "fmi2GetFMUstate",
+              "fmi2SetFMUstate", "fmi2FreeFMUstate", "fmi2Terminate"]:
+        getattr(lib, f).argtypes = None
+    vp = ctypes.c_void_p
+    out = {}
+
+    def new(name, guid):
+        return lib.fmi2Instantiate(name, 1, guid, b"", ctypes.byref(callbacks), 0, 0)
+
+    guid = md.guid.encode()
+    out["wrong_guid_is_null"] = new(b"a", b"{00000000-0000-0000-0000-000000000000}") is None
+    out["wrong_guid_logged"] = any(s == 3 and "GUID" in m for s, m in messages)
+    out["null_name_is_null"] = new(None, guid) is None
+    out["null_component"] = lib.fmi2EnterInitializationMode(vp(None))
+    vrs = {v.name: v.valueReference for v in md.modelVariables}
+    outputs = [v.valueReference for v in md.modelVariables if v.causality == "output"]
+    inputs = [v.valueReference for v in md.modelVariables if v.causality == "input"]
+    params = [v.valueReference for v in md.modelVariables if v.causality == "parameter"]
+    a, b = vp(new(b"a", guid)), vp(new(b"b", guid))
+    n = len(outputs)
+    buf = (ctypes.c_double * n)()
+    refs = (ctypes.c_uint * n)(*outputs)
+    messages.clear()
+    out["step_before_init"] = lib.fmi2DoStep(a, ctypes.c_double(0.0), ctypes.c_double(0.01), 1)
+    out["step_before_init_logged"] = any(s == 3 and "fmi2DoStep" in m for s, m in messages)
+    out["null_values"] = lib.fmi2GetReal(a, refs, ctypes.c_size_t(n), None)
+    for c in (a, b):
+        lib.fmi2SetupExperiment(c, 1, ctypes.c_double(1e-8), ctypes.c_double(0.0), 0, ctypes.c_double(0.0))
+        lib.fmi2EnterInitializationMode(c)
+        lib.fmi2ExitInitializationMode(c)
+    p = (ctypes.c_uint * 1)(params[0])
+    out["param_after_init"] = lib.fmi2SetReal(a, p, ctypes.c_size_t(1), (ctypes.c_double * 1)(1.0))
+    one = (ctypes.c_uint * 1)(inputs[0])
+    lib.fmi2SetReal(a, one, ctypes.c_size_t(1), (ctypes.c_double * 1)(1.0))
+
+    def run(c, t0, steps):
+        for k in range(steps):
+            status = lib.fmi2DoStep(c, ctypes.c_double(t0 + k * 0.01), ctypes.c_double(0.01), 1)
+            if status != 0:
+                return None
+        lib.fmi2GetReal(c, refs, ctypes.c_size_t(n), buf)
+        return list(buf)
+
+    out["a"] = run(a, 0.0, 5)
+    out["b"] = run(b, 0.0, 5)
+    state = vp(None)
+    out["get_state"] = lib.fmi2GetFMUstate(a, ctypes.byref(state))
+    out["a_on"] = run(a, 0.05, 5)
+    out["set_state"] = lib.fmi2SetFMUstate(a, state)
+    out["a_again"] = run(a, 0.05, 5)
+    lib.fmi2FreeFMUstate(a, ctypes.byref(state))
+    out["reset"] = lib.fmi2Reset(a)
+    for c in (a,):
+        lib.fmi2SetupExperiment(c, 1, ctypes.c_double(1e-8), ctypes.c_double(0.0), 0, ctypes.c_double(0.0))
+        lib.fmi2EnterInitializationMode(c)
+        lib.fmi2ExitInitializationMode(c)
+    out["after_reset"] = run(a, 0.0, 5)
+    lib.fmi2FreeInstance(a)
+    lib.fmi2FreeInstance(b)
+    lib.fmi2FreeInstance(vp(None))
+    print(json.dumps(out))
+
+
 if __name__ == "__main__":
     if sys.argv[1] == "simulate":
         simulate(*sys.argv[2:8])
+    elif sys.argv[1] == "interface":
+        interface(sys.argv[2])
     else:
         jacobian(*sys.argv[2:4])

@@ -301,3 +301,13 @@ pub fn fmpy_jacobian(fmu: &Path, s: &Scenario) -> (Vec<Vec<f64>>, Vec<Vec<f64>>)
     };
     (matrix("dd"), matrix("fd"))
 }
+
+/// The driver's calls of the C interface against the standard's rules (see `interface` in the driver).
+pub fn fmpy_interface(fmu: &Path) -> serde_json::Value {
+    let o = run(Command::new(python())
+        .arg(driver())
+        .arg("interface")
+        .arg(fmu));
+    assert!(o.status.success(), "interface: {}", text(&o.stderr));
+    serde_json::from_str(&text(&o.stdout)).unwrap_or_else(|e| panic!("{e}"))
+}

@@ -1,4 +1,4 @@
-//! FMUs of `bgc fmu` in FMPy, a real importer: `fmpy validate` accepts the FMU of every model in `models/`, and
+//! FMUs of `bgc fmu` (FMI 2.0 and 3.0) in FMPy, a real importer: `fmpy validate` accepts the FMU of every model in `models/`, and
 //! the simulations of the back-support plant, the walking leg (mass matrix) and the diode loop (nonlinear
 //! algebraic loop), through Model Exchange (FMPy's CVode) and Co-Simulation (the FMU's own integrator), give the
 //! outputs of `bgc simulate` to 1e-6 of each output's range; the directional derivatives equal central
@@ -93,32 +93,39 @@ fn fmpy_validates_the_fmu_of_every_model() {
         .collect();
     models.sort();
     assert!(models.len() >= 4, "{models:?}");
-    for m in models {
-        validate(&fmu(&format!("models/{m}"), 2));
+    for version in [2, 3] {
+        for m in &models {
+            validate(&fmu(&format!("models/{m}"), version));
+        }
+        validate(&fmu(DIODE.model, version));
     }
-    validate(&fmu(DIODE.model, 2));
 }
 
 #[test]
 fn back_support_fmu_follows_bgc_simulate() {
     agrees(&BACK_SUPPORT, 2);
+    agrees(&BACK_SUPPORT, 3);
 }
 
 #[test]
 fn walking_leg_fmu_follows_bgc_simulate() {
     agrees(&WALKING_LEG, 2);
+    agrees(&WALKING_LEG, 3);
 }
 
 #[test]
 fn diode_loop_fmu_follows_bgc_simulate() {
     agrees(&DIODE, 2);
+    agrees(&DIODE, 3);
 }
 
 #[test]
 fn directional_derivatives_equal_central_differences() {
-    jacobian_matches_differences(&BACK_SUPPORT, 2);
-    jacobian_matches_differences(&WALKING_LEG, 2);
-    jacobian_matches_differences(&DIODE, 2);
+    for version in [2, 3] {
+        jacobian_matches_differences(&BACK_SUPPORT, version);
+        jacobian_matches_differences(&WALKING_LEG, version);
+        jacobian_matches_differences(&DIODE, version);
+    }
 }
 
 #[test]

@@ -6,7 +6,7 @@ simulate FMU KIND STOP DT RTOL SCENARIO.json
     {"inputs": [names], "rows": [[t, values...], ...], "start": {name: value}}; a step is two rows at one time.
 
 jacobian FMU SCENARIO.json
-    Instantiates the Model Exchange interface, sets the states and inputs of SCENARIO ("start" and the first row)
+    Instantiates the Model Exchange interface (FMI 2.0 or 3.0), sets the states and inputs of SCENARIO ("start" and the first row)
     and prints JSON {"dd": ..., "fd": ...}: for each state and input (columns), the directional derivatives of
     the state derivatives and outputs (rows) from fmi2GetDirectionalDerivative, and the same by central
     differences of fmi2GetDerivatives and fmi2GetReal.
@@ -18,6 +18,7 @@ import sys
 import numpy as np
 from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi2 import FMU2Model
+from fmpy.fmi3 import FMU3Model
 
 
 def scenario(path):
@@ -56,13 +57,22 @@ def jacobian(fmu, path):
     deriv_vrs = [v.valueReference for v in states]
     output_vrs = [v.valueReference for v in md.modelVariables if v.causality == "output"]
     input_vrs = [v.valueReference for v in md.modelVariables if v.causality == "input"]
-    m = FMU2Model(guid=md.guid, unzipDirectory=extract(fmu),
-                  modelIdentifier=md.modelExchange.modelIdentifier, instanceName="jacobian")
+    fmi3 = md.fmiVersion.startswith("3")
+    model = FMU3Model if fmi3 else FMU2Model
+    m = model(guid=md.guid, unzipDirectory=extract(fmu),
+              modelIdentifier=md.modelExchange.modelIdentifier, instanceName="jacobian")
     m.instantiate()
-    m.setupExperiment(startTime=0.0)
-    m.enterInitializationMode()
-    m.exitInitializationMode()
-    m.newDiscreteStates()
+    if fmi3:
+        m.enterInitializationMode(startTime=0.0)
+        m.exitInitializationMode()
+        m.updateDiscreteStates()
+        get, put = m.getFloat64, m.setFloat64
+    else:
+        m.setupExperiment(startTime=0.0)
+        m.enterInitializationMode()
+        m.exitInitializationMode()
+        m.newDiscreteStates()
+        get, put = m.getReal, m.setReal
     m.enterContinuousTimeMode()
     nx = len(states)
     x0 = np.zeros(nx)
@@ -78,8 +88,8 @@ def jacobian(fmu, path):
         xs = np.ascontiguousarray(x, dtype=np.float64)
         m.setContinuousStates(xs.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), nx)
         if input_vrs:
-            m.setReal(input_vrs, list(uu))
-        return np.array(m.getReal(deriv_vrs + output_vrs))
+            put(input_vrs, list(uu))
+        return np.array(get(deriv_vrs + output_vrs))
 
     unknowns = deriv_vrs + output_vrs
     dd, fd = [], []

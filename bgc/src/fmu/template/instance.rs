@@ -238,6 +238,22 @@ impl Instance {
         })
     }
 
+    /// `Σ seed · ∂unknown/∂known` for each known: the transposed Jacobian times the seed (FMI 3.0's adjoint).
+    pub fn adjoint_derivative(
+        &self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        seed: &[f64],
+        out: &mut [f64],
+    ) -> Outcome<()> {
+        let mut column = vec![0.0; unknowns.len()];
+        for (known, o) in knowns.iter().zip(out.iter_mut()) {
+            self.directional_derivative(unknowns, std::slice::from_ref(known), &[1.0], &mut column)?;
+            *o = column.iter().zip(seed).map(|(j, s)| j * s).sum();
+        }
+        Ok(())
+    }
+
     /// Co-Simulation: integrates over `[t, t + h]` with the inputs held; on failure the state is unchanged.
     pub fn do_step(&mut self, t: f64, h: f64) -> Outcome<()> {
         if !(h > 0.0 && h.is_finite()) {

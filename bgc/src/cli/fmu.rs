@@ -46,10 +46,6 @@ pub fn fmu(
             super::io::stderr(&rendered);
             Status::InputErrors
         }
-        Err(e @ Error::Model { .. }) => {
-            stderrln(&format!("error: {e}"));
-            Status::InputErrors
-        }
         Err(e) => {
             stderrln(&format!("error: {e}"));
             Status::UsageOrIo

@@ -46,7 +46,8 @@ pub enum Error {
     /// Errors in the `.bg` file, rendered (`FILE:LINE:COL` and the source excerpt).
     #[error("{file}: bgc found errors:\n{rendered}")]
     Diagnostics { file: PathBuf, rendered: String },
-    #[error("{file}: {message}")]
+    /// No model, or an ambiguous choice: `{file} declares several models (...)`, `{file} has no model ...`.
+    #[error("{file} {message}")]
     Model { file: PathBuf, message: String },
     #[error("cannot run cargo ({cargo}): {source}")]
     Cargo {

@@ -42,17 +42,13 @@ pub fn package_sources(
         (None, many) => {
             let names: Vec<&str> = many.iter().map(|m| m.model.name.as_str()).collect();
             return Err(format!(
-                "the file declares {} models ({}): choose one with --model",
-                many.len(),
+                "declares several models ({}); choose one with --model",
                 names.join(", ")
             ));
         }
         (Some(name), many) => many.iter().find(|m| m.model.name == name).ok_or_else(|| {
             let names: Vec<&str> = many.iter().map(|m| m.model.name.as_str()).collect();
-            format!(
-                "no model `{name}` in the file (it declares {})",
-                names.join(", ")
-            )
+            format!("has no model `{name}`; it declares {}", names.join(", "))
         })?,
     };
     let identifier = identifier(&chosen.model.name);

@@ -1,6 +1,7 @@
 //! `modelDescription.xml` for FMI 2.0 and 3.0, from the variables of [`super::variables`].
 
 use super::Version;
+use super::structure::Dependencies;
 use super::variables::{Role, Variable};
 use crate::units::Dim;
 use std::fmt::Write;
@@ -14,7 +15,12 @@ pub struct Header<'a> {
 }
 
 /// The text of `modelDescription.xml`.
-pub fn model_description(version: Version, h: &Header, vars: &[Variable]) -> String {
+pub fn model_description(
+    version: Version,
+    h: &Header,
+    vars: &[Variable],
+    deps: &Dependencies,
+) -> String {
     let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let description = h
         .description
@@ -69,7 +75,7 @@ pub fn model_description(version: Version, h: &Header, vars: &[Variable]) -> Str
         Version::Fmi2 => variables2(&mut x, vars),
         Version::Fmi3 => variables3(&mut x, vars),
     }
-    structure(&mut x, version, vars);
+    structure(&mut x, version, vars, deps);
     x.push_str("</fmiModelDescription>\n");
     x
 }
@@ -195,41 +201,72 @@ fn state_index(vars: &[Variable], k: usize) -> Option<usize> {
         .map(|v| v.vr as usize + 1)
 }
 
-/// `ModelStructure`: outputs, derivatives and initial unknowns. Dependencies are not listed, which the standard
-/// reads as "depends on every input and state": always true, if not the sparsest description.
-fn structure(x: &mut String, version: Version, vars: &[Variable]) {
+/// `ModelStructure`: outputs, derivatives and initial unknowns. Outputs and derivatives list their dependencies
+/// on states and inputs where [`Dependencies`] knows them; initial unknowns list none, which the standard reads as
+/// "depends on every state start value, parameter and input" (they depend on the parameters).
+fn structure(x: &mut String, version: Version, vars: &[Variable], deps: &Dependencies) {
     let outputs: Vec<&Variable> = vars.iter().filter(|v| v.role == Role::Output).collect();
     let derivatives: Vec<&Variable> = vars
         .iter()
         .filter(|v| matches!(v.role, Role::Derivative(_)))
         .collect();
+    // The value reference of each dependency column: the states, then the inputs.
+    let columns: Vec<u32> = vars
+        .iter()
+        .filter(|v| v.role == Role::State)
+        .chain(vars.iter().filter(|v| v.role == Role::Input))
+        .map(|v| v.vr)
+        .collect();
+    let listed = |sets: &Option<Vec<std::collections::BTreeSet<usize>>>, k: usize, offset: u32| {
+        let set = sets.as_ref()?.get(k)?;
+        let mut refs: Vec<u32> = set
+            .iter()
+            .filter_map(|&c| columns.get(c))
+            .map(|vr| vr + offset)
+            .collect();
+        refs.sort_unstable();
+        let text: Vec<String> = refs.iter().map(u32::to_string).collect();
+        Some(format!(" dependencies=\"{}\"", text.join(" ")))
+    };
+    // FMI 2.0 refers to variables by their 1-based index in ModelVariables (the value reference + 1).
+    let offset = match version {
+        Version::Fmi2 => 1,
+        Version::Fmi3 => 0,
+    };
+    let output_deps: Vec<String> = (0..outputs.len())
+        .map(|k| listed(&deps.outputs, k, offset).unwrap_or_default())
+        .collect();
+    let derivative_deps: Vec<String> = (0..derivatives.len())
+        .map(|k| listed(&deps.derivatives, k, offset).unwrap_or_default())
+        .collect();
     x.push_str("  <ModelStructure>\n");
     match version {
         Version::Fmi2 => {
-            let list = |x: &mut String, tag: &str, vs: &[&Variable]| {
+            let list = |x: &mut String, tag: &str, vs: &[&Variable], extra: &[String]| {
                 if vs.is_empty() {
                     return;
                 }
                 let _ = writeln!(x, "    <{tag}>");
-                for v in vs {
-                    let _ = writeln!(x, "      <Unknown index=\"{}\"/>", v.vr + 1);
+                for (k, v) in vs.iter().enumerate() {
+                    let more = extra.get(k).map_or("", String::as_str);
+                    let _ = writeln!(x, "      <Unknown index=\"{}\"{more}/>", v.vr + 1);
                 }
                 let _ = writeln!(x, "    </{tag}>");
             };
-            list(x, "Outputs", &outputs);
-            list(x, "Derivatives", &derivatives);
+            list(x, "Outputs", &outputs, &output_deps);
+            list(x, "Derivatives", &derivatives, &derivative_deps);
             let mut initial: Vec<&Variable> = outputs.iter().chain(&derivatives).copied().collect();
             initial.sort_by_key(|v| v.vr);
-            list(x, "InitialUnknowns", &initial);
+            list(x, "InitialUnknowns", &initial, &[]);
         }
         Version::Fmi3 => {
-            for v in &outputs {
-                let _ = writeln!(x, "    <Output valueReference=\"{}\"/>", v.vr);
+            for (v, more) in outputs.iter().zip(&output_deps) {
+                let _ = writeln!(x, "    <Output valueReference=\"{}\"{more}/>", v.vr);
             }
-            for v in &derivatives {
+            for (v, more) in derivatives.iter().zip(&derivative_deps) {
                 let _ = writeln!(
                     x,
-                    "    <ContinuousStateDerivative valueReference=\"{}\"/>",
+                    "    <ContinuousStateDerivative valueReference=\"{}\"{more}/>",
                     v.vr
                 );
             }

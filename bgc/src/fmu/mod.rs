@@ -14,6 +14,7 @@
 
 pub mod description;
 mod package;
+pub mod structure;
 pub mod variables;
 pub mod zip;
 

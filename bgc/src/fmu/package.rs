@@ -3,6 +3,7 @@
 
 use super::Version;
 use super::description::{Header, model_description};
+use super::structure::dependencies;
 use super::variables::variables;
 use crate::codegen::{CompiledFile, Fnv1a, rust};
 
@@ -63,6 +64,7 @@ pub fn package_sources(
             description: (!chosen.model.doc.is_empty()).then(|| chosen.model.doc.join(" ")),
         },
         &vars,
+        &dependencies(&chosen.equations),
     );
     let single = CompiledFile {
         models: vec![chosen.clone()],

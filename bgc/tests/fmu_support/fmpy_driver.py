@@ -9,7 +9,8 @@ jacobian FMU SCENARIO.json
     Instantiates the Model Exchange interface (FMI 2.0 or 3.0), sets the states and inputs of SCENARIO ("start" and the first row)
     and prints JSON {"dd": ..., "fd": ...}: for each state and input (columns), the directional derivatives of
     the state derivatives and outputs (rows) from fmi2GetDirectionalDerivative, and the same by central
-    differences of fmi2GetDerivatives and fmi2GetReal.
+    differences of fmi2GetDerivatives and fmi2GetReal; and, as column indices, the dependencies ModelStructure
+    lists for each row (null where it lists none, meaning every state and input).
 """
 import ctypes
 import json
@@ -108,7 +109,14 @@ def jacobian(fmu, path):
         evaluate(x0, u)
     m.terminate()
     m.freeInstance()
-    print(json.dumps({"dd": dd, "fd": fd}))
+    # The ModelStructure dependencies of each row, as column indices (None: not listed, i.e. all).
+    columns = state_vrs + input_vrs
+    listed = {u.variable.valueReference: u.dependencies for u in md.derivatives + md.outputs}
+    deps = []
+    for r in unknowns:
+        d = listed.get(r)
+        deps.append(None if d is None else sorted(columns.index(v.valueReference) for v in d))
+    print(json.dumps({"dd": dd, "fd": fd, "deps": deps}))
 
 
 def interface(fmu):

@@ -275,8 +275,15 @@ pub fn compare(reference: &Table, fmu: &Table, s: &Scenario) -> Vec<(String, f64
     out
 }
 
-/// FMPy's directional derivatives and central differences: `(dd, fd)`, one column per state and input.
-pub fn fmpy_jacobian(fmu: &Path, s: &Scenario) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+/// FMPy's directional derivatives and central differences, one column per state and input, and the dependencies
+/// the description lists per row (`None`: all).
+pub struct Jacobians {
+    pub dd: Vec<Vec<f64>>,
+    pub fd: Vec<Vec<f64>>,
+    pub deps: Vec<Option<Vec<usize>>>,
+}
+
+pub fn fmpy_jacobian(fmu: &Path, s: &Scenario) -> Jacobians {
     let o = run(Command::new(python())
         .arg(driver())
         .arg("jacobian")
@@ -299,7 +306,23 @@ pub fn fmpy_jacobian(fmu: &Path, s: &Scenario) -> (Vec<Vec<f64>>, Vec<Vec<f64>>)
             })
             .collect()
     };
-    (matrix("dd"), matrix("fd"))
+    let deps = v["deps"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .map(|d| {
+            d.as_array().map(|cols| {
+                cols.iter()
+                    .filter_map(|c| c.as_u64().map(|c| c as usize))
+                    .collect()
+            })
+        })
+        .collect();
+    Jacobians {
+        dd: matrix("dd"),
+        fd: matrix("fd"),
+        deps,
+    }
 }
 
 /// The driver's calls of the C interface against the standard's rules (see `interface` in the driver).

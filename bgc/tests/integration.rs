@@ -39,6 +39,7 @@ mod equations_scaling;
 mod equations_signs;
 mod equations_state_space;
 mod fmu_cli;
+mod fmu_description;
 mod fmu_fmpy;
 mod front_end_props;
 mod hostile_props;

@@ -1,6 +1,7 @@
 //! Command-line parsing and dispatch.
 
 mod commands;
+mod fmu;
 mod io;
 mod matrix_text;
 mod model;
@@ -215,6 +216,23 @@ enum Command {
         stdio: bool,
     },
     /// Print .bg files in the canonical layout (in place), or with --check report the files that differ.
+    /// Export a model as a Functional Mock-up Unit (FMI 2.0 or 3.0, Model Exchange and Co-Simulation in one
+    /// FMU), built with cargo; see docs/fmu.md.
+    Fmu {
+        file: PathBuf,
+        /// The model to export (required when the file declares several).
+        #[arg(long)]
+        model: Option<String>,
+        /// The FMI version: 2 (default) or 3.
+        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(2..=3))]
+        fmi: u8,
+        /// The FMU file to write.
+        #[arg(short, long, value_name = "OUT.fmu")]
+        output: PathBuf,
+        /// Cargo's target directory for the FMU's library (default: `bgc-fmu` in the temporary directory).
+        #[arg(long, value_name = "DIR")]
+        target_dir: Option<PathBuf>,
+    },
     Fmt {
         #[arg(required = true)]
         files: Vec<PathBuf>,
@@ -251,6 +269,20 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
         Command::Check { files, format } => commands::check(&files, format, color),
         Command::Rust { file, no_runtime } => commands::rust(&file, !no_runtime, color),
         Command::Fmt { files, check } => commands::fmt(&files, check, color),
+        Command::Fmu {
+            file,
+            model,
+            fmi,
+            output,
+            target_dir,
+        } => fmu::fmu(
+            &file,
+            model.as_deref(),
+            fmi,
+            &output,
+            target_dir,
+            &cli.include,
+        ),
         Command::Lsp { stdio: _ } => commands::lsp(&cli.include),
         Command::Causality {
             file,

@@ -11,6 +11,7 @@ pub mod codegen;
 pub mod diagnostic;
 pub mod draw;
 pub mod equations;
+pub mod fmu;
 pub mod ir;
 pub mod lower;
 #[cfg(feature = "lsp")]

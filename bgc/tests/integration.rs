@@ -3,6 +3,7 @@
 mod cli_support;
 mod codegen_support;
 mod equations_support;
+mod fmu_support;
 mod lsp_support;
 
 mod causality_allow;
@@ -37,6 +38,9 @@ mod equations_robustness;
 mod equations_scaling;
 mod equations_signs;
 mod equations_state_space;
+mod fmu_cli;
+mod fmu_description;
+mod fmu_fmpy;
 mod front_end_props;
 mod hostile_props;
 mod language_examples;

@@ -17,11 +17,11 @@
 //! | BG0701 | equations that cannot be generated (incomplete, or an expression with no value in code) |
 
 mod adapter;
-mod emit;
+pub(crate) mod emit;
 mod format;
 mod layout;
 mod loops;
-mod mass;
+pub(crate) mod mass;
 mod names;
 pub mod rust;
 #[cfg(test)]

@@ -1,0 +1,88 @@
+//! `modelDescription.xml` of the back-support plant against the model file and a hand derivation of its
+//! structure: units with their SI exponents, parameters with default and description, derivatives naming their
+//! states, and the dependencies of `ModelStructure`.
+//!
+//! The dependencies, by hand (states in the order p_rotor, q_gear_spring, p_sensor_in, q_sensor_spring,
+//! p_sensor_out, q_coupling_spring, then the four angles; ModelVariables indices 22..=31; inputs tau_m 17,
+//! omega_h 18): the motor shaft (rotor and gearbox input as one inertia) obeys
+//! `(J_m + J_g) ω̇_m = τ_m − b_f ω_m − (b_g ω_m / r_g + k_g q_g + d_g (ω_m / r_g − ω_sint)) / r_g`, so `der(p_rotor)`
+//! depends on tau_m, p_rotor, q_gear_spring and p_sensor_in (17 22 23 24); the coupling torque
+//! `tau_h = k_eh q_c + d_eh (ω_sext − ω_h)` on omega_h, p_sensor_out and q_coupling_spring (18 26 27), whatever
+//! the values of the parameters (d_eh is 0 by default, and still a dependency).
+
+use bgc::build::FsLoader;
+use bgc::fmu::{Version, package_sources};
+use bgc::span::SourceMap;
+
+fn description(version: Version) -> String {
+    let path = crate::fmu_support::workspace().join("models/back_support.bg");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut sources = SourceMap::new();
+    let root = sources.add("models/back_support.bg", text);
+    let compiled = bgc::codegen::compile(&mut sources, root, &mut FsLoader::default())
+        .unwrap_or_else(|d| panic!("{d:?}"));
+    package_sources(&compiled, None, version, "models/back_support.bg")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .description
+}
+
+#[test]
+fn units_carry_their_si_exponents() {
+    let d = description(Version::Fmi2);
+    assert!(
+        d.contains("<Unit name=\"N m\">\n      <BaseUnit m=\"2\" kg=\"1\" s=\"-2\"/>"),
+        "{d}"
+    );
+    assert!(
+        d.contains("<Unit name=\"kg m^2\">\n      <BaseUnit m=\"2\" kg=\"1\"/>"),
+        "{d}"
+    );
+    assert!(
+        d.contains("<Unit name=\"rad/s\">\n      <BaseUnit s=\"-1\"/>"),
+        "{d}"
+    );
+}
+
+#[test]
+fn parameters_have_their_defaults_and_descriptions() {
+    let d = description(Version::Fmi2);
+    assert!(d.contains(
+        "<ScalarVariable name=\"J_m\" valueReference=\"1\" causality=\"parameter\" variability=\"fixed\" \
+         description=\"inertia of the brushless DC motor (I1)\">\n      <Real unit=\"kg m^2\" start=\"0.000306\"/>"
+    ), "{d}");
+    // A dimensionless parameter (`[1]`) has no unit.
+    assert!(d.contains("<Real start=\"160.0\"/>"), "{d}");
+    // der(p_rotor) names p_rotor, the 22nd variable (after time, 15 parameters, 2 inputs and 3 outputs).
+    assert!(d.contains("name=\"p_rotor\" valueReference=\"21\""), "{d}");
+    assert!(
+        d.contains("name=\"der(p_rotor)\" valueReference=\"31\""),
+        "{d}"
+    );
+    assert!(d.contains("<Real derivative=\"22\"/>"), "{d}");
+}
+
+#[test]
+fn model_structure_lists_the_hand_derived_dependencies() {
+    let d = description(Version::Fmi2);
+    assert!(
+        d.contains("<Unknown index=\"32\" dependencies=\"17 22 23 24\"/>"),
+        "{d}"
+    );
+    assert!(
+        d.contains("<Unknown index=\"21\" dependencies=\"18 26 27\"/>"),
+        "{d}"
+    );
+    // FMI 3.0 names value references (one less than the indices).
+    let d3 = description(Version::Fmi3);
+    assert!(
+        d3.contains(
+            "<ContinuousStateDerivative valueReference=\"31\" dependencies=\"16 21 22 23\"/>"
+        ),
+        "{d3}"
+    );
+    assert!(
+        d3.contains("<Output valueReference=\"20\" dependencies=\"17 25 26\"/>"),
+        "{d3}"
+    );
+    assert!(d3.contains("instantiationToken=\"{"), "{d3}");
+}

@@ -1,0 +1,174 @@
+//! FMUs of `bgc fmu` (FMI 2.0 and 3.0) in FMPy, a real importer: `fmpy validate` accepts the FMU of every model in `models/`, and
+//! the simulations of the back-support plant, the walking leg (mass matrix) and the diode loop (nonlinear
+//! algebraic loop), through Model Exchange (FMPy's CVode) and Co-Simulation (the FMU's own integrator), give the
+//! outputs of `bgc simulate` to 1e-6 of each output's range; the directional derivatives equal central
+//! differences of the derivatives and outputs, and every dependency they show is listed in `ModelStructure`.
+
+use crate::fmu_support::{
+    Scenario, bgc_simulate, compare, fmpy_jacobian, fmpy_simulate, fmu, validate, workspace,
+};
+
+const BACK_SUPPORT: Scenario = Scenario {
+    model: "models/back_support.bg",
+    t_end: 0.2,
+    dt: 1e-3,
+    inputs: &[("tau_m", "0.2*step(0.01)"), ("omega_h", "0.5*step(0.02)")],
+    rows: &[
+        &[0.0, 0.0, 0.0],
+        &[0.01, 0.0, 0.0],
+        &[0.01, 0.2, 0.0],
+        &[0.02, 0.2, 0.0],
+        &[0.02, 0.2, 0.5],
+        &[0.2, 0.2, 0.5],
+    ],
+    x0: &[],
+    jumps: &[0.01, 0.02],
+};
+
+const WALKING_LEG: Scenario = Scenario {
+    model: "models/walking_leg.bg",
+    t_end: 1.0,
+    dt: 1e-2,
+    inputs: &[("tau_a3", "2*step(0.1)")],
+    rows: &[&[0.0, 0.0], &[0.1, 0.0], &[0.1, 2.0], &[1.0, 2.0]],
+    x0: &[("q_leg_1", 0.2)],
+    jumps: &[0.1],
+};
+
+const DIODE: Scenario = Scenario {
+    model: "bgc/tests/corpus/diode_rc.bg",
+    t_end: 0.5,
+    dt: 5e-3,
+    inputs: &[("u", "5-8*step(0.25)")],
+    rows: &[&[0.0, 5.0], &[0.25, 5.0], &[0.25, -3.0], &[0.5, -3.0]],
+    x0: &[],
+    jumps: &[0.25],
+};
+
+/// The required agreement with `bgc simulate`, relative to each output's range.
+const AGREEMENT: f64 = 1e-6;
+
+fn agrees(s: &Scenario, version: u8) {
+    let path = fmu(s.model, version);
+    let reference = bgc_simulate(s);
+    for (kind, rtol) in [("ModelExchange", 1e-11), ("CoSimulation", 1e-10)] {
+        let run = fmpy_simulate(&path, kind, s, rtol);
+        for (name, worst) in compare(&reference, &run, s) {
+            eprintln!(
+                "{} FMI {version} {kind}: {name} within {worst:.2e} of its range",
+                s.model
+            );
+            assert!(
+                worst <= AGREEMENT,
+                "{} FMI {version} {kind}: `{name}` differs from bgc simulate by {worst:e} of its range",
+                s.model
+            );
+        }
+    }
+}
+
+fn jacobian_matches_differences(s: &Scenario, version: u8) {
+    let j = fmpy_jacobian(&fmu(s.model, version), s);
+    let (dd, fd) = (&j.dd, &j.fd);
+    assert!(!dd.is_empty() && dd.len() == fd.len(), "{dd:?} {fd:?}");
+    let scale = fd.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    for (c, (a, b)) in dd.iter().zip(fd).enumerate() {
+        assert_eq!(a.len(), b.len());
+        for (r, (x, y)) in a.iter().zip(b).enumerate() {
+            assert!(
+                (x - y).abs() <= 1e-6 * (y.abs() + 1e-6 * scale),
+                "{} column {c} row {r}: directional derivative {x}, central difference {y}",
+                s.model
+            );
+            // Every entry that is not zero is a dependency ModelStructure lists.
+            let listed = j
+                .deps
+                .get(r)
+                .is_some_and(|d| d.as_ref().is_none_or(|d| d.contains(&c)));
+            assert!(
+                y.abs() <= 1e-9 * scale || listed,
+                "{} FMI {version}: row {r} depends on column {c} ({y}) but ModelStructure lists {:?}",
+                s.model,
+                j.deps.get(r)
+            );
+        }
+    }
+}
+
+#[test]
+fn fmpy_validates_the_fmu_of_every_model() {
+    let mut models: Vec<String> = std::fs::read_dir(workspace().join("models"))
+        .unwrap_or_else(|e| panic!("models/: {e}"))
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".bg"))
+        .collect();
+    models.sort();
+    assert!(models.len() >= 4, "{models:?}");
+    for version in [2, 3] {
+        for m in &models {
+            validate(&fmu(&format!("models/{m}"), version));
+        }
+        validate(&fmu(DIODE.model, version));
+    }
+}
+
+#[test]
+fn back_support_fmu_follows_bgc_simulate() {
+    agrees(&BACK_SUPPORT, 2);
+    agrees(&BACK_SUPPORT, 3);
+}
+
+#[test]
+fn walking_leg_fmu_follows_bgc_simulate() {
+    agrees(&WALKING_LEG, 2);
+    agrees(&WALKING_LEG, 3);
+}
+
+#[test]
+fn diode_loop_fmu_follows_bgc_simulate() {
+    agrees(&DIODE, 2);
+    agrees(&DIODE, 3);
+}
+
+#[test]
+fn directional_derivatives_equal_central_differences_within_the_listed_dependencies() {
+    for version in [2, 3] {
+        jacobian_matches_differences(&BACK_SUPPORT, version);
+        jacobian_matches_differences(&WALKING_LEG, version);
+        jacobian_matches_differences(&DIODE, version);
+    }
+}
+
+#[test]
+fn the_c_interface_refuses_misuse_and_keeps_instances_apart() {
+    let v = crate::fmu_support::fmpy_interface(&fmu(BACK_SUPPORT.model, 2));
+    let error = serde_json::json!(3);
+    // Another model's GUID and a null name give no instance; the first is logged.
+    assert_eq!(v["wrong_guid_is_null"], true, "{v}");
+    assert_eq!(v["wrong_guid_logged"], true, "{v}");
+    assert_eq!(v["null_name_is_null"], true, "{v}");
+    // A null component, a step before initialisation, a null value array, a parameter after initialisation:
+    // fmi2Error, and the step's refusal is logged.
+    for key in [
+        "null_component",
+        "step_before_init",
+        "null_values",
+        "param_after_init",
+    ] {
+        assert_eq!(v[key], error, "{key}: {v}");
+    }
+    assert_eq!(v["step_before_init_logged"], true, "{v}");
+    // Instance a is driven by a motor torque, b is not: b stays at rest.
+    let a: Vec<f64> = serde_json::from_value(v["a"].clone()).unwrap_or_default();
+    let b: Vec<f64> = serde_json::from_value(v["b"].clone()).unwrap_or_default();
+    assert!(a.len() == 3 && a.iter().all(|x| x.abs() > 1e-3), "{v}");
+    assert_eq!(b, vec![0.0; 3], "{v}");
+    // Restoring a saved state repeats the steps from it exactly; Reset returns to the start (input 0: rest).
+    assert_eq!(v["get_state"], 0);
+    assert_eq!(v["set_state"], 0);
+    assert_eq!(v["a_on"], v["a_again"], "{v}");
+    assert_ne!(v["a_on"], v["a"], "{v}");
+    assert_eq!(v["reset"], 0);
+    assert_eq!(v["after_reset"], v["b"], "{v}");
+}

@@ -1,0 +1,214 @@
+"""Drives a bgc FMU with FMPy, the importer the FMU tests check against (run by bgc/tests/fmu_fmpy.rs).
+
+simulate FMU KIND STOP DT RTOL SCENARIO.json
+    Simulates with FMPy's simulate_fmu (KIND ModelExchange: CVode; CoSimulation: the FMU's own integrator) and
+    prints CSV: `time` and the outputs, every number in Python's round-trip form. SCENARIO holds
+    {"inputs": [names], "rows": [[t, values...], ...], "start": {name: value}}; a step is two rows at one time.
+
+jacobian FMU SCENARIO.json
+    Instantiates the Model Exchange interface (FMI 2.0 or 3.0), sets the states and inputs of SCENARIO ("start" and the first row)
+    and prints JSON {"dd": ..., "fd": ...}: for each state and input (columns), the directional derivatives of
+    the state derivatives and outputs (rows) from fmi2GetDirectionalDerivative, and the same by central
+    differences of fmi2GetDerivatives and fmi2GetReal; and, as column indices, the dependencies ModelStructure
+    lists for each row (null where it lists none, meaning every state and input).
+"""
+import ctypes
+import json
+import sys
+
+import numpy as np
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi2 import FMU2Model
+from fmpy.fmi3 import FMU3Model
+
+
+def scenario(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def simulate(fmu, kind, stop, dt, rtol, path):
+    s = scenario(path)
+    md = read_model_description(fmu)
+    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+    # Every input in the table (those the scenario leaves out at 0, as `bgc simulate` holds them).
+    names = s["inputs"]
+    given = [v.name for v in md.modelVariables if v.causality == "input"]
+    rows = s["rows"] or [[0.0]]
+    columns = [[r[0] for r in rows]] + [
+        [r[1 + names.index(n)] if n in names else 0.0 for r in rows] for n in given]
+    signals = None
+    if given:
+        signals = np.array(list(zip(*columns)),
+                           dtype=[("time", np.float64)] + [(n, np.float64) for n in given])
+    result = simulate_fmu(fmu, fmi_type=kind, stop_time=float(stop), output_interval=float(dt),
+                          relative_tolerance=float(rtol), input=signals, start_values=s["start"],
+                          output=outputs)
+    print(",".join(["time"] + outputs))
+    for row in result:
+        print(",".join(repr(float(v)) for v in row))
+
+
+def jacobian(fmu, path):
+    s = scenario(path)
+    md = read_model_description(fmu)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    states = [v for v in md.modelVariables if v.derivative is not None]
+    state_vrs = [v.derivative.valueReference for v in states]
+    deriv_vrs = [v.valueReference for v in states]
+    output_vrs = [v.valueReference for v in md.modelVariables if v.causality == "output"]
+    input_vrs = [v.valueReference for v in md.modelVariables if v.causality == "input"]
+    fmi3 = md.fmiVersion.startswith("3")
+    model = FMU3Model if fmi3 else FMU2Model
+    m = model(guid=md.guid, unzipDirectory=extract(fmu),
+              modelIdentifier=md.modelExchange.modelIdentifier, instanceName="jacobian")
+    m.instantiate()
+    if fmi3:
+        m.enterInitializationMode(startTime=0.0)
+        m.exitInitializationMode()
+        m.updateDiscreteStates()
+        get, put = m.getFloat64, m.setFloat64
+    else:
+        m.setupExperiment(startTime=0.0)
+        m.enterInitializationMode()
+        m.exitInitializationMode()
+        m.newDiscreteStates()
+        get, put = m.getReal, m.setReal
+    m.enterContinuousTimeMode()
+    nx = len(states)
+    x0 = np.zeros(nx)
+    for k, sv in enumerate(state_vrs):
+        for name, value in s["start"].items():
+            if vr[name] == sv:
+                x0[k] = value
+    row = s["rows"][0] if s["rows"] else []
+    u0 = {vr[n]: v for n, v in zip(s["inputs"], row[1:])}
+    u = np.array([u0.get(r, 0.0) for r in input_vrs])
+
+    def evaluate(x, uu):
+        xs = np.ascontiguousarray(x, dtype=np.float64)
+        m.setContinuousStates(xs.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), nx)
+        if input_vrs:
+            put(input_vrs, list(uu))
+        return np.array(get(deriv_vrs + output_vrs))
+
+    unknowns = deriv_vrs + output_vrs
+    dd, fd = [], []
+    evaluate(x0, u)
+    for col, known in enumerate(state_vrs + input_vrs):
+        dd.append(m.getDirectionalDerivative(unknowns, [known], [1.0]))
+        dx, du = np.zeros(nx), np.zeros(len(input_vrs))
+        base = x0[col] if col < nx else u[col - nx]
+        h = 1e-6 * max(abs(base), 1e-3)
+        if col < nx:
+            dx[col] = h
+        else:
+            du[col - nx] = h
+        plus, minus = evaluate(x0 + dx, u + du), evaluate(x0 - dx, u - du)
+        fd.append(list((plus - minus) / (2 * h)))
+        evaluate(x0, u)
+    m.terminate()
+    m.freeInstance()
+    # The ModelStructure dependencies of each row, as column indices (None: not listed, i.e. all).
+    columns = state_vrs + input_vrs
+    listed = {u.variable.valueReference: u.dependencies for u in md.derivatives + md.outputs}
+    deps = []
+    for r in unknowns:
+        d = listed.get(r)
+        deps.append(None if d is None else sorted(columns.index(v.valueReference) for v in d))
+    print(json.dumps({"dd": dd, "fd": fd, "deps": deps}))
+
+
+def interface(fmu):
+    """Calls the C interface directly, against the standard's rules too, and prints JSON of what it answered."""
+    md = read_model_description(fmu)
+    ident = md.coSimulation.modelIdentifier
+    lib = ctypes.CDLL(f"{extract(fmu)}/binaries/linux64/{ident}.so")
+    messages = []
+    LOGGER = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p,
+                              ctypes.c_char_p, ctypes.c_char_p)
+
+    def log(env, name, status, category, fmt, arg):
+        messages.append((status, (arg or b"").decode()))
+
+    logger = LOGGER(log)
+
+    class Callbacks(ctypes.Structure):
+        _fields_ = [("logger", LOGGER), ("allocate", ctypes.c_void_p), ("free", ctypes.c_void_p),
+                    ("step_finished", ctypes.c_void_p), ("env", ctypes.c_void_p)]
+
+    callbacks = Callbacks(logger, None, None, None, None)
+    lib.fmi2Instantiate.restype = ctypes.c_void_p
+    lib.fmi2Instantiate.argtypes = [ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_char_p,
+                                    ctypes.POINTER(Callbacks), ctypes.c_int, ctypes.c_int]
+    for f in ["fmi2SetupExperiment", "fmi2EnterInitializationMode", "fmi2ExitInitializationMode",
+              "fmi2DoStep", "fmi2GetReal", "fmi2SetReal", "fmi2Reset", "fmi2FreeInstance", "fmi2GetFMUstate",
+              "fmi2SetFMUstate", "fmi2FreeFMUstate", "fmi2Terminate"]:
+        getattr(lib, f).argtypes = None
+    vp = ctypes.c_void_p
+    out = {}
+
+    def new(name, guid):
+        return lib.fmi2Instantiate(name, 1, guid, b"", ctypes.byref(callbacks), 0, 0)
+
+    guid = md.guid.encode()
+    out["wrong_guid_is_null"] = new(b"a", b"{00000000-0000-0000-0000-000000000000}") is None
+    out["wrong_guid_logged"] = any(s == 3 and "GUID" in m for s, m in messages)
+    out["null_name_is_null"] = new(None, guid) is None
+    out["null_component"] = lib.fmi2EnterInitializationMode(vp(None))
+    vrs = {v.name: v.valueReference for v in md.modelVariables}
+    outputs = [v.valueReference for v in md.modelVariables if v.causality == "output"]
+    inputs = [v.valueReference for v in md.modelVariables if v.causality == "input"]
+    params = [v.valueReference for v in md.modelVariables if v.causality == "parameter"]
+    a, b = vp(new(b"a", guid)), vp(new(b"b", guid))
+    n = len(outputs)
+    buf = (ctypes.c_double * n)()
+    refs = (ctypes.c_uint * n)(*outputs)
+    messages.clear()
+    out["step_before_init"] = lib.fmi2DoStep(a, ctypes.c_double(0.0), ctypes.c_double(0.01), 1)
+    out["step_before_init_logged"] = any(s == 3 and "fmi2DoStep" in m for s, m in messages)
+    out["null_values"] = lib.fmi2GetReal(a, refs, ctypes.c_size_t(n), None)
+    for c in (a, b):
+        lib.fmi2SetupExperiment(c, 1, ctypes.c_double(1e-8), ctypes.c_double(0.0), 0, ctypes.c_double(0.0))
+        lib.fmi2EnterInitializationMode(c)
+        lib.fmi2ExitInitializationMode(c)
+    p = (ctypes.c_uint * 1)(params[0])
+    out["param_after_init"] = lib.fmi2SetReal(a, p, ctypes.c_size_t(1), (ctypes.c_double * 1)(1.0))
+    one = (ctypes.c_uint * 1)(inputs[0])
+    lib.fmi2SetReal(a, one, ctypes.c_size_t(1), (ctypes.c_double * 1)(1.0))
+
+    def run(c, t0, steps):
+        for k in range(steps):
+            status = lib.fmi2DoStep(c, ctypes.c_double(t0 + k * 0.01), ctypes.c_double(0.01), 1)
+            if status != 0:
+                return None
+        lib.fmi2GetReal(c, refs, ctypes.c_size_t(n), buf)
+        return list(buf)
+
+    out["a"] = run(a, 0.0, 5)
+    out["b"] = run(b, 0.0, 5)
+    state = vp(None)
+    out["get_state"] = lib.fmi2GetFMUstate(a, ctypes.byref(state))
+    out["a_on"] = run(a, 0.05, 5)
+    out["set_state"] = lib.fmi2SetFMUstate(a, state)
+    out["a_again"] = run(a, 0.05, 5)
+    lib.fmi2FreeFMUstate(a, ctypes.byref(state))
+    out["reset"] = lib.fmi2Reset(a)
+    for c in (a,):
+        lib.fmi2SetupExperiment(c, 1, ctypes.c_double(1e-8), ctypes.c_double(0.0), 0, ctypes.c_double(0.0))
+        lib.fmi2EnterInitializationMode(c)
+        lib.fmi2ExitInitializationMode(c)
+    out["after_reset"] = run(a, 0.0, 5)
+    lib.fmi2FreeInstance(a)
+    lib.fmi2FreeInstance(b)
+    lib.fmi2FreeInstance(vp(None))
+    print(json.dumps(out))
+
+
+if __name__ == "__main__":
+    if sys.argv[1] == "simulate":
+        simulate(*sys.argv[2:8])
+    elif sys.argv[1] == "interface":
+        interface(sys.argv[2])
+    else:
+        jacobian(*sys.argv[2:4])

@@ -71,6 +71,11 @@ pub fn model_description(
         }
     }
     unit_definitions(&mut x, vars);
+    // The categories the C interface logs under (`template/fmi2.rs`, `template/fmi3.rs`).
+    x.push_str(
+        "  <LogCategories>\n    <Category name=\"logStatusError\" description=\"a call refused, and why\"/>\n    \
+         <Category name=\"logStatusFatal\" description=\"an internal error\"/>\n  </LogCategories>\n",
+    );
     match version {
         Version::Fmi2 => variables2(&mut x, vars),
         Version::Fmi3 => variables3(&mut x, vars),

@@ -2,7 +2,6 @@
 //! (`plant`), an instance with the standard's state machine (`instance`), the Co-Simulation integrator
 //! (`solver`) and the C interfaces of FMI 2.0 (`fmi2`) and 3.0 (`fmi3`).
 
-#[allow(clippy::all, unused_imports)]
 mod model;
 mod instance;
 mod plant;

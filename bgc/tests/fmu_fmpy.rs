@@ -142,7 +142,7 @@ fn directional_derivatives_equal_central_differences_within_the_listed_dependenc
 
 #[test]
 fn the_c_interface_refuses_misuse_and_keeps_instances_apart() {
-    let v = crate::fmu_support::fmpy_interface(&fmu(BACK_SUPPORT.model, 2));
+    let v = crate::fmu_support::fmpy_interface(&fmu(BACK_SUPPORT.model, 2), "interface");
     let error = serde_json::json!(3);
     // Another model's GUID and a null name give no instance; the first is logged.
     assert_eq!(v["wrong_guid_is_null"], true, "{v}");
@@ -171,4 +171,21 @@ fn the_c_interface_refuses_misuse_and_keeps_instances_apart() {
     assert_ne!(v["a_on"], v["a"], "{v}");
     assert_eq!(v["reset"], 0);
     assert_eq!(v["after_reset"], v["b"], "{v}");
+}
+
+#[test]
+fn the_fmi3_interface_refuses_misuse() {
+    let v = crate::fmu_support::fmpy_interface(&fmu(BACK_SUPPORT.model, 3), "interface3");
+    // Another model's instantiation token gives no instance, and the importer is told why.
+    assert_eq!(v["wrong_token_is_null"], true, "{v}");
+    assert_eq!(v["wrong_token_logged"], true, "{v}");
+    // A step before initialisation, a parameter after it, as many values as references: fmi3Error.
+    let error = serde_json::json!(3);
+    for key in ["step_before_init", "param_after_init", "counts_differ"] {
+        assert_eq!(v[key], error, "{key}: {v}");
+    }
+    assert_eq!(v["enter_init"], 0, "{v}");
+    assert_eq!(v["exit_init"], 0, "{v}");
+    assert_eq!(v["step"], 0, "{v}");
+    assert_eq!(v["last_successful_time"], 0.01, "{v}");
 }

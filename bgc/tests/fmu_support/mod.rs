@@ -325,12 +325,10 @@ pub fn fmpy_jacobian(fmu: &Path, s: &Scenario) -> Jacobians {
     }
 }
 
-/// The driver's calls of the C interface against the standard's rules (see `interface` in the driver).
-pub fn fmpy_interface(fmu: &Path) -> serde_json::Value {
-    let o = run(Command::new(python())
-        .arg(driver())
-        .arg("interface")
-        .arg(fmu));
+/// The driver's calls of the C interface against the standard's rules (`interface` for FMI 2.0, `interface3` for
+/// FMI 3.0, in the driver).
+pub fn fmpy_interface(fmu: &Path, command: &str) -> serde_json::Value {
+    let o = run(Command::new(python()).arg(driver()).arg(command).arg(fmu));
     assert!(o.status.success(), "interface: {}", text(&o.stderr));
     serde_json::from_str(&text(&o.stdout)).unwrap_or_else(|e| panic!("{e}"))
 }

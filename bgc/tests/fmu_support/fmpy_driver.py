@@ -1,9 +1,13 @@
-"""Drives a bgc FMU with FMPy, the importer the FMU tests check against (run by bgc/tests/fmu_fmpy.rs).
+"""Drives a bgc FMU with FMPy and libcosim, the importers the FMU tests check against (run by
+bgc/tests/fmu_fmpy.rs).
 
 simulate FMU KIND STOP DT RTOL SCENARIO.json
     Simulates with FMPy's simulate_fmu (KIND ModelExchange: CVode; CoSimulation: the FMU's own integrator) and
     prints CSV: `time` and the outputs, every number in Python's round-trip form. SCENARIO holds
     {"inputs": [names], "rows": [[t, values...], ...], "start": {name: value}}; a step is two rows at one time.
+
+libcosim FMU STOP DT SCENARIO.json
+    The same with the Open Simulation Platform's libcosim (FMI 2.0 Co-Simulation), a second importer.
 
 jacobian FMU SCENARIO.json
     Instantiates the Model Exchange interface (FMI 2.0 or 3.0), sets the states and inputs of SCENARIO ("start" and the first row)
@@ -251,11 +255,57 @@ def interface3(fmu):
     print(json.dumps(out))
 
 
+def libcosim(fmu, stop, dt, path):
+    """The second importer: the Open Simulation Platform's libcosim (FMI 2.0 Co-Simulation) steps the FMU with
+    the scenario's inputs, held over each communication step, and prints CSV like `simulate`."""
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimManipulator import CosimManipulator
+    from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy.CosimSlave import CosimLocalSlave
+
+    log_output_level(CosimLogLevel.ERROR)
+    s = scenario(path)
+    md = read_model_description(fmu)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+    step_ns = round(float(dt) * 1e9)
+    steps = round(float(stop) / float(dt))
+    execution = CosimExecution.from_step_size(step_size=step_ns)
+    index = execution.add_local_slave(local_slave=CosimLocalSlave(fmu_path=fmu, instance_name="plant"))
+    for name, value in s["start"].items():
+        execution.real_initial_value(slave_index=index, variable_reference=vr[name], value=value)
+    observer = CosimObserver.create_last_value()
+    execution.add_observer(observer=observer)
+    manipulator = CosimManipulator.create_override()
+    execution.add_manipulator(manipulator=manipulator)
+    out_refs = [vr[n] for n in outputs]
+    in_refs = [vr[n] for n in s["inputs"]]
+
+    def inputs_at(t):
+        # The value from t on: the last row at or before t (at a step, the row after the jump).
+        row = [r for r in s["rows"] if r[0] <= t + 1e-12][-1]
+        return row[1:]
+
+    print(",".join(["time"] + outputs))
+    for k in range(steps + 1):
+        t = k * step_ns * 1e-9
+        if in_refs:
+            manipulator.slave_real_values(slave_index=index, variable_references=in_refs, values=inputs_at(t))
+        if k == steps:
+            break
+        execution.step()
+        y = observer.last_real_values(slave_index=index, variable_references=out_refs)
+        print(",".join(repr(float(v)) for v in [(k + 1) * step_ns * 1e-9] + list(y)))
+
+
 if __name__ == "__main__":
     if sys.argv[1] == "simulate":
         simulate(*sys.argv[2:8])
     elif sys.argv[1] == "interface":
         interface(sys.argv[2])
+    elif sys.argv[1] == "libcosim":
+        libcosim(*sys.argv[2:6])
     elif sys.argv[1] == "interface3":
         interface3(sys.argv[2])
     else:

@@ -49,7 +49,7 @@ pub struct Instance {
 }
 
 /// The relative tolerance of Co-Simulation steps when the importer gives none.
-const DEFAULT_TOLERANCE: f64 = 1e-6;
+const DEFAULT_TOLERANCE: f64 = 1e-8;
 
 pub type Outcome<T> = Result<T, String>;
 

@@ -3,11 +3,11 @@
 //! states, and the dependencies of `ModelStructure`.
 //!
 //! The dependencies, by hand (states in the order p_rotor, q_gear_spring, p_sensor_in, q_sensor_spring,
-//! p_sensor_out, q_coupling_spring, then the four angles; ModelVariables indices 22..=31; inputs tau_m 17,
-//! omega_h 18): the motor shaft (rotor and gearbox input as one inertia) obeys
+//! p_sensor_out, q_coupling_spring, then the four angles; value references, and FMI 2.0 indices, 21..=30; inputs
+//! tau_m 16, omega_h 17): the motor shaft (rotor and gearbox input as one inertia) obeys
 //! `(J_m + J_g) ω̇_m = τ_m − b_f ω_m − (b_g ω_m / r_g + k_g q_g + d_g (ω_m / r_g − ω_sint)) / r_g`, so `der(p_rotor)`
-//! depends on tau_m, p_rotor, q_gear_spring and p_sensor_in (17 22 23 24); the coupling torque
-//! `tau_h = k_eh q_c + d_eh (ω_sext − ω_h)` on omega_h, p_sensor_out and q_coupling_spring (18 26 27), whatever
+//! depends on tau_m, p_rotor, q_gear_spring and p_sensor_in (16 21 22 23); the coupling torque
+//! `tau_h = k_eh q_c + d_eh (ω_sext − ω_h)` on omega_h, p_sensor_out and q_coupling_spring (17 25 26), whatever
 //! the values of the parameters (d_eh is 0 by default, and still a dependency).
 
 use bgc::build::FsLoader;
@@ -52,27 +52,29 @@ fn parameters_have_their_defaults_and_descriptions() {
     ), "{d}");
     // A dimensionless parameter (`[1]`) has no unit.
     assert!(d.contains("<Real start=\"160.0\"/>"), "{d}");
-    // der(p_rotor) names p_rotor, the 22nd variable (after time, 15 parameters, 2 inputs and 3 outputs).
+    // der(p_rotor) names p_rotor, variable 21 (after 15 parameters, 2 inputs and 3 outputs; the time, value
+    // reference 0, is implicit in FMI 2.0).
     assert!(d.contains("name=\"p_rotor\" valueReference=\"21\""), "{d}");
     assert!(
         d.contains("name=\"der(p_rotor)\" valueReference=\"31\""),
         "{d}"
     );
-    assert!(d.contains("<Real derivative=\"22\"/>"), "{d}");
+    assert!(d.contains("<Real derivative=\"21\"/>"), "{d}");
+    assert!(!d.contains("name=\"time\""), "{d}");
 }
 
 #[test]
 fn model_structure_lists_the_hand_derived_dependencies() {
     let d = description(Version::Fmi2);
     assert!(
-        d.contains("<Unknown index=\"32\" dependencies=\"17 22 23 24\"/>"),
+        d.contains("<Unknown index=\"31\" dependencies=\"16 21 22 23\"/>"),
         "{d}"
     );
     assert!(
-        d.contains("<Unknown index=\"21\" dependencies=\"18 26 27\"/>"),
+        d.contains("<Unknown index=\"20\" dependencies=\"17 25 26\"/>"),
         "{d}"
     );
-    // FMI 3.0 names value references (one less than the indices).
+    // FMI 3.0 names value references: the same numbers, and declares the time.
     let d3 = description(Version::Fmi3);
     assert!(
         d3.contains(
@@ -85,4 +87,8 @@ fn model_structure_lists_the_hand_derived_dependencies() {
         "{d3}"
     );
     assert!(d3.contains("instantiationToken=\"{"), "{d3}");
+    assert!(
+        d3.contains("<Float64 name=\"time\" valueReference=\"0\" causality=\"independent\""),
+        "{d3}"
+    );
 }

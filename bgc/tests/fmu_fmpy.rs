@@ -1,11 +1,13 @@
-//! FMUs of `bgc fmu` (FMI 2.0 and 3.0) in FMPy, a real importer: `fmpy validate` accepts the FMU of every model in `models/`, and
+//! FMUs of `bgc fmu` (FMI 2.0 and 3.0) in FMPy, a real importer, and FMI 2.0 Co-Simulation also in the Open
+//! Simulation Platform's libcosim, a second one: `fmpy validate` accepts the FMU of every model in `models/`, and
 //! the simulations of the back-support plant, the walking leg (mass matrix) and the diode loop (nonlinear
 //! algebraic loop), through Model Exchange (FMPy's CVode) and Co-Simulation (the FMU's own integrator), give the
 //! outputs of `bgc simulate` to 1e-6 of each output's range; the directional derivatives equal central
 //! differences of the derivatives and outputs, and every dependency they show is listed in `ModelStructure`.
 
 use crate::fmu_support::{
-    Scenario, bgc_simulate, compare, fmpy_jacobian, fmpy_simulate, fmu, validate, workspace,
+    Scenario, bgc_simulate, compare, fmpy_jacobian, fmpy_simulate, fmu, libcosim_simulate,
+    validate, workspace,
 };
 
 const BACK_SUPPORT: Scenario = Scenario {
@@ -51,8 +53,21 @@ const AGREEMENT: f64 = 1e-6;
 fn agrees(s: &Scenario, version: u8) {
     let path = fmu(s.model, version);
     let reference = bgc_simulate(s);
-    for (kind, rtol) in [("ModelExchange", 1e-11), ("CoSimulation", 1e-10)] {
-        let run = fmpy_simulate(&path, kind, s, rtol);
+    let mut runs = vec![
+        (
+            "FMPy ModelExchange",
+            fmpy_simulate(&path, "ModelExchange", s, 1e-11),
+        ),
+        (
+            "FMPy CoSimulation",
+            fmpy_simulate(&path, "CoSimulation", s, 1e-10),
+        ),
+    ];
+    if version == 2 {
+        // The second importer, with its own experiment settings.
+        runs.push(("libcosim CoSimulation", libcosim_simulate(&path, s)));
+    }
+    for (kind, run) in runs {
         for (name, worst) in compare(&reference, &run, s) {
             eprintln!(
                 "{} FMI {version} {kind}: {name} within {worst:.2e} of its range",
@@ -142,7 +157,7 @@ fn directional_derivatives_equal_central_differences_within_the_listed_dependenc
 
 #[test]
 fn the_c_interface_refuses_misuse_and_keeps_instances_apart() {
-    let v = crate::fmu_support::fmpy_interface(&fmu(BACK_SUPPORT.model, 2));
+    let v = crate::fmu_support::fmpy_interface(&fmu(BACK_SUPPORT.model, 2), "interface");
     let error = serde_json::json!(3);
     // Another model's GUID and a null name give no instance; the first is logged.
     assert_eq!(v["wrong_guid_is_null"], true, "{v}");
@@ -171,4 +186,21 @@ fn the_c_interface_refuses_misuse_and_keeps_instances_apart() {
     assert_ne!(v["a_on"], v["a"], "{v}");
     assert_eq!(v["reset"], 0);
     assert_eq!(v["after_reset"], v["b"], "{v}");
+}
+
+#[test]
+fn the_fmi3_interface_refuses_misuse() {
+    let v = crate::fmu_support::fmpy_interface(&fmu(BACK_SUPPORT.model, 3), "interface3");
+    // Another model's instantiation token gives no instance, and the importer is told why.
+    assert_eq!(v["wrong_token_is_null"], true, "{v}");
+    assert_eq!(v["wrong_token_logged"], true, "{v}");
+    // A step before initialisation, a parameter after it, as many values as references: fmi3Error.
+    let error = serde_json::json!(3);
+    for key in ["step_before_init", "param_after_init", "counts_differ"] {
+        assert_eq!(v[key], error, "{key}: {v}");
+    }
+    assert_eq!(v["enter_init"], 0, "{v}");
+    assert_eq!(v["exit_init"], 0, "{v}");
+    assert_eq!(v["step"], 0, "{v}");
+    assert_eq!(v["last_successful_time"], 0.01, "{v}");
 }

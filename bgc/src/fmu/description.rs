@@ -71,6 +71,11 @@ pub fn model_description(
         }
     }
     unit_definitions(&mut x, vars);
+    // The categories the C interface logs under (`template/fmi2.rs`, `template/fmi3.rs`).
+    x.push_str(
+        "  <LogCategories>\n    <Category name=\"logStatusError\" description=\"a call refused, and why\"/>\n    \
+         <Category name=\"logStatusFatal\" description=\"an internal error\"/>\n  </LogCategories>\n",
+    );
     match version {
         Version::Fmi2 => variables2(&mut x, vars),
         Version::Fmi3 => variables3(&mut x, vars),
@@ -143,14 +148,17 @@ fn kind(v: &Variable, version: Version) -> &'static str {
 
 fn variables2(x: &mut String, vars: &[Variable]) {
     x.push_str("  <ModelVariables>\n");
-    for v in vars {
+    // The time is left out: FMI 2.0 then declares it implicitly, and some importers (the FMI Library) refuse an
+    // `independent` variable without a start value, which the standard forbids it to have. The value reference
+    // 0 it keeps in the binary makes each variable's 1-based index in ModelVariables its value reference.
+    for v in vars.iter().filter(|v| v.role != Role::Time) {
         let (description, unit) = attributes(v);
         let start = v
             .start
             .map(|s| format!(" start=\"{}\"", number(s)))
             .unwrap_or_default();
         let derivative = match v.role {
-            Role::Derivative(k) => state_index(vars, k)
+            Role::Derivative(k) => state_vr(vars, k)
                 .map(|i| format!(" derivative=\"{i}\""))
                 .unwrap_or_default(),
             _ => String::new(),
@@ -177,8 +185,8 @@ fn variables3(x: &mut String, vars: &[Variable]) {
             .unwrap_or_default();
         // FMI 3.0 refers to the state by its value reference.
         let derivative = match v.role {
-            Role::Derivative(k) => state_index(vars, k)
-                .map(|i| format!(" derivative=\"{}\"", i - 1))
+            Role::Derivative(k) => state_vr(vars, k)
+                .map(|i| format!(" derivative=\"{i}\""))
                 .unwrap_or_default(),
             _ => String::new(),
         };
@@ -193,12 +201,13 @@ fn variables3(x: &mut String, vars: &[Variable]) {
     x.push_str("  </ModelVariables>\n");
 }
 
-/// The 1-based index in `ModelVariables` of the state with index `k` among the states.
-fn state_index(vars: &[Variable], k: usize) -> Option<usize> {
+/// The value reference of the state with index `k` among the states (in FMI 2.0 also its 1-based index in
+/// `ModelVariables`, see `variables2`).
+fn state_vr(vars: &[Variable], k: usize) -> Option<u32> {
     vars.iter()
         .filter(|v| v.role == Role::State)
         .nth(k)
-        .map(|v| v.vr as usize + 1)
+        .map(|v| v.vr)
 }
 
 /// `ModelStructure`: outputs, derivatives and initial unknowns. Outputs and derivatives list their dependencies
@@ -217,27 +226,23 @@ fn structure(x: &mut String, version: Version, vars: &[Variable], deps: &Depende
         .chain(vars.iter().filter(|v| v.role == Role::Input))
         .map(|v| v.vr)
         .collect();
-    let listed = |sets: &Option<Vec<std::collections::BTreeSet<usize>>>, k: usize, offset: u32| {
+    // FMI 2.0 names variables by their index in ModelVariables, FMI 3.0 by value reference: the same numbers.
+    let listed = |sets: &Option<Vec<std::collections::BTreeSet<usize>>>, k: usize| {
         let set = sets.as_ref()?.get(k)?;
         let mut refs: Vec<u32> = set
             .iter()
             .filter_map(|&c| columns.get(c))
-            .map(|vr| vr + offset)
+            .copied()
             .collect();
         refs.sort_unstable();
         let text: Vec<String> = refs.iter().map(u32::to_string).collect();
         Some(format!(" dependencies=\"{}\"", text.join(" ")))
     };
-    // FMI 2.0 refers to variables by their 1-based index in ModelVariables (the value reference + 1).
-    let offset = match version {
-        Version::Fmi2 => 1,
-        Version::Fmi3 => 0,
-    };
     let output_deps: Vec<String> = (0..outputs.len())
-        .map(|k| listed(&deps.outputs, k, offset).unwrap_or_default())
+        .map(|k| listed(&deps.outputs, k).unwrap_or_default())
         .collect();
     let derivative_deps: Vec<String> = (0..derivatives.len())
-        .map(|k| listed(&deps.derivatives, k, offset).unwrap_or_default())
+        .map(|k| listed(&deps.derivatives, k).unwrap_or_default())
         .collect();
     x.push_str("  <ModelStructure>\n");
     match version {
@@ -249,7 +254,7 @@ fn structure(x: &mut String, version: Version, vars: &[Variable], deps: &Depende
                 let _ = writeln!(x, "    <{tag}>");
                 for (k, v) in vs.iter().enumerate() {
                     let more = extra.get(k).map_or("", String::as_str);
-                    let _ = writeln!(x, "      <Unknown index=\"{}\"{more}/>", v.vr + 1);
+                    let _ = writeln!(x, "      <Unknown index=\"{}\"{more}/>", v.vr);
                 }
                 let _ = writeln!(x, "    </{tag}>");
             };

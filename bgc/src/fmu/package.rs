@@ -22,7 +22,20 @@ pub struct Sources {
     pub files: Vec<(String, String)>,
 }
 
-const TEMPLATE: [(&str, &str); 5] = [
+const TEMPLATE: [(&str, &str); 9] = [
+    (
+        "src/fmi3_absent.rs",
+        include_str!("template/fmi3_absent.rs"),
+    ),
+    ("src/ffi.rs", include_str!("template/ffi.rs")),
+    (
+        "src/fmi2_solving.rs",
+        include_str!("template/fmi2_solving.rs"),
+    ),
+    (
+        "src/fmi3_solving.rs",
+        include_str!("template/fmi3_solving.rs"),
+    ),
     ("src/instance.rs", include_str!("template/instance.rs")),
     ("src/plant.rs", include_str!("template/plant.rs")),
     ("src/solver.rs", include_str!("template/solver.rs")),

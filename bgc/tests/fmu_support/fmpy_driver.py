@@ -1,9 +1,13 @@
-"""Drives a bgc FMU with FMPy, the importer the FMU tests check against (run by bgc/tests/fmu_fmpy.rs).
+"""Drives a bgc FMU with FMPy and libcosim, the importers the FMU tests check against (run by
+bgc/tests/fmu_fmpy.rs).
 
 simulate FMU KIND STOP DT RTOL SCENARIO.json
     Simulates with FMPy's simulate_fmu (KIND ModelExchange: CVode; CoSimulation: the FMU's own integrator) and
     prints CSV: `time` and the outputs, every number in Python's round-trip form. SCENARIO holds
     {"inputs": [names], "rows": [[t, values...], ...], "start": {name: value}}; a step is two rows at one time.
+
+libcosim FMU STOP DT SCENARIO.json
+    The same with the Open Simulation Platform's libcosim (FMI 2.0 Co-Simulation), a second importer.
 
 jacobian FMU SCENARIO.json
     Instantiates the Model Exchange interface (FMI 2.0 or 3.0), sets the states and inputs of SCENARIO ("start" and the first row)
@@ -205,10 +209,104 @@ def interface(fmu):
     print(json.dumps(out))
 
 
+def interface3(fmu):
+    """The FMI 3.0 interface called directly, against the standard's rules too; prints JSON of its answers."""
+    md = read_model_description(fmu)
+    lib = ctypes.CDLL(f"{extract(fmu)}/binaries/x86_64-linux/{md.coSimulation.modelIdentifier}.so")
+    messages = []
+    LOG = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_char_p)
+    log = LOG(lambda env, status, category, message: messages.append((status, message.decode())))
+    b, d, vp = ctypes.c_bool, ctypes.c_double, ctypes.c_void_p
+    lib.fmi3InstantiateCoSimulation.restype = vp
+    lib.fmi3InstantiateCoSimulation.argtypes = [ctypes.c_char_p, ctypes.c_char_p, ctypes.c_char_p, b, b, b, b,
+                                                vp, ctypes.c_size_t, vp, LOG, vp]
+    lib.fmi3DoStep.argtypes = [vp, d, d, b, ctypes.POINTER(b), ctypes.POINTER(b), ctypes.POINTER(b),
+                               ctypes.POINTER(d)]
+    lib.fmi3EnterInitializationMode.argtypes = [vp, b, d, d, b, d]
+    lib.fmi3ExitInitializationMode.argtypes = [vp]
+    lib.fmi3SetFloat64.argtypes = [vp, vp, ctypes.c_size_t, vp, ctypes.c_size_t]
+    lib.fmi3GetFloat64.argtypes = [vp, vp, ctypes.c_size_t, vp, ctypes.c_size_t]
+    lib.fmi3FreeInstance.argtypes = [vp]
+
+    def new(token):
+        return lib.fmi3InstantiateCoSimulation(b"a", token, None, False, False, False, False, None, 0, None,
+                                               log, None)
+
+    out = {"wrong_token_is_null": new(b"{0}") is None}
+    out["wrong_token_logged"] = any(st == 3 and "instantiation token" in m for st, m in messages)
+    c = new(md.guid.encode())
+    flags = [b(), b(), b()]
+    last = d(-1.0)
+
+    def step(t):
+        return lib.fmi3DoStep(c, t, 0.01, True, *(ctypes.byref(f) for f in flags), ctypes.byref(last))
+
+    out["step_before_init"] = step(0.0)
+    out["enter_init"] = lib.fmi3EnterInitializationMode(c, True, 1e-8, 0.0, False, 0.0)
+    out["exit_init"] = lib.fmi3ExitInitializationMode(c)
+    param = [v.valueReference for v in md.modelVariables if v.causality == "parameter"][0]
+    vr = (ctypes.c_uint * 1)(param)
+    value = (d * 2)(1.0, 2.0)
+    out["param_after_init"] = lib.fmi3SetFloat64(c, vr, 1, value, 1)
+    out["counts_differ"] = lib.fmi3GetFloat64(c, vr, 1, value, 2)
+    out["step"] = step(0.0)
+    out["last_successful_time"] = last.value
+    lib.fmi3FreeInstance(c)
+    print(json.dumps(out))
+
+
+def libcosim(fmu, stop, dt, path):
+    """The second importer: the Open Simulation Platform's libcosim (FMI 2.0 Co-Simulation) steps the FMU with
+    the scenario's inputs, held over each communication step, and prints CSV like `simulate`."""
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimManipulator import CosimManipulator
+    from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy.CosimSlave import CosimLocalSlave
+
+    log_output_level(CosimLogLevel.ERROR)
+    s = scenario(path)
+    md = read_model_description(fmu)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+    step_ns = round(float(dt) * 1e9)
+    steps = round(float(stop) / float(dt))
+    execution = CosimExecution.from_step_size(step_size=step_ns)
+    index = execution.add_local_slave(local_slave=CosimLocalSlave(fmu_path=fmu, instance_name="plant"))
+    for name, value in s["start"].items():
+        execution.real_initial_value(slave_index=index, variable_reference=vr[name], value=value)
+    observer = CosimObserver.create_last_value()
+    execution.add_observer(observer=observer)
+    manipulator = CosimManipulator.create_override()
+    execution.add_manipulator(manipulator=manipulator)
+    out_refs = [vr[n] for n in outputs]
+    in_refs = [vr[n] for n in s["inputs"]]
+
+    def inputs_at(t):
+        # The value from t on: the last row at or before t (at a step, the row after the jump).
+        row = [r for r in s["rows"] if r[0] <= t + 1e-12][-1]
+        return row[1:]
+
+    print(",".join(["time"] + outputs))
+    for k in range(steps + 1):
+        t = k * step_ns * 1e-9
+        if in_refs:
+            manipulator.slave_real_values(slave_index=index, variable_references=in_refs, values=inputs_at(t))
+        if k == steps:
+            break
+        execution.step()
+        y = observer.last_real_values(slave_index=index, variable_references=out_refs)
+        print(",".join(repr(float(v)) for v in [(k + 1) * step_ns * 1e-9] + list(y)))
+
+
 if __name__ == "__main__":
     if sys.argv[1] == "simulate":
         simulate(*sys.argv[2:8])
     elif sys.argv[1] == "interface":
         interface(sys.argv[2])
+    elif sys.argv[1] == "libcosim":
+        libcosim(*sys.argv[2:6])
+    elif sys.argv[1] == "interface3":
+        interface3(sys.argv[2])
     else:
         jacobian(*sys.argv[2:4])

@@ -31,8 +31,8 @@ fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
 
-/// The Python of a virtual environment with FMPy from the package registry, made once. A failure to make it
-/// fails the test: FMPy is the importer the FMUs are checked against.
+/// The Python of a virtual environment with FMPy and libcosimpy from the package registry, made once. A failure
+/// to make it fails the test: they are the importers the FMUs are checked against.
 pub fn python() -> &'static Path {
     static PYTHON: OnceLock<PathBuf> = OnceLock::new();
     PYTHON.get_or_init(|| {
@@ -40,7 +40,7 @@ pub fn python() -> &'static Path {
         let python = venv.join("bin").join("python");
         let ready = |p: &Path| {
             Command::new(p)
-                .args(["-c", "import fmpy, numpy"])
+                .args(["-c", "import fmpy, numpy, libcosimpy"])
                 .output()
                 .is_ok_and(|o| o.status.success())
         };
@@ -52,14 +52,24 @@ pub fn python() -> &'static Path {
                 venv.display(),
                 text(&made.stderr)
             );
-            let pip = run(Command::new(&python).args(["-m", "pip", "install", "--quiet", "fmpy"]));
+            let pip = run(Command::new(&python).args([
+                "-m",
+                "pip",
+                "install",
+                "--quiet",
+                "fmpy",
+                "libcosimpy",
+            ]));
             assert!(
                 pip.status.success(),
-                "pip install fmpy failed:\n{}{}",
+                "pip install fmpy libcosimpy failed:\n{}{}",
                 text(&pip.stdout),
                 text(&pip.stderr)
             );
-            assert!(ready(&python), "fmpy does not import after pip install");
+            assert!(
+                ready(&python),
+                "fmpy or libcosimpy does not import after pip install"
+            );
         }
         python
     })
@@ -241,6 +251,18 @@ pub fn fmpy_simulate(fmu: &Path, kind: &str, s: &Scenario, rtol: f64) -> Table {
     Table::parse(&text(&o.stdout))
 }
 
+/// libcosim's Co-Simulation of an FMI 2.0 FMU, the inputs held over each communication step of `s.dt`.
+pub fn libcosim_simulate(fmu: &Path, s: &Scenario) -> Table {
+    let o = run(Command::new(python())
+        .arg(driver())
+        .arg("libcosim")
+        .arg(fmu)
+        .args([&s.t_end.to_string(), &s.dt.to_string()])
+        .arg(scenario_file(s)));
+    assert!(o.status.success(), "libcosim: {}", text(&o.stderr));
+    Table::parse(&text(&o.stdout))
+}
+
 /// The largest difference of each output from `bgc simulate`, relative to the output's range in `bgc simulate`,
 /// over the rows at common times away from the jumps.
 pub fn compare(reference: &Table, fmu: &Table, s: &Scenario) -> Vec<(String, f64)> {
@@ -325,12 +347,10 @@ pub fn fmpy_jacobian(fmu: &Path, s: &Scenario) -> Jacobians {
     }
 }
 
-/// The driver's calls of the C interface against the standard's rules (see `interface` in the driver).
-pub fn fmpy_interface(fmu: &Path) -> serde_json::Value {
-    let o = run(Command::new(python())
-        .arg(driver())
-        .arg("interface")
-        .arg(fmu));
+/// The driver's calls of the C interface against the standard's rules (`interface` for FMI 2.0, `interface3` for
+/// FMI 3.0, in the driver).
+pub fn fmpy_interface(fmu: &Path, command: &str) -> serde_json::Value {
+    let o = run(Command::new(python()).arg(driver()).arg(command).arg(fmu));
     assert!(o.status.success(), "interface: {}", text(&o.stderr));
     serde_json::from_str(&text(&o.stdout)).unwrap_or_else(|e| panic!("{e}"))
 }

@@ -2,21 +2,22 @@
 //! `fmi2Functions.h`. Every function checks its pointers, catches panics (none may unwind into the importer),
 //! checks the phase of the standard's state machine and reports errors through the importer's logger.
 
+use crate::ffi::{RUNNING, slice, slice_mut};
 use crate::instance::{Instance, Kind, Outcome, Phase, Snapshot};
-use crate::plant::NX;
 use core::ffi::{c_char, c_int, c_void};
 use std::ffi::{CStr, CString};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-type Status = c_int;
-const OK: Status = 0;
-const WARNING: Status = 1;
-const ERROR: Status = 3;
-const FATAL: Status = 4;
-type Boolean = c_int;
-const FALSE: Boolean = 0;
+pub(crate) type Status = c_int;
+pub(crate) const OK: Status = 0;
+pub(crate) const WARNING: Status = 1;
+pub(crate) const ERROR: Status = 3;
+pub(crate) const FATAL: Status = 4;
+pub(crate) type Boolean = c_int;
+pub(crate) const FALSE: Boolean = 0;
 
-type Logger = unsafe extern "C" fn(*mut c_void, *const c_char, Status, *const c_char, *const c_char, ...);
+pub(crate) type Logger =
+    unsafe extern "C" fn(*mut c_void, *const c_char, Status, *const c_char, *const c_char, ...);
 
 #[repr(C)]
 pub struct CallbackFunctions {
@@ -27,18 +28,8 @@ pub struct CallbackFunctions {
     component_environment: *mut c_void,
 }
 
-#[repr(C)]
-pub struct EventInfo {
-    new_discrete_states_needed: Boolean,
-    terminate_simulation: Boolean,
-    nominals_of_continuous_states_changed: Boolean,
-    values_of_continuous_states_changed: Boolean,
-    next_event_time_defined: Boolean,
-    next_event_time: f64,
-}
-
-struct Component {
-    inst: Instance,
+pub(crate) struct Component {
+    pub(crate) inst: Instance,
     logger: Option<Logger>,
     env: *mut c_void,
     name: CString,
@@ -57,12 +48,25 @@ impl Component {
             return;
         };
         // SAFETY: the importer's logger, with C strings that live for the call.
-        unsafe { logger(self.env, self.name.as_ptr(), status, category.as_ptr(), c"%s".as_ptr(), message.as_ptr()) };
+        unsafe {
+            logger(
+                self.env,
+                self.name.as_ptr(),
+                status,
+                category.as_ptr(),
+                c"%s".as_ptr(),
+                message.as_ptr(),
+            )
+        };
     }
 }
 
 /// Runs `body` on the instance behind `c`: null checked, panics caught, errors logged.
-fn guarded(c: *mut c_void, call: &str, body: impl FnOnce(&mut Component) -> Outcome<()>) -> Status {
+pub(crate) fn guarded(
+    c: *mut c_void,
+    call: &str,
+    body: impl FnOnce(&mut Component) -> Outcome<()>,
+) -> Status {
     if c.is_null() {
         return ERROR;
     }
@@ -76,54 +80,15 @@ fn guarded(c: *mut c_void, call: &str, body: impl FnOnce(&mut Component) -> Outc
         }
         Err(_) => {
             comp.inst.phase = Phase::Error;
-            comp.log(FATAL, "logStatusFatal", &format!("{call}: internal error (a panic was caught)"));
+            comp.log(
+                FATAL,
+                "logStatusFatal",
+                &format!("{call}: internal error (a panic was caught)"),
+            );
             ERROR
         }
     }
 }
-
-/// `n` values at `ptr` (an empty slice for `n == 0`, whatever the pointer), or an error for a null pointer.
-fn slice<'a, T>(ptr: *const T, n: usize, what: &str) -> Outcome<&'a [T]> {
-    if n == 0 {
-        Ok(&[])
-    } else if ptr.is_null() {
-        Err(format!("{what} is a null pointer"))
-    } else {
-        // SAFETY: the standard makes the importer pass `n` valid values.
-        Ok(unsafe { std::slice::from_raw_parts(ptr, n) })
-    }
-}
-
-fn slice_mut<'a, T>(ptr: *mut T, n: usize, what: &str) -> Outcome<&'a mut [T]> {
-    if n == 0 {
-        Ok(&mut [])
-    } else if ptr.is_null() {
-        Err(format!("{what} is a null pointer"))
-    } else {
-        // SAFETY: as for `slice`, and the importer does not read the values during the call.
-        Ok(unsafe { std::slice::from_raw_parts_mut(ptr, n) })
-    }
-}
-
-fn write<T>(ptr: *mut T, value: T, what: &str) -> Outcome<()> {
-    if ptr.is_null() {
-        return Err(format!("{what} is a null pointer"));
-    }
-    // SAFETY: a non-null pointer the importer gave for this value.
-    unsafe { ptr.write(value) };
-    Ok(())
-}
-
-const RUNNING: &[Phase] = &[
-    Phase::Instantiated,
-    Phase::Initialization,
-    Phase::Event,
-    Phase::ContinuousTime,
-    Phase::StepComplete,
-    Phase::StepFailed,
-    Phase::Terminated,
-];
-const ME_SOLVING: &[Phase] = &[Phase::Event, Phase::ContinuousTime];
 
 #[unsafe(no_mangle)]
 pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
@@ -152,8 +117,13 @@ pub unsafe extern "C" fn fmi2Instantiate(
             return None;
         }
         // SAFETY: non-null C strings and callback table from the importer.
-        let (name, guid, functions) =
-            unsafe { (CStr::from_ptr(instance_name), CStr::from_ptr(guid), &*functions) };
+        let (name, guid, functions) = unsafe {
+            (
+                CStr::from_ptr(instance_name),
+                CStr::from_ptr(guid),
+                &*functions,
+            )
+        };
         let kind = match fmu_type {
             0 => Kind::ModelExchange,
             1 => Kind::CoSimulation,
@@ -230,7 +200,8 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> Status {
     guarded(c, "fmi2EnterInitializationMode", |comp| {
-        comp.inst.expect("fmi2EnterInitializationMode", &[Phase::Instantiated])?;
+        comp.inst
+            .expect("fmi2EnterInitializationMode", &[Phase::Instantiated])?;
         comp.inst.phase = Phase::Initialization;
         Ok(())
     })
@@ -241,7 +212,8 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> Status {
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> Status {
     guarded(c, "fmi2ExitInitializationMode", |comp| {
-        comp.inst.expect("fmi2ExitInitializationMode", &[Phase::Initialization])?;
+        comp.inst
+            .expect("fmi2ExitInitializationMode", &[Phase::Initialization])?;
         comp.inst.phase = match comp.inst.kind {
             Kind::ModelExchange => Phase::Event,
             Kind::CoSimulation => Phase::StepComplete,
@@ -257,7 +229,12 @@ pub unsafe extern "C" fn fmi2Terminate(c: *mut c_void) -> Status {
     guarded(c, "fmi2Terminate", |comp| {
         comp.inst.expect(
             "fmi2Terminate",
-            &[Phase::Event, Phase::ContinuousTime, Phase::StepComplete, Phase::StepFailed],
+            &[
+                Phase::Event,
+                Phase::ContinuousTime,
+                Phase::StepComplete,
+                Phase::StepFailed,
+            ],
         )?;
         comp.inst.phase = Phase::Terminated;
         Ok(())
@@ -277,7 +254,12 @@ pub unsafe extern "C" fn fmi2Reset(c: *mut c_void) -> Status {
 /// # Safety
 /// As the standard requires.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetReal(c: *mut c_void, vr: *const u32, n: usize, value: *mut f64) -> Status {
+pub unsafe extern "C" fn fmi2GetReal(
+    c: *mut c_void,
+    vr: *const u32,
+    n: usize,
+    value: *mut f64,
+) -> Status {
     guarded(c, "fmi2GetReal", |comp| {
         comp.inst.expect("fmi2GetReal", RUNNING)?;
         let vrs = slice(vr, n, "vr")?;
@@ -288,10 +270,16 @@ pub unsafe extern "C" fn fmi2GetReal(c: *mut c_void, vr: *const u32, n: usize, v
 /// # Safety
 /// As the standard requires.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetReal(c: *mut c_void, vr: *const u32, n: usize, value: *const f64) -> Status {
+pub unsafe extern "C" fn fmi2SetReal(
+    c: *mut c_void,
+    vr: *const u32,
+    n: usize,
+    value: *const f64,
+) -> Status {
     guarded(c, "fmi2SetReal", |comp| {
         comp.inst.expect("fmi2SetReal", RUNNING)?;
-        comp.inst.set_real(slice(vr, n, "vr")?, slice(value, n, "value")?)
+        comp.inst
+            .set_real(slice(vr, n, "vr")?, slice(value, n, "value")?)
     })
 }
 
@@ -306,28 +294,48 @@ fn no_variables(vr: *const u32, n: usize, kind: &str) -> Outcome<()> {
 /// # Safety
 /// As the standard requires.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetInteger(c: *mut c_void, vr: *const u32, n: usize, _v: *mut c_int) -> Status {
+pub unsafe extern "C" fn fmi2GetInteger(
+    c: *mut c_void,
+    vr: *const u32,
+    n: usize,
+    _v: *mut c_int,
+) -> Status {
     guarded(c, "fmi2GetInteger", |_| no_variables(vr, n, "Integer"))
 }
 
 /// # Safety
 /// As the standard requires.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetInteger(c: *mut c_void, vr: *const u32, n: usize, _v: *const c_int) -> Status {
+pub unsafe extern "C" fn fmi2SetInteger(
+    c: *mut c_void,
+    vr: *const u32,
+    n: usize,
+    _v: *const c_int,
+) -> Status {
     guarded(c, "fmi2SetInteger", |_| no_variables(vr, n, "Integer"))
 }
 
 /// # Safety
 /// As the standard requires.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetBoolean(c: *mut c_void, vr: *const u32, n: usize, _v: *mut Boolean) -> Status {
+pub unsafe extern "C" fn fmi2GetBoolean(
+    c: *mut c_void,
+    vr: *const u32,
+    n: usize,
+    _v: *mut Boolean,
+) -> Status {
     guarded(c, "fmi2GetBoolean", |_| no_variables(vr, n, "Boolean"))
 }
 
 /// # Safety
 /// As the standard requires.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetBoolean(c: *mut c_void, vr: *const u32, n: usize, _v: *const Boolean) -> Status {
+pub unsafe extern "C" fn fmi2SetBoolean(
+    c: *mut c_void,
+    vr: *const u32,
+    n: usize,
+    _v: *const Boolean,
+) -> Status {
     guarded(c, "fmi2SetBoolean", |_| no_variables(vr, n, "Boolean"))
 }
 
@@ -412,15 +420,28 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(c: *mut c_void, state: *mut *mut c_voi
 /// # Safety
 /// As the standard requires.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SerializedFMUstateSize(c: *mut c_void, _s: *mut c_void, _size: *mut usize) -> Status {
-    guarded(c, "fmi2SerializedFMUstateSize", |_| Err("this FMU does not serialize its state".into()))
+pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
+    c: *mut c_void,
+    _s: *mut c_void,
+    _size: *mut usize,
+) -> Status {
+    guarded(c, "fmi2SerializedFMUstateSize", |_| {
+        Err("this FMU does not serialize its state".into())
+    })
 }
 
 /// # Safety
 /// As the standard requires.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SerializeFMUstate(c: *mut c_void, _s: *mut c_void, _b: *mut u8, _n: usize) -> Status {
-    guarded(c, "fmi2SerializeFMUstate", |_| Err("this FMU does not serialize its state".into()))
+pub unsafe extern "C" fn fmi2SerializeFMUstate(
+    c: *mut c_void,
+    _s: *mut c_void,
+    _b: *mut u8,
+    _n: usize,
+) -> Status {
+    guarded(c, "fmi2SerializeFMUstate", |_| {
+        Err("this FMU does not serialize its state".into())
+    })
 }
 
 /// # Safety
@@ -432,7 +453,9 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     _n: usize,
     _s: *mut *mut c_void,
 ) -> Status {
-    guarded(c, "fmi2DeSerializeFMUstate", |_| Err("this FMU does not serialize its state".into()))
+    guarded(c, "fmi2DeSerializeFMUstate", |_| {
+        Err("this FMU does not serialize its state".into())
+    })
 }
 
 /// # Safety
@@ -456,240 +479,4 @@ pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
             slice_mut(dv_unknown, n_unknown, "dvUnknown")?,
         )
     })
-}
-
-fn expect_kind(comp: &Component, call: &str, kind: Kind) -> Outcome<()> {
-    if comp.inst.kind == kind {
-        Ok(())
-    } else {
-        Err(format!("{call} is not a function of {:?} (this instance is {:?})", kind, comp.inst.kind))
-    }
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2EnterEventMode(c: *mut c_void) -> Status {
-    guarded(c, "fmi2EnterEventMode", |comp| {
-        expect_kind(comp, "fmi2EnterEventMode", Kind::ModelExchange)?;
-        comp.inst.expect("fmi2EnterEventMode", ME_SOLVING)?;
-        comp.inst.phase = Phase::Event;
-        Ok(())
-    })
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2NewDiscreteStates(c: *mut c_void, info: *mut EventInfo) -> Status {
-    guarded(c, "fmi2NewDiscreteStates", |comp| {
-        expect_kind(comp, "fmi2NewDiscreteStates", Kind::ModelExchange)?;
-        comp.inst.expect("fmi2NewDiscreteStates", &[Phase::Event])?;
-        // No discrete states and no events: the iteration ends at once.
-        let none = EventInfo {
-            new_discrete_states_needed: FALSE,
-            terminate_simulation: FALSE,
-            nominals_of_continuous_states_changed: FALSE,
-            values_of_continuous_states_changed: FALSE,
-            next_event_time_defined: FALSE,
-            next_event_time: 0.0,
-        };
-        write(info, none, "fmi2EventInfo")
-    })
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: *mut c_void) -> Status {
-    guarded(c, "fmi2EnterContinuousTimeMode", |comp| {
-        expect_kind(comp, "fmi2EnterContinuousTimeMode", Kind::ModelExchange)?;
-        comp.inst.expect("fmi2EnterContinuousTimeMode", &[Phase::Event])?;
-        comp.inst.phase = Phase::ContinuousTime;
-        Ok(())
-    })
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
-    c: *mut c_void,
-    _no_set_prior: Boolean,
-    enter_event_mode: *mut Boolean,
-    terminate: *mut Boolean,
-) -> Status {
-    guarded(c, "fmi2CompletedIntegratorStep", |comp| {
-        expect_kind(comp, "fmi2CompletedIntegratorStep", Kind::ModelExchange)?;
-        comp.inst.expect("fmi2CompletedIntegratorStep", &[Phase::ContinuousTime])?;
-        write(enter_event_mode, FALSE, "enterEventMode")?;
-        write(terminate, FALSE, "terminateSimulation")
-    })
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetTime(c: *mut c_void, time: f64) -> Status {
-    guarded(c, "fmi2SetTime", |comp| {
-        expect_kind(comp, "fmi2SetTime", Kind::ModelExchange)?;
-        comp.inst.expect("fmi2SetTime", ME_SOLVING)?;
-        comp.inst.set_time(time)
-    })
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetContinuousStates(c: *mut c_void, x: *const f64, n: usize) -> Status {
-    guarded(c, "fmi2SetContinuousStates", |comp| {
-        expect_kind(comp, "fmi2SetContinuousStates", Kind::ModelExchange)?;
-        comp.inst.expect("fmi2SetContinuousStates", ME_SOLVING)?;
-        check_count(n)?;
-        comp.inst.set_states(slice(x, n, "x")?)
-    })
-}
-
-fn check_count(n: usize) -> Outcome<()> {
-    if n == NX {
-        Ok(())
-    } else {
-        Err(format!("the model has {NX} continuous states, not {n}"))
-    }
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetContinuousStates(c: *mut c_void, x: *mut f64, n: usize) -> Status {
-    guarded(c, "fmi2GetContinuousStates", |comp| {
-        check_count(n)?;
-        slice_mut(x, n, "x")?.copy_from_slice(comp.inst.states());
-        Ok(())
-    })
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetDerivatives(c: *mut c_void, dx: *mut f64, n: usize) -> Status {
-    guarded(c, "fmi2GetDerivatives", |comp| {
-        check_count(n)?;
-        let out = slice_mut(dx, n, "derivatives")?;
-        out.copy_from_slice(&comp.inst.derivatives()?);
-        Ok(())
-    })
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetEventIndicators(c: *mut c_void, _z: *mut f64, n: usize) -> Status {
-    guarded(c, "fmi2GetEventIndicators", |_| {
-        if n == 0 { Ok(()) } else { Err(format!("the model has no event indicators, not {n}")) }
-    })
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(c: *mut c_void, x: *mut f64, n: usize) -> Status {
-    guarded(c, "fmi2GetNominalsOfContinuousStates", |_| {
-        check_count(n)?;
-        slice_mut(x, n, "x_nominal")?.fill(1.0);
-        Ok(())
-    })
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
-    c: *mut c_void,
-    _vr: *const u32,
-    n: usize,
-    _order: *const c_int,
-    _value: *const f64,
-) -> Status {
-    guarded(c, "fmi2SetRealInputDerivatives", |_| {
-        if n == 0 { Ok(()) } else { Err("this FMU does not interpolate inputs (canInterpolateInputs is false)".into()) }
-    })
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
-    c: *mut c_void,
-    _vr: *const u32,
-    n: usize,
-    _order: *const c_int,
-    _value: *mut f64,
-) -> Status {
-    guarded(c, "fmi2GetRealOutputDerivatives", |_| {
-        if n == 0 { Ok(()) } else { Err("this FMU does not give output derivatives (maxOutputDerivativeOrder is 0)".into()) }
-    })
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2DoStep(c: *mut c_void, t: f64, h: f64, _no_set_prior: Boolean) -> Status {
-    guarded(c, "fmi2DoStep", |comp| {
-        expect_kind(comp, "fmi2DoStep", Kind::CoSimulation)?;
-        comp.inst.expect("fmi2DoStep", &[Phase::StepComplete])?;
-        comp.inst.do_step(t, h)
-    })
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2CancelStep(c: *mut c_void) -> Status {
-    guarded(c, "fmi2CancelStep", |_| Err("fmi2DoStep is never pending: nothing to cancel".into()))
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetStatus(c: *mut c_void, _kind: c_int, _value: *mut Status) -> Status {
-    guarded(c, "fmi2GetStatus", |_| Err("fmi2DoStep is never pending: no status to ask for".into()))
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetRealStatus(c: *mut c_void, kind: c_int, value: *mut f64) -> Status {
-    guarded(c, "fmi2GetRealStatus", |comp| {
-        // fmi2LastSuccessfulTime
-        if kind == 2 {
-            write(value, comp.inst.time(), "value")
-        } else {
-            Err(format!("no real status of kind {kind}"))
-        }
-    })
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetIntegerStatus(c: *mut c_void, kind: c_int, _value: *mut c_int) -> Status {
-    guarded(c, "fmi2GetIntegerStatus", |_| Err(format!("no integer status of kind {kind}")))
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetBooleanStatus(c: *mut c_void, kind: c_int, value: *mut Boolean) -> Status {
-    guarded(c, "fmi2GetBooleanStatus", |_| {
-        // fmi2Terminated: the FMU never asks to stop.
-        if kind == 3 { write(value, FALSE, "value") } else { Err(format!("no boolean status of kind {kind}")) }
-    })
-}
-
-/// # Safety
-/// As the standard requires.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetStringStatus(c: *mut c_void, kind: c_int, _value: *mut *const c_char) -> Status {
-    guarded(c, "fmi2GetStringStatus", |_| Err(format!("no string status of kind {kind}")))
 }

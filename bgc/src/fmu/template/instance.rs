@@ -49,7 +49,7 @@ pub struct Instance {
 }
 
 /// The relative tolerance of Co-Simulation steps when the importer gives none.
-const DEFAULT_TOLERANCE: f64 = 1e-6;
+const DEFAULT_TOLERANCE: f64 = 1e-8;
 
 pub type Outcome<T> = Result<T, String>;
 
@@ -120,7 +120,11 @@ impl Instance {
 
     pub fn set_states(&mut self, x: &[f64]) -> Outcome<()> {
         if let Some(k) = x.iter().position(|v| !v.is_finite()) {
-            return Err(format!("state {} = {} is not finite", plant::Var::State(k).name(), x[k]));
+            return Err(format!(
+                "state {} = {} is not finite",
+                plant::Var::State(k).name(),
+                x[k]
+            ));
         }
         self.x.copy_from_slice(x);
         Ok(())
@@ -231,11 +235,14 @@ impl Instance {
                     ));
                 }
             };
-            *o = cols.iter().zip(seed).map(|(&c, s)| jac[c * rows + row] * s).sum();
+            *o = cols
+                .iter()
+                .zip(seed)
+                .map(|(&c, s)| jac[c * rows + row] * s)
+                .sum();
         }
-        finite(out, |_| Var::Time, self.t).map_err(|_| {
-            format!("a directional derivative is not finite at t = {}", self.t)
-        })
+        finite(out, |_| Var::Time, self.t)
+            .map_err(|_| format!("a directional derivative is not finite at t = {}", self.t))
     }
 
     /// `Σ seed · ∂unknown/∂known` for each known: the transposed Jacobian times the seed (FMI 3.0's adjoint).
@@ -248,7 +255,12 @@ impl Instance {
     ) -> Outcome<()> {
         let mut column = vec![0.0; unknowns.len()];
         for (known, o) in knowns.iter().zip(out.iter_mut()) {
-            self.directional_derivative(unknowns, std::slice::from_ref(known), &[1.0], &mut column)?;
+            self.directional_derivative(
+                unknowns,
+                std::slice::from_ref(known),
+                &[1.0],
+                &mut column,
+            )?;
             *o = column.iter().zip(seed).map(|(j, s)| j * s).sum();
         }
         Ok(())

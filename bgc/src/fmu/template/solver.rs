@@ -84,7 +84,14 @@ impl Integrator {
 
     /// One extrapolated step: the new state and its error norm, or `None` when a matrix is singular or a value
     /// is not finite.
-    fn try_step(&self, p: &Params, t: f64, h: f64, x: &[f64], u: &[f64]) -> Option<(Vec<f64>, f64)> {
+    fn try_step(
+        &self,
+        p: &Params,
+        t: f64,
+        h: f64,
+        x: &[f64],
+        u: &[f64],
+    ) -> Option<(Vec<f64>, f64)> {
         let jac = plant::jac_x(p, t, x, u);
         let mut f0 = vec![0.0; NX];
         plant::rhs(p, t, x, u, &mut f0);

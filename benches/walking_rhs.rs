@@ -3,6 +3,7 @@
 //! same equations (`LegModel::derivative`: `M`, `C q̇`, `G` and friction, solved by nalgebra's Cholesky).
 
 use bgc_models::walking_leg as m;
+use bgc_runtime::model::ContinuousModel;
 use bgc_workspace::walking::anthropometry::{LegFriction, LegSegments};
 use bgc_workspace::walking::plant::LegModel;
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -18,6 +19,15 @@ fn rhs(c: &mut Criterion) {
     group.bench_function("generated", |b| {
         b.iter(|| {
             m::rhs_into(black_box(&p), 0.0, black_box(&x), black_box(&u), &mut dx);
+            black_box(&dx);
+        })
+    });
+    // What the runtime calls: `Model` holds the parameter terms (the derived inertia and gravity constants,
+    // `1/eps`, ...); the free `rhs_into` above computes them at each call.
+    let model = m::Model::default();
+    group.bench_function("model_rhs", |b| {
+        b.iter(|| {
+            black_box(&model).rhs(0.0, black_box(&x), black_box(&u), &mut dx);
             black_box(&dx);
         })
     });

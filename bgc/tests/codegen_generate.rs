@@ -125,7 +125,8 @@ fn without_the_runtime_the_module_has_its_own_param_error_and_no_runtime_impls()
             })
             .collect::<Vec<_>>()
     };
-    assert_eq!(functions(&with).len(), 2);
+    // Two models, each with `rhs_with` (which reads the parameter terms) and `rhs_into` (which computes them).
+    assert_eq!(functions(&with).len(), 4);
     assert_eq!(functions(&with), functions(&without));
 }
 
@@ -161,16 +162,17 @@ fn elementary_functions_are_libm_calls_bound_once() {
         code.matches("libm::sin(theta)").count(),
         code.matches("let sin_theta").count()
     );
-    // The gravity torque uses it, with the equation above; its derivative uses the cosine.
+    // The gravity torque uses it, with the equation above; its derivative uses the cosine. The product of the
+    // parameters is a parameter term, computed once per parameter set.
     assert!(
         code.contains(
-            "    // e_weight = -g*l*m*sin(theta)\n    let e_weight = -p.g * p.l * p.m * sin_theta;\n"
+            "    // e_weight = -g*l*m*sin(theta)\n    let e_weight = -c.k_g_l_m * sin_theta;\n"
         ),
         "{code}"
     );
     assert!(
         code.contains(
-            "    // ∂(d/dt p_bob)/∂theta = -g*l*m*cos(theta)\n    jac[(0, 1)] = -p.g * p.l * p.m * cos_theta;\n"
+            "    // ∂(d/dt p_bob)/∂theta = -g*l*m*cos(theta)\n    jac[(0, 1)] = -c.k_g_l_m * cos_theta;\n"
         ),
         "{code}"
     );
@@ -222,7 +224,7 @@ fn unused_arguments_are_named_with_an_underscore() {
     // No input and no time: `_u`, `_t`; the output depends on theta only, not on the parameters' p_bob.
     assert!(
         code.contains(
-            "pub fn rhs_into(p: &Params, _t: f64, x: &State, _u: &Inputs, dx: &mut State) {"
+            "pub fn rhs_with(p: &Params, c: &ParamTerms, _t: f64, x: &State, _u: &Inputs, dx: &mut State) {"
         ),
         "{code}"
     );
@@ -347,16 +349,17 @@ fn a_jacobian_of_the_parameters_only_is_computed_once_per_parameter_set() {
     // `set_param` recomputes them.
     let set_param = trait_method(&linear, "set_param");
     assert!(
-        set_param.contains("self.constant = ConstantJacobians::at(&self.params);"),
+        set_param.contains("*self = Model::at(self.params);"),
         "{set_param}"
     );
-    // A pendulum: `∂f/∂x` reads the angle, the output Jacobians do not.
+    // A pendulum: `∂f/∂x` reads the angle (and the parameter terms `Model` holds), the output Jacobians do not.
     let pendulum =
         std::fs::read_to_string(codegen_support::workspace().join("bgc/tests/corpus/pendulum.bg"))
             .unwrap_or_default();
     let nonlinear = generate(&pendulum);
     assert!(
-        trait_method(&nonlinear, "jac_x").ends_with("jac_x_into(&self.params, t, x, u, jac);"),
+        trait_method(&nonlinear, "jac_x")
+            .ends_with("jac_x_with(&self.params, &self.terms, t, x, u, jac);"),
         "{nonlinear}"
     );
     // It has no inputs: `∂f/∂u` has no columns, nothing to solve with its mass matrix, and is constant.

@@ -21,6 +21,7 @@ mod codegen_build;
 mod codegen_generate;
 mod codegen_hostile_names;
 mod codegen_no_std;
+mod codegen_param_terms;
 mod codegen_rustfmt;
 mod codegen_state_space;
 mod equations_back_support;

@@ -62,6 +62,34 @@ pub fn cholesky_lower<const N: usize>(p: &SMatrix<f64, N, N>) -> Option<SMatrix<
     Some(l)
 }
 
+/// Whether the symmetric `p` (only the lower triangle is read) is numerically positive definite: the test of
+/// [`cholesky_lower`] (every pivot positive and finite) by an `LDLᵀ` sweep, which needs one division per column and
+/// no square root; the filters check their covariance with it after every step.
+pub fn positive_definite<const N: usize>(p: &SMatrix<f64, N, N>) -> bool {
+    // `P = L D Lᵀ` with unit lower `L`, kept as `ld[(i, k)] = l_ik d_k`, and the pivots' reciprocals.
+    let mut ld = SMatrix::<f64, N, N>::zeros();
+    let mut inv = [0.0_f64; N];
+    for j in 0..N {
+        let mut d = p[(j, j)];
+        for k in 0..j {
+            d -= ld[(j, k)] * ld[(j, k)] * inv[k];
+        }
+        if !(d > 0.0 && d.is_finite()) {
+            return false;
+        }
+        inv[j] = 1.0 / d;
+        ld[(j, j)] = d;
+        for i in (j + 1)..N {
+            let mut s = p[(i, j)];
+            for k in 0..j {
+                s -= ld[(i, k)] * ld[(j, k)] * inv[k];
+            }
+            ld[(i, j)] = s;
+        }
+    }
+    true
+}
+
 /// Lower Cholesky factor of `p` whose pivots must each exceed `floor` (the rounding error with which the
 /// diagonal of `p` is known), or `None`: a pivot at or below its floor means that `p` is singular to within
 /// the accuracy of its entries, even when rounding left it a tiny positive value.

@@ -17,7 +17,7 @@
 //!
 //! Nothing here panics.
 
-use super::dense::{all_finite, cholesky_lower, symmetric_eigen, symmetrise};
+use super::dense::{all_finite, cholesky_lower, positive_definite, symmetric_eigen, symmetrise};
 use crate::model::ParamError;
 use nalgebra::{SMatrix, SVector};
 
@@ -210,7 +210,7 @@ pub(crate) fn repair_covariance<const N: usize>(
         return Err(EstimationError::NonFiniteCovariance { filter });
     }
     symmetrise(p);
-    if cholesky_lower(p).is_some() {
+    if positive_definite(p) {
         return Ok(None);
     }
     let (vals, vecs) = symmetric_eigen(p).ok_or(EstimationError::NonFiniteCovariance { filter })?;

@@ -4,8 +4,17 @@
 //!
 //! Time update (predict): `x⁻ = A x + B u`, `P⁻ = A P Aᵀ + Q`.
 //! Measurement update with the innovation `e = y − C x⁻ − D u`, `S = C P⁻ Cᵀ + R`:
-//! `x = x⁻ + K e` and the Joseph form `P = (I − K C) P⁻ (I − K C)ᵀ + K R Kᵀ`, which stays symmetric positive
-//! semi-definite under rounding and is the correct covariance for *any* gain `K`, not only the optimal one.
+//! `x = x⁻ + K e` and the Joseph form `P = (I − K C) P⁻ (I − K C)ᵀ + K R Kᵀ`, the correct covariance for *any* gain
+//! `K`, not only the optimal one. It is evaluated from `C P⁻` (computed for `S` anyway) as `P⁻ − K C P⁻ − W Kᵀ`,
+//! `W = P⁻ Cᵀ − K S` (the same matrix for any `K`), the upper triangle mirrored, so it is exactly symmetric:
+//! about `2 n² m` flops instead of the `4 n³` of the products as written. `A P Aᵀ` likewise computes one triangle.
+//!
+//! # Cost
+//!
+//! With `n` states and `m` measurements a step (predict and update) takes about `(11/3) n³ + 6 n² m` flops
+//! (a multiply-add counted as two) and lower-order terms: `2 n³` for `A P`, `n³` for one triangle of `(A P) Aᵀ`,
+//! `2 n² m` for `C P⁻`, `2 n² m` for the diagonal of `|C| |P⁻| |C|ᵀ` (the singularity floor of `S`), `2 n² m` for
+//! the Joseph form, and a positive-definiteness check of `P` after each half step (an `LDLᵀ` sweep, `n³/3` each).
 //!
 //! # Filter gain and predictor gain
 //!
@@ -178,7 +187,7 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
                 quantity: "predicted state",
             });
         }
-        let mut p = m.a * self.p * m.a.transpose() + self.q;
+        let mut p = congruence_plus(&m.a, &self.p, &self.q);
         let repair = repair_covariance(&mut p, self.policy.eigen_floor, FILTER)?;
         self.x = x;
         self.p = p;
@@ -201,7 +210,9 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         }
         let m = &self.model;
         let e = y - m.c * self.x - m.d * u;
-        let mut s = m.c * self.p * m.c.transpose() + self.r;
+        // M = C P⁻ serves the innovation covariance, the gain and the Joseph form.
+        let cp = m.c * self.p;
+        let mut s = cp * m.c.transpose() + self.r;
         symmetrise(&mut s);
         let singular = EstimationError::SingularInnovation { filter: FILTER };
         let ls = cholesky_above_floor(&s, &self.innovation_floor()).ok_or(singular.clone())?;
@@ -224,16 +235,13 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         let k = match self.gain_mode {
             GainMode::Fixed(k) => k,
             // K = P Cᵀ S⁻¹, i.e. Kᵀ = S⁻¹ C P (P and S symmetric).
-            GainMode::TimeVarying => cholesky_solve(&ls, &(m.c * self.p))
-                .ok_or(singular)?
-                .transpose(),
+            GainMode::TimeVarying => cholesky_solve(&ls, &cp).ok_or(singular)?.transpose(),
         };
-        let i_kc = SMatrix::<f64, NX, NX>::identity() - k * m.c;
         let x = self.x + k * e;
         if first_non_finite(&x).is_some() {
             return Err(overflow("corrected state"));
         }
-        let mut p = i_kc * self.p * i_kc.transpose() + k * self.r * k.transpose();
+        let mut p = joseph(&self.p, &k, &cp, &s);
         let repair = repair_covariance(&mut p, self.policy.eigen_floor, FILTER)?;
         self.x = x;
         self.p = p;
@@ -244,10 +252,18 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
     /// The rounding error with which `diag(C P Cᵀ + R)` is known, `NX ε (|C| |P| |C|ᵀ)ⱼⱼ + ε Rⱼⱼ`: a Cholesky
     /// pivot of `S` at or below it means `S` is singular to working accuracy.
     fn innovation_floor(&self) -> SVector<f64, NY> {
-        let c = self.model.c.abs();
-        let spread = c * self.p.abs() * c.transpose();
+        let c = &self.model.c;
         SVector::from_fn(|j, _| {
-            f64::EPSILON * (NX.max(1) as f64 * spread[(j, j)] + self.r[(j, j)].abs())
+            // Only the diagonal of |C| |P| |C|ᵀ: Σₐ |cⱼₐ| Σ_b |pₐ_b| |cⱼ_b|.
+            let mut spread = 0.0;
+            for a in 0..NX {
+                let mut row = 0.0;
+                for b in 0..NX {
+                    row += self.p[(a, b)].abs() * c[(j, b)].abs();
+                }
+                spread += c[(j, a)].abs() * row;
+            }
+            f64::EPSILON * (NX.max(1) as f64 * spread + self.r[(j, j)].abs())
         })
     }
 
@@ -280,6 +296,55 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
     pub fn model(&self) -> &LinearDiscreteModel<NX, NU, NY> {
         &self.model
     }
+}
+
+/// `A P Aᵀ + Q` for symmetric `P` and `Q`: `A P` in full, then the upper triangle of `(A P) Aᵀ`, mirrored (the
+/// product is symmetric, so half of its `2 NX³` flops are not needed).
+fn congruence_plus<const NX: usize>(
+    a: &SMatrix<f64, NX, NX>,
+    p: &SMatrix<f64, NX, NX>,
+    q: &SMatrix<f64, NX, NX>,
+) -> SMatrix<f64, NX, NX> {
+    // (A P)ᵀ = P Aᵀ, so row i of A P is column i of P Aᵀ: each entry is a dot product of two columns.
+    let at = a.transpose();
+    let pat = p * at;
+    let mut out = *q;
+    for j in 0..NX {
+        for i in 0..=j {
+            let mut sum = q[(i, j)];
+            for k in 0..NX {
+                sum += pat[(k, i)] * at[(k, j)];
+            }
+            out[(i, j)] = sum;
+            out[(j, i)] = sum;
+        }
+    }
+    out
+}
+
+/// The Joseph form `(I − K C) P (I − K C)ᵀ + K R Kᵀ` for any gain `K`, from `M = C P` and `S = C P Cᵀ + R`
+/// (already computed for the innovation), without forming `I − K C`: with `G = I − K C`, `G P = P − K M` and
+/// `G P Cᵀ = Mᵀ − K (S − R)` (`P` is symmetric), so `G P Gᵀ + K R Kᵀ = P − K M − W Kᵀ` with `W = Mᵀ − K S`. The
+/// upper triangle is computed and mirrored: `2 NX (NX + 1) NY` flops for the result instead of about `4 NX³`.
+fn joseph<const NX: usize, const NY: usize>(
+    p: &SMatrix<f64, NX, NX>,
+    k: &SMatrix<f64, NX, NY>,
+    m: &SMatrix<f64, NY, NX>,
+    s: &SMatrix<f64, NY, NY>,
+) -> SMatrix<f64, NX, NX> {
+    let w = m.transpose() - k * s;
+    let mut out = *p;
+    for j in 0..NX {
+        for i in 0..=j {
+            let mut sum = p[(i, j)];
+            for a in 0..NY {
+                sum -= k[(i, a)] * m[(a, j)] + w[(i, a)] * k[(j, a)];
+            }
+            out[(i, j)] = sum;
+            out[(j, i)] = sum;
+        }
+    }
+    out
 }
 
 /// Copies a dynamically sized matrix (e.g. a gain from [`crate::design`]) into a fixed-size one, checking

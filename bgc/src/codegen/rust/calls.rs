@@ -98,7 +98,11 @@ pub(super) fn with_bound_calls(code: RustCode, calls: &BTreeMap<String, String>)
 pub(super) fn call_name(call: &RustCode) -> String {
     fn words(code: &RustCode, out: &mut Vec<String>) {
         match code {
-            RustCode::Atom(s) => out.push(s.trim_start_matches("p.").to_string()),
+            RustCode::Atom(s) => out.push(
+                s.trim_start_matches("p.")
+                    .trim_start_matches("c.")
+                    .to_string(),
+            ),
             RustCode::Neg(inner) | RustCode::Paren(inner) => words(inner, out),
             RustCode::Chain(first, rest) => {
                 words(first, out);

@@ -7,6 +7,7 @@ use super::super::emit::{Block, MAX_LETS, StateSpace};
 use super::super::layout::Body;
 use super::super::names::{Namer, comment};
 use super::calls::{call_depth, call_name, early_calls, with_bound_calls};
+use super::terms::term_field;
 use super::{Arg, Function, Uses, Writer, output_names};
 use crate::equations::{EnergyKind, StateSelection};
 use crate::symbolic::{Expr, RustCode, Symbol, SymbolKind};
@@ -22,6 +23,10 @@ pub(in crate::codegen) struct Draft {
     next_temp: usize,
     /// Calls bound at the top of the body: the call's text and the name bound to it.
     calls: BTreeMap<String, String>,
+    /// Whether the body reads its parameter-only subexpressions from `c: &ParamTerms` ([`super::terms`]).
+    cache: bool,
+    /// Whether it reads any.
+    reads_terms: bool,
 }
 
 impl Draft {
@@ -34,8 +39,33 @@ impl Draft {
 impl Writer<'_> {
     /// A body that binds the states and inputs `exprs` use, and what it uses.
     pub(in crate::codegen) fn draft(&self, exprs: &[&Expr]) -> Draft {
+        self.draft_with(exprs, false)
+    }
+
+    /// A body as [`Self::draft`] whose statements read parameter-only subexpressions from `c: &ParamTerms`.
+    fn draft_cached(&self, exprs: &[&Expr]) -> Draft {
+        self.draft_with(exprs, self.terms_enabled)
+    }
+
+    /// `e` as the body of `d` computes it: with its parameter terms when `d` reads them from `c`.
+    fn as_computed(&self, d: &Draft, e: &Expr) -> Expr {
+        if d.cache {
+            self.terms.borrow_mut().rewrite(e)
+        } else {
+            e.clone()
+        }
+    }
+
+    fn draft_with(&self, exprs: &[&Expr], cache: bool) -> Draft {
+        let rewritten: Vec<Expr> = if cache {
+            let mut terms = self.terms.borrow_mut();
+            exprs.iter().map(|e| terms.rewrite(e)).collect()
+        } else {
+            exprs.iter().map(|e| (*e).clone()).collect()
+        };
+        let exprs: Vec<&Expr> = rewritten.iter().collect();
         let mut used: BTreeSet<Symbol> = BTreeSet::new();
-        for e in exprs {
+        for e in &exprs {
             used.extend(e.free_symbols());
         }
         let mut d = Draft {
@@ -43,13 +73,17 @@ impl Writer<'_> {
             lines: Vec::new(),
             locals: Vec::new(),
             uses: Uses {
-                p: used.iter().any(|s| s.kind() == SymbolKind::Param),
+                p: used
+                    .iter()
+                    .any(|s| s.kind() == SymbolKind::Param && term_field(s).is_none()),
                 t: used.iter().any(|s| s.kind() == SymbolKind::Time),
                 x: false,
                 u: false,
             },
             next_temp: 1,
             calls: BTreeMap::new(),
+            cache,
+            reads_terms: used.iter().any(|s| term_field(s).is_some()),
         };
         for (vector, symbols) in [("x", &self.plan.states), ("u", &self.plan.inputs)] {
             for (i, s) in symbols.iter().enumerate() {
@@ -72,7 +106,7 @@ impl Writer<'_> {
             .map(|s| self.name(s))
             .collect();
         let mut calls = BTreeMap::new();
-        for e in exprs {
+        for e in &exprs {
             early_calls(&self.code(e), &early, &mut calls);
         }
         let mut calls: Vec<(String, RustCode)> = calls.into_iter().collect();
@@ -104,7 +138,17 @@ impl Writer<'_> {
         head: &str,
         tail: &str,
     ) {
-        let code = with_bound_calls(self.code(e), &d.calls);
+        let computed = self.as_computed(d, e);
+        if d.cache {
+            for s in computed.free_symbols() {
+                if term_field(&s).is_some() {
+                    d.reads_terms = true;
+                } else if s.kind() == SymbolKind::Param {
+                    d.uses.p = true;
+                }
+            }
+        }
+        let code = with_bound_calls(self.code(&computed), &d.calls);
         self.statement_code(d, self.equation(4, label, e), &code, head, tail);
     }
 
@@ -148,7 +192,7 @@ impl Writer<'_> {
     ) {
         let mut all: Vec<&Expr> = b.lets.iter().map(|l| &l.1).collect();
         all.extend(b.results.iter());
-        let mut d = self.draft(&all);
+        let mut d = self.draft_cached(&all);
         self.solve_tears(&mut d, &all);
         for (s, v) in &b.lets {
             let local = self.name(s);
@@ -174,16 +218,58 @@ impl Writer<'_> {
         if target.0 == "dx" {
             self.mass_solve_in_rhs(&mut d);
         }
+        let out = Arg::new(target.0, target.1, !b.results.is_empty());
+        self.model_function(name, doc, d, out);
+    }
+
+    /// The model function `name` with the body of `d` and the output argument `out` (`dx`, `y`, `jac`): itself
+    /// when the body reads no parameter term, else `{base}_with(p, c, t, x, u, out)` that reads them from `c` and
+    /// `name` that computes them and calls it.
+    fn model_function(&mut self, name: &str, doc: &str, d: Draft, out: Arg) {
         let mut args = Self::model_args(d.uses);
-        args.push(Arg::new(target.0, target.1, !b.results.is_empty()));
+        if !d.reads_terms {
+            args.push(out);
+            self.function(Function {
+                doc: doc.to_string(),
+                name: name.to_string(),
+                args,
+                ret: String::new(),
+                body: Self::body_text(&d.lines),
+                locals: d.locals,
+            });
+            return;
+        }
+        let with = with_terms_name(name);
+        args.insert(1, Arg::new("c", "&ParamTerms", true));
+        let (out_name, out_ty) = (out.name, out.ty);
+        args.push(out);
         self.function(Function {
-            doc: doc.to_string(),
-            name: name.to_string(),
+            doc: format!(
+                "{doc} `c` holds the parameter terms, `ParamTerms::at(p)` (`Model` computes them once per \
+                 parameter set)."
+            ),
+            name: with.clone(),
             args,
             ret: String::new(),
             body: Self::body_text(&d.lines),
             locals: d.locals,
         });
+        let mut wrapper = Self::model_args(Uses {
+            p: true,
+            t: true,
+            x: true,
+            u: true,
+        });
+        wrapper.push(Arg::new(out_name, out_ty, true));
+        self.function(Function {
+            doc: format!("{doc} Computes the parameter terms first: `{with}` takes them."),
+            name: name.to_string(),
+            args: wrapper,
+            ret: String::new(),
+            body: format!("    {with}(p, &ParamTerms::at(p), t, x, u, {out_name});\n"),
+            locals: Vec::new(),
+        });
+        self.with_terms.push(name.to_string());
     }
 
     /// Emits a function with the body of `d`; `args` are `(name, type, used)`.
@@ -214,6 +300,7 @@ impl Writer<'_> {
     }
 
     pub(super) fn functions(&mut self) {
+        self.terms_enabled = self.param_terms_fit();
         self.loop_fns();
         self.mass_fns();
         self.rhs();
@@ -314,7 +401,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         };
         let correction = self.loop_correction_exprs(g_z, r_v);
         nonzero.extend(correction.iter());
-        let mut d = self.draft(&nonzero);
+        let mut d = self.draft_cached(&nonzero);
         self.solve_tears(&mut d, &nonzero);
         d.lines.push("    jac.fill(0.0);".into());
         for (r, row) in m.iter().enumerate() {
@@ -343,16 +430,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             self.constant_jacobian(name, ty);
         }
         let sparse = name == "jac_x_into" && self.wants_sparse_jac_x();
-        let mut args = Self::model_args(d.uses);
-        args.push(Arg::new("jac", ty, true));
-        self.function(Function {
-            doc: doc.to_string(),
-            name: name.to_string(),
-            args,
-            ret: String::new(),
-            body: Self::body_text(&d.lines),
-            locals: d.locals,
-        });
+        self.model_function(name, doc, d, Arg::new("jac", ty, true));
         if sparse {
             self.sparse_jac_x(m, rows, cols, row_prefix);
         }
@@ -680,4 +758,9 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             });
         }
     }
+}
+
+/// The function that takes the parameter terms for the model function `name`: `rhs_into` → `rhs_with`.
+pub(super) fn with_terms_name(name: &str) -> String {
+    format!("{}_with", name.strip_suffix("_into").unwrap_or(name))
 }

@@ -50,6 +50,7 @@ mod calls;
 mod functions;
 mod model;
 mod params;
+mod terms;
 
 pub(super) use functions::Draft;
 
@@ -59,7 +60,8 @@ use super::layout::MAX_WIDTH;
 use super::names::{Namer, comment, string_literal};
 use super::{CompiledFile, CompiledModel};
 use crate::symbolic::{Expr, RustCode, Symbol, rust_helpers_used, to_rust_code};
-use std::collections::HashMap;
+use std::cell::RefCell;
+use std::collections::{HashMap, HashSet};
 use std::fmt::Write;
 
 /// The version written into the header of generated files.
@@ -276,6 +278,14 @@ pub(in crate::codegen) struct Writer<'a> {
     /// The Jacobians whose bodies read neither `t`, `x` nor `u` (those of a linear model): `Model` computes them
     /// once per parameter set.
     constant_jacobians: Vec<model::ConstantJacobian>,
+    /// The parameter-only subexpressions of the bodies that take `c: &ParamTerms` ([`terms`]), found while
+    /// they are written.
+    terms: RefCell<terms::ParamTerms>,
+    /// The functions written as `{name}_with(p, c, ...)` and a `{name}` that computes `c` (`rhs_into`).
+    with_terms: Vec<String>,
+    /// Whether the bodies read parameter terms: not when there would be more than `MAX_LETS` of them (a large
+    /// model), which `ParamTerms::at` could not bind.
+    terms_enabled: bool,
     pub(in crate::codegen) out: String,
 }
 
@@ -296,6 +306,10 @@ impl<'a> Writer<'a> {
             .filter_map(|&k| all_fields.get(k).cloned())
             .collect();
         let mut names = HashMap::new();
+        let derived_symbols: HashSet<Symbol> = (0..eqs.params.len())
+            .filter(|&k| derived(k))
+            .filter_map(|k| eqs.params.get(k).map(|p| Symbol::param(p.0.as_str())))
+            .collect();
         for (k, (p, field)) in eqs.params.iter().zip(&all_fields).enumerate() {
             let access = if derived(k) {
                 format!("p.{field}()")
@@ -326,12 +340,18 @@ impl<'a> Writer<'a> {
             all_fields,
             width,
             constant_jacobians: Vec::new(),
+            terms: RefCell::new(terms::ParamTerms::new(derived_symbols)),
+            with_terms: Vec::new(),
+            terms_enabled: false,
             out: String::new(),
         }
     }
 
     /// The name of `s` inside a model function.
     pub(in crate::codegen) fn name(&self, s: &Symbol) -> String {
+        if let Some(field) = terms::term_field(s) {
+            return format!("c.{field}");
+        }
         self.names.get(s).cloned().unwrap_or_else(|| {
             format!(
                 "compile_error!({})",
@@ -422,6 +442,7 @@ impl<'a> Writer<'a> {
         self.sizes();
         self.params();
         self.functions();
+        self.param_terms_struct();
         self.model();
         // The helpers the code calls (comments and documentation, the model's text, left out).
         let code: String = self

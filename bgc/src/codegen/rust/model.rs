@@ -5,6 +5,7 @@
 //! back-support `jac_x` would otherwise divide by parameters 22 times and fill 100 entries at each call. The cache
 //! lives in `Model`, which is `Copy` and on the stack, so it is kept only while its matrices fit in
 //! [`MAX_CONSTANT_JACOBIAN_BYTES`]; a larger model computes its Jacobians at each call, as the free functions do.
+//! `Model` also holds the parameter terms ([`super::terms`]) that its functions read, computed at the same times.
 
 use super::super::names::comment;
 use super::Writer;
@@ -58,12 +59,12 @@ impl Model {
 }
 ";
 
-/// `Model` and its inherent methods, with the constant Jacobians `ConstantJacobians::at(&params)`.
-const MODEL_WITH_CONSTANTS: &str = "#[derive(Clone, Copy, Debug, PartialEq)]
+/// `Model` and its inherent methods when it holds values computed from its parameters (`{fields}`: their
+/// declarations, `{values}`: their values in `Model::at`).
+const MODEL_WITH_CACHE: &str = "#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Model {
     params: Params,
-    constant: ConstantJacobians,
-}
+{fields}}
 
 impl Model {
     /// The model with parameters `params`, refused when they are not physical.
@@ -72,12 +73,11 @@ impl Model {
         Ok(Model::at(params))
     }
 
-    /// The model at `params` (validated or the defaults), with its constant Jacobians.
+    /// The model at `params` (validated or the defaults), with what it computes from them once.
     fn at(params: Params) -> Model {
         Model {
             params,
-            constant: ConstantJacobians::at(&params),
-        }
+{values}        }
     }
 
     /// The parameters.
@@ -117,9 +117,9 @@ impl bgc_runtime::model::Parametric for Model {
 }
 ";
 
-/// The body of `set_param` when `Model` holds constant Jacobians.
-const SET_PARAM_WITH_CONSTANTS: &str = "self.params.set(index, value)?;
-        self.constant = ConstantJacobians::at(&self.params);
+/// The body of `set_param` when `Model` holds values computed from its parameters.
+const SET_PARAM_WITH_CACHE: &str = "self.params.set(index, value)?;
+        *self = Model::at(self.params);
         Ok(())";
 
 /// The runtime's Jacobian methods, in trait order: method, free function, matrix type.
@@ -146,17 +146,34 @@ impl Writer<'_> {
         let name = comment(&self.m.model.name);
         self.doc(0, &format!("Model `{name}` with its parameters: {what}"));
         let constants = self.cached_jacobians();
-        if constants.is_empty() {
-            self.out.push_str(MODEL);
+        // Without the runtime's traits nothing would read the parameter terms from `Model`.
+        let terms = self.options.runtime && !self.with_terms.is_empty();
+        let mut fields = String::new();
+        let mut values = String::new();
+        if terms {
+            fields.push_str("    terms: ParamTerms,\n");
+            values.push_str("            terms: ParamTerms::at(&params),\n");
+        }
+        if !constants.is_empty() {
+            fields.push_str("    constant: ConstantJacobians,\n");
+            values.push_str("            constant: ConstantJacobians::at(&params),\n");
+        }
+        let cached = !fields.is_empty();
+        if cached {
+            self.out.push_str(
+                &MODEL_WITH_CACHE
+                    .replace("{fields}", &fields)
+                    .replace("{values}", &values),
+            );
         } else {
-            self.out.push_str(MODEL_WITH_CONSTANTS);
+            self.out.push_str(MODEL);
         }
         if self.options.runtime {
             self.continuous_model(&constants);
-            let set_param = if constants.is_empty() {
-                "self.params.set(index, value)"
+            let set_param = if cached {
+                SET_PARAM_WITH_CACHE
             } else {
-                SET_PARAM_WITH_CONSTANTS
+                "self.params.set(index, value)"
             };
             self.out
                 .push_str(&RUNTIME_IMPLS.replace("{set_param}", set_param));
@@ -198,20 +215,33 @@ impl Writer<'_> {
         self.constant_jacobians.clone()
     }
 
+    /// The call of the model function `function` from a method of `Model`: with the parameter terms it holds
+    /// when the function reads any.
+    fn model_call(&self, function: &str, out: &str) -> String {
+        if self.with_terms.iter().any(|f| f == function) {
+            let with = super::functions::with_terms_name(function);
+            format!("{with}(&self.params, &self.terms, t, x, u, {out});")
+        } else {
+            format!("{function}(&self.params, t, x, u, {out});")
+        }
+    }
+
     /// `ContinuousModel` for `Model`: a constant Jacobian is copied, the others are computed.
     fn continuous_model(&mut self, constants: &[ConstantJacobian]) {
         let mut text = String::from(
             "
 impl bgc_runtime::model::ContinuousModel<N_STATES, N_INPUTS, N_OUTPUTS> for Model {
     fn rhs(&self, t: f64, x: &State, u: &Inputs, dx: &mut State) {
-        rhs_into(&self.params, t, x, u, dx);
+        {rhs}
     }
 
     fn outputs(&self, t: f64, x: &State, u: &Inputs, y: &mut Outputs) {
-        outputs_into(&self.params, t, x, u, y);
+        {outputs}
     }
 ",
-        );
+        )
+        .replace("{rhs}", &self.model_call("rhs_into", "dx"))
+        .replace("{outputs}", &self.model_call("outputs_into", "y"));
         for (method, function, ty) in JACOBIANS {
             if constants.iter().any(|c| c.function == function) {
                 let _ = write!(
@@ -223,11 +253,12 @@ impl bgc_runtime::model::ContinuousModel<N_STATES, N_INPUTS, N_OUTPUTS> for Mode
 "
                 );
             } else {
+                let call = self.model_call(function, "jac");
                 let _ = write!(
                     text,
                     "
     fn {method}(&self, t: f64, x: &State, u: &Inputs, jac: &mut {ty}) {{
-        {function}(&self.params, t, x, u, jac);
+        {call}
     }}
 "
                 );

@@ -1,0 +1,2 @@
+(body "}" @end) @indent
+(law_block "}" @end) @indent

@@ -74,7 +74,7 @@ fn spec() -> FitSpec {
 
 #[test]
 fn pendulum_estimates_cover_the_truth_and_their_errors_match_the_spread() {
-    let times: Vec<f64> = (0..=150).map(|k| k as f64 * 0.01).collect();
+    let times: Vec<f64> = (0..=100).map(|k| k as f64 * 0.01).collect();
     let clean = truth(&times);
     let defaults = Params::default();
     let true_values = [defaults.J_p, defaults.d_s];

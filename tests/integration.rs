@@ -1,6 +1,8 @@
 //! The integration tests of this crate, in one test binary: one module per concern.
 
 mod back_support;
+mod fit_back_support;
+mod fit_pendulum;
 mod rehab_fusion;
 mod walking;
 mod walking_equations;

@@ -1,6 +1,10 @@
 //! Command-line parsing and dispatch.
 
 mod commands;
+mod fit;
+mod fit_model;
+mod fit_plot;
+mod fit_report;
 mod fmu;
 mod io;
 mod matrix_text;
@@ -74,6 +78,15 @@ pub enum Coords {
     Energy,
     /// The coordinates the model declares with `coords`.
     Declared,
+}
+
+/// The input reconstruction of `bgc fit`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum InputInterp {
+    /// Zero-order hold: each sample holds until the next (the way loggers record commands).
+    Zoh,
+    /// Straight lines between samples.
+    Linear,
 }
 
 /// The integration methods of `bgc simulate`.
@@ -198,6 +211,46 @@ enum Command {
         /// Print the effective parameter values (declared unit and SI) and initial state on standard error.
         #[arg(long, short)]
         verbose: bool,
+    },
+    /// Identify parameters (and initial states) from a measured CSV record: weighted least squares of the output
+    /// error by Levenberg–Marquardt, with standard errors, correlations and the combinations the record does not
+    /// determine.
+    Fit {
+        file: PathBuf,
+        /// Only this model of the file.
+        #[arg(long)]
+        model: Option<String>,
+        /// The record: a `t` column, one column per model input, one per measured output (by name; an empty cell
+        /// is a missing sample), values in the declared units.
+        #[arg(long, value_name = "LOG.csv")]
+        data: PathBuf,
+        /// The parameters to fit, comma-separated; their values (default or --param) are the starting guesses.
+        #[arg(long, required = true, value_name = "NAME,...", value_delimiter = ',')]
+        free: Vec<String>,
+        /// A parameter value other than the default (repeatable), as for `bgc simulate`.
+        #[arg(long = "param", value_name = "NAME=VALUE", value_parser = params::parse_assignment)]
+        params: Vec<params::Assignment>,
+        /// An initial state value (repeatable), as for `bgc simulate`; states not given start at 0.
+        #[arg(long = "x0", value_name = "STATE=VALUE", value_parser = params::parse_assignment)]
+        x0: Vec<params::Assignment>,
+        /// Also fit the initial states: those given with --x0 (from their values), or all when none is given.
+        #[arg(long)]
+        free_x0: bool,
+        /// The weight of an output's squared errors (repeatable; 1 when absent): 1/σ² of its noise makes the
+        /// weighted residual variance 1 for a correct model.
+        #[arg(long = "weight", value_name = "OUT=W", value_parser = params::parse_assignment)]
+        weights: Vec<params::Assignment>,
+        /// Bounds on a fitted parameter in its declared unit (repeatable): `NAME=LO..HI`, either side may be empty.
+        #[arg(long = "bound", value_name = "NAME=LO..HI", value_parser = params::parse_assignment)]
+        bounds: Vec<params::Assignment>,
+        #[arg(long, value_enum, default_value_t = ReportFormat::Text)]
+        format: ReportFormat,
+        /// Write the measured and fitted outputs as an SVG picture.
+        #[arg(long, value_name = "OUT.svg")]
+        plot: Option<PathBuf>,
+        /// How inputs are reconstructed between samples.
+        #[arg(long, value_enum, default_value_t = InputInterp::Zoh)]
+        interp: InputInterp,
     },
     /// Print the Rust module that `bgc::build` generates for FILE (the same text, byte for byte).
     Rust {
@@ -347,6 +400,37 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
                 verbose,
             };
             simulate::simulate(&file, model.as_deref(), &args, color)
+        }
+        Command::Fit {
+            file,
+            model,
+            data,
+            free,
+            params,
+            x0,
+            free_x0,
+            weights,
+            bounds,
+            format,
+            plot,
+            interp,
+        } => {
+            let args = fit::FitArgs {
+                data: &data,
+                free: &free,
+                params: &params,
+                x0: &x0,
+                free_x0,
+                weights: &weights,
+                bounds: &bounds,
+                format,
+                plot: plot.as_ref(),
+                interp: match interp {
+                    InputInterp::Zoh => bgc_runtime::fit::Interp::Zoh,
+                    InputInterp::Linear => bgc_runtime::fit::Interp::Linear,
+                },
+            };
+            fit::run(&file, model.as_deref(), &args, color)
         }
     };
     ExitCode::from(status as u8)

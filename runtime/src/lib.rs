@@ -8,11 +8,13 @@
 //! - [`control`]: impedance control and the gait-phase supervisor.
 //! - [`analysis`]: frequency response and stability margins.
 //! - [`sim`]: sampled-data closed-loop simulation on diffsol.
+//! - [`fit`]: parameter identification from measured records (Levenberg–Marquardt on forward sensitivities).
 
 pub mod analysis;
 pub mod control;
 pub mod design;
 pub mod estimation;
+pub mod fit;
 pub mod linalg;
 pub mod linearize;
 pub mod matrix;

@@ -14,6 +14,7 @@
 //! [`study`] runs all of it.
 
 pub mod block_diagram;
+pub mod identification;
 pub mod lqr;
 pub mod model_check;
 pub mod observer;

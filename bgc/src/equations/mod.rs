@@ -66,6 +66,7 @@ pub mod newton;
 mod numeric;
 mod print;
 mod resolve;
+mod sensitivity;
 mod solve;
 pub mod sym;
 pub mod tear;
@@ -81,6 +82,7 @@ pub use linear::{
     jacobians, linear_state_space, linearise, numeric_state_space,
 };
 pub use print::{expr_latex, expr_text, to_json, to_latex, to_text};
+pub use sensitivity::PointJacobians;
 pub(crate) use tear::block_jacobian;
 pub use tear::{LoopFailure, TearBlock, residual_scale, solve_all};
 

@@ -1,0 +1,110 @@
+//! The derived equations of a model as a [`FitModel`] for `bgc fit`: rates and outputs by
+//! [`Equations::rates_at`] and [`Equations::outputs_at`], Jacobians by [`Equations::param_jacobian_at`].
+
+use bgc::equations::{Equations, PointJacobians};
+use bgc_runtime::fit::FitModel;
+use nalgebra::DMatrix;
+
+/// The equations with the parameter values as given: the fitted ones set by the fit, the derived ones recomputed
+/// from them.
+pub struct Interpreted<'a> {
+    eqs: &'a Equations,
+    given: Vec<Option<f64>>,
+    values: Vec<f64>,
+    free: Vec<usize>,
+}
+
+impl<'a> Interpreted<'a> {
+    /// `given`: the values set on the command line (the rest follow from the defaults); `free`: the fitted ones.
+    pub fn new(eqs: &'a Equations, given: Vec<Option<f64>>, free: Vec<usize>) -> Interpreted<'a> {
+        let values = eqs.param_values(&given);
+        Interpreted {
+            eqs,
+            given,
+            values,
+            free,
+        }
+    }
+
+    fn jacobians(
+        &self,
+        (t, x, u): (f64, &[f64], &[f64]),
+        free: &[usize],
+        outputs: bool,
+    ) -> Result<PointJacobians, String> {
+        let j = if outputs {
+            self.eqs.param_jacobian_at(&self.given, x, u, t, free)
+        } else {
+            self.eqs.rate_param_jacobian_at(&self.given, x, u, t, free)
+        };
+        j.map_err(|e| e.to_string())
+    }
+}
+
+fn matrix(rows: &[Vec<f64>], ncols: usize) -> DMatrix<f64> {
+    DMatrix::from_fn(rows.len(), ncols, |i, j| rows[i][j])
+}
+
+impl FitModel for Interpreted<'_> {
+    fn state_count(&self) -> usize {
+        self.eqs.states.len()
+    }
+    fn input_count(&self) -> usize {
+        self.eqs.inputs.len()
+    }
+    fn output_count(&self) -> usize {
+        self.eqs.outputs.len()
+    }
+    fn param_count(&self) -> usize {
+        self.eqs.params.len()
+    }
+
+    fn set_params(&mut self, p: &[f64]) -> Result<(), String> {
+        for &k in &self.free {
+            let v = p.get(k).copied().ok_or("too few parameter values")?;
+            self.given[k] = Some(v);
+        }
+        self.values = self.eqs.param_values(&self.given);
+        Ok(())
+    }
+
+    fn rhs(&self, t: f64, x: &[f64], u: &[f64], dx: &mut [f64]) -> Result<(), String> {
+        let rates = self
+            .eqs
+            .rates_at(&self.values, x, u, t)
+            .map_err(|e| e.to_string())?;
+        dx.copy_from_slice(&rates);
+        Ok(())
+    }
+
+    fn outputs(&self, t: f64, x: &[f64], u: &[f64], y: &mut [f64]) -> Result<(), String> {
+        let out = self
+            .eqs
+            .outputs_at(&self.values, x, u, t)
+            .map_err(|e| e.to_string())?;
+        y.copy_from_slice(&out);
+        Ok(())
+    }
+
+    fn rate_jacobians(
+        &self,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        free: &[usize],
+    ) -> Result<(DMatrix<f64>, DMatrix<f64>), String> {
+        let j = self.jacobians((t, x, u), free, false)?;
+        Ok((matrix(&j.fx, x.len()), matrix(&j.fp, free.len())))
+    }
+
+    fn output_jacobians(
+        &self,
+        t: f64,
+        x: &[f64],
+        u: &[f64],
+        free: &[usize],
+    ) -> Result<(DMatrix<f64>, DMatrix<f64>), String> {
+        let j = self.jacobians((t, x, u), free, true)?;
+        Ok((matrix(&j.hx, x.len()), matrix(&j.hp, free.len())))
+    }
+}

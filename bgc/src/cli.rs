@@ -268,7 +268,6 @@ enum Command {
         #[arg(long)]
         stdio: bool,
     },
-    /// Print .bg files in the canonical layout (in place), or with --check report the files that differ.
     /// Export a model as a Functional Mock-up Unit (FMI 2.0 or 3.0, Model Exchange and Co-Simulation in one
     /// FMU), built with cargo; see docs/fmu.md.
     Fmu {
@@ -286,6 +285,7 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         target_dir: Option<PathBuf>,
     },
+    /// Print .bg files in the canonical layout (in place), or with --check report the files that differ.
     Fmt {
         #[arg(required = true)]
         files: Vec<PathBuf>,

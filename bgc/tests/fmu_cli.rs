@@ -69,3 +69,21 @@ fn an_unknown_model_or_version_is_a_usage_error() {
     assert!(stderr(&o).contains("models/missing.bg"), "{}", stderr(&o));
     assert!(!out.exists());
 }
+
+#[test]
+fn the_command_list_describes_fmu_and_fmt_each_by_its_own_text() {
+    let o = Command::new(env!("CARGO_BIN_EXE_bgc"))
+        .arg("--help")
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run bgc: {e}"));
+    let help = String::from_utf8_lossy(&o.stdout).into_owned();
+    let line = |cmd: &str| {
+        help.lines()
+            .find(|l| l.trim_start().starts_with(&format!("{cmd} ")))
+            .unwrap_or_else(|| panic!("no `{cmd}` in:\n{help}"))
+            .to_string()
+    };
+    assert!(line("fmu").contains("Functional Mock-up Unit"), "{help}");
+    assert!(!line("fmu").contains("canonical layout"), "{help}");
+    assert!(line("fmt").contains("canonical layout"), "{help}");
+}

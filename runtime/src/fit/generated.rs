@@ -1,9 +1,9 @@
 //! A model of fixed size (a generated model, or any [`ContinuousModel`] with [`Parametric`]) as a [`FitModel`].
 //!
 //! `∂f/∂x` and `∂h/∂x` come from the model's `jac_x` and `output_jac_x` (symbolic in generated models). The
-//! parameter Jacobians come from [`ParamJacobians`] when the model implements it ([`Generated::exact`]: generated
-//! models do, with their symbolic derivatives), else from central differences over [`Parametric::set_param`]
-//! ([`Generated::new`]).
+//! parameter Jacobians come from [`ParamJacobians`] when the model implements it ([`Generated::exact`]; the code
+//! generator does not emit them yet, so generated models use the other way), else from central differences over
+//! [`Parametric::set_param`] ([`Generated::new`]).
 
 use nalgebra::{DMatrix, SMatrix, SVector};
 
@@ -104,6 +104,34 @@ where
     }
 }
 
+impl<M, const NX: usize, const NU: usize, const NY: usize> Generated<M, NX, NU, NY> {
+    /// The matrix whose columns are `column(k)` for the free parameters `k`.
+    fn param_columns<const R: usize>(
+        &self,
+        free: &[usize],
+        column: impl Fn(usize) -> Result<SVector<f64, R>, String>,
+    ) -> Result<DMatrix<f64>, String> {
+        let mut m = DMatrix::zeros(R, free.len());
+        for (c, &k) in free.iter().enumerate() {
+            m.column_mut(c).copy_from(&column(k)?);
+        }
+        Ok(m)
+    }
+}
+
+/// A column filled by a [`ParamJacobians`] method, which answers `false` for an index that is no parameter.
+fn exact_column<const R: usize>(
+    fill: impl FnOnce(&mut SVector<f64, R>) -> bool,
+    k: usize,
+) -> Result<SVector<f64, R>, String> {
+    let mut col = SVector::zeros();
+    if fill(&mut col) {
+        Ok(col)
+    } else {
+        Err(format!("no parameter {k}"))
+    }
+}
+
 fn fixed<const N: usize>(v: &[f64]) -> SVector<f64, N> {
     SVector::from_fn(|i, _| v[i])
 }
@@ -158,20 +186,10 @@ where
         let (x, u) = (fixed::<NX>(x), fixed::<NU>(u));
         let mut a = SMatrix::<f64, NX, NX>::zeros();
         self.model.jac_x(t, &x, &u, &mut a);
-        let mut fp = DMatrix::zeros(NX, free.len());
-        for (c, &k) in free.iter().enumerate() {
-            let col = match self.exact {
-                Some((jac_p, _)) => {
-                    let mut col = SVector::zeros();
-                    if !jac_p(&self.model, t, &x, &u, k, &mut col) {
-                        return Err(format!("no parameter {k}"));
-                    }
-                    col
-                }
-                None => self.difference(t, &x, &u, k)?.0,
-            };
-            fp.column_mut(c).copy_from(&col);
-        }
+        let fp = self.param_columns(free, |k| match self.exact {
+            Some((jac_p, _)) => exact_column(|col| jac_p(&self.model, t, &x, &u, k, col), k),
+            None => Ok(self.difference(t, &x, &u, k)?.0),
+        })?;
         Ok((DMatrix::from_column_slice(NX, NX, a.as_slice()), fp))
     }
 
@@ -185,20 +203,12 @@ where
         let (x, u) = (fixed::<NX>(x), fixed::<NU>(u));
         let mut c_mat = SMatrix::<f64, NY, NX>::zeros();
         self.model.output_jac_x(t, &x, &u, &mut c_mat);
-        let mut hp = DMatrix::zeros(NY, free.len());
-        for (c, &k) in free.iter().enumerate() {
-            let col = match self.exact {
-                Some((_, output_jac_p)) => {
-                    let mut col = SVector::zeros();
-                    if !output_jac_p(&self.model, t, &x, &u, k, &mut col) {
-                        return Err(format!("no parameter {k}"));
-                    }
-                    col
-                }
-                None => self.difference(t, &x, &u, k)?.1,
-            };
-            hp.column_mut(c).copy_from(&col);
-        }
+        let hp = self.param_columns(free, |k| match self.exact {
+            Some((_, output_jac_p)) => {
+                exact_column(|col| output_jac_p(&self.model, t, &x, &u, k, col), k)
+            }
+            None => Ok(self.difference(t, &x, &u, k)?.1),
+        })?;
         Ok((DMatrix::from_column_slice(NY, NX, c_mat.as_slice()), hp))
     }
 }

@@ -166,6 +166,52 @@ fn covariance_that_loses_definiteness_is_repaired_and_reported() {
     assert!((ukf.state()[0] - 1.0).abs() < 1e-12);
 }
 
+/// The Kalman filter's time update skips the factorisation of `P⁻` only where `Q` alone keeps it definite. Here
+/// `Q = 10⁻²⁰ I` is positive definite but far below the rounding of `A P Aᵀ = [[2, 2], [2, 2]]` (singular, exact in
+/// floating point), so the computed `P⁻` is singular: the filter must still find it and report the repair. With
+/// `Q = 10⁻³ I` the same step needs none and gives `A P Aᵀ + Q` exactly.
+#[test]
+fn kalman_prediction_that_rounds_to_singular_is_repaired_and_a_definite_one_is_not() {
+    let model = LinearDiscreteModel {
+        a: Matrix2::new(1.0, 1.0, 1.0, 1.0),
+        b: SMatrix::<f64, 2, 1>::zeros(),
+        c: SMatrix::<f64, 1, 2>::new(1.0, 0.0),
+        d: Matrix1::zeros(),
+    };
+    let filter = |q: f64| {
+        let mut kf = KalmanFilter::new(
+            model,
+            Matrix2::identity() * q,
+            Matrix1::new(0.01),
+            Vector2::zeros(),
+            Matrix2::identity(),
+        )
+        .unwrap();
+        kf.set_fault_policy(FaultPolicy {
+            eigen_floor: 1e-9,
+            ..FaultPolicy::default()
+        })
+        .unwrap();
+        kf
+    };
+    let u = Vector1::zeros();
+    let mut tiny = filter(1e-20);
+    let repair = tiny
+        .predict(&u)
+        .unwrap()
+        .expect("a prediction that rounds to singular must be repaired");
+    assert!(repair.min_eigenvalue.abs() < 1e-14, "{repair:?}");
+    assert_eq!(repair.floor, 1e-9);
+    // The eigenvalues 0 and 4 become 1e-9 and 4: [[2, 2], [2, 2]] + 1e-9/2 [[1, -1], [-1, 1]].
+    let p = tiny.covariance();
+    assert!((p[(0, 0)] - (2.0 + 0.5e-9)).abs() < 1e-14, "{p}");
+    assert!((p[(0, 1)] - (2.0 - 0.5e-9)).abs() < 1e-14, "{p}");
+
+    let mut definite = filter(1e-3);
+    assert_eq!(definite.predict(&u).unwrap(), None);
+    assert_eq!(*definite.covariance(), Matrix2::new(2.001, 2.0, 2.0, 2.001));
+}
+
 /// A process function that returns NaN is an error naming the sigma point; the filter stays as it was.
 #[test]
 fn non_finite_model_output_is_an_error_and_changes_nothing() {

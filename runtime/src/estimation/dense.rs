@@ -66,28 +66,32 @@ pub fn cholesky_lower<const N: usize>(p: &SMatrix<f64, N, N>) -> Option<SMatrix<
 /// [`cholesky_lower`] (every pivot positive and finite) by an `LDLᵀ` sweep, which needs one division per column and
 /// no square root; the filters check their covariance with it after every step.
 pub fn positive_definite<const N: usize>(p: &SMatrix<f64, N, N>) -> bool {
-    // `P = L D Lᵀ` with unit lower `L`, kept as `ld[(i, k)] = l_ik d_k`, and the pivots' reciprocals.
-    let mut ld = SMatrix::<f64, N, N>::zeros();
+    // `P = L D Lᵀ` with unit lower `L`, kept by rows as `ld[i][k] = l_ik d_k` so that every sum below is a dot
+    // product of two contiguous row prefixes: one multiply-add per term.
+    let mut ld = [[0.0_f64; N]; N];
+    // `w[k] = l_jk` (`= ld[j][k] / d_k`) for the current column `j`.
+    let mut w = [0.0_f64; N];
     let mut inv = [0.0_f64; N];
     for j in 0..N {
-        let mut d = p[(j, j)];
         for k in 0..j {
-            d -= ld[(j, k)] * ld[(j, k)] * inv[k];
+            w[k] = ld[j][k] * inv[k];
         }
+        let d = p[(j, j)] - dot(&ld[j][..j], &w[..j]);
         if !(d > 0.0 && d.is_finite()) {
             return false;
         }
         inv[j] = 1.0 / d;
-        ld[(j, j)] = d;
         for i in (j + 1)..N {
-            let mut s = p[(i, j)];
-            for k in 0..j {
-                s -= ld[(i, k)] * ld[(j, k)] * inv[k];
-            }
-            ld[(i, j)] = s;
+            ld[i][j] = p[(i, j)] - dot(&ld[i][..j], &w[..j]);
         }
     }
     true
+}
+
+/// `Σ a_k b_k` over two slices of one length.
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 /// Lower Cholesky factor of `p` whose pivots must each exceed `floor` (the rounding error with which the

@@ -236,6 +236,7 @@ impl Writer<'_> {
                 ret: String::new(),
                 body: Self::body_text(&d.lines),
                 locals: d.locals,
+                inline: true,
             });
             return;
         }
@@ -253,6 +254,7 @@ impl Writer<'_> {
             ret: String::new(),
             body: Self::body_text(&d.lines),
             locals: d.locals,
+            inline: true,
         });
         let mut wrapper = Self::model_args(Uses {
             p: true,
@@ -268,6 +270,7 @@ impl Writer<'_> {
             ret: String::new(),
             body: format!("    {with}(p, &ParamTerms::at(p), t, x, u, {out_name});\n"),
             locals: Vec::new(),
+            inline: false,
         });
         self.with_terms.push(name.to_string());
     }
@@ -291,6 +294,7 @@ impl Writer<'_> {
             ret: ret.to_string(),
             body: Self::body_text(&d.lines),
             locals: d.locals,
+            inline: false,
         });
     }
 
@@ -514,6 +518,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             ret: String::new(),
             body: Self::body_text(&d.lines),
             locals: d.locals,
+            inline: false,
         });
     }
 
@@ -630,6 +635,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             ret: format!(" -> {ty}"),
             body: Self::body_text(&d.lines),
             locals: d.locals,
+            inline: false,
         });
     }
 
@@ -755,6 +761,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
                 ret: " -> f64".into(),
                 body: Self::body_text(&d.lines),
                 locals: d.locals,
+                inline: false,
             });
         }
     }

@@ -248,6 +248,9 @@ struct Function {
     body: String,
     /// The local names the body binds (for `non_snake_case`).
     locals: Vec<String>,
+    /// Marked `#[inline]`: the functions behind `Model`'s methods, so that a caller in another crate (the
+    /// runtime's integrators and filters are generic over the model) can inline the model into its loop.
+    inline: bool,
 }
 
 /// Which of the model function's arguments a body uses.
@@ -420,6 +423,9 @@ impl<'a> Writer<'a> {
         if let Some(attr) = Self::allows(&f.locals, &f.body) {
             self.out.push_str(&attr);
             self.out.push('\n');
+        }
+        if f.inline {
+            self.out.push_str("#[inline]\n");
         }
         let args: Vec<String> = f.args.iter().map(Arg::text).collect();
         let sig = format::signature(

@@ -231,10 +231,12 @@ impl Writer<'_> {
         let mut text = String::from(
             "
 impl bgc_runtime::model::ContinuousModel<N_STATES, N_INPUTS, N_OUTPUTS> for Model {
+    #[inline]
     fn rhs(&self, t: f64, x: &State, u: &Inputs, dx: &mut State) {
         {rhs}
     }
 
+    #[inline]
     fn outputs(&self, t: f64, x: &State, u: &Inputs, y: &mut Outputs) {
         {outputs}
     }
@@ -247,6 +249,7 @@ impl bgc_runtime::model::ContinuousModel<N_STATES, N_INPUTS, N_OUTPUTS> for Mode
                 let _ = write!(
                     text,
                     "
+    #[inline]
     fn {method}(&self, _t: f64, _x: &State, _u: &Inputs, jac: &mut {ty}) {{
         *jac = self.constant.{method};
     }}
@@ -257,6 +260,7 @@ impl bgc_runtime::model::ContinuousModel<N_STATES, N_INPUTS, N_OUTPUTS> for Mode
                 let _ = write!(
                     text,
                     "
+    #[inline]
     fn {method}(&self, t: f64, x: &State, u: &Inputs, jac: &mut {ty}) {{
         {call}
     }}

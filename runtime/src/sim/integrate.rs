@@ -95,6 +95,10 @@ pub(crate) struct Segment<'a, const NX: usize> {
 }
 
 /// Integrates one segment; returns the state at `t_end` and pushes the states at `output_times` to `out`.
+///
+/// Only the model's side is generic: the rates and the Jacobian-vector product are handed on as trait objects
+/// over slices, so diffsol's four solvers are compiled once, in this crate, and not again for every model type
+/// and input closure of every crate that simulates.
 pub(crate) fn integrate_segment<Mdl, U, const NX: usize, const NU: usize, const NY: usize>(
     model: &Mdl,
     input: U,
@@ -113,7 +117,7 @@ where
     }
     // The first non-finite derivative seen by the solver, reported if the solver then fails.
     let bad_derivative: Cell<Option<(f64, usize)>> = Cell::new(None);
-    let rhs = |x: &[f64], _p: &[f64], t: f64, dx: &mut [f64]| {
+    let rhs = |x: &[f64], t: f64, dx: &mut [f64]| {
         let xs = SVector::<f64, NX>::from_column_slice(x);
         let mut d = SVector::<f64, NX>::zeros();
         model.rhs(t, &xs, &input(t), &mut d);
@@ -128,7 +132,7 @@ where
     // diffsol assembles its Jacobian from one product per column, all at the same point: the model's
     // Jacobian is evaluated once per point and reused for the other columns.
     let cached: RefCell<Option<JacobianAt<NX>>> = RefCell::new(None);
-    let jac = |x: &[f64], _p: &[f64], t: f64, v: &[f64], jv: &mut [f64]| {
+    let jac = |x: &[f64], t: f64, v: &[f64], jv: &mut [f64]| {
         let xs = SVector::<f64, NX>::from_column_slice(x);
         let mut cache = cached.borrow_mut();
         let j = match &*cache {
@@ -143,44 +147,84 @@ where
         let prod = j * SVector::<f64, NX>::from_column_slice(v);
         jv.copy_from_slice(prod.as_slice());
     };
-    let x0 = *seg.x0;
-    let init = move |_p: &[f64], _t: f64, y: &mut [f64]| y.copy_from_slice(x0.as_slice());
+    let erased = ErasedSegment {
+        t0: seg.t0,
+        t_end: seg.t_end,
+        x0: seg.x0.as_slice(),
+        output_times: seg.output_times,
+    };
+    let mut push = |y: &[f64]| out.push(SVector::<f64, NX>::from_column_slice(y));
+    let end = integrate_erased(&rhs, &jac, &erased, opts, &bad_derivative, &mut push)?;
+    Ok(SVector::<f64, NX>::from_column_slice(&end))
+}
+
+/// `ẋ = f(x, t)` written into the last argument.
+type Rates<'a> = dyn Fn(&[f64], f64, &mut [f64]) + 'a;
+/// `(∂f/∂x) v` at `(x, t)` written into the last argument.
+type JacobianProduct<'a> = dyn Fn(&[f64], f64, &[f64], &mut [f64]) + 'a;
+/// Receives the state at each output time.
+type Sink<'a> = dyn FnMut(&[f64]) + 'a;
+
+/// [`Segment`] as slices.
+struct ErasedSegment<'a> {
+    t0: f64,
+    t_end: f64,
+    x0: &'a [f64],
+    output_times: &'a [f64],
+}
+
+/// The segment on diffsol, for any model: see [`integrate_segment`].
+fn integrate_erased(
+    rhs: &Rates<'_>,
+    jac: &JacobianProduct<'_>,
+    seg: &ErasedSegment<'_>,
+    opts: &SolverOptions,
+    bad_derivative: &Cell<Option<(f64, usize)>>,
+    out: &mut Sink<'_>,
+) -> Result<Vec<f64>, SimError> {
+    let n = seg.x0.len();
     let problem = OdeBuilder::<M>::new()
         .t0(seg.t0)
         .rtol(opts.rtol)
         .atol([opts.atol])
-        .rhs_implicit(rhs, jac)
-        .init(init, NX)
+        .rhs_implicit(
+            |x: &[f64], _p: &[f64], t: f64, dx: &mut [f64]| rhs(x, t, dx),
+            |x: &[f64], _p: &[f64], t: f64, v: &[f64], jv: &mut [f64]| jac(x, t, v, jv),
+        )
+        .init(
+            |_p: &[f64], _t: f64, y: &mut [f64]| y.copy_from_slice(seg.x0),
+            n,
+        )
         .build()
         .map_err(|e| solver_error(seg.t0, e))?;
-    let failure = |time: f64, e: DiffsolError| failure_cause(&bad_derivative, time, e);
+    let failure = |time: f64, e: DiffsolError| failure_cause(bad_derivative, time, e);
     match opts.method {
         Method::Bdf => {
             let solver = problem.bdf::<Ls>().map_err(|e| failure(seg.t0, e))?;
-            drive(solver, seg, opts, out, &bad_derivative)
+            drive(solver, seg, opts, out, bad_derivative)
         }
         Method::Esdirk34 => {
             let solver = problem.esdirk34::<Ls>().map_err(|e| failure(seg.t0, e))?;
-            drive(solver, seg, opts, out, &bad_derivative)
+            drive(solver, seg, opts, out, bad_derivative)
         }
         Method::TrBdf2 => {
             let solver = problem.tr_bdf2::<Ls>().map_err(|e| failure(seg.t0, e))?;
-            drive(solver, seg, opts, out, &bad_derivative)
+            drive(solver, seg, opts, out, bad_derivative)
         }
         Method::Tsit45 => {
             let solver = problem.tsit45().map_err(|e| failure(seg.t0, e))?;
-            drive(solver, seg, opts, out, &bad_derivative)
+            drive(solver, seg, opts, out, bad_derivative)
         }
     }
 }
 
-fn drive<'a, Eqn, S, const NX: usize>(
+fn drive<'a, Eqn, S>(
     mut solver: S,
-    seg: &Segment<'_, NX>,
+    seg: &ErasedSegment<'_>,
     opts: &SolverOptions,
-    out: &mut Vec<SVector<f64, NX>>,
+    out: &mut Sink<'_>,
     bad_derivative: &Cell<Option<(f64, usize)>>,
-) -> Result<SVector<f64, NX>, SimError>
+) -> Result<Vec<f64>, SimError>
 where
     Eqn: OdeEquations<T = f64, V = NalgebraVec<f64>> + 'a,
     S: OdeSolverMethod<'a, Eqn>,
@@ -193,7 +237,8 @@ where
     for _ in 0..opts.max_steps {
         let reason = solver.step().map_err(|e| failure(solver.state().t, e))?;
         let t_now = solver.state().t;
-        let y = to_svector::<NX>(solver.state().y);
+        // An unbatched vector is its batch 0.
+        let y = solver.state().y.batch_as_slice(0);
         if let Some(index) = y.iter().position(|v| !v.is_finite()) {
             // Prefer the cause (the first non-finite derivative) over the symptom when it is known.
             return Err(match bad_derivative.get() {
@@ -204,17 +249,17 @@ where
         let reached = matches!(reason, OdeSolverStopReason::TstopReached);
         while let Some(&t) = seg.output_times.get(next_output) {
             if reached && t >= seg.t_end {
-                out.push(y);
+                out(y);
             } else if t <= t_now {
                 let v = solver.interpolate(t).map_err(|e| failure(t, e))?;
-                out.push(to_svector::<NX>(&v));
+                out(v.batch_as_slice(0));
             } else {
                 break;
             }
             next_output += 1;
         }
         if reached {
-            return Ok(y);
+            return Ok(y.to_vec());
         }
     }
     Err(SimError::TooManySteps {
@@ -223,10 +268,6 @@ where
         time: solver.state().t,
         max_steps: opts.max_steps,
     })
-}
-
-fn to_svector<const NX: usize>(v: &NalgebraVec<f64>) -> SVector<f64, NX> {
-    SVector::<f64, NX>::from_fn(|i, _| v[i])
 }
 
 /// A solver error, attributed to the model when it had returned a non-finite derivative.

@@ -268,3 +268,36 @@ fn bad_records_are_refused_with_the_row_or_column_named() {
     assert_eq!(code, 1);
     assert!(err.contains("--free `J_q`"), "{err}");
 }
+
+#[test]
+fn a_fit_that_stalls_is_reported_and_exits_with_3() {
+    // A record of zeros: the rig, driven by its stepper, cannot stay at rest for any positive J_p and d_s; the
+    // iteration drives J_p towards zero and stops moving far from any minimum.
+    let mut zeros = String::from("t,theta_pend,omega_pend\n");
+    for k in 0..61 {
+        zeros.push_str(&format!("{},0,0\n", 0.02 * k as f64));
+    }
+    let data = temp_file("zeros.csv", &zeros);
+    let (code, out, err) = bgc(&[
+        "fit",
+        &repo("models/pendulum_rig.bg"),
+        "--data",
+        &data,
+        "--free",
+        "J_p,d_s",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 3, "stderr: {err}\nstdout: {out}");
+    assert!(err.contains("stalled"), "{err}");
+    let v: Value = serde_json::from_str(&out).expect("the report is printed");
+    assert_eq!(v["status"], "stalled");
+    assert_eq!(v["converged"], false);
+    assert!(v["optimality"].as_f64().unwrap() > 0.01, "{v}");
+    // The statistics of a point that is no minimum hold nothing, but the quantities they cannot vouch for are
+    // flagged.
+    let undetermined = v["undetermined"].as_array().expect("a list");
+    assert!(!undetermined.is_empty(), "{v}");
+    assert!(undetermined.iter().all(|u| u["held"].is_null()), "{v}");
+    assert_eq!(estimate(&v, "J_p")["determined"], false);
+}

@@ -187,7 +187,7 @@ pub fn identify(
         &[0.0; generated::N_STATES],
         &spec,
     )?;
-    if !report.stop.converged()
+    if !report.convergence.converged()
         || report.residual_variance.is_nan()
         || report.residual_variance > MAX_RESIDUAL_VARIANCE
     {

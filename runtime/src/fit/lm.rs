@@ -12,15 +12,17 @@
 //!   `max_k |J_kᵀ r| / (‖J_k‖ ‖r‖)` (MINPACK's `gnorm`, independent of the units of `z`), is at most `gtol`;
 //! - `ftol`: an accepted step reduced the cost by at most `ftol` times the cost;
 //! - `xtol`: the step became smaller than `xtol (‖z‖ + xtol)`;
+//! - the `ftol` and `xtol` tests do not stop an iteration whose damping is small (`λ < 1`, the step is
+//!   nearly the Gauss–Newton one) while that step is still longer than [`LmOptions::optimality`] standard errors:
+//!   a record can be so precise that its standard errors lie below `xtol`;
 //! - a step that became negligible, a cost that stopped decreasing, or a damping that grew without bound says
 //!   only that the iteration stopped moving: it counts as convergence when the Gauss–Newton step from the final
 //!   point is also small *in standard errors*. That measure, [`Minimum::optimality`], is `‖P r‖ / s`, with `P`
 //!   the projection onto the range of the free columns of `J` and `s² = ‖r‖² / (m − n)`: the size of the
 //!   Gauss–Newton step in the metric of the estimate's covariance `s² (JᵀJ)⁻¹`. Below
-//!   [`LmOptions::optimality`] (1 % of a standard error by default) the remaining distance to the minimum is
-//!   statistically nothing. A record without noise (or as many residuals as unknowns) has no standard error to
-//!   measure by: there the undamped Gauss–Newton step must be below `√xtol (‖z‖ + √xtol)` instead. Otherwise the
-//!   fit **stalled** (e.g. a parameter running off towards infinity, where
+//!   [`LmOptions::optimality`] (a tenth of a standard error by default) the remaining distance to the minimum is
+//!   statistically nothing. With no more residuals than unknowns there is no standard error to measure by: there
+//!   the undamped Gauss–Newton step must be below `√xtol (‖z‖ + √xtol)` instead. Otherwise the fit **stalled** (e.g. a parameter running off towards infinity, where
 //!   the cost keeps falling ever more slowly and the gradient is parallel to the residuals) and is reported as
 //!   not converged.
 
@@ -30,6 +32,12 @@ use nalgebra::{DMatrix, DVector};
 pub trait Residuals {
     /// `(r(z), ∂r/∂z)`; an error is a point where the model cannot be evaluated.
     fn evaluate(&mut self, z: &[f64]) -> Result<(DVector<f64>, DMatrix<f64>), String>;
+
+    /// The largest change of each coordinate in one step (empty: none). A step that would exceed one is not
+    /// tried; the damping grows instead, as a trust region's radius shrinks.
+    fn step_limits(&self) -> Vec<f64> {
+        Vec::new()
+    }
 }
 
 /// Stopping tolerances.
@@ -42,9 +50,13 @@ pub struct LmOptions {
     pub xtol: f64,
     /// Stop when an accepted step reduces the cost by less than `ftol` times the cost.
     pub ftol: f64,
+    /// The largest change of a logarithmic coordinate in one step (1: a factor of e), for problems that say which
+    /// coordinates are logarithmic ([`Residuals::step_limits`]): a first Gauss–Newton step along a direction the
+    /// data barely determine can otherwise throw a parameter many decades away, onto a plateau it never leaves.
+    pub max_log_step: f64,
     /// A stop by `xtol`, `ftol` or unbounded damping counts as convergence only when the Gauss–Newton step from
-    /// the final point is below this many standard errors ([`Minimum::optimality`]) or below
-    /// `√xtol (‖z‖ + √xtol)` in length.
+    /// the final point is below this many standard errors ([`Minimum::optimality`]) (or, with no more residuals
+    /// than unknowns, below `√xtol (‖z‖ + √xtol)` in length).
     pub optimality: f64,
 }
 
@@ -55,7 +67,8 @@ impl Default for LmOptions {
             gtol: 1e-10,
             xtol: 1e-8,
             ftol: 1e-10,
-            optimality: 1e-2,
+            optimality: 0.1,
+            max_log_step: 1.0,
         }
     }
 }
@@ -157,6 +170,7 @@ pub fn minimise(
     let mut nu = 2.0;
     let mut stop = StopReason::MaxIterations;
     let mut iterations = 0;
+    let limits = problem.step_limits();
     while iterations < opts.max_iterations {
         let jtj = j.transpose() * &j;
         let g = j.transpose() * &r;
@@ -178,11 +192,20 @@ pub fn minimise(
             nu *= 2.0;
             continue;
         };
+        if delta.iter().zip(&limits).any(|(d, limit)| d.abs() > *limit) {
+            lambda *= nu;
+            nu *= 2.0;
+            continue;
+        }
         let mut trial: Vec<f64> = z.iter().zip(delta.iter()).map(|(a, d)| a + d).collect();
         project(&mut trial);
         let step = DVector::from_iterator(z.len(), trial.iter().zip(&z).map(|(a, b)| a - b));
         let z_norm = DVector::from_column_slice(&z).norm();
-        if step.norm() <= opts.xtol * (z_norm + opts.xtol) {
+        // A small step with little damping is the Gauss–Newton step itself: when the statistics say it is still
+        // worth taking (a record so precise that its standard errors are below xtol), it is taken.
+        if step.norm() <= opts.xtol * (z_norm + opts.xtol)
+            && (lambda >= 1.0 || gauss_newton_distance(&z, &j, &r, lower, upper) <= opts.optimality)
+        {
             stop = StopReason::Step;
             break;
         }
@@ -204,7 +227,10 @@ pub fn minimise(
                 cost = new_cost;
                 lambda *= (1.0 / 3.0f64).max(1.0 - (2.0 * rho - 1.0).powi(3));
                 nu = 2.0;
-                if reduction <= opts.ftol * cost {
+                if reduction <= opts.ftol * cost
+                    && (lambda >= 1.0
+                        || gauss_newton_distance(&z, &j, &r, lower, upper) <= opts.optimality)
+                {
                     stop = StopReason::Cost;
                     break;
                 }
@@ -220,9 +246,11 @@ pub fn minimise(
         }
     }
     let optimality = gauss_newton_distance(&z, &j, &r, lower, upper);
+    // Without degrees of freedom there is no standard error to measure by: the step's length decides.
     let near = opts.xtol.sqrt();
-    let gn_negligible = gauss_newton_step(&z, &j, &r, lower, upper)
-        .is_some_and(|step| step <= near * (DVector::from_column_slice(&z).norm() + near));
+    let gn_negligible = j.nrows() <= j.ncols()
+        && gauss_newton_step(&z, &j, &r, lower, upper)
+            .is_some_and(|step| step <= near * (DVector::from_column_slice(&z).norm() + near));
     let convergence = match stop {
         StopReason::Gradient => Convergence::Converged,
         StopReason::MaxIterations => Convergence::IterationLimit,

@@ -15,6 +15,10 @@ use super::sensitivity::{self, FitModel, Fitted, SensitivityError};
 use super::stats;
 use crate::sim::{Method, SolverOptions};
 
+/// The Gauss–Newton step (in standard errors) within which a fit that did not converge is near enough to its
+/// minimum for the statistics to decide what to hold.
+const NEAR_MINIMUM_STANDARD_ERRORS: f64 = 1.0;
+
 /// A parameter to fit.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FreeParam {
@@ -175,9 +179,13 @@ pub fn fit(
         let st = stats::statistics(min.residuals.norm_squared(), &jac_rel, &scales);
         let found = objective.name_directions(&st.undetermined);
         // Statistics away from a minimum say nothing about what the record determines, and a fit needs at least
-        // one quantity: then the combinations are reported without holding anything.
+        // one quantity: then the combinations are reported without holding anything. A fit that did not converge
+        // but ended within a standard error of the Gauss–Newton minimum (an undetermined direction is exactly
+        // what makes the iteration crawl) is near enough for its statistics to hold.
         let held: Vec<usize> = found.iter().map(|&(q, _)| q).collect();
-        let holdable = min.convergence.converged() && held.len() < objective.active.len();
+        let near_minimum =
+            min.convergence.converged() || min.optimality <= NEAR_MINIMUM_STANDARD_ERRORS;
+        let holdable = near_minimum && held.len() < objective.active.len();
         if found.is_empty() || !holdable {
             let unheld = found.into_iter().map(|(_, u)| u);
             undetermined.extend(unheld);
@@ -523,6 +531,19 @@ impl Objective<'_> {
 }
 
 impl Residuals for Objective<'_> {
+    fn step_limits(&self) -> Vec<f64> {
+        self.active
+            .iter()
+            .map(|&q| {
+                if self.is_log(q) {
+                    self.spec.lm.max_log_step
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .collect()
+    }
+
     fn evaluate(&mut self, z: &[f64]) -> Result<(DVector<f64>, DMatrix<f64>), String> {
         self.set(z);
         let sim = self.simulate().map_err(|e| e.to_string())?;

@@ -32,9 +32,12 @@
 //!   ring) all four are determined: J_g 4.000004e-5 ± 8.2e-11, k_g 26399.99 ± 0.0098, k_s 33800.01 ± 0.016, J_sint
 //!   9.890e-5 ± 2.3e-6 (2.3 %), each within 0.7 standard errors of the truth, weighted residual variance 0.978.
 //!   The last stage **stalls** 1.44 standard errors (Gauss–Newton step) short of the minimum of the narrow valley,
-//!   and restarts do not move it; the report says so. (Not verified: the central-difference parameter Jacobians,
-//!   accurate to about 10⁻¹⁰, may be too coarse for a valley this narrow; the exact parameter Jacobians the code
-//!   generator is to emit would tell.)
+//!   and restarts do not move it (every trial step raises the cost); the report says so. The cause is not found.
+//!   It is not the central-difference parameter Jacobians: their error, about 10⁻¹⁰ of a column (≈ 0.3 on the
+//!   largest, 4·10⁹), is far below the smallest singular value of the weighted Jacobian (≈ 65); nor, by estimate,
+//!   the curvature of the logarithms or the drift of the ringing's phase over one standard error (both orders of
+//!   magnitude below it). Candidates left: the accuracy of the matrix exponential of the 53-state augmented system
+//!   at this precision (signal-to-noise 10⁸–10⁹), which the ODE path cannot check (it agrees only to 10⁻⁷).
 //! - With a realistic encoder ([`BenchConfig::realistic`]: a 17-bit encoder differentiated at 1 kHz, velocity
 //!   quantum `2π/2¹⁷/1 ms ≈ 0.048 rad/s`, so `|v_v| ≤ 0.048 rad/s`) the record no longer sees what separates
 //!   `J_sint` from `J_g`: the identifiability analysis flags `J_sint` (relative standard error 103 %), holds it at

@@ -92,7 +92,7 @@ fn pendulum_estimates_cover_the_truth_and_their_errors_match_the_spread() {
         let rec = record(&times, &clean, 1000 + seed);
         let mut model = Generated::new(Model::default());
         let r = fit(&mut model, &rec, &start, &[0.0; 4], &spec).expect("the fit runs");
-        assert!(r.stop.converged(), "seed {seed}: {:?}", r.stop);
+        assert!(r.convergence.converged(), "seed {seed}: {:?}", r.stop);
         assert!(
             r.undetermined.is_empty(),
             "seed {seed}: {:?}",

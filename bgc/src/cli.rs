@@ -436,10 +436,13 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
     ExitCode::from(status as u8)
 }
 
-/// The three outcomes of a command.
+/// The outcomes of a command.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Status {
     Ok = 0,
     InputErrors = 1,
     UsageOrIo = 2,
+    /// `bgc fit` ran but found no minimum (it stalled or reached the iteration limit): the report is printed, the
+    /// estimates are no identification.
+    NotConverged = 3,
 }

@@ -268,3 +268,93 @@ fn bad_records_are_refused_with_the_row_or_column_named() {
     assert_eq!(code, 1);
     assert!(err.contains("--free `J_q`"), "{err}");
 }
+
+#[test]
+fn a_fit_that_stalls_is_reported_and_exits_with_3() {
+    // A record of zeros: the rig, driven by its stepper, cannot stay at rest for any positive J_p and d_s; the
+    // iteration drives J_p towards zero and stops moving far from any minimum.
+    let mut zeros = String::from("t,theta_pend,omega_pend\n");
+    for k in 0..61 {
+        zeros.push_str(&format!("{},0,0\n", 0.02 * k as f64));
+    }
+    let data = temp_file("zeros.csv", &zeros);
+    let (code, out, err) = bgc(&[
+        "fit",
+        &repo("models/pendulum_rig.bg"),
+        "--data",
+        &data,
+        "--free",
+        "J_p,d_s",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(code, 3, "stderr: {err}\nstdout: {out}");
+    assert!(err.contains("stalled"), "{err}");
+    let v: Value = serde_json::from_str(&out).expect("the report is printed");
+    assert_eq!(v["status"], "stalled");
+    assert_eq!(v["converged"], false);
+    assert!(v["optimality"].as_f64().unwrap() > 0.01, "{v}");
+    // The statistics of a point that is no minimum hold nothing, but the quantities they cannot vouch for are
+    // flagged.
+    let undetermined = v["undetermined"].as_array().expect("a list");
+    assert!(!undetermined.is_empty(), "{v}");
+    assert!(undetermined.iter().all(|u| u["held"].is_null()), "{v}");
+    assert_eq!(estimate(&v, "J_p")["determined"], false);
+}
+
+#[test]
+fn a_linear_model_with_held_inputs_is_fitted_on_the_exact_path() {
+    // The back-support drive (linear) answering a held torque step, simulated by `bgc simulate` at the defaults
+    // (J_g = 4e-5 kg m², k_g = 26400 N m/rad) and measured without noise: the fit from 10 % off must come back
+    // to the simulated values (to the simulation's tolerance) and converge.
+    let (code, sim, err) = bgc(&[
+        "simulate",
+        &repo("models/back_support.bg"),
+        "--t-end",
+        "0.2",
+        "--dt-out",
+        "0.001",
+        "--input",
+        "tau_m=0.1*step(0.01)",
+        "--input",
+        "omega_h=0",
+        "--rtol",
+        "1e-10",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let mut lines = sim.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h.split(' ').next() == Some(name))
+            .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+    };
+    let (t, w, tau) = (col("t"), col("omega_m"), col("tau_s"));
+    let mut csv = String::from("t,tau_m,omega_h,omega_m,tau_s\n");
+    for line in lines {
+        let cells: Vec<f64> = line
+            .split(',')
+            .map(|c| c.parse().expect("a number"))
+            .collect();
+        let u = if cells[t] >= 0.01 - 1e-12 { 0.1 } else { 0.0 };
+        csv.push_str(&format!("{},{u},0,{},{}\n", cells[t], cells[w], cells[tau]));
+    }
+    let data = temp_file("back-support-step.csv", &csv);
+    let v = fit_json(&[
+        &repo("models/back_support.bg"),
+        "--data",
+        &data,
+        "--free",
+        "J_g,k_g",
+        "--param",
+        "J_g=4.4e-5",
+        "--param",
+        "k_g=23760",
+    ]);
+    assert_eq!(v["status"], "converged", "{v}");
+    let j_g = estimate(&v, "J_g")["value"].as_f64().unwrap();
+    let k_g = estimate(&v, "k_g")["value"].as_f64().unwrap();
+    assert!((j_g / 4e-5 - 1.0).abs() < 1e-5, "J_g = {j_g}");
+    assert!((k_g / 26400.0 - 1.0).abs() < 1e-5, "k_g = {k_g}");
+}

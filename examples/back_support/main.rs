@@ -1,6 +1,8 @@
 //! The back-support exoskeleton of Shojaei Barjuei, Caldwell & Ortiz (Designs 2020, 4, 53) end to end: model
 //! check (Sec. 5.1), LQR with single and double integral action (Eqs. 10–17), observer (Eqs. 4–9), lifting
-//! scenario at 1 kHz with noise (Sec. 5.2), margins and disturbance rejection, beside the paper's figures.
+//! scenario at 1 kHz with noise (Sec. 5.2), margins and disturbance rejection, beside the paper's figures, and the
+//! bench identification of the unprinted J_g, k_g, k_s, J_sint (at the paper's sensor bounds and with a realistic
+//! encoder; `bench_identification` in the JSON).
 //!
 //! ```text
 //! cargo run --release --example back_support -- [--json PATH] [--out DIR]
@@ -11,6 +13,7 @@
 //! Figs. 10–11 and 14–20, and the margins against the recovery weight) go to `--out DIR` (default
 //! `target/exo/back_support/`). The computations live in `bgc_workspace::back_support`.
 
+mod bench;
 mod charts;
 mod figures;
 mod plots;
@@ -19,6 +22,7 @@ mod table;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use bgc_workspace::back_support::identification::BenchConfig;
 use bgc_workspace::back_support::{scenario::ScenarioConfig, study};
 
 struct Args {
@@ -68,8 +72,16 @@ fn main() -> ExitCode {
         }
     };
     table::print_table(&s);
+    let bench = serde_json::json!([
+        bench::run("paper's sensor bounds", &BenchConfig::paper()),
+        bench::run("realistic 17-bit encoder", &BenchConfig::realistic()),
+    ]);
     if let Some(path) = &args.json {
-        let text = match serde_json::to_string_pretty(&figures::json(&s)) {
+        let mut figures = figures::json(&s);
+        if let Some(map) = figures.as_object_mut() {
+            map.insert("bench_identification".into(), bench);
+        }
+        let text = match serde_json::to_string_pretty(&figures) {
             Ok(t) => t,
             Err(e) => {
                 eprintln!("error: cannot serialise the figures: {e}");

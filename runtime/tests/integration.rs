@@ -15,6 +15,7 @@ mod estimation_faults;
 mod estimation_health;
 mod estimation_reference;
 mod estimation_robustness;
+mod fit_identifiability;
 mod linalg_care;
 mod linalg_dare;
 mod linalg_design;

@@ -89,13 +89,16 @@ fn fit_record(
         super::fit_plot::write(out, &record, &report, &names)
             .map_err(|e| format!("cannot write the plot {}: {e}", out.display()))?;
     }
-    if !report.stop.converged() {
+    if !report.convergence.converged() {
         stderrln(&format!(
-            "error: the fit did not converge: {} after {} iterations; the estimates above are not a minimum",
+            "error: the fit {}: {} after {} iterations with the Gauss–Newton step still {:.3} standard errors \
+             long; the estimates above are not a minimum",
+            report.convergence.describe(),
             report.stop.describe(),
-            report.iterations
+            report.iterations,
+            report.optimality
         ));
-        return Ok(Status::InputErrors);
+        return Ok(Status::NotConverged);
     }
     Ok(Status::Ok)
 }

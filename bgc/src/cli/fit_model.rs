@@ -1,7 +1,7 @@
 //! The derived equations of a model as a [`FitModel`] for `bgc fit`: rates and outputs by
 //! [`Equations::rates_at`] and [`Equations::outputs_at`], Jacobians by [`Equations::param_jacobian_at`].
 
-use bgc::equations::{Equations, PointJacobians};
+use bgc::equations::{self, Equations, PointJacobians, StateSelection};
 use bgc_runtime::fit::FitModel;
 use nalgebra::DMatrix;
 
@@ -12,17 +12,22 @@ pub struct Interpreted<'a> {
     given: Vec<Option<f64>>,
     values: Vec<f64>,
     free: Vec<usize>,
+    /// The rates and outputs are linear in the states and inputs (a symbolic state space exists): fits with held
+    /// inputs take the exact discretisation path.
+    linear: bool,
 }
 
 impl<'a> Interpreted<'a> {
     /// `given`: the values set on the command line (the rest follow from the defaults); `free`: the fitted ones.
     pub fn new(eqs: &'a Equations, given: Vec<Option<f64>>, free: Vec<usize>) -> Interpreted<'a> {
         let values = eqs.param_values(&given);
+        let linear = equations::linear_state_space(eqs, StateSelection::All).is_ok();
         Interpreted {
             eqs,
             given,
             values,
             free,
+            linear,
         }
     }
 
@@ -46,6 +51,10 @@ fn matrix(rows: &[Vec<f64>], ncols: usize) -> DMatrix<f64> {
 }
 
 impl FitModel for Interpreted<'_> {
+    fn is_linear(&self) -> bool {
+        self.linear
+    }
+
     fn state_count(&self) -> usize {
         self.eqs.states.len()
     }

@@ -56,10 +56,11 @@ fn text(
         "quantity", "estimate", "std. error", "rel.", "start"
     );
     for (name, value, se, start, unit, determined) in estimates_in_units(report, units) {
-        if determined {
+        if determined || se.is_finite() {
+            let mark = if determined { "" } else { "  not determined" };
             let _ = writeln!(
                 s,
-                "{name:<16} {value:>13.6e} {se:>12.3e} {:>8.2} % {start:>13.6e}  {unit}",
+                "{name:<16} {value:>13.6e} {se:>12.3e} {:>8.2} % {start:>13.6e}  {unit}{mark}",
                 100.0 * se / value.abs()
             );
         } else {
@@ -71,13 +72,15 @@ fn text(
         }
     }
     for u in &report.undetermined {
+        let what = match &u.held {
+            Some(h) => format!("`{h}` is held at its start"),
+            None => "nothing is held; its leading quantity is reported as not determined".into(),
+        };
         let _ = writeln!(
             s,
-            "\nnot identifiable: the record does not determine {} (relative standard error {}); `{}` is held at \
-             its start",
+            "\nnot identifiable: the record does not determine {} (relative standard error {}); {what}",
             combination(&u.combination),
             percent(u.relative_std_error),
-            u.held
         );
     }
     if report.correlated.len() > 1 {
@@ -106,9 +109,11 @@ fn text(
     );
     let _ = writeln!(
         s,
-        "stopped after {} iterations: {}",
+        "stopped after {} iterations: {}; {} (Gauss–Newton step {:.2e} standard errors)",
         report.iterations,
-        report.stop.describe()
+        report.stop.describe(),
+        report.convergence.describe(),
+        report.optimality
     );
     s
 }
@@ -193,6 +198,8 @@ fn value(
         "degrees_of_freedom": report.degrees_of_freedom,
         "iterations": report.iterations,
         "stop": report.stop,
-        "converged": report.stop.converged(),
+        "status": report.convergence,
+        "converged": report.convergence.converged(),
+        "optimality": finite_or_null(report.optimality),
     })
 }

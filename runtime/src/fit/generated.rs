@@ -42,6 +42,7 @@ type OutputColumn<M, const NX: usize, const NU: usize, const NY: usize> =
 pub struct Generated<M, const NX: usize, const NU: usize, const NY: usize> {
     model: M,
     exact: Option<(RateColumn<M, NX, NU>, OutputColumn<M, NX, NU, NY>)>,
+    linear: bool,
 }
 
 impl<M, const NX: usize, const NU: usize, const NY: usize> Generated<M, NX, NU, NY>
@@ -50,7 +51,11 @@ where
 {
     /// Parameter Jacobians by central differences.
     pub fn new(model: M) -> Self {
-        Generated { model, exact: None }
+        Generated {
+            model,
+            exact: None,
+            linear: false,
+        }
     }
 
     /// Parameter Jacobians from the model's own derivatives.
@@ -61,7 +66,15 @@ where
         Generated {
             model,
             exact: Some((M::jac_p, M::output_jac_p)),
+            linear: false,
         }
+    }
+
+    /// Declares the model linear time-invariant (a generated model with a `state_space` function is): fits with
+    /// held inputs then use the exact discretisation of [`super::linear`] (checked at a probe point).
+    pub fn declared_linear(mut self) -> Self {
+        self.linear = true;
+        self
     }
 
     /// The model with its current parameters.
@@ -151,6 +164,10 @@ where
     }
     fn param_count(&self) -> usize {
         self.model.param_names().len()
+    }
+
+    fn is_linear(&self) -> bool {
+        self.linear
     }
 
     fn set_params(&mut self, p: &[f64]) -> Result<(), String> {

@@ -5,6 +5,26 @@
 //! reduction. Bounds are kept by projecting each trial point onto the box; the gradient test ignores components
 //! that push against an active bound. A trial point at which the residuals cannot be computed (the simulation
 //! fails) counts as a rejected step.
+//!
+//! **Convergence** is decided as MINPACK and SciPy's `least_squares` do, by three tests, and one more that tells a
+//! minimum from a stall:
+//! - `gtol` (first-order optimality): the largest cosine between `r` and a free column of `J`,
+//!   `max_k |J_kᵀ r| / (‖J_k‖ ‖r‖)` (MINPACK's `gnorm`, independent of the units of `z`), is at most `gtol`;
+//! - `ftol`: an accepted step reduced the cost by at most `ftol` times the cost;
+//! - `xtol`: the step became smaller than `xtol (‖z‖ + xtol)`;
+//! - the `ftol` and `xtol` tests do not stop an iteration whose damping is small (`λ < 1`, the step is
+//!   nearly the Gauss–Newton one) while that step is still longer than [`LmOptions::optimality`] standard errors:
+//!   a record can be so precise that its standard errors lie below `xtol`;
+//! - a step that became negligible, a cost that stopped decreasing, or a damping that grew without bound says
+//!   only that the iteration stopped moving: it counts as convergence when the Gauss–Newton step from the final
+//!   point is also small *in standard errors*. That measure, [`Minimum::optimality`], is `‖P r‖ / s`, with `P`
+//!   the projection onto the range of the free columns of `J` and `s² = ‖r‖² / (m − n)`: the size of the
+//!   Gauss–Newton step in the metric of the estimate's covariance `s² (JᵀJ)⁻¹`. Below
+//!   [`LmOptions::optimality`] (a tenth of a standard error by default) the remaining distance to the minimum is
+//!   statistically nothing. With no more residuals than unknowns there is no standard error to measure by: there
+//!   the undamped Gauss–Newton step must be below `√xtol (‖z‖ + √xtol)` instead. Otherwise the fit **stalled** (e.g. a parameter running off towards infinity, where
+//!   the cost keeps falling ever more slowly and the gradient is parallel to the residuals) and is reported as
+//!   not converged.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -12,18 +32,32 @@ use nalgebra::{DMatrix, DVector};
 pub trait Residuals {
     /// `(r(z), ∂r/∂z)`; an error is a point where the model cannot be evaluated.
     fn evaluate(&mut self, z: &[f64]) -> Result<(DVector<f64>, DMatrix<f64>), String>;
+
+    /// The largest change of each coordinate in one step (empty: none). A step that would exceed one is not
+    /// tried; the damping grows instead, as a trust region's radius shrinks.
+    fn step_limits(&self) -> Vec<f64> {
+        Vec::new()
+    }
 }
 
 /// Stopping tolerances.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LmOptions {
     pub max_iterations: usize,
-    /// Stop when the largest (projected) gradient component of the scaled problem is below this.
+    /// Stop when the largest cosine between the residuals and a free column of the Jacobian is below this.
     pub gtol: f64,
     /// Stop when the step is below `xtol (‖z‖ + xtol)`.
     pub xtol: f64,
     /// Stop when an accepted step reduces the cost by less than `ftol` times the cost.
     pub ftol: f64,
+    /// The largest change of a logarithmic coordinate in one step (1: a factor of e), for problems that say which
+    /// coordinates are logarithmic ([`Residuals::step_limits`]): a first Gauss–Newton step along a direction the
+    /// data barely determine can otherwise throw a parameter many decades away, onto a plateau it never leaves.
+    pub max_log_step: f64,
+    /// A stop by `xtol`, `ftol` or unbounded damping counts as convergence only when the Gauss–Newton step from
+    /// the final point is below this many standard errors ([`Minimum::optimality`]) (or, with no more residuals
+    /// than unknowns, below `√xtol (‖z‖ + √xtol)` in length).
+    pub optimality: f64,
 }
 
 impl Default for LmOptions {
@@ -33,6 +67,8 @@ impl Default for LmOptions {
             gtol: 1e-10,
             xtol: 1e-8,
             ftol: 1e-10,
+            optimality: 0.1,
+            max_log_step: 1.0,
         }
     }
 }
@@ -41,7 +77,7 @@ impl Default for LmOptions {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum StopReason {
-    /// The gradient vanished (to `gtol`): a minimum.
+    /// The gradient vanished (to `gtol`).
     Gradient,
     /// The step became negligible (to `xtol`).
     Step,
@@ -64,10 +100,34 @@ impl StopReason {
             StopReason::MaxIterations => "the iteration limit was reached",
         }
     }
+}
 
-    /// True for the reasons that mean convergence.
+/// Whether the minimisation found a minimum.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Convergence {
+    /// A minimum: the gradient test passed, or the iteration stopped moving within
+    /// [`LmOptions::optimality`] standard errors of the minimum (or a negligible Gauss–Newton step from it).
+    Converged,
+    /// The iteration stopped moving (negligible step, cost or no progress) while the Gauss–Newton step was
+    /// still larger than [`LmOptions::optimality`] standard errors: not a minimum.
+    Stalled,
+    /// The iteration limit was reached.
+    IterationLimit,
+}
+
+impl Convergence {
     pub fn converged(self) -> bool {
-        !matches!(self, StopReason::MaxIterations)
+        self == Convergence::Converged
+    }
+
+    /// A word for reports.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Convergence::Converged => "converged",
+            Convergence::Stalled => "stalled (not a minimum)",
+            Convergence::IterationLimit => "not converged (iteration limit)",
+        }
     }
 }
 
@@ -79,6 +139,10 @@ pub struct Minimum {
     pub jacobian: DMatrix<f64>,
     pub iterations: usize,
     pub stop: StopReason,
+    pub convergence: Convergence,
+    /// The Gauss–Newton step from `z` in standard errors, `‖P r‖ / s` (see the module docs); 0 at an exact
+    /// minimum.
+    pub optimality: f64,
 }
 
 /// The damping beyond which no step is worth trying.
@@ -106,11 +170,12 @@ pub fn minimise(
     let mut nu = 2.0;
     let mut stop = StopReason::MaxIterations;
     let mut iterations = 0;
+    let limits = problem.step_limits();
     while iterations < opts.max_iterations {
         let jtj = j.transpose() * &j;
         let g = j.transpose() * &r;
         let diag = jtj.diagonal().map(|d| d.max(1e-30));
-        if projected_gradient(&z, &g, &diag, lower, upper) <= opts.gtol * (1.0 + cost.sqrt()) {
+        if largest_cosine(&z, &j, &r, &g, lower, upper) <= opts.gtol {
             stop = StopReason::Gradient;
             break;
         }
@@ -127,11 +192,20 @@ pub fn minimise(
             nu *= 2.0;
             continue;
         };
+        if delta.iter().zip(&limits).any(|(d, limit)| d.abs() > *limit) {
+            lambda *= nu;
+            nu *= 2.0;
+            continue;
+        }
         let mut trial: Vec<f64> = z.iter().zip(delta.iter()).map(|(a, d)| a + d).collect();
         project(&mut trial);
         let step = DVector::from_iterator(z.len(), trial.iter().zip(&z).map(|(a, b)| a - b));
         let z_norm = DVector::from_column_slice(&z).norm();
-        if step.norm() <= opts.xtol * (z_norm + opts.xtol) {
+        // A small step with little damping is the Gauss–Newton step itself: when the statistics say it is still
+        // worth taking (a record so precise that its standard errors are below xtol), it is taken.
+        if step.norm() <= opts.xtol * (z_norm + opts.xtol)
+            && (lambda >= 1.0 || gauss_newton_distance(&z, &j, &r, lower, upper) <= opts.optimality)
+        {
             stop = StopReason::Step;
             break;
         }
@@ -153,7 +227,10 @@ pub fn minimise(
                 cost = new_cost;
                 lambda *= (1.0 / 3.0f64).max(1.0 - (2.0 * rho - 1.0).powi(3));
                 nu = 2.0;
-                if reduction <= opts.ftol * cost {
+                if reduction <= opts.ftol * cost
+                    && (lambda >= 1.0
+                        || gauss_newton_distance(&z, &j, &r, lower, upper) <= opts.optimality)
+                {
                     stop = StopReason::Cost;
                     break;
                 }
@@ -168,31 +245,115 @@ pub fn minimise(
             }
         }
     }
+    let optimality = gauss_newton_distance(&z, &j, &r, lower, upper);
+    // Without degrees of freedom there is no standard error to measure by: the step's length decides.
+    let near = opts.xtol.sqrt();
+    let gn_negligible = j.nrows() <= j.ncols()
+        && gauss_newton_step(&z, &j, &r, lower, upper)
+            .is_some_and(|step| step <= near * (DVector::from_column_slice(&z).norm() + near));
+    let convergence = match stop {
+        StopReason::Gradient => Convergence::Converged,
+        StopReason::MaxIterations => Convergence::IterationLimit,
+        _ if optimality <= opts.optimality || gn_negligible => Convergence::Converged,
+        _ => Convergence::Stalled,
+    };
     Ok(Minimum {
         z,
         residuals: r,
         jacobian: j,
         iterations,
         stop,
+        convergence,
+        optimality,
     })
 }
 
-/// The largest gradient component in Marquardt's scaling (`g_k / √D_k`), leaving out components that point out
-/// of the box at an active bound.
-fn projected_gradient(
+/// MINPACK's first-order optimality: the largest `|J_kᵀ r| / (‖J_k‖ ‖r‖)` over the columns free to move
+/// (0 when the residuals vanish; a column the residuals do not depend on counts as 0).
+fn largest_cosine(
     z: &[f64],
+    j: &DMatrix<f64>,
+    r: &DVector<f64>,
     g: &DVector<f64>,
-    diag: &DVector<f64>,
     lower: &[f64],
     upper: &[f64],
 ) -> f64 {
+    let r_norm = r.norm();
+    if r_norm == 0.0 {
+        return 0.0;
+    }
     let mut worst: f64 = 0.0;
     for k in 0..z.len() {
-        if !blocked(z[k], g[k], lower[k], upper[k]) {
-            worst = worst.max(g[k].abs() / diag[k].sqrt());
+        let col = j.column(k).norm();
+        if col > 0.0 && !blocked(z[k], g[k], lower[k], upper[k]) {
+            worst = worst.max(g[k].abs() / (col * r_norm));
         }
     }
     worst
+}
+
+/// `‖P r‖ / s`: the Gauss–Newton step from `z` in standard errors, with `P` the projection onto the range of
+/// the free columns of `J` (directions below [`TRUNCATION`] left out, as in the step) and `s² = ‖r‖²/(m − n)`.
+/// Infinite when the decomposition fails.
+fn gauss_newton_distance(
+    z: &[f64],
+    j: &DMatrix<f64>,
+    r: &DVector<f64>,
+    lower: &[f64],
+    upper: &[f64],
+) -> f64 {
+    let (m, n) = j.shape();
+    let r_norm = r.norm();
+    if r_norm == 0.0 || n == 0 {
+        return 0.0;
+    }
+    let g = j.transpose() * r;
+    // Columns scaled to unit norm: the projection does not change, the truncation becomes unit-free.
+    let mut free = j.clone();
+    for k in 0..n {
+        let norm = free.column(k).norm();
+        if blocked(z[k], g[k], lower[k], upper[k]) || norm == 0.0 {
+            free.column_mut(k).fill(0.0);
+        } else {
+            free.column_mut(k).scale_mut(1.0 / norm);
+        }
+    }
+    let Some(svd) = nalgebra::SVD::try_new(free, true, false, f64::EPSILON, 1000) else {
+        return f64::INFINITY;
+    };
+    let Some(u) = svd.u.as_ref() else {
+        return f64::INFINITY;
+    };
+    let sigma_max = svd.singular_values.max();
+    let projected: f64 = svd
+        .singular_values
+        .iter()
+        .enumerate()
+        .filter(|&(_, &sigma)| sigma > TRUNCATION * sigma_max && sigma > 0.0)
+        .map(|(i, _)| u.column(i).dot(r).powi(2))
+        .sum();
+    let s = r_norm / (m.saturating_sub(n).max(1) as f64).sqrt();
+    projected.sqrt() / s
+}
+
+/// The length of the undamped (truncated) Gauss–Newton step from `z` over the free coordinates.
+fn gauss_newton_step(
+    z: &[f64],
+    j: &DMatrix<f64>,
+    r: &DVector<f64>,
+    lower: &[f64],
+    upper: &[f64],
+) -> Option<f64> {
+    let g = j.transpose() * r;
+    let mut free = j.clone();
+    for k in 0..z.len() {
+        if blocked(z[k], g[k], lower[k], upper[k]) {
+            free.column_mut(k).fill(0.0);
+        }
+    }
+    let diag = free.column_iter().map(|c| c.norm_squared().max(1e-30));
+    let diag = DVector::from_iterator(z.len(), diag);
+    solve_damped(&free, r, &diag, 0.0).map(|d| d.norm())
 }
 
 /// The singular values of the scaled Jacobian below this fraction of the largest are dropped from the step:
@@ -265,7 +426,7 @@ mod tests {
             "{:?}",
             m.z
         );
-        assert!(m.stop.converged());
+        assert_eq!(m.convergence, Convergence::Converged);
     }
 
     #[test]
@@ -285,5 +446,58 @@ mod tests {
             "{:?}",
             m.z
         );
+    }
+
+    /// `r = (z − 1, z − 2)` with the Jacobian given with the wrong sign: every step goes uphill, the damping grows
+    /// without bound, and the gradient is far from zero.
+    struct WrongJacobian;
+
+    impl Residuals for WrongJacobian {
+        fn evaluate(&mut self, z: &[f64]) -> Result<(DVector<f64>, DMatrix<f64>), String> {
+            let r = DVector::from_vec(vec![z[0] - 1.0, z[0] - 2.0]);
+            Ok((r, DMatrix::from_element(2, 1, -1.0)))
+        }
+    }
+
+    #[test]
+    fn a_fit_that_stops_moving_away_from_a_minimum_is_a_stall() {
+        let m = minimise(
+            &mut WrongJacobian,
+            &[0.0],
+            &[f64::NEG_INFINITY],
+            &[f64::INFINITY],
+            &LmOptions::default(),
+        )
+        .unwrap();
+        assert_eq!(m.stop, StopReason::NoProgress);
+        assert_eq!(m.convergence, Convergence::Stalled);
+        // At z = 0: r = (−1, −2), P r = −1.5 (1, 1), s = ‖r‖/√(2 − 1) = √5: ‖P r‖/s = 1.5 √2/√5.
+        let want = 1.5 * 2.0f64.sqrt() / 5.0f64.sqrt();
+        assert!((m.optimality - want).abs() < 1e-12, "{}", m.optimality);
+    }
+
+    #[test]
+    fn the_optimality_of_a_noisy_minimum_is_nil_and_of_a_start_is_its_distance_in_standard_errors()
+    {
+        // A straight line through (0, 0), (1, 1), (2, 3): the Gauss–Newton step from the least-squares slope is
+        // zero; from a slope one standard error off it is one standard error long.
+        struct Line;
+        impl Residuals for Line {
+            fn evaluate(&mut self, z: &[f64]) -> Result<(DVector<f64>, DMatrix<f64>), String> {
+                let r = DVector::from_vec(vec![0.0, z[0] - 1.0, 2.0 * z[0] - 3.0]);
+                Ok((r, DMatrix::from_column_slice(3, 1, &[0.0, 1.0, 2.0])))
+            }
+        }
+        let inf = f64::INFINITY;
+        let m = minimise(&mut Line, &[0.0], &[-inf], &[inf], &LmOptions::default()).unwrap();
+        // Slope 7/5, residuals (0, 0.4, −0.2): s² = 0.2/2, se = s/√5.
+        assert!((m.z[0] - 1.4).abs() < 1e-9 && m.optimality < 1e-6, "{m:?}");
+        assert_eq!(m.convergence, Convergence::Converged);
+        let se = (0.1f64 / 5.0).sqrt();
+        let (r, j) = Line.evaluate(&[1.4 + se]).unwrap();
+        let d = gauss_newton_distance(&[1.4 + se], &j, &r, &[-inf], &[inf]);
+        // There s² is that of the displaced residuals: ‖r‖² = 0.2 + 5 se² = 0.3, s = √(0.3/2).
+        let want = (5.0f64).sqrt() * se / (0.3f64 / 2.0).sqrt();
+        assert!((d - want).abs() < 1e-12, "{d} vs {want}");
     }
 }

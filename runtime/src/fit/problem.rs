@@ -9,11 +9,15 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::lm::{self, LmOptions, Residuals, StopReason};
+use super::lm::{self, Convergence, LmOptions, Minimum, Residuals, StopReason};
 use super::record::{Interp, Record};
 use super::sensitivity::{self, FitModel, Fitted, SensitivityError};
 use super::stats;
 use crate::sim::{Method, SolverOptions};
+
+/// The Gauss–Newton step (in standard errors) within which a fit that did not converge is near enough to its
+/// minimum for the statistics to decide what to hold.
+const NEAR_MINIMUM_STANDARD_ERRORS: f64 = 1.0;
 
 /// A parameter to fit.
 #[derive(Clone, Debug, PartialEq)]
@@ -97,7 +101,10 @@ pub struct Undetermined {
     pub combination: Vec<(String, f64)>,
     /// The standard error of the logarithm of the combination (infinite: the record does not depend on it).
     pub relative_std_error: f64,
-    pub held: String,
+    /// The quantity held at its start because of it; `None` when none could be (the fit did not converge, or
+    /// holding it would leave nothing to fit): its dominant quantity is then reported as not determined at the
+    /// value the fit reached.
+    pub held: Option<String>,
 }
 
 /// The answer of a fit.
@@ -114,6 +121,11 @@ pub struct FitReport {
     pub degrees_of_freedom: usize,
     pub iterations: usize,
     pub stop: StopReason,
+    /// Whether the last minimisation found a minimum ([`Convergence`]); estimates of a fit that did not are no
+    /// identification.
+    pub convergence: Convergence,
+    /// The Gauss–Newton step from the final point in standard errors ([`lm::Minimum::optimality`]).
+    pub optimality: f64,
     pub undetermined: Vec<Undetermined>,
     /// All parameter values and the initial state at the optimum.
     pub params: Vec<f64>,
@@ -165,28 +177,23 @@ pub fn fit(
         let scales = objective.scales();
         let jac_rel = relative(&min.jacobian, &objective, &scales);
         let st = stats::statistics(min.residuals.norm_squared(), &jac_rel, &scales);
-        // Statistics away from a minimum say nothing about what the record determines.
-        if st.undetermined.is_empty() || objective.active.len() <= 1 || !min.stop.converged() {
-            return objective.report(st, min.stop, iterations, undetermined);
+        let found = objective.name_directions(&st.undetermined);
+        // Statistics away from a minimum say nothing about what the record determines, and a fit needs at least
+        // one quantity: then the combinations are reported without holding anything. A fit that did not converge
+        // but ended within a standard error of the Gauss–Newton minimum (an undetermined direction is exactly
+        // what makes the iteration crawl) is near enough for its statistics to hold.
+        let held: Vec<usize> = found.iter().map(|&(q, _)| q).collect();
+        let near_minimum =
+            min.convergence.converged() || min.optimality <= NEAR_MINIMUM_STANDARD_ERRORS;
+        let holdable = near_minimum && held.len() < objective.active.len();
+        if found.is_empty() || !holdable {
+            let unheld = found.into_iter().map(|(_, u)| u);
+            undetermined.extend(unheld);
+            return objective.report(st, &min, iterations, undetermined);
         }
-        let mut held = Vec::new();
-        for d in &st.undetermined {
-            let Some(&(k, _)) = d.combination.first() else {
-                continue;
-            };
-            let q = objective.active[k];
-            if !held.contains(&q) {
-                held.push(q);
-                undetermined.push(Undetermined {
-                    combination: d
-                        .combination
-                        .iter()
-                        .map(|&(k, e)| (objective.name(objective.active[k]).to_string(), e))
-                        .collect(),
-                    relative_std_error: d.relative_std_error,
-                    held: objective.name(q).to_string(),
-                });
-            }
+        for (_, mut u) in found {
+            u.held = u.combination.first().map(|(n, _)| n.clone());
+            undetermined.push(u);
         }
         // Held quantities go back to their starting values; the others are fitted again from where they are.
         for &q in &held {
@@ -331,15 +338,49 @@ impl Objective<'_> {
         if self.is_log(q) { self.value(q) } else { 1.0 }
     }
 
-    /// The size `c` of each active quantity for relative statistics: its value, or 1 when it is zero.
+    /// The size `c` of each active quantity for relative statistics. A log-space parameter's is its value (the
+    /// statistics are then those of `ln θ`); a linear-space parameter's is the larger of its value and its start,
+    /// so a parameter that wandered towards zero is judged against the size it was expected to have; an initial
+    /// state's is its value. 1 (one SI unit) when that is zero.
     fn scales(&self) -> Vec<f64> {
         self.active
             .iter()
-            .map(|&q| match self.value(q) {
-                v if v != 0.0 => v.abs(),
-                _ => 1.0,
+            .map(|&q| {
+                let size = match self.spec.params.get(q) {
+                    Some(p) if !p.log => self.value(q).abs().max(self.start.0[p.index].abs()),
+                    _ => self.value(q).abs(),
+                };
+                if size > 0.0 { size } else { 1.0 }
             })
             .collect()
+    }
+
+    /// The undetermined directions named, each with its dominant active quantity (one direction per quantity).
+    fn name_directions(&self, directions: &[stats::Direction]) -> Vec<(usize, Undetermined)> {
+        let mut out: Vec<(usize, Undetermined)> = Vec::new();
+        for d in directions {
+            let Some(&(k, _)) = d.combination.first() else {
+                continue;
+            };
+            let q = self.active[k];
+            if out.iter().any(|(held, _)| *held == q) {
+                continue;
+            }
+            let combination = d
+                .combination
+                .iter()
+                .map(|&(k, e)| (self.name(self.active[k]).to_string(), e))
+                .collect();
+            out.push((
+                q,
+                Undetermined {
+                    combination,
+                    relative_std_error: d.relative_std_error,
+                    held: None,
+                },
+            ));
+        }
+        out
     }
 
     fn start_coordinates(&self) -> Vec<f64> {
@@ -401,6 +442,9 @@ impl Objective<'_> {
             x0: &free_x0,
             scale: &scale,
         };
+        if self.spec.interp == Interp::Zoh && self.model.is_linear() {
+            return super::linear::simulate(&*self.model, self.record, &self.x0, &fitted);
+        }
         sensitivity::simulate(
             &*self.model,
             self.record,
@@ -414,7 +458,7 @@ impl Objective<'_> {
     fn report(
         &mut self,
         st: stats::Statistics,
-        stop: StopReason,
+        min: &Minimum,
         iterations: usize,
         undetermined: Vec<Undetermined>,
     ) -> Result<FitReport, FitError> {
@@ -429,12 +473,17 @@ impl Objective<'_> {
                 None => self.start.1[self.spec.x0[q - self.np()].index],
             };
             let active = self.active.iter().position(|&a| a == q);
+            let name = self.name(q).to_string();
+            // Not determined: held at its start, or the dominant quantity of a combination left free.
+            let dominates = undetermined.iter().any(|u| {
+                u.held.is_none() && u.combination.first().is_some_and(|(n, _)| *n == name)
+            });
             estimates.push(Estimate {
-                name: self.name(q).to_string(),
                 value: self.value(q),
                 std_error: active.map_or(f64::NAN, |k| st.std_errors[k]),
                 start,
-                determined: active.is_some(),
+                determined: active.is_some() && !dominates,
+                name,
             });
         }
         let columns = self.record.outputs.len();
@@ -470,7 +519,9 @@ impl Objective<'_> {
             residual_variance: st.residual_variance,
             degrees_of_freedom: st.degrees_of_freedom,
             iterations,
-            stop,
+            stop: min.stop,
+            convergence: min.convergence,
+            optimality: min.optimality,
             undetermined,
             params: self.params.clone(),
             x0: self.x0.clone(),
@@ -480,6 +531,19 @@ impl Objective<'_> {
 }
 
 impl Residuals for Objective<'_> {
+    fn step_limits(&self) -> Vec<f64> {
+        self.active
+            .iter()
+            .map(|&q| {
+                if self.is_log(q) {
+                    self.spec.lm.max_log_step
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .collect()
+    }
+
     fn evaluate(&mut self, z: &[f64]) -> Result<(DVector<f64>, DMatrix<f64>), String> {
         self.set(z);
         let sim = self.simulate().map_err(|e| e.to_string())?;

@@ -56,6 +56,13 @@ pub trait FitModel {
         u: &[f64],
         free: &[usize],
     ) -> Result<(DMatrix<f64>, DMatrix<f64>), String>;
+
+    /// True when the rates are affine in the states and inputs with constant coefficients (a linear
+    /// time-invariant model): a fit with held inputs then takes the exact discretisation of
+    /// [`super::linear`] instead of the ODE solver. The declaration is checked at a probe point.
+    fn is_linear(&self) -> bool {
+        false
+    }
 }
 
 /// What is fitted: parameter indices, then initial-state indices, each with its column scale.
@@ -122,7 +129,7 @@ pub fn simulate(
 }
 
 /// The outputs and their sensitivities from the augmented states at each sample.
-fn sample_outputs(
+pub(super) fn sample_outputs(
     model: &dyn FitModel,
     record: &Record,
     interp: Interp,

@@ -43,6 +43,15 @@ pub fn statistics(ssr: f64, jac_rel: &DMatrix<f64>, scales: &[f64]) -> Statistic
     let dof = m.saturating_sub(n);
     let s2 = if dof > 0 { ssr / dof as f64 } else { f64::NAN };
     let s = s2.sqrt();
+    if n == 0 || m == 0 {
+        return Statistics {
+            residual_variance: s2,
+            degrees_of_freedom: dof,
+            std_errors: Vec::new(),
+            correlation: DMatrix::zeros(n, n),
+            undetermined: Vec::new(),
+        };
+    }
     let svd = jac_rel.clone().svd(false, true);
     let sigma = &svd.singular_values;
     let sigma_max = sigma.max();

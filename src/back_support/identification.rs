@@ -179,7 +179,7 @@ pub fn identify(
     // The encoder noise is 10⁻⁷ rad/s: the integration error must be well below it.
     spec.solver.rtol = 1e-10;
     spec.solver.atol = 1e-12;
-    let mut model = Generated::new(Model::default());
+    let mut model = Generated::exact(Model::default());
     let report = fit(
         &mut model,
         record,

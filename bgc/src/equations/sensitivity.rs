@@ -277,31 +277,7 @@ impl Sensitivity<'_> {
         outputs: bool,
     ) -> Result<PointJacobians, LinearError> {
         let eqs = self.eqs;
-        check_len("parameter", eqs.params.len(), params.len())?;
-        check_len("state", eqs.states.len(), x.len())?;
-        check_len("input", eqs.inputs.len(), u.len())?;
-        let mut values: HashMap<Symbol, f64> = HashMap::new();
-        let base = |s: Sym| point(s, params, x, u, t);
-        for (i, &v) in params.iter().enumerate() {
-            values.insert(symbol(eqs, Sym::Param(i)), v);
-        }
-        for (i, &v) in x.iter().enumerate() {
-            values.insert(symbol(eqs, Sym::State(i)), v);
-        }
-        for (i, &v) in u.iter().enumerate() {
-            values.insert(symbol(eqs, Sym::Input(i)), v);
-        }
-        values.insert(symbol(eqs, Sym::Time), t);
-        if self.loops.is_some() {
-            let tears = solve_all(eqs, &base).map_err(|e| LinearError::LoopNotSolved {
-                tears: e.tear_list(),
-                reason: e.failure.kind.describe(),
-                residual: e.failure.residual,
-            })?;
-            for (z, v) in tears {
-                values.insert(symbol(eqs, z), v);
-            }
-        }
+        let values = self.values_at(params, (x, u, t))?;
         let at = Point { eqs, values };
         let rate = |i: usize| format!("the rate of `{}`", eqs.sym_name(Sym::State(i)));
         let output = |k: usize| format!("output `{}`", eqs.sym_name(Sym::Output(k)));
@@ -334,6 +310,43 @@ impl Sensitivity<'_> {
         let (fx, fp) = split(fv);
         let (hx, hp) = split(hv);
         Ok(PointJacobians { fx, fp, hx, hp })
+    }
+
+    /// The value of every symbol the expressions read at a point: parameters, states, inputs, time and, with
+    /// nonlinear loops, the tears (solved by Newton's method, as `rates_at` solves them).
+    fn values_at(
+        &self,
+        params: &[f64],
+        (x, u, t): (&[f64], &[f64], f64),
+    ) -> Result<HashMap<Symbol, f64>, LinearError> {
+        let eqs = self.eqs;
+        check_len("parameter", eqs.params.len(), params.len())?;
+        check_len("state", eqs.states.len(), x.len())?;
+        check_len("input", eqs.inputs.len(), u.len())?;
+        let mut values: HashMap<Symbol, f64> = HashMap::new();
+        for (i, &v) in params.iter().enumerate() {
+            values.insert(symbol(eqs, Sym::Param(i)), v);
+        }
+        for (i, &v) in x.iter().enumerate() {
+            values.insert(symbol(eqs, Sym::State(i)), v);
+        }
+        for (i, &v) in u.iter().enumerate() {
+            values.insert(symbol(eqs, Sym::Input(i)), v);
+        }
+        values.insert(symbol(eqs, Sym::Time), t);
+        if self.loops.is_some() {
+            let tears = solve_all(eqs, &|s| point(s, params, x, u, t)).map_err(|e| {
+                LinearError::LoopNotSolved {
+                    tears: e.tear_list(),
+                    reason: e.failure.kind.describe(),
+                    residual: e.failure.residual,
+                }
+            })?;
+            for (z, v) in tears {
+                values.insert(symbol(eqs, z), v);
+            }
+        }
+        Ok(values)
     }
 
     /// Adds the loops' contribution `∂g/∂z · dz/dv` to the rates' and outputs' columns; returns `dz/dv`.

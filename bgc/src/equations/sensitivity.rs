@@ -22,8 +22,7 @@ use super::numeric::point;
 use super::param_chain::ParamChain;
 use super::sym::Sym;
 use super::tear::solve_all;
-use crate::symbolic::{Expr, Symbol, SymbolicError};
-use std::collections::HashMap;
+use crate::symbolic::{Compiled, Expr, Symbol};
 
 /// `∂f/∂x`, `∂f/∂p`, `∂h/∂x`, `∂h/∂p` at a point, row-major (`fx[i][j] = ∂f_i/∂x_j`); the parameter columns are
 /// those asked for, in that order.
@@ -39,34 +38,65 @@ pub struct PointJacobians {
 /// chosen parameters' (total through the derived parameters).
 type Partials = Vec<Vec<Expr>>;
 
+/// A matrix of expressions, compiled once to be evaluated at every point.
+#[derive(Debug)]
+struct Matrix {
+    exprs: Vec<Vec<Expr>>,
+    compiled: Compiled,
+    /// Where the value of each of the compiled symbols is in a point's values ([`Sensitivity::symbols`] order);
+    /// `None` for a symbol that has none.
+    slots: Vec<Option<usize>>,
+}
+
+impl Matrix {
+    fn new(exprs: Vec<Vec<Expr>>, symbols: &[Symbol]) -> Matrix {
+        let flat: Vec<Expr> = exprs.iter().flatten().cloned().collect();
+        let compiled = Compiled::new(&flat);
+        let slots = compiled
+            .symbols()
+            .iter()
+            .map(|s| symbols.iter().position(|k| k == s))
+            .collect();
+        Matrix {
+            exprs,
+            compiled,
+            slots,
+        }
+    }
+}
+
 /// The nonlinear algebraic loops' part.
 #[derive(Debug)]
 struct Loops {
     tears: Vec<Symbol>,
     /// `∂r/∂z` over all tears (block-triangular).
-    rz: Vec<Vec<Expr>>,
-    rv: Partials,
-    fz: Vec<Vec<Expr>>,
-    hz: Vec<Vec<Expr>>,
+    rz: Matrix,
+    rv: Matrix,
+    fz: Matrix,
+    hz: Matrix,
 }
 
-/// One inertia matrix, its entries flattened row-major.
+/// One inertia matrix `M`, the generalised forces `F` of its rows, and the derivatives of `M`'s entries
+/// (flattened row-major) by the states and parameters and by the tears.
 #[derive(Debug)]
 struct Mass {
     element: String,
     rows: Vec<usize>,
-    entries: Vec<Expr>,
-    mv: Partials,
-    mz: Vec<Vec<Expr>>,
+    m: Matrix,
+    forces: Matrix,
+    mv: Matrix,
+    mz: Matrix,
 }
 
 /// The symbolic Jacobians of a model with respect to its states and chosen parameters, ready to evaluate.
 #[derive(Debug)]
 pub struct Sensitivity<'e> {
     eqs: &'e Equations,
-    f: Vec<Expr>,
-    fv: Partials,
-    hv: Partials,
+    /// The symbols with a value at a point: the parameters, states and inputs in order, time, then the tears of
+    /// the loops in solving order.
+    symbols: Vec<Symbol>,
+    fv: Matrix,
+    hv: Matrix,
     loops: Option<Loops>,
     mass: Vec<Mass>,
 }
@@ -88,6 +118,19 @@ impl Equations {
         let states: Vec<Symbol> = (0..self.states.len())
             .map(|i| symbol(self, Sym::State(i)))
             .collect();
+        let symbols: Vec<Symbol> = (0..self.params.len())
+            .map(Sym::Param)
+            .map(|s| symbol(self, s))
+            .chain(states.iter().cloned())
+            .chain((0..self.inputs.len()).map(|i| symbol(self, Sym::Input(i))))
+            .chain(std::iter::once(symbol(self, Sym::Time)))
+            .chain(
+                self.tear_blocks
+                    .iter()
+                    .flat_map(|b| b.tears.iter().map(|&z| symbol(self, z))),
+            )
+            .collect();
+        let matrix = |m: Vec<Vec<Expr>>| Matrix::new(m, &symbols);
         let partials = |exprs: &[Expr]| -> Partials {
             let x = Expr::jacobian(exprs, &states);
             x.into_iter()
@@ -100,7 +143,7 @@ impl Equations {
         };
         let f = self.explicit_rates()?;
         let h = self.explicit_outputs()?;
-        let loops = self.loop_partials(&f, &h, &partials)?;
+        let loops = self.loop_partials(&f, &h, &partials, &matrix)?;
         let tears = loops.as_ref().map_or(&[][..], |l| &l.tears[..]);
         let mut mass = Vec::with_capacity(self.mass.len());
         for b in &self.mass {
@@ -110,19 +153,29 @@ impl Equations {
                 .flatten()
                 .map(|e| self.convert(e, || format!("M_{}", b.element)))
                 .collect::<Result<_, _>>()?;
+            let m: Vec<Vec<Expr>> = entries
+                .chunks(b.states.len().max(1))
+                .map(<[Expr]>::to_vec)
+                .collect();
+            let forces: Vec<Vec<Expr>> = b
+                .states
+                .iter()
+                .map(|&r| vec![f.get(r).cloned().unwrap_or_else(Expr::zero)])
+                .collect();
             mass.push(Mass {
                 element: b.element.clone(),
                 rows: b.states.clone(),
-                mv: partials(&entries),
-                mz: Expr::jacobian(&entries, tears),
-                entries,
+                m: matrix(m),
+                forces: matrix(forces),
+                mv: matrix(partials(&entries)),
+                mz: matrix(Expr::jacobian(&entries, tears)),
             });
         }
         Ok(Sensitivity {
             eqs: self,
-            fv: partials(&f),
-            hv: partials(&h),
-            f,
+            fv: matrix(partials(&f)),
+            hv: matrix(partials(&h)),
+            symbols,
             loops,
             mass,
         })
@@ -191,6 +244,7 @@ impl Equations {
         f: &[Expr],
         h: &[Expr],
         partials: &dyn Fn(&[Expr]) -> Partials,
+        matrix: &dyn Fn(Vec<Vec<Expr>>) -> Matrix,
     ) -> Result<Option<Loops>, LinearError> {
         if self.tear_blocks.is_empty() {
             return Ok(None);
@@ -204,10 +258,10 @@ impl Equations {
             }
         }
         Ok(Some(Loops {
-            rz: Expr::jacobian(&residuals, &tears),
-            rv: partials(&residuals),
-            fz: Expr::jacobian(f, &tears),
-            hz: Expr::jacobian(h, &tears),
+            rz: matrix(Expr::jacobian(&residuals, &tears)),
+            rv: matrix(partials(&residuals)),
+            fz: matrix(Expr::jacobian(f, &tears)),
+            hz: matrix(Expr::jacobian(h, &tears)),
             tears,
         }))
     }
@@ -216,45 +270,57 @@ impl Equations {
 /// The values of the symbols at a point.
 struct Point<'a> {
     eqs: &'a Equations,
-    values: HashMap<Symbol, f64>,
+    /// In [`Sensitivity::symbols`] order.
+    values: Vec<f64>,
 }
 
 impl Point<'_> {
-    fn value(&self, e: &Expr, what: &dyn Fn() -> String) -> Result<f64, LinearError> {
-        if let Some(c) = e.as_const() {
-            return Ok(c);
-        }
-        let v = e
-            .eval(|s| self.values.get(s).copied())
-            .map_err(|err| match err {
-                SymbolicError::UnboundSymbol { name, .. } => LinearError::Unbound {
-                    what: what(),
-                    symbol: name,
-                },
-                _ => LinearError::NonFinite { what: what() },
-            })?;
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(LinearError::NonFinite { what: what() })
-        }
-    }
-
     /// `m` evaluated; `what(i, j)` names an entry in errors.
     fn matrix(
         &self,
-        m: &[Vec<Expr>],
+        m: &Matrix,
         what: &dyn Fn(usize, usize) -> String,
     ) -> Result<Mat, LinearError> {
-        m.iter()
+        let mut symbol_values = Vec::with_capacity(m.slots.len());
+        for (s, slot) in m.compiled.symbols().iter().zip(&m.slots) {
+            match slot.and_then(|k| self.values.get(k)) {
+                Some(&v) => symbol_values.push(v),
+                None => return Err(self.unbound(m, s, what)),
+            }
+        }
+        let mut values = m.compiled.eval(&symbol_values).into_iter();
+        m.exprs
+            .iter()
             .enumerate()
             .map(|(i, row)| {
                 row.iter()
                     .enumerate()
-                    .map(|(j, e)| self.value(e, &|| what(i, j)))
+                    .map(|(j, _)| match values.next() {
+                        Some(v) if v.is_finite() => Ok(v),
+                        _ => Err(LinearError::NonFinite { what: what(i, j) }),
+                    })
                     .collect()
             })
             .collect()
+    }
+
+    /// The error for the symbol `s` without a value, naming the first entry of `m` that reads it.
+    fn unbound(
+        &self,
+        m: &Matrix,
+        s: &Symbol,
+        what: &dyn Fn(usize, usize) -> String,
+    ) -> LinearError {
+        let (i, j) = m
+            .exprs
+            .iter()
+            .enumerate()
+            .find_map(|(i, row)| row.iter().position(|e| e.depends_on(s)).map(|j| (i, j)))
+            .unwrap_or((0, 0));
+        LinearError::Unbound {
+            what: what(i, j),
+            symbol: s.name().to_string(),
+        }
     }
 
     /// The name of column `j` of a `[∂/∂x | ∂/∂p]` matrix.
@@ -318,22 +384,16 @@ impl Sensitivity<'_> {
         &self,
         params: &[f64],
         (x, u, t): (&[f64], &[f64], f64),
-    ) -> Result<HashMap<Symbol, f64>, LinearError> {
+    ) -> Result<Vec<f64>, LinearError> {
         let eqs = self.eqs;
         check_len("parameter", eqs.params.len(), params.len())?;
         check_len("state", eqs.states.len(), x.len())?;
         check_len("input", eqs.inputs.len(), u.len())?;
-        let mut values: HashMap<Symbol, f64> = HashMap::new();
-        for (i, &v) in params.iter().enumerate() {
-            values.insert(symbol(eqs, Sym::Param(i)), v);
-        }
-        for (i, &v) in x.iter().enumerate() {
-            values.insert(symbol(eqs, Sym::State(i)), v);
-        }
-        for (i, &v) in u.iter().enumerate() {
-            values.insert(symbol(eqs, Sym::Input(i)), v);
-        }
-        values.insert(symbol(eqs, Sym::Time), t);
+        let mut values = Vec::with_capacity(self.symbols.len());
+        values.extend_from_slice(params);
+        values.extend_from_slice(x);
+        values.extend_from_slice(u);
+        values.push(t);
         if self.loops.is_some() {
             let tears = solve_all(eqs, &|s| point(s, params, x, u, t)).map_err(|e| {
                 LinearError::LoopNotSolved {
@@ -342,9 +402,8 @@ impl Sensitivity<'_> {
                     residual: e.failure.residual,
                 }
             })?;
-            for (z, v) in tears {
-                values.insert(symbol(eqs, z), v);
-            }
+            // In solving order, as `symbols` lists them.
+            values.extend(tears.into_iter().map(|(_, v)| v));
         }
         Ok(values)
     }
@@ -397,27 +456,14 @@ impl Sensitivity<'_> {
         let what = |k: usize, _: usize| {
             format!("M_{element}[{},{}]", k / nb.max(1) + 1, k % nb.max(1) + 1)
         };
-        let flat: Vec<f64> = b
-            .entries
-            .iter()
-            .enumerate()
-            .map(|(k, e)| at.value(e, &|| what(k, 0)))
-            .collect::<Result<_, _>>()?;
-        let m: Mat = flat.chunks(nb.max(1)).map(<[f64]>::to_vec).collect();
+        let m = at.matrix(&b.m, &|i, j| format!("M_{element}[{},{}]", i + 1, j + 1))?;
         let singular = || LinearError::SingularMass {
             element: element.clone(),
         };
-        let forces: Mat = b
-            .rows
-            .iter()
-            .map(|&r| {
-                let e = self.f.get(r).cloned().unwrap_or_else(Expr::zero);
-                at.value(&e, &|| {
-                    format!("the rate of `{}`", eqs.sym_name(Sym::State(r)))
-                })
-                .map(|v| vec![v])
-            })
-            .collect::<Result<_, _>>()?;
+        let forces = at.matrix(&b.forces, &|i, _| {
+            let r = b.rows.get(i).copied().unwrap_or_default();
+            format!("the rate of `{}`", eqs.sym_name(Sym::State(r)))
+        })?;
         let rates: Vec<f64> = dense::solve(&m, &forces)
             .ok_or_else(singular)?
             .into_iter()

@@ -81,7 +81,7 @@ fn the_exact_linear_path_agrees_with_the_ode_sensitivities() {
         x0: &[],
         scale: &scale,
     };
-    let mut model = Generated::new(Model::default()).declared_linear();
+    let mut model = Generated::exact(Model::default()).declared_linear();
     model.set_params(&p).expect("valid parameters");
     let x0 = [0.0; generated::N_STATES];
     let exact = linear::simulate(&model, &record, &x0, &fitted).expect("the exact path runs");

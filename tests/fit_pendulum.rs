@@ -90,7 +90,7 @@ fn pendulum_estimates_cover_the_truth_and_their_errors_match_the_spread() {
     let mut errors = vec![Vec::new(); 2];
     for seed in 0..100 {
         let rec = record(&times, &clean, 1000 + seed);
-        let mut model = Generated::new(Model::default());
+        let mut model = Generated::exact(Model::default());
         let r = fit(&mut model, &rec, &start, &[0.0; 4], &spec).expect("the fit runs");
         assert!(r.convergence.converged(), "seed {seed}: {:?}", r.stop);
         assert!(

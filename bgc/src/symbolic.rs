@@ -57,6 +57,7 @@
 //! - [`from_ir`] from the IR's expressions.
 
 mod build;
+mod compiled;
 mod cse;
 mod dag;
 mod diff;
@@ -73,6 +74,7 @@ mod solve;
 #[cfg(test)]
 mod tests;
 
+pub use compiled::Compiled;
 pub use cse::{cse, to_rust_cse, to_text_cse};
 pub use error::SymbolicError;
 pub use eval::{max, min, sign};

@@ -428,3 +428,62 @@ fn a_large_model_gets_its_state_jacobian_as_triplets() {
     // A small model keeps the matrix alone.
     assert!(!generate(&codegen_support::chain(10)).contains("jac_x_sparse_into"));
 }
+
+/// A mass-spring-damper whose spring stiffness is derived: `k_s = 2 k`.
+const DERIVED_SPRING: &str = r#"
+model msd {
+    domain translational;
+    param m = 2 [kg] "mass";
+    param k = 400 [N/m] "stiffness";
+    param k_s = 2 * k [N/m] "spring stiffness, twice k";
+    param b = 4 [N s/m] "damping";
+    input F [N] "force";
+    Se push = F;
+    I mass = m;
+    C spring = 1 / k_s;
+    R damper = b;
+    1 v;
+    bond push -> v -> mass, spring, damper;
+    output x [m] = q(spring) "deflection";
+}
+"#;
+
+/// The text of `jac_p_into` for ṗ = F − k_s q − b p/m, q̇ = p/m with k_s = 2 k: one column per free parameter
+/// (`m`, `k`, `b`; the derived `k_s` has none), the column of `k` through `k_s`, each entry under its equation.
+#[test]
+fn the_parameter_jacobian_has_a_column_per_free_parameter_through_the_derived_ones() {
+    let code = generate(DERIVED_SPRING);
+    assert!(
+        code.contains("pub type JacP = SMatrix<f64, N_STATES, N_PARAMS>;"),
+        "{code}"
+    );
+    assert!(code.contains("pub type OutJacP = SMatrix<f64, N_OUTPUTS, N_PARAMS>;"));
+    let body = [
+        "pub fn jac_p_into(p: &Params, _t: f64, x: &State, _u: &Inputs, jac: &mut JacP) {",
+        "    let p_mass = x[0];",
+        "    let q_spring = x[1];",
+        "    jac.fill(0.0);",
+        "    // ∂(d/dt p_mass)/∂m = b*p_mass/m^2",
+        "    jac[(0, 0)] = p.b * p_mass / bgc_powi(p.m, 2);",
+        "    // ∂(d/dt p_mass)/∂k = -2*q_spring",
+        "    jac[(0, 1)] = -2.0 * q_spring;",
+        "    // ∂(d/dt p_mass)/∂b = -p_mass/m",
+        "    jac[(0, 2)] = -p_mass / p.m;",
+        "    // ∂(d/dt q_spring)/∂m = -p_mass/m^2",
+        "    jac[(1, 0)] = -p_mass / bgc_powi(p.m, 2);",
+        "}",
+    ]
+    .join("\n");
+    assert!(code.contains(&body), "{code}");
+    // The output x = q reads no parameter: its Jacobian is all zeros and uses none of its arguments.
+    assert!(code.contains(
+        "pub fn output_jac_p_into(_p: &Params, _t: f64, _x: &State, _u: &Inputs, jac: &mut OutJacP) {\n    jac.fill(0.0);\n}"
+    ));
+    assert!(code.contains(
+        "impl bgc_runtime::fit::generated::ParamJacobians<N_STATES, N_INPUTS, N_OUTPUTS> for Model {"
+    ));
+    // Without the runtime, the functions stay and the impl goes.
+    let bare = generate_with(DERIVED_SPRING, Options { runtime: false });
+    assert!(bare.contains(&body));
+    assert!(!bare.contains("ParamJacobians"));
+}

@@ -8,5 +8,6 @@ mod agreement;
 mod energy;
 mod loops;
 mod no_alloc;
+mod param_jacobians;
 mod params;
 mod runtime;

@@ -237,7 +237,7 @@ fn fit_stage(
         3.0 / cfg.encoder_bound.powi(2),
         3.0 / TORQUE_SENSOR_BOUND.powi(2),
     ];
-    let mut model = Generated::new(Model::default()).declared_linear();
+    let mut model = Generated::exact(Model::default()).declared_linear();
     Ok(fit(
         &mut model,
         record,

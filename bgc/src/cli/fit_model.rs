@@ -1,7 +1,8 @@
 //! The derived equations of a model as a [`FitModel`] for `bgc fit`: rates and outputs by
-//! [`Equations::rates_at`] and [`Equations::outputs_at`], Jacobians by [`Equations::param_jacobian_at`].
+//! [`Equations::rates_at`] and [`Equations::outputs_at`], Jacobians by the symbolic derivatives of
+//! [`Equations::sensitivity`] (built once, evaluated at every step).
 
-use bgc::equations::{self, Equations, PointJacobians, StateSelection};
+use bgc::equations::{self, Equations, PointJacobians, Sensitivity, StateSelection};
 use bgc_runtime::fit::FitModel;
 use nalgebra::DMatrix;
 
@@ -15,6 +16,8 @@ pub struct Interpreted<'a> {
     /// The rates and outputs are linear in the states and inputs (a symbolic state space exists): fits with held
     /// inputs take the exact discretisation path.
     linear: bool,
+    /// The symbolic Jacobians, or why they could not be formed (reported when they are asked for).
+    sensitivity: Result<Sensitivity<'a>, String>,
 }
 
 impl<'a> Interpreted<'a> {
@@ -22,27 +25,50 @@ impl<'a> Interpreted<'a> {
     pub fn new(eqs: &'a Equations, given: Vec<Option<f64>>, free: Vec<usize>) -> Interpreted<'a> {
         let values = eqs.param_values(&given);
         let linear = equations::linear_state_space(eqs, StateSelection::All).is_ok();
+        let sensitivity = eqs.sensitivity(&given, &free).map_err(|e| e.to_string());
         Interpreted {
             eqs,
             given,
             values,
             free,
             linear,
+            sensitivity,
         }
     }
 
+    /// The Jacobians at a point, with the parameter columns `free`: picked from the prepared ones when the model
+    /// was made with them, else formed for this call.
     fn jacobians(
         &self,
         (t, x, u): (f64, &[f64], &[f64]),
         free: &[usize],
         outputs: bool,
     ) -> Result<PointJacobians, String> {
-        let j = if outputs {
-            self.eqs.param_jacobian_at(&self.given, x, u, t, free)
-        } else {
-            self.eqs.rate_param_jacobian_at(&self.given, x, u, t, free)
+        let picked: Option<Vec<usize>> = free
+            .iter()
+            .map(|k| self.free.iter().position(|f| f == k))
+            .collect();
+        let Some(picked) = picked else {
+            return self
+                .eqs
+                .sensitivity(&self.given, free)
+                .and_then(|s| s.at(&self.values, (x, u, t), outputs))
+                .map_err(|e| e.to_string());
         };
-        j.map_err(|e| e.to_string())
+        let sensitivity = self.sensitivity.as_ref().map_err(Clone::clone)?;
+        let mut j = sensitivity
+            .at(&self.values, (x, u, t), outputs)
+            .map_err(|e| e.to_string())?;
+        if picked.len() != self.free.len() || picked.iter().enumerate().any(|(c, &k)| c != k) {
+            let pick = |rows: &mut Vec<Vec<f64>>| {
+                for row in rows.iter_mut() {
+                    *row = picked.iter().map(|&k| row[k]).collect();
+                }
+            };
+            pick(&mut j.fp);
+            pick(&mut j.hp);
+        }
+        Ok(j)
     }
 }
 

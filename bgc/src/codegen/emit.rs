@@ -14,8 +14,8 @@
 use super::adapter::{AdaptError, explicit_outputs, to_symbolic};
 use crate::equations::sym::Ex;
 use crate::equations::{
-    EnergyKind, Equations, LinearError, StateSelection, declared_state_space_symbolic, jacobians,
-    linear_state_space,
+    EnergyKind, Equations, LinearError, ParamChain, StateSelection, declared_state_space_symbolic,
+    jacobians, linear_state_space,
 };
 use crate::symbolic::{Expr, Symbol, SymbolKind};
 use std::collections::{BTreeSet, HashMap};
@@ -51,6 +51,10 @@ pub(crate) struct Plan {
     pub dfdu: Vec<Vec<Expr>>,
     pub dhdx: Vec<Vec<Expr>>,
     pub dhdu: Vec<Vec<Expr>>,
+    /// `∂f/∂p` and `∂h/∂p` with respect to the free parameters (`PARAM_NAMES` order), total through the derived
+    /// parameters ([`ParamChain`]); partial at fixed tears, and the mass-matrix rows hold `∂F/∂p`, as in `dfdx`.
+    pub dfdp: Vec<Vec<Expr>>,
+    pub dhdp: Vec<Vec<Expr>>,
     /// `A, B, C, D` in the energy states, or (when the rates or outputs read an integrated flow) in all states,
     /// or why there is none.
     pub linear_ss: Result<StateSpace, String>,
@@ -144,8 +148,12 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
             },
         ));
     }
-    let mass = super::mass::plan(eqs, &states)?;
-    let loops = super::loops::plan(eqs, &f, &h, &states, &inputs)?;
+    let free: Vec<usize> = (0..eqs.params.len())
+        .filter(|&k| eqs.derived.get(k).is_none_or(Option::is_none))
+        .collect();
+    let chain = ParamChain::new(eqs, &free, &[]).map_err(|e| e.to_string())?;
+    let mass = super::mass::plan(eqs, &states, &chain)?;
+    let loops = super::loops::plan(eqs, &f, &h, (&states, &inputs), &chain)?;
     if let Some(l) = &loops {
         let in_mass = mass
             .iter()
@@ -164,6 +172,8 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
         dfdu: Expr::jacobian(&f, &inputs),
         dhdx: Expr::jacobian(&h, &states),
         dhdu: Expr::jacobian(&h, &inputs),
+        dfdp: chain.jacobian(&f),
+        dhdp: chain.jacobian(&h),
         states,
         inputs,
         rhs,

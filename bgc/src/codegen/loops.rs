@@ -22,7 +22,7 @@
 
 use super::adapter::to_symbolic;
 use super::rust::{Draft, Writer};
-use crate::equations::{Equations, residual_scale};
+use crate::equations::{Equations, ParamChain, residual_scale};
 use crate::symbolic::{Expr, Symbol};
 use std::fmt::Write;
 
@@ -46,6 +46,8 @@ pub(crate) struct LoopPlan {
     pub drdz: Vec<Vec<Expr>>,
     pub drdx: Vec<Vec<Expr>>,
     pub drdu: Vec<Vec<Expr>>,
+    /// `∂r/∂p` with respect to the free parameters, total through the derived ones.
+    pub drdp: Vec<Vec<Expr>>,
     /// `∂f/∂z` and `∂h/∂z`.
     pub dfdz: Vec<Vec<Expr>>,
     pub dhdz: Vec<Vec<Expr>>,
@@ -56,8 +58,8 @@ pub(crate) fn plan(
     eqs: &Equations,
     f: &[Expr],
     h: &[Expr],
-    states: &[Symbol],
-    inputs: &[Symbol],
+    (states, inputs): (&[Symbol], &[Symbol]),
+    chain: &ParamChain,
 ) -> Result<Option<LoopPlan>, String> {
     if eqs.tear_blocks.is_empty() {
         return Ok(None);
@@ -93,6 +95,7 @@ pub(crate) fn plan(
         drdz: Expr::jacobian(&residuals, &tears),
         drdx: Expr::jacobian(&residuals, states),
         drdu: Expr::jacobian(&residuals, inputs),
+        drdp: chain.jacobian(&residuals),
         dfdz: Expr::jacobian(f, &tears),
         dhdz: Expr::jacobian(h, &tears),
         tears,

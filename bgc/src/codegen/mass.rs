@@ -17,7 +17,7 @@
 use super::adapter::to_symbolic;
 use super::names::comment;
 use super::rust::{Draft, Writer};
-use crate::equations::Equations;
+use crate::equations::{Equations, ParamChain};
 use crate::symbolic::{Expr, Symbol};
 
 /// One I-field's block for the generator.
@@ -33,10 +33,17 @@ pub(crate) struct MassPlan {
     pub matrix: Vec<Vec<Expr>>,
     /// Per state `k` that `M` depends on: `(k, ∂M/∂x_k)`.
     pub derivatives: Vec<(usize, Vec<Vec<Expr>>)>,
+    /// Per free parameter `c` (`PARAM_NAMES` order) that `M` depends on: `(c, dM/dp_c)`, total through the
+    /// derived parameters.
+    pub param_derivatives: Vec<(usize, Vec<Vec<Expr>>)>,
 }
 
 /// The blocks of every I-field of the equations.
-pub(crate) fn plan(eqs: &Equations, states: &[Symbol]) -> Result<Vec<MassPlan>, String> {
+pub(crate) fn plan(
+    eqs: &Equations,
+    states: &[Symbol],
+    chain: &ParamChain,
+) -> Result<Vec<MassPlan>, String> {
     let mut out = Vec::with_capacity(eqs.mass.len());
     // `a.leg` and `a_leg` give one sanitized name; each field gets its own function.
     let mut idents = super::names::Namer::default();
@@ -57,8 +64,22 @@ pub(crate) fn plan(eqs: &Equations, states: &[Symbol]) -> Result<Vec<MassPlan>, 
                 derivatives.push((k, d));
             }
         }
+        let n = matrix.len();
+        let flat: Vec<Expr> = matrix.iter().flatten().cloned().collect();
+        let by_param = chain.jacobian(&flat);
+        let param_derivatives = (0..chain.columns.len())
+            .filter(|&c| by_param.iter().any(|row| !row[c].is_zero()))
+            .map(|c| {
+                let d: Vec<Vec<Expr>> = by_param
+                    .chunks(n.max(1))
+                    .map(|rows| rows.iter().map(|row| row[c].clone()).collect())
+                    .collect();
+                (c, d)
+            })
+            .collect();
         let ident = idents.ident(&b.element);
         out.push(MassPlan {
+            param_derivatives,
             element: b.element.clone(),
             ident,
             rows: b.states.clone(),
@@ -124,6 +145,28 @@ fn bgc_solve<const N: usize, const C: usize>(
 }
 ";
 
+/// `(column, ∂M/∂v_column)` for the columns `M` depends on.
+type Derivatives = [(usize, Vec<Vec<Expr>>)];
+
+/// The columns of a Jacobian whose mass-matrix rows are solved.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum MassColumns {
+    States,
+    Inputs,
+    Params,
+}
+
+impl MassColumns {
+    /// The number of columns, as the generated code names it.
+    fn size(self) -> &'static str {
+        match self {
+            MassColumns::States => "N_STATES",
+            MassColumns::Inputs => "N_INPUTS",
+            MassColumns::Params => "N_PARAMS",
+        }
+    }
+}
+
 impl Writer<'_> {
     /// `pub fn mass_<field>(p, x) -> SMatrix`: the inertia matrix of each I-field.
     pub(super) fn mass_fns(&mut self) {
@@ -184,15 +227,22 @@ impl Writer<'_> {
         }
     }
 
-    /// The lines of `jac_x_into` (`with_dm`) or `jac_u_into` that turn the rows of `∂F` in `jac` into those of the
-    /// rates: `M ∂ḟ = ∂F − (∂M/∂x_k) ḟ`.
-    pub(super) fn mass_solve_in_jacobian(&self, d: &mut Draft, with_dm: bool, cols: &str) {
+    /// The lines of a Jacobian function (`jac_x_into`, `jac_u_into`, `jac_p_into`: the columns `columns`) that
+    /// turn the rows of `∂F` in `jac` into those of the rates: `M ∂ḟ = ∂F − (∂M/∂v) ḟ` (`M` does not depend on the
+    /// inputs).
+    pub(super) fn mass_solve_in_jacobian(&self, d: &mut Draft, columns: MassColumns) {
+        let cols = columns.size();
         for b in &self.plan.mass {
             let n = b.rows.len();
-            let correction = if with_dm {
-                " − (∂M/∂x_k) ḟ"
+            let (derivatives, v): (&Derivatives, &str) = match columns {
+                MassColumns::States => (&b.derivatives, "x_k"),
+                MassColumns::Inputs => (&[], ""),
+                MassColumns::Params => (&b.param_derivatives, "p_k"),
+            };
+            let correction = if v.is_empty() {
+                String::new()
             } else {
-                ""
+                format!(" − (∂M/∂{v}) ḟ")
             };
             d.lines.extend(self.comment_lines(&format!(
                 "The rows of d/dt [{}]: M (∂ḟ) = ∂F{correction}, solved with M.",
@@ -206,24 +256,19 @@ impl Writer<'_> {
                     "    for c in 0..{cols} {{\n        rows[({k}, c)] = jac[({r}, c)];\n    }}"
                 ));
             }
-            if with_dm && !b.derivatives.is_empty() {
+            if !derivatives.is_empty() {
                 d.lines.push("    let mut dx = State::zeros();".into());
                 d.lines.push("    rhs_into(p, t, x, u, &mut dx);".into());
                 d.uses.t = true;
                 d.uses.u = true;
-                for (k, dm) in &b.derivatives {
-                    let state = self
-                        .plan
-                        .states
-                        .get(*k)
-                        .map(|s| s.name().to_string())
-                        .unwrap_or_default();
+                for (k, dm) in derivatives {
+                    let by = self.column_name(columns, *k);
                     for (i, row) in dm.iter().enumerate() {
                         for (j, e) in row.iter().enumerate() {
                             if e.is_zero() {
                                 continue;
                             }
-                            let label = format!("∂M[{}, {}]/∂{state} = ", i + 1, j + 1);
+                            let label = format!("∂M[{}, {}]/∂{by} = ", i + 1, j + 1);
                             self.statement(d, &label, e, "let dm = ", ";");
                             let rate = b.rows.get(j).copied().unwrap_or_default();
                             d.lines
@@ -244,6 +289,16 @@ impl Writer<'_> {
             d.uses.p = true;
             d.uses.x = true;
         }
+    }
+
+    /// The name of column `k` of a Jacobian by `columns`.
+    fn column_name(&self, columns: MassColumns, k: usize) -> String {
+        let symbol = match columns {
+            MassColumns::States => self.plan.states.get(k),
+            MassColumns::Inputs => self.plan.inputs.get(k),
+            MassColumns::Params => return self.free_param_name(k),
+        };
+        symbol.map(|s| s.name().to_string()).unwrap_or_default()
     }
 
     fn state_list(&self, rows: &[usize]) -> String {

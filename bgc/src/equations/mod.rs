@@ -64,6 +64,7 @@ mod linear;
 mod naming;
 pub mod newton;
 mod numeric;
+mod param_chain;
 mod print;
 mod resolve;
 mod sensitivity;
@@ -81,8 +82,9 @@ pub use linear::{
     Jacobians, LinearError, NumericStateSpace, StateSelection, SymbolicStateSpace, evaluate_at,
     jacobians, linear_state_space, linearise, numeric_state_space,
 };
+pub use param_chain::ParamChain;
 pub use print::{expr_latex, expr_text, to_json, to_latex, to_text};
-pub use sensitivity::PointJacobians;
+pub use sensitivity::{PointJacobians, Sensitivity};
 pub(crate) use tear::block_jacobian;
 pub use tear::{LoopFailure, TearBlock, residual_scale, solve_all};
 

@@ -1,13 +1,28 @@
 //! The Jacobians of the rates and outputs at a point with respect to the states and to chosen parameters, for
 //! the forward sensitivities of `bgc fit`.
 //!
-//! They are taken numerically, by central differences of [`Equations::rates_at`] and [`Equations::outputs_at`],
-//! so they cover every model those evaluate (mass-matrix rows, algebraic loops) with one rule. A parameter is
-//! perturbed through [`Equations::param_values`], so the derived parameters that depend on it move with it.
-//! The step `∛ε · |v|` (`∛ε · max(|x|, 1)` for a state) balances truncation against rounding (relative error about 1e-10).
+//! They are symbolic derivatives of the explicit rates `f` and outputs `h` (in the shared engine
+//! [`crate::symbolic`], after [`super::to_symbolic`]), evaluated at the point. The derivative with respect to a
+//! parameter is total through the derived parameters ([`ParamChain`]). Where the rates are not explicit the
+//! implicit function theorem supplies the rest, so no derivative is taken by differences:
+//! - nonlinear algebraic loops, `0 = r(z, x, u, p, t)` for the tears `z` ([`super::tear`]):
+//!   `∂r/∂z · dz/dv = −∂r/∂v` for `v` a state or a parameter, and `df/dv = ∂f/∂v + ∂f/∂z · dz/dv` (the same for
+//!   `h` and for the inertia matrices);
+//! - the mass-matrix rows of I-fields, `M ẋ_B = F` ([`super::MassBlock`]): `M · dẋ_B/dv = dF/dv − (dM/dv) ẋ_B`.
+//!
+//! Affine algebraic loops need nothing of their own: the equations stage solves them symbolically, so their
+//! solution is part of `f` and `h`. [`Equations::sensitivity`] does the symbolic work once (the fit evaluates it at
+//! every step); [`Equations::param_jacobian_at`] is the one-off form.
 
 use super::Equations;
-use super::linear::LinearError;
+use super::bridge::{symbol, to_symbolic};
+use super::dense::{self, Mat};
+use super::linear::{LinearError, check_len};
+use super::numeric::point;
+use super::param_chain::ParamChain;
+use super::sym::Sym;
+use super::tear::solve_all;
+use crate::symbolic::{Compiled, Expr, Symbol};
 
 /// `∂f/∂x`, `∂f/∂p`, `∂h/∂x`, `∂h/∂p` at a point, row-major (`fx[i][j] = ∂f_i/∂x_j`); the parameter columns are
 /// those asked for, in that order.
@@ -19,10 +34,153 @@ pub struct PointJacobians {
     pub hp: Vec<Vec<f64>>,
 }
 
-/// ∛ε: the relative step of a central difference.
-const STEP: f64 = 6.0554544523933395e-6;
+/// Partial derivatives `[∂/∂x | ∂/∂p]` of some expressions: one row per expression, the state columns then the
+/// chosen parameters' (total through the derived parameters).
+type Partials = Vec<Vec<Expr>>;
+
+/// A matrix of expressions, compiled once to be evaluated at every point.
+#[derive(Debug)]
+struct Matrix {
+    exprs: Vec<Vec<Expr>>,
+    compiled: Compiled,
+    /// Where the value of each of the compiled symbols is in a point's values ([`Sensitivity::symbols`] order);
+    /// `None` for a symbol that has none.
+    slots: Vec<Option<usize>>,
+}
+
+impl Matrix {
+    fn new(exprs: Vec<Vec<Expr>>, symbols: &[Symbol]) -> Matrix {
+        let flat: Vec<Expr> = exprs.iter().flatten().cloned().collect();
+        let compiled = Compiled::new(&flat);
+        let slots = compiled
+            .symbols()
+            .iter()
+            .map(|s| symbols.iter().position(|k| k == s))
+            .collect();
+        Matrix {
+            exprs,
+            compiled,
+            slots,
+        }
+    }
+}
+
+/// The nonlinear algebraic loops' part.
+#[derive(Debug)]
+struct Loops {
+    tears: Vec<Symbol>,
+    /// `∂r/∂z` over all tears (block-triangular).
+    rz: Matrix,
+    rv: Matrix,
+    fz: Matrix,
+    hz: Matrix,
+}
+
+/// One inertia matrix `M`, the generalised forces `F` of its rows, and the derivatives of `M`'s entries
+/// (flattened row-major) by the states and parameters and by the tears.
+#[derive(Debug)]
+struct Mass {
+    element: String,
+    rows: Vec<usize>,
+    m: Matrix,
+    forces: Matrix,
+    mv: Matrix,
+    mz: Matrix,
+}
+
+/// The symbolic Jacobians of a model with respect to its states and chosen parameters, ready to evaluate.
+#[derive(Debug)]
+pub struct Sensitivity<'e> {
+    eqs: &'e Equations,
+    /// The symbols with a value at a point: the parameters, states and inputs in order, time, then the tears of
+    /// the loops in solving order.
+    symbols: Vec<Symbol>,
+    fv: Matrix,
+    hv: Matrix,
+    loops: Option<Loops>,
+    mass: Vec<Mass>,
+}
 
 impl Equations {
+    /// The symbolic Jacobians with respect to the states and the parameters `free` (indices into
+    /// [`Equations::params`]), for the parameter values that follow from `given` ([`Equations::param_values`]): a
+    /// derived parameter given a value is held there, the others follow the parameters they are defined from.
+    pub fn sensitivity(
+        &self,
+        given: &[Option<f64>],
+        free: &[usize],
+    ) -> Result<Sensitivity<'_>, LinearError> {
+        let pinned: Vec<usize> = (0..self.params.len())
+            .filter(|&j| self.derived.get(j).is_some_and(Option::is_some))
+            .filter(|&j| given.get(j).copied().flatten().is_some())
+            .collect();
+        let chain = ParamChain::new(self, free, &pinned)?;
+        let states: Vec<Symbol> = (0..self.states.len())
+            .map(|i| symbol(self, Sym::State(i)))
+            .collect();
+        let symbols: Vec<Symbol> = (0..self.params.len())
+            .map(Sym::Param)
+            .map(|s| symbol(self, s))
+            .chain(states.iter().cloned())
+            .chain((0..self.inputs.len()).map(|i| symbol(self, Sym::Input(i))))
+            .chain(std::iter::once(symbol(self, Sym::Time)))
+            .chain(
+                self.tear_blocks
+                    .iter()
+                    .flat_map(|b| b.tears.iter().map(|&z| symbol(self, z))),
+            )
+            .collect();
+        let matrix = |m: Vec<Vec<Expr>>| Matrix::new(m, &symbols);
+        let partials = |exprs: &[Expr]| -> Partials {
+            let x = Expr::jacobian(exprs, &states);
+            x.into_iter()
+                .zip(chain.jacobian(exprs))
+                .map(|(mut row, p)| {
+                    row.extend(p);
+                    row
+                })
+                .collect()
+        };
+        let f = self.explicit_rates()?;
+        let h = self.explicit_outputs()?;
+        let loops = self.loop_partials(&f, &h, &partials, &matrix)?;
+        let tears = loops.as_ref().map_or(&[][..], |l| &l.tears[..]);
+        let mut mass = Vec::with_capacity(self.mass.len());
+        for b in &self.mass {
+            let entries: Vec<Expr> = b
+                .matrix
+                .iter()
+                .flatten()
+                .map(|e| self.convert(e, || format!("M_{}", b.element)))
+                .collect::<Result<_, _>>()?;
+            let m: Vec<Vec<Expr>> = entries
+                .chunks(b.states.len().max(1))
+                .map(<[Expr]>::to_vec)
+                .collect();
+            let forces: Vec<Vec<Expr>> = b
+                .states
+                .iter()
+                .map(|&r| vec![f.get(r).cloned().unwrap_or_else(Expr::zero)])
+                .collect();
+            mass.push(Mass {
+                element: b.element.clone(),
+                rows: b.states.clone(),
+                m: matrix(m),
+                forces: matrix(forces),
+                mv: matrix(partials(&entries)),
+                mz: matrix(Expr::jacobian(&entries, tears)),
+            });
+        }
+        Ok(Sensitivity {
+            eqs: self,
+            fv: matrix(partials(&f)),
+            hv: matrix(partials(&h)),
+            symbols,
+            loops,
+            mass,
+        })
+    }
+
     /// The Jacobians at state `x`, input `u`, time `t`, with the parameter values that follow from `given`
     /// ([`Equations::param_values`]), differentiated with respect to the parameters `free` (indices into
     /// [`Equations::params`]).
@@ -34,11 +192,11 @@ impl Equations {
         t: f64,
         free: &[usize],
     ) -> Result<PointJacobians, LinearError> {
-        self.jacobians_at(given, (x, u, t), free, true)
+        self.sensitivity(given, free)?
+            .at(&self.param_values(given), (x, u, t), true)
     }
 
-    /// [`Equations::param_jacobian_at`] without the outputs (`hx`, `hp` are left empty): half the evaluations,
-    /// for an integrator that needs only the rates' Jacobians.
+    /// [`Equations::param_jacobian_at`] without the outputs (`hx`, `hp` are left empty).
     pub fn rate_param_jacobian_at(
         &self,
         given: &[Option<f64>],
@@ -47,87 +205,302 @@ impl Equations {
         t: f64,
         free: &[usize],
     ) -> Result<PointJacobians, LinearError> {
-        self.jacobians_at(given, (x, u, t), free, false)
+        self.sensitivity(given, free)?
+            .at(&self.param_values(given), (x, u, t), false)
     }
 
-    fn jacobians_at(
-        &self,
-        given: &[Option<f64>],
-        (x, u, t): (&[f64], &[f64], f64),
-        free: &[usize],
-        outputs: bool,
-    ) -> Result<PointJacobians, LinearError> {
-        let params = self.param_values(given);
-        let (nx, ny) = (x.len(), if outputs { self.outputs.len() } else { 0 });
-        let mut out = PointJacobians {
-            fx: vec![vec![0.0; nx]; nx],
-            fp: vec![vec![0.0; free.len()]; nx],
-            hx: vec![vec![0.0; nx]; ny],
-            hp: vec![vec![0.0; free.len()]; ny],
-        };
-        let mut xs = x.to_vec();
-        for j in 0..nx {
-            let h = STEP * x[j].abs().max(1.0);
-            xs[j] = x[j] + h;
-            let plus = self.point(&params, &xs, u, t, outputs)?;
-            xs[j] = x[j] - h;
-            let minus = self.point(&params, &xs, u, t, outputs)?;
-            xs[j] = x[j];
-            column(&mut out.fx, &mut out.hx, j, &plus, &minus, h);
-        }
-        let mut perturbed = given.to_vec();
-        perturbed.resize(self.params.len(), None);
-        for (c, &k) in free.iter().enumerate() {
-            let Some(&v) = params.get(k) else {
-                return Err(LinearError::Dimension {
-                    what: "parameter",
-                    expected: self.params.len(),
-                    got: k + 1,
-                });
-            };
-            // Relative to the value: a tiny positive inertia is stepped in proportion, never across zero.
-            let h = STEP * if v == 0.0 { 1.0 } else { v.abs() };
-            perturbed[k] = Some(v + h);
-            let plus = self.point(&self.param_values(&perturbed), x, u, t, outputs)?;
-            perturbed[k] = Some(v - h);
-            let minus = self.point(&self.param_values(&perturbed), x, u, t, outputs)?;
-            perturbed[k] = given.get(k).copied().flatten();
-            column(&mut out.fp, &mut out.hp, c, &plus, &minus, h);
-        }
-        Ok(out)
+    fn convert(&self, e: &super::sym::Ex, what: impl Fn() -> String) -> Result<Expr, LinearError> {
+        to_symbolic(self, e).ok_or_else(|| LinearError::Incomplete { what: what() })
     }
 
-    /// The rates and the outputs at a point.
-    fn point(
+    fn explicit_rates(&self) -> Result<Vec<Expr>, LinearError> {
+        self.f
+            .iter()
+            .enumerate()
+            .map(|(i, f)| {
+                let what = || format!("the rate of `{}`", self.sym_name(Sym::State(i)));
+                let e = f
+                    .as_ref()
+                    .ok_or_else(|| LinearError::Incomplete { what: what() })?;
+                self.convert(e, what)
+            })
+            .collect()
+    }
+
+    fn explicit_outputs(&self) -> Result<Vec<Expr>, LinearError> {
+        self.outputs
+            .iter()
+            .zip(self.outputs_inlined())
+            .map(|(o, e)| {
+                let what = || format!("output `{}`", o.name);
+                let e = e.ok_or_else(|| LinearError::Incomplete { what: what() })?;
+                self.convert(&e, what)
+            })
+            .collect()
+    }
+
+    fn loop_partials(
         &self,
-        params: &[f64],
-        x: &[f64],
-        u: &[f64],
-        t: f64,
-        outputs: bool,
-    ) -> Result<(Vec<f64>, Vec<f64>), LinearError> {
-        let y = if outputs {
-            self.outputs_at(params, x, u, t)?
-        } else {
-            Vec::new()
-        };
-        Ok((self.rates_at(params, x, u, t)?, y))
+        f: &[Expr],
+        h: &[Expr],
+        partials: &dyn Fn(&[Expr]) -> Partials,
+        matrix: &dyn Fn(Vec<Vec<Expr>>) -> Matrix,
+    ) -> Result<Option<Loops>, LinearError> {
+        if self.tear_blocks.is_empty() {
+            return Ok(None);
+        }
+        let mut tears = Vec::new();
+        let mut residuals = Vec::new();
+        for b in &self.tear_blocks {
+            tears.extend(b.tears.iter().map(|&z| symbol(self, z)));
+            for (r, name) in b.residuals.iter().zip(&b.names) {
+                residuals.push(self.convert(r, || format!("the algebraic loop for `{name}`"))?);
+            }
+        }
+        Ok(Some(Loops {
+            rz: matrix(Expr::jacobian(&residuals, &tears)),
+            rv: matrix(partials(&residuals)),
+            fz: matrix(Expr::jacobian(f, &tears)),
+            hz: matrix(Expr::jacobian(h, &tears)),
+            tears,
+        }))
     }
 }
 
-/// Writes column `c` of the rate and output Jacobians from the two perturbed points.
-fn column(
-    f: &mut [Vec<f64>],
-    h: &mut [Vec<f64>],
-    c: usize,
-    plus: &(Vec<f64>, Vec<f64>),
-    minus: &(Vec<f64>, Vec<f64>),
-    step: f64,
-) {
-    for (row, (a, b)) in f.iter_mut().zip(plus.0.iter().zip(&minus.0)) {
-        row[c] = (a - b) / (2.0 * step);
+/// The values of the symbols at a point.
+struct Point<'a> {
+    eqs: &'a Equations,
+    /// In [`Sensitivity::symbols`] order.
+    values: Vec<f64>,
+}
+
+impl Point<'_> {
+    /// `m` evaluated; `what(i, j)` names an entry in errors.
+    fn matrix(
+        &self,
+        m: &Matrix,
+        what: &dyn Fn(usize, usize) -> String,
+    ) -> Result<Mat, LinearError> {
+        let mut symbol_values = Vec::with_capacity(m.slots.len());
+        for (s, slot) in m.compiled.symbols().iter().zip(&m.slots) {
+            match slot.and_then(|k| self.values.get(k)) {
+                Some(&v) => symbol_values.push(v),
+                None => return Err(self.unbound(m, s, what)),
+            }
+        }
+        let mut values = m.compiled.eval(&symbol_values).into_iter();
+        m.exprs
+            .iter()
+            .enumerate()
+            .map(|(i, row)| {
+                row.iter()
+                    .enumerate()
+                    .map(|(j, _)| match values.next() {
+                        Some(v) if v.is_finite() => Ok(v),
+                        _ => Err(LinearError::NonFinite { what: what(i, j) }),
+                    })
+                    .collect()
+            })
+            .collect()
     }
-    for (row, (a, b)) in h.iter_mut().zip(plus.1.iter().zip(&minus.1)) {
-        row[c] = (a - b) / (2.0 * step);
+
+    /// The error for the symbol `s` without a value, naming the first entry of `m` that reads it.
+    fn unbound(
+        &self,
+        m: &Matrix,
+        s: &Symbol,
+        what: &dyn Fn(usize, usize) -> String,
+    ) -> LinearError {
+        let (i, j) = m
+            .exprs
+            .iter()
+            .enumerate()
+            .find_map(|(i, row)| row.iter().position(|e| e.depends_on(s)).map(|j| (i, j)))
+            .unwrap_or((0, 0));
+        LinearError::Unbound {
+            what: what(i, j),
+            symbol: s.name().to_string(),
+        }
+    }
+
+    /// The name of column `j` of a `[∂/∂x | ∂/∂p]` matrix.
+    fn column(&self, j: usize) -> String {
+        match self.eqs.states.get(j) {
+            Some(s) => s.name.clone(),
+            None => format!("parameter column {}", j - self.eqs.states.len()),
+        }
+    }
+}
+
+impl Sensitivity<'_> {
+    /// The Jacobians at the parameter values `params` (all of them, in [`Equations::params`] order, as
+    /// [`Equations::param_values`] gives them), state `x`, input `u` and time `t`; without the outputs' (left
+    /// empty) unless `outputs`.
+    pub fn at(
+        &self,
+        params: &[f64],
+        (x, u, t): (&[f64], &[f64], f64),
+        outputs: bool,
+    ) -> Result<PointJacobians, LinearError> {
+        let eqs = self.eqs;
+        let values = self.values_at(params, (x, u, t))?;
+        let at = Point { eqs, values };
+        let rate = |i: usize| format!("the rate of `{}`", eqs.sym_name(Sym::State(i)));
+        let output = |k: usize| format!("output `{}`", eqs.sym_name(Sym::Output(k)));
+        let mut fv = at.matrix(&self.fv, &|i, j| {
+            format!("∂({})/∂{}", rate(i), at.column(j))
+        })?;
+        let mut hv = if outputs {
+            at.matrix(&self.hv, &|k, j| {
+                format!("∂({})/∂{}", output(k), at.column(j))
+            })?
+        } else {
+            Vec::new()
+        };
+        let dz = match &self.loops {
+            Some(l) => Some(self.through_loops(&at, l, &mut fv, &mut hv, outputs)?),
+            None => None,
+        };
+        for b in &self.mass {
+            self.solve_mass_rows(&at, b, dz.as_ref(), &mut fv)?;
+        }
+        let n = x.len();
+        let split = |m: Mat| -> (Mat, Mat) {
+            m.into_iter()
+                .map(|mut row| {
+                    let p = row.split_off(n.min(row.len()));
+                    (row, p)
+                })
+                .unzip()
+        };
+        let (fx, fp) = split(fv);
+        let (hx, hp) = split(hv);
+        Ok(PointJacobians { fx, fp, hx, hp })
+    }
+
+    /// The value of every symbol the expressions read at a point: parameters, states, inputs, time and, with
+    /// nonlinear loops, the tears (solved by Newton's method, as `rates_at` solves them).
+    fn values_at(
+        &self,
+        params: &[f64],
+        (x, u, t): (&[f64], &[f64], f64),
+    ) -> Result<Vec<f64>, LinearError> {
+        let eqs = self.eqs;
+        check_len("parameter", eqs.params.len(), params.len())?;
+        check_len("state", eqs.states.len(), x.len())?;
+        check_len("input", eqs.inputs.len(), u.len())?;
+        let mut values = Vec::with_capacity(self.symbols.len());
+        values.extend_from_slice(params);
+        values.extend_from_slice(x);
+        values.extend_from_slice(u);
+        values.push(t);
+        if self.loops.is_some() {
+            let tears = solve_all(eqs, &|s| point(s, params, x, u, t)).map_err(|e| {
+                LinearError::LoopNotSolved {
+                    tears: e.tear_list(),
+                    reason: e.failure.kind.describe(),
+                    residual: e.failure.residual,
+                }
+            })?;
+            // In solving order, as `symbols` lists them.
+            values.extend(tears.into_iter().map(|(_, v)| v));
+        }
+        Ok(values)
+    }
+
+    /// Adds the loops' contribution `∂g/∂z · dz/dv` to the rates' and outputs' columns; returns `dz/dv`.
+    fn through_loops(
+        &self,
+        at: &Point,
+        l: &Loops,
+        fv: &mut Mat,
+        hv: &mut Mat,
+        outputs: bool,
+    ) -> Result<Mat, LinearError> {
+        let eqs = self.eqs;
+        let names = l
+            .tears
+            .iter()
+            .map(|z| z.name().to_string())
+            .collect::<Vec<_>>()
+            .join("`, `");
+        let what = |_: usize, _: usize| format!("the algebraic loop for `{names}`");
+        let rz = at.matrix(&l.rz, &what)?;
+        let mut rv = at.matrix(&l.rv, &what)?;
+        rv.iter_mut().flatten().for_each(|v| *v = -*v);
+        // dz/dv = −(∂r/∂z)⁻¹ ∂r/∂v
+        let dz = dense::solve(&rz, &rv).ok_or(LinearError::SingularLoop { tears: names })?;
+        let rate =
+            |i: usize, _: usize| format!("∂(the rate of `{}`)/∂z", eqs.sym_name(Sym::State(i)));
+        add_product(fv, &at.matrix(&l.fz, &rate)?, &dz);
+        if outputs {
+            let output =
+                |k: usize, _: usize| format!("∂(output `{}`)/∂z", eqs.sym_name(Sym::Output(k)));
+            add_product(hv, &at.matrix(&l.hz, &output)?, &dz);
+        }
+        Ok(dz)
+    }
+
+    /// Replaces the rows of the generalised forces' derivatives `dF/dv` of a mass block by those of the rates:
+    /// `M · dẋ_B/dv = dF/dv − (dM/dv) ẋ_B`.
+    fn solve_mass_rows(
+        &self,
+        at: &Point,
+        b: &Mass,
+        dz: Option<&Mat>,
+        fv: &mut Mat,
+    ) -> Result<(), LinearError> {
+        let eqs = self.eqs;
+        let element = &b.element;
+        let nb = b.rows.len();
+        let what = |k: usize, _: usize| {
+            format!("M_{element}[{},{}]", k / nb.max(1) + 1, k % nb.max(1) + 1)
+        };
+        let m = at.matrix(&b.m, &|i, j| format!("M_{element}[{},{}]", i + 1, j + 1))?;
+        let singular = || LinearError::SingularMass {
+            element: element.clone(),
+        };
+        let forces = at.matrix(&b.forces, &|i, _| {
+            let r = b.rows.get(i).copied().unwrap_or_default();
+            format!("the rate of `{}`", eqs.sym_name(Sym::State(r)))
+        })?;
+        let rates: Vec<f64> = dense::solve(&m, &forces)
+            .ok_or_else(singular)?
+            .into_iter()
+            .map(|r| r.first().copied().unwrap_or(0.0))
+            .collect();
+        let mut dm = at.matrix(&b.mv, &what)?;
+        if let Some(dz) = dz {
+            add_product(&mut dm, &at.matrix(&b.mz, &what)?, dz);
+        }
+        let mut rhs: Mat = b
+            .rows
+            .iter()
+            .map(|&r| fv.get(r).cloned().unwrap_or_default())
+            .collect();
+        for (i, row) in rhs.iter_mut().enumerate() {
+            for (j, rate) in rates.iter().enumerate() {
+                if let Some(d) = dm.get(i * nb + j) {
+                    row.iter_mut()
+                        .zip(d)
+                        .for_each(|(slot, d)| *slot -= d * rate);
+                }
+            }
+        }
+        let solved = dense::solve(&m, &rhs).ok_or_else(singular)?;
+        for (&r, row) in b.rows.iter().zip(solved) {
+            if let Some(slot) = fv.get_mut(r) {
+                *slot = row;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `acc += a · b`.
+fn add_product(acc: &mut Mat, a: &Mat, b: &Mat) {
+    let product = dense::mul(a, b);
+    for (row, add) in acc.iter_mut().zip(product) {
+        row.iter_mut().zip(add).for_each(|(v, a)| *v += a);
     }
 }

@@ -1,9 +1,10 @@
 //! A model of fixed size (a generated model, or any [`ContinuousModel`] with [`Parametric`]) as a [`FitModel`].
 //!
 //! `∂f/∂x` and `∂h/∂x` come from the model's `jac_x` and `output_jac_x` (symbolic in generated models). The
-//! parameter Jacobians come from [`ParamJacobians`] when the model implements it ([`Generated::exact`]; the code
-//! generator does not emit them yet, so generated models use the other way), else from central differences over
-//! [`Parametric::set_param`] ([`Generated::new`]).
+//! parameter Jacobians come from [`ParamJacobians`] when the model implements it ([`Generated::exact`]; every
+//! generated `Model` does, from its symbolic `jac_p_into` and `output_jac_p_into`, which follow the derived
+//! parameters and solve the model's loops and mass matrices), else from central differences over
+//! [`Parametric::set_param`] ([`Generated::new`], for a hand-written model).
 
 use nalgebra::{DMatrix, SMatrix, SVector};
 

@@ -5,6 +5,7 @@
 
 use super::super::emit::{Block, MAX_LETS, StateSpace};
 use super::super::layout::Body;
+use super::super::mass::MassColumns;
 use super::super::names::{Namer, comment};
 use super::calls::{call_depth, call_name, early_calls, with_bound_calls};
 use super::terms::term_field;
@@ -225,7 +226,7 @@ impl Writer<'_> {
     /// The model function `name` with the body of `d` and the output argument `out` (`dx`, `y`, `jac`): itself
     /// when the body reads no parameter term, else `{base}_with(p, c, t, x, u, out)` that reads them from `c` and
     /// `name` that computes them and calls it.
-    fn model_function(&mut self, name: &str, doc: &str, d: Draft, out: Arg) {
+    pub(super) fn model_function(&mut self, name: &str, doc: &str, d: Draft, out: Arg) {
         let mut args = Self::model_args(d.uses);
         if !d.reads_terms {
             args.push(out);
@@ -310,6 +311,7 @@ impl Writer<'_> {
         self.rhs();
         self.outputs();
         self.jacobians();
+        self.param_jacobians();
         self.state_spaces();
         self.energy();
     }
@@ -423,10 +425,10 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         }
         self.loop_correction(&mut d, g_z, r_v, size);
         match name {
-            "jac_x_into" => self.mass_solve_in_jacobian(&mut d, true, "N_STATES"),
+            "jac_x_into" => self.mass_solve_in_jacobian(&mut d, MassColumns::States),
             // Without inputs `∂f/∂u` has no columns to solve for (and an empty loop fails `clippy`).
             "jac_u_into" if !self.plan.inputs.is_empty() => {
-                self.mass_solve_in_jacobian(&mut d, false, "N_INPUTS")
+                self.mass_solve_in_jacobian(&mut d, MassColumns::Inputs)
             }
             _ => {}
         }

@@ -11,6 +11,10 @@
 //!   `jac_x_into`, `jac_u_into`, `output_jac_x_into`, `output_jac_u_into` from symbolic derivatives; when a
 //!   `JacX` takes more than 256 KiB (above 181 states) and no loop or mass matrix corrects it, also the triplets
 //!   `JAC_X_NNZ`, `JAC_X_ROWS`, `JAC_X_COLS` and `jac_x_sparse_into`, which need no `N_STATES²` matrix;
+//! - the parameter Jacobians `jac_p_into` (`JacP`, `N_STATES × N_PARAMS`) and `output_jac_p_into` (`OutJacP`,
+//!   `N_OUTPUTS × N_PARAMS`): full matrices, a column per free parameter in `PARAM_NAMES` order, total through the
+//!   derived parameters, with the loops' and mass matrices' contributions as in `jac_x_into`
+//!   (`param_jacobians.rs`);
 //! - for a linear model `state_space(&Params) -> (A, B, C, D)` whenever `bgc statespace` prints one: in the energy
 //!   states (type `EnergyStateSpace`), or, when the outputs or rates read an integrated flow (`var`), in all states,
 //!   energy states then integrated flows (type `FullStateSpace`); and, when the model declares coordinates,
@@ -20,7 +24,8 @@
 //!   `solve_loops(p, t, x, u) -> Result<Tears, LoopError>` (damped Newton's method per block, see
 //!   `codegen::loops`); the functions above solve the loops first and give NaN where `solve_loops` fails;
 //! - `Model` (the parameters, validated) and, with [`Options::runtime`], its implementations of
-//!   `bgc_runtime::model::ContinuousModel` and `Parametric`.
+//!   `bgc_runtime::model::ContinuousModel`, `Parametric` and `bgc_runtime::fit::generated::ParamJacobians` (a column of
+//!   `jac_p_into` or `output_jac_p_into` by index, for `Generated::exact`).
 //!
 //! # What the code needs
 //! The functions of the model take fixed-size values, allocate nothing, never panic (indices are constants within
@@ -49,6 +54,7 @@
 mod calls;
 mod functions;
 mod model;
+mod param_jacobians;
 mod params;
 mod terms;
 

@@ -177,6 +177,7 @@ impl Writer<'_> {
             };
             self.out
                 .push_str(&RUNTIME_IMPLS.replace("{set_param}", set_param));
+            self.param_jacobians_impl();
         }
         if !constants.is_empty() {
             self.constant_jacobians_struct(&constants);

@@ -178,8 +178,16 @@ fn chirp(cfg: &BenchConfig, t: f64) -> f64 {
     cfg.amplitude * (2.0 * std::f64::consts::PI * (cfg.f0 * t + 0.5 * rate * t * t)).sin()
 }
 
-/// Simulates the lab test with the paper's parameters and returns the noisy record of `omega_m` and `tau_s`.
-pub fn bench_record(cfg: &BenchConfig) -> Result<Record, IdentificationError> {
+/// The noise-free lab test: sample times, the held commands and the true `omega_m`, `tau_s` at each sample.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CleanBench {
+    pub times: Vec<f64>,
+    pub inputs: Vec<Vec<f64>>,
+    pub outputs: Vec<[f64; 2]>,
+}
+
+/// Simulates the lab test with the paper's parameters, without noise.
+pub fn bench_clean(cfg: &BenchConfig) -> Result<CleanBench, IdentificationError> {
     let model = Model::default();
     let mut run = SampledLoopConfig::new(cfg.sample_time, cfg.samples, SVector::zeros());
     run.solver = SolverOptions {
@@ -191,10 +199,27 @@ pub fn bench_record(cfg: &BenchConfig) -> Result<Record, IdentificationError> {
     let mut command =
         |_k: usize, t: f64, _y: &SVector<f64, 3>| SVector::<f64, 2>::new(chirp(cfg, t), 0.0);
     let traj = simulate_sampled_loop(&model, &mut command, &run)?;
-    let mut rng = Rng::new(cfg.seed);
+    // The logger records the command held from each sample; the last sample holds the last command.
+    let mut inputs: Vec<Vec<f64>> = traj.inputs.iter().map(|u| vec![u[0], u[1]]).collect();
+    inputs.push(inputs.last().cloned().unwrap_or_else(|| vec![0.0, 0.0]));
+    Ok(CleanBench {
+        times: traj.times,
+        inputs,
+        outputs: traj.measurements.iter().map(|y| [y[0], y[1]]).collect(),
+    })
+}
+
+/// `clean` as measured: uniform noise within the encoder bound of `cfg` and the torque sensor's bound, drawn
+/// from `seed`.
+pub fn with_noise(
+    clean: &CleanBench,
+    cfg: &BenchConfig,
+    seed: u64,
+) -> Result<Record, IdentificationError> {
+    let mut rng = Rng::new(seed);
     let mut uniform = |bound: f64| bound * (2.0 * rng.uniform() - 1.0);
-    let measured: Vec<Vec<f64>> = traj
-        .measurements
+    let measured: Vec<Vec<f64>> = clean
+        .outputs
         .iter()
         .map(|y| {
             vec![
@@ -203,10 +228,17 @@ pub fn bench_record(cfg: &BenchConfig) -> Result<Record, IdentificationError> {
             ]
         })
         .collect();
-    // The logger records the command held from each sample; the last sample holds the last command.
-    let mut inputs: Vec<Vec<f64>> = traj.inputs.iter().map(|u| vec![u[0], u[1]]).collect();
-    inputs.push(inputs.last().cloned().unwrap_or_else(|| vec![0.0, 0.0]));
-    Ok(Record::new(traj.times, inputs, vec![0, 1], measured)?)
+    Ok(Record::new(
+        clean.times.clone(),
+        clean.inputs.clone(),
+        vec![0, 1],
+        measured,
+    )?)
+}
+
+/// Simulates the lab test with the paper's parameters and returns the noisy record of `omega_m` and `tau_s`.
+pub fn bench_record(cfg: &BenchConfig) -> Result<Record, IdentificationError> {
+    with_noise(&bench_clean(cfg)?, cfg, cfg.seed)
 }
 
 /// The first `n` samples of a record.

@@ -1,18 +1,30 @@
 //! The bench-identification step: the simulated lab test (trunk held, chirp motor torque) at the paper's encoder
 //! bound and at a realistic one, the fit of J_g, k_g, k_s and J_sint, a table and its JSON.
 
+use std::fmt::Write as _;
+use std::path::Path;
+
+use bgc_models::back_support::{INPUT_NAMES, OUTPUT_NAMES};
+use bgc_runtime::fit::Record;
 use bgc_workspace::back_support::identification::{
     BenchConfig, BenchIdentification, bench_record, identify,
 };
 use serde_json::{Value, json};
 
-/// Runs the identification for one test and prints its table; the JSON of the result (or of its error).
-pub fn run(label: &str, cfg: &BenchConfig) -> Value {
+/// Runs the identification for one test and prints its table; writes the record to `csv` in the form
+/// `bgc fit --data` reads. The JSON of the result (or of its error).
+pub fn run(label: &str, cfg: &BenchConfig, csv: &Path) -> Value {
     println!(
         "\nbench identification, {label} (encoder |v_v| <= {:.1e} rad/s, torque sensor |v_t| <= 35e-3 N m)",
         cfg.encoder_bound
     );
-    let result = bench_record(cfg).and_then(|r| identify(cfg, &r));
+    let result = bench_record(cfg).and_then(|r| {
+        match std::fs::write(csv, record_csv(&r)) {
+            Ok(()) => println!("  record written to {}", csv.display()),
+            Err(e) => println!("  cannot write {}: {e}", csv.display()),
+        }
+        identify(cfg, &r)
+    });
     match result {
         Ok(id) => {
             print_table(&id);
@@ -23,6 +35,22 @@ pub fn run(label: &str, cfg: &BenchConfig) -> Value {
             json!({"test": label, "encoder_bound": cfg.encoder_bound, "error": e.to_string()})
         }
     }
+}
+
+/// The record as CSV: `t`, the inputs and the measured outputs by their model names.
+fn record_csv(r: &Record) -> String {
+    let mut header = vec!["t"];
+    header.extend(INPUT_NAMES);
+    header.extend(r.outputs.iter().map(|&k| OUTPUT_NAMES.get(k).copied().unwrap_or("?")));
+    let mut text = header.join(",") + "\n";
+    for ((t, u), y) in r.times.iter().zip(&r.inputs).zip(&r.measured) {
+        let _ = write!(text, "{t:e}");
+        for v in u.iter().chain(y) {
+            let _ = write!(text, ",{v:e}");
+        }
+        text.push('\n');
+    }
+    text
 }
 
 fn print_table(id: &BenchIdentification) {

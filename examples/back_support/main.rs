@@ -72,9 +72,21 @@ fn main() -> ExitCode {
         }
     };
     table::print_table(&s);
+    if let Err(e) = std::fs::create_dir_all(&args.out) {
+        eprintln!("error: cannot create {}: {e}", args.out.display());
+        return ExitCode::FAILURE;
+    }
     let bench = serde_json::json!([
-        bench::run("paper's sensor bounds", &BenchConfig::paper()),
-        bench::run("realistic 17-bit encoder", &BenchConfig::realistic()),
+        bench::run(
+            "paper's sensor bounds",
+            &BenchConfig::paper(),
+            &args.out.join("bench_paper.csv")
+        ),
+        bench::run(
+            "realistic 17-bit encoder",
+            &BenchConfig::realistic(),
+            &args.out.join("bench_realistic.csv")
+        ),
     ]);
     if let Some(path) = &args.json {
         let mut figures = figures::json(&s);

@@ -2,6 +2,7 @@
 //! chirp command with the trunk held and bounded noise, the exact linear path against the ODE sensitivities, and
 //! the identification at the paper's encoder bound and at a realistic one.
 
+use crate::coverage::Coverage;
 use bgc_models::back_support::{self as generated, Model, Params};
 use bgc_runtime::fit::sensitivity::{self, Fitted};
 use bgc_runtime::fit::{FitModel, FitSpec, FreeParam, Generated, Interp, Record, fit, linear};
@@ -181,9 +182,8 @@ fn at_the_papers_encoder_bound_all_four_are_determined() {
 }
 
 /// 100 seeded records of a shorter bench test (0.4 s) at the paper's noise bounds, J_g, k_g and k_s fitted
-/// from 10 % off with J_sint known: each estimate lies within 3 standard errors of the truth in at least 95 of
-/// them (a 3σ interval misses 0.27 % of the time), and the mean reported standard error agrees with the spread
-/// over the records to within 30 %. The noise is uniform on ±b, so the weights are 3/b² (its variance b²/3).
+/// from 10 % off with J_sint known, checked by [`Coverage`]. The noise is uniform on ±b, so the weights are 3/b²
+/// (its variance b²/3).
 #[test]
 fn back_support_estimates_cover_the_truth_and_their_errors_match_the_spread() {
     let cfg = BenchConfig {
@@ -220,9 +220,7 @@ fn back_support_estimates_cover_the_truth_and_their_errors_match_the_spread() {
         3.0 / cfg.encoder_bound.powi(2),
         3.0 / TORQUE_SENSOR_BOUND.powi(2),
     ];
-    let mut covered = 0;
-    let mut estimates = vec![Vec::new(); 3];
-    let mut errors = vec![Vec::new(); 3];
+    let mut study = Coverage::new(true_values);
     for seed in 0..100 {
         let record = with_noise(&clean, &cfg, 5000 + seed).expect("a valid record");
         let mut model = Generated::exact(Model::default()).declared_linear();
@@ -234,37 +232,7 @@ fn back_support_estimates_cover_the_truth_and_their_errors_match_the_spread() {
             &spec,
         )
         .expect("the fit runs");
-        assert!(r.convergence.converged(), "seed {seed}: {:?}", r.stop);
-        assert!(
-            r.undetermined.is_empty(),
-            "seed {seed}: {:?}",
-            r.undetermined
-        );
-        let inside = r
-            .estimates
-            .iter()
-            .zip(&true_values)
-            .all(|(e, t)| (e.value - t).abs() <= 3.0 * e.std_error);
-        covered += usize::from(inside);
-        for k in 0..3 {
-            estimates[k].push(r.estimates[k].value);
-            errors[k].push(r.estimates[k].std_error);
-        }
+        study.add(seed, &r);
     }
-    assert!(
-        covered >= 95,
-        "only {covered} of 100 records cover the truth within 3 standard errors"
-    );
-    for k in 0..3 {
-        let n = estimates[k].len() as f64;
-        let mean = estimates[k].iter().sum::<f64>() / n;
-        let spread =
-            (estimates[k].iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
-        let reported = errors[k].iter().sum::<f64>() / n;
-        assert!(
-            (0.7..=1.3).contains(&(reported / spread)),
-            "{}: reported {reported:e}, spread {spread:e}",
-            names[k]
-        );
-    }
+    study.check(&names);
 }

@@ -3,6 +3,7 @@
 //! them (a 3σ interval misses 0.27 % of the time), and the mean reported standard error must agree with the
 //! spread of the estimates over the records to within 30 %.
 
+use crate::coverage::Coverage;
 use bgc_models::pendulum_rig::{self as pend, Model, Params};
 use bgc_runtime::fit::{FitSpec, FreeParam, Generated, Record, fit};
 use bgc_runtime::noise::Rng;
@@ -85,49 +86,12 @@ fn pendulum_estimates_cover_the_truth_and_their_errors_match_the_spread() {
     start[index("J_p")] *= 1.3;
     start[index("d_s")] *= 0.7;
     let spec = spec();
-    let mut covered = 0;
-    let mut estimates = vec![Vec::new(); 2];
-    let mut errors = vec![Vec::new(); 2];
+    let mut study = Coverage::new(true_values.to_vec());
     for seed in 0..100 {
         let rec = record(&times, &clean, 1000 + seed);
         let mut model = Generated::exact(Model::default());
         let r = fit(&mut model, &rec, &start, &[0.0; 4], &spec).expect("the fit runs");
-        assert!(r.convergence.converged(), "seed {seed}: {:?}", r.stop);
-        assert!(
-            r.undetermined.is_empty(),
-            "seed {seed}: {:?}",
-            r.undetermined
-        );
-        let inside = r
-            .estimates
-            .iter()
-            .zip(true_values)
-            .all(|(e, t)| (e.value - t).abs() <= 3.0 * e.std_error);
-        covered += usize::from(inside);
-        for k in 0..2 {
-            estimates[k].push(r.estimates[k].value);
-            errors[k].push(r.estimates[k].std_error);
-        }
+        study.add(seed, &r);
     }
-    assert!(
-        covered >= 95,
-        "only {covered} of 100 records cover the truth within 3 standard errors"
-    );
-    for k in 0..2 {
-        let n = estimates[k].len() as f64;
-        let mean = estimates[k].iter().sum::<f64>() / n;
-        let spread =
-            (estimates[k].iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
-        let reported = errors[k].iter().sum::<f64>() / n;
-        let ratio = reported / spread;
-        assert!(
-            (0.7..=1.3).contains(&ratio),
-            "parameter {k}: reported {reported:e}, spread {spread:e}"
-        );
-        // And unbiased: the mean within 4 standard errors of the mean.
-        assert!(
-            (mean - true_values[k]).abs() < 4.0 * spread / n.sqrt(),
-            "parameter {k}: mean {mean:e}"
-        );
-    }
+    study.check(&["J_p", "d_s"]);
 }

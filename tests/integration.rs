@@ -1,6 +1,7 @@
 //! The integration tests of this crate, in one test binary: one module per concern.
 
 mod back_support;
+mod coverage;
 mod fit_back_support;
 mod fit_pendulum;
 mod rehab_fusion;

@@ -41,7 +41,11 @@ pub fn run(label: &str, cfg: &BenchConfig, csv: &Path) -> Value {
 fn record_csv(r: &Record) -> String {
     let mut header = vec!["t"];
     header.extend(INPUT_NAMES);
-    header.extend(r.outputs.iter().map(|&k| OUTPUT_NAMES.get(k).copied().unwrap_or("?")));
+    header.extend(
+        r.outputs
+            .iter()
+            .map(|&k| OUTPUT_NAMES.get(k).copied().unwrap_or("?")),
+    );
     let mut text = header.join(",") + "\n";
     for ((t, u), y) in r.times.iter().zip(&r.inputs).zip(&r.measured) {
         let _ = write!(text, "{t:e}");

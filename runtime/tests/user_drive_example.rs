@@ -82,13 +82,16 @@ fn target_dir() -> PathBuf {
     base.join("user_drive")
 }
 
-/// `cargo build` of the crate at `dir` as a user's crate: its own target directory, warnings denied.
+/// `cargo build` of the crate at `dir` as a user's crate: its own target directory, warnings denied. Without
+/// debug information or an incremental cache, which the test reads neither of.
 fn cargo_build(dir: &Path) -> Output {
     Command::new(env!("CARGO"))
         .args(["build", "--offline", "--quiet"])
         .current_dir(dir)
         .env("CARGO_TARGET_DIR", target_dir())
         .env("RUSTFLAGS", "-D warnings")
+        .env("CARGO_PROFILE_DEV_DEBUG", "false")
+        .env("CARGO_INCREMENTAL", "0")
         .env_remove("CARGO_ENCODED_RUSTFLAGS")
         .env_remove("RUSTDOCFLAGS")
         .output()

@@ -409,20 +409,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         nonzero.extend(correction.iter());
         let mut d = self.draft_cached(&nonzero);
         self.solve_tears(&mut d, &nonzero);
-        d.lines.push("    jac.fill(0.0);".into());
-        for (r, row) in m.iter().enumerate() {
-            for (c, e) in row.iter().enumerate() {
-                if e.is_zero() {
-                    continue;
-                }
-                let lhs = format!(
-                    "∂({row_prefix}{})/∂{} = ",
-                    rows.get(r).cloned().unwrap_or_default(),
-                    cols.get(c).cloned().unwrap_or_default()
-                );
-                self.statement(&mut d, &lhs, e, &format!("jac[({r}, {c})] = "), ";");
-            }
-        }
+        self.matrix_entries(&mut d, m, (rows, cols, row_prefix));
         self.loop_correction(&mut d, g_z, r_v, size);
         match name {
             "jac_x_into" => self.mass_solve_in_jacobian(&mut d, MassColumns::States),
@@ -439,6 +426,30 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         self.model_function(name, doc, d, Arg::new("jac", ty, true));
         if sparse {
             self.sparse_jac_x(m, rows, cols, row_prefix);
+        }
+    }
+
+    /// `jac.fill(0.0)` and one assignment per entry of `m` that is not identically zero, under a comment
+    /// naming it (`∂(d/dt p_mass)/∂q_spring = …`): rows and columns named by `names`, the rows with a prefix.
+    pub(super) fn matrix_entries(
+        &self,
+        d: &mut Draft,
+        m: &[Vec<Expr>],
+        (rows, cols, row_prefix): (&[String], &[String], &str),
+    ) {
+        d.lines.push("    jac.fill(0.0);".into());
+        for (r, row) in m.iter().enumerate() {
+            for (c, e) in row.iter().enumerate() {
+                if e.is_zero() {
+                    continue;
+                }
+                let lhs = format!(
+                    "∂({row_prefix}{})/∂{} = ",
+                    rows.get(r).cloned().unwrap_or_default(),
+                    cols.get(c).cloned().unwrap_or_default()
+                );
+                self.statement(d, &lhs, e, &format!("jac[({r}, {c})] = "), ";");
+            }
         }
     }
 

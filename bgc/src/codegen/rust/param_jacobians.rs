@@ -83,20 +83,7 @@ pub type OutJacP = SMatrix<f64, N_OUTPUTS, N_PARAMS>;
         needed.extend(correction.iter());
         let mut d = self.draft(&needed);
         self.solve_tears(&mut d, &needed);
-        d.lines.push("    jac.fill(0.0);".into());
-        for (r, row) in m.iter().enumerate() {
-            for (c, e) in row.iter().enumerate() {
-                if e.is_zero() {
-                    continue;
-                }
-                let lhs = format!(
-                    "∂({row_prefix}{})/∂{} = ",
-                    rows.get(r).cloned().unwrap_or_default(),
-                    cols.get(c).cloned().unwrap_or_default()
-                );
-                self.statement(&mut d, &lhs, e, &format!("jac[({r}, {c})] = "), ";");
-            }
-        }
+        self.matrix_entries(&mut d, m, (rows, cols, row_prefix));
         let size = if mass { "N_STATES" } else { "N_OUTPUTS" };
         self.loop_correction(&mut d, g_z, r_p, (size, "N_PARAMS"));
         if solve_mass {

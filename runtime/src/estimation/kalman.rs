@@ -14,7 +14,8 @@
 //! With `n` states and `m` measurements a step (predict and update) takes about `(11/3) n³ + 6 n² m` flops
 //! (a multiply-add counted as two) and lower-order terms: `2 n³` for `A P`, `n³` for one triangle of `(A P) Aᵀ`,
 //! `2 n² m` for `C P⁻`, `2 n² m` for the diagonal of `|C| |P⁻| |C|ᵀ` (the singularity floor of `S`), `2 n² m` for
-//! the Joseph form, and a positive-definiteness check of `P` after each half step (an `LDLᵀ` sweep, `n³/3` each).
+//! the Joseph form, and a positive-definiteness check of `P` after the update (an `LDLᵀ` sweep, `n³/3`); after the
+//! prediction the check runs only when `Q` is not definite enough to guarantee the result (see `DefinitePrediction` in the source).
 //!
 //! # Filter gain and predictor gain
 //!

@@ -2,7 +2,7 @@
 //! [`Equations::rates_at`] and [`Equations::outputs_at`], Jacobians by the symbolic derivatives of
 //! [`Equations::sensitivity`] (built once, evaluated at every step).
 
-use bgc::equations::{self, Equations, PointJacobians, Sensitivity, StateSelection};
+use bgc::equations::{self, Equations, PointJacobians, Rows, Sensitivity, StateSelection};
 use bgc_runtime::fit::FitModel;
 use nalgebra::DMatrix;
 
@@ -42,7 +42,7 @@ impl<'a> Interpreted<'a> {
         &self,
         (t, x, u): (f64, &[f64], &[f64]),
         free: &[usize],
-        outputs: bool,
+        rows: Rows,
     ) -> Result<PointJacobians, String> {
         let picked: Option<Vec<usize>> = free
             .iter()
@@ -52,12 +52,12 @@ impl<'a> Interpreted<'a> {
             return self
                 .eqs
                 .sensitivity(&self.given, free)
-                .and_then(|s| s.at(&self.values, (x, u, t), outputs))
+                .and_then(|s| s.at(&self.values, (x, u, t), rows))
                 .map_err(|e| e.to_string());
         };
         let sensitivity = self.sensitivity.as_ref().map_err(Clone::clone)?;
         let mut j = sensitivity
-            .at(&self.values, (x, u, t), outputs)
+            .at(&self.values, (x, u, t), rows)
             .map_err(|e| e.to_string())?;
         if picked.len() != self.free.len() || picked.iter().enumerate().any(|(c, &k)| c != k) {
             let pick = |rows: &mut Vec<Vec<f64>>| {
@@ -128,7 +128,7 @@ impl FitModel for Interpreted<'_> {
         u: &[f64],
         free: &[usize],
     ) -> Result<(DMatrix<f64>, DMatrix<f64>), String> {
-        let j = self.jacobians((t, x, u), free, false)?;
+        let j = self.jacobians((t, x, u), free, Rows::Rates)?;
         Ok((matrix(&j.fx, x.len()), matrix(&j.fp, free.len())))
     }
 
@@ -139,7 +139,7 @@ impl FitModel for Interpreted<'_> {
         u: &[f64],
         free: &[usize],
     ) -> Result<(DMatrix<f64>, DMatrix<f64>), String> {
-        let j = self.jacobians((t, x, u), free, true)?;
+        let j = self.jacobians((t, x, u), free, Rows::Outputs)?;
         Ok((matrix(&j.hx, x.len()), matrix(&j.hp, free.len())))
     }
 }

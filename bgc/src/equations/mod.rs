@@ -84,7 +84,7 @@ pub use linear::{
 };
 pub use param_chain::ParamChain;
 pub use print::{expr_latex, expr_text, to_json, to_latex, to_text};
-pub use sensitivity::{PointJacobians, Sensitivity};
+pub use sensitivity::{PointJacobians, Rows, Sensitivity};
 pub(crate) use tear::block_jacobian;
 pub use tear::{LoopFailure, TearBlock, residual_scale, solve_all};
 

@@ -24,6 +24,25 @@ use super::sym::Sym;
 use super::tear::solve_all;
 use crate::symbolic::{Compiled, Expr, Symbol};
 
+/// Which Jacobians [`Sensitivity::at`] evaluates: a caller that needs only the outputs' (or only the rates')
+/// does not pay for the others.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rows {
+    Rates,
+    Outputs,
+    Both,
+}
+
+impl Rows {
+    fn rates(self) -> bool {
+        matches!(self, Rows::Rates | Rows::Both)
+    }
+
+    fn outputs(self) -> bool {
+        matches!(self, Rows::Outputs | Rows::Both)
+    }
+}
+
 /// `∂f/∂x`, `∂f/∂p`, `∂h/∂x`, `∂h/∂p` at a point, row-major (`fx[i][j] = ∂f_i/∂x_j`); the parameter columns are
 /// those asked for, in that order.
 #[derive(Clone, Debug, PartialEq)]
@@ -193,7 +212,7 @@ impl Equations {
         free: &[usize],
     ) -> Result<PointJacobians, LinearError> {
         self.sensitivity(given, free)?
-            .at(&self.param_values(given), (x, u, t), true)
+            .at(&self.param_values(given), (x, u, t), Rows::Both)
     }
 
     /// [`Equations::param_jacobian_at`] without the outputs (`hx`, `hp` are left empty).
@@ -206,7 +225,7 @@ impl Equations {
         free: &[usize],
     ) -> Result<PointJacobians, LinearError> {
         self.sensitivity(given, free)?
-            .at(&self.param_values(given), (x, u, t), false)
+            .at(&self.param_values(given), (x, u, t), Rows::Rates)
     }
 
     fn convert(&self, e: &super::sym::Ex, what: impl Fn() -> String) -> Result<Expr, LinearError> {
@@ -334,23 +353,27 @@ impl Point<'_> {
 
 impl Sensitivity<'_> {
     /// The Jacobians at the parameter values `params` (all of them, in [`Equations::params`] order, as
-    /// [`Equations::param_values`] gives them), state `x`, input `u` and time `t`; without the outputs' (left
-    /// empty) unless `outputs`.
+    /// [`Equations::param_values`] gives them), state `x`, input `u` and time `t`; the rows not in `rows` are
+    /// left empty.
     pub fn at(
         &self,
         params: &[f64],
         (x, u, t): (&[f64], &[f64], f64),
-        outputs: bool,
+        rows: Rows,
     ) -> Result<PointJacobians, LinearError> {
         let eqs = self.eqs;
         let values = self.values_at(params, (x, u, t))?;
         let at = Point { eqs, values };
         let rate = |i: usize| format!("the rate of `{}`", eqs.sym_name(Sym::State(i)));
         let output = |k: usize| format!("output `{}`", eqs.sym_name(Sym::Output(k)));
-        let mut fv = at.matrix(&self.fv, &|i, j| {
-            format!("∂({})/∂{}", rate(i), at.column(j))
-        })?;
-        let mut hv = if outputs {
+        let mut fv = if rows.rates() {
+            at.matrix(&self.fv, &|i, j| {
+                format!("∂({})/∂{}", rate(i), at.column(j))
+            })?
+        } else {
+            Vec::new()
+        };
+        let mut hv = if rows.outputs() {
             at.matrix(&self.hv, &|k, j| {
                 format!("∂({})/∂{}", output(k), at.column(j))
             })?
@@ -358,11 +381,13 @@ impl Sensitivity<'_> {
             Vec::new()
         };
         let dz = match &self.loops {
-            Some(l) => Some(self.through_loops(&at, l, &mut fv, &mut hv, outputs)?),
+            Some(l) => Some(self.through_loops(&at, l, &mut fv, &mut hv, rows)?),
             None => None,
         };
-        for b in &self.mass {
-            self.solve_mass_rows(&at, b, dz.as_ref(), &mut fv)?;
+        if rows.rates() {
+            for b in &self.mass {
+                self.solve_mass_rows(&at, b, dz.as_ref(), &mut fv)?;
+            }
         }
         let n = x.len();
         let split = |m: Mat| -> (Mat, Mat) {
@@ -415,7 +440,7 @@ impl Sensitivity<'_> {
         l: &Loops,
         fv: &mut Mat,
         hv: &mut Mat,
-        outputs: bool,
+        rows: Rows,
     ) -> Result<Mat, LinearError> {
         let eqs = self.eqs;
         let names = l
@@ -430,10 +455,12 @@ impl Sensitivity<'_> {
         rv.iter_mut().flatten().for_each(|v| *v = -*v);
         // dz/dv = −(∂r/∂z)⁻¹ ∂r/∂v
         let dz = dense::solve(&rz, &rv).ok_or(LinearError::SingularLoop { tears: names })?;
-        let rate =
-            |i: usize, _: usize| format!("∂(the rate of `{}`)/∂z", eqs.sym_name(Sym::State(i)));
-        add_product(fv, &at.matrix(&l.fz, &rate)?, &dz);
-        if outputs {
+        if rows.rates() {
+            let rate =
+                |i: usize, _: usize| format!("∂(the rate of `{}`)/∂z", eqs.sym_name(Sym::State(i)));
+            add_product(fv, &at.matrix(&l.fz, &rate)?, &dz);
+        }
+        if rows.outputs() {
             let output =
                 |k: usize, _: usize| format!("∂(output `{}`)/∂z", eqs.sym_name(Sym::Output(k)));
             add_product(hv, &at.matrix(&l.hz, &output)?, &dz);

@@ -41,6 +41,7 @@ fn main() -> Result<(), bgc::build::Error> {
         .collect();
     bgc::build::Config::new()
         .out_dir(out_dir.join("corpus"))
+        .warnings(false)
         .compile(&corpus)?;
     Ok(())
 }

@@ -7,8 +7,13 @@
 //! - [`estimation`]: Kalman filters, the UKF and dual UKF, sensor fusion, filter health.
 //! - [`control`]: impedance control and the gait-phase supervisor.
 //! - [`analysis`]: frequency response and stability margins.
-//! - [`sim`]: sampled-data closed-loop simulation on diffsol.
+//! - [`sim`]: sampled-data closed-loop simulation (exact for linear plants, on diffsol for nonlinear ones).
 //! - [`fit`]: parameter identification from measured records (Levenberg–Marquardt on forward sensitivities).
+//!
+//! # Features
+//! - `ode` (default): the ODE solver (diffsol) behind `sim`'s open-loop and nonlinear sampled-loop simulation and
+//!   behind `fit`'s fits. Without it the crate keeps everything else, including the exact linear-plant loop
+//!   (`sim::simulate_sampled_linear_loop`), and a first build skips diffsol and its dense linear algebra.
 
 pub mod analysis;
 pub mod control;

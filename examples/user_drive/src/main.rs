@@ -1,8 +1,9 @@
 //! A position drive designed and run in closed loop from its own `.bg` model, step by step as in
 //! `docs/runtime.md`: the generated state space, an LQR with integral action on the load angle, the
 //! zero-order-hold model and a steady-state Kalman filter on the sampled measurements, and a sampled-data
-//! simulation of the loop on the generated nonlinear-capable model. Prints the design and the run as
-//! `name: value` lines.
+//! simulation of the loop on the plant's exact zero-order-hold step (the drive is linear, so the runtime's ODE
+//! solver is not needed: the crate uses `bgc-runtime` without its `ode` feature). Prints the design and the run
+//! as `name: value` lines.
 
 /// The code generated from `drive.bg` by `build.rs`.
 mod drive {
@@ -14,7 +15,9 @@ use bgc_runtime::estimation::{EstimationError, KalmanFilter, LinearDiscreteModel
 use bgc_runtime::linalg::c2d_zoh;
 use bgc_runtime::linearize::jacobians_at;
 use bgc_runtime::matrix::{self, dynamic};
-use bgc_runtime::sim::{SampledController, SampledLoopConfig, simulate_sampled_loop};
+use bgc_runtime::sim::{
+    LinearPlant, SampledController, SampledLoopConfig, simulate_sampled_linear_loop,
+};
 use nalgebra::{DMatrix, SMatrix, SVector};
 
 /// States `p_inductance, p_rotor, q_shaft_spring, p_load, theta_L`; input `V`; outputs `angle, current`.
@@ -39,7 +42,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // 1. The linear model: `state_space` in all five states (the energy states and `theta_L`, which the
     //    `angle` output reads). The linearisation at rest from the symbolic Jacobians is the same model.
     let fixed = drive::state_space(&params);
-    let (a, b, c, _) = fixed;
+    let (a, b, c, d) = fixed;
     let at_rest = jacobians_at(&model, 0.0, &SVector::zeros(), &SVector::zeros())?;
     let difference = (a - at_rest.0).abs().max() + (b - at_rest.1).abs().max();
     println!("states: {}", drive::STATE_NAMES.join(" "));
@@ -52,7 +55,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let weights = [0.0, 0.0, 0.0, 0.0, 1e3, 1e5];
     let q = DMatrix::from_diagonal(&nalgebra::DVector::from_row_slice(&weights));
     let r = DMatrix::from_element(1, 1, 1.0);
-    let design = lqi(&dynamic(&a), &dynamic(&b), &c_angle, &q, &r, IntegralAction::Single)?;
+    let design = lqi(
+        &dynamic(&a),
+        &dynamic(&b),
+        &c_angle,
+        &q,
+        &r,
+        IntegralAction::Single,
+    )?;
     let kx: SMatrix<f64, NU, NX> = matrix::fixed("K_x", &design.kx)?;
     let kz: SMatrix<f64, NU, 1> = matrix::fixed("K_z", &design.kz1)?;
     println!("K: {}", row_major(&design.k));
@@ -88,7 +98,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("M: {}", row_major(&gains.filter_gain));
     let filter = KalmanFilter::with_fixed_gain(plant, qd, rd, filter_gain, SVector::zeros(), p0)?;
 
-    // 4. The sampled-data loop on the generated model, with noisy measurements.
+    // 4. The sampled-data loop on the linear plant (its exact zero-order-hold step), with noisy measurements.
+    let drive_plant = LinearPlant { a, b, c, d };
     let mut controller = PositionController {
         filter,
         kx,
@@ -102,14 +113,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut config = SampledLoopConfig::<NX, NU, NY>::new(SAMPLE_TIME, samples, SVector::zeros());
     config.measurement_noise_std = SVector::from([ANGLE_NOISE, CURRENT_NOISE]);
     config.seed = 15;
-    let run = simulate_sampled_loop(&model, &mut controller, &config)?;
+    let run = simulate_sampled_linear_loop(&drive_plant, &mut controller, &config)?;
     if let Some(fault) = controller.fault {
         return Err(fault.into());
     }
 
     let angle = |x: &SVector<f64, NX>| x[4];
     let last = run.states.last().ok_or("the run recorded no state")?;
-    let peak = run.states.iter().map(angle).fold(f64::NEG_INFINITY, f64::max);
+    let peak = run
+        .states
+        .iter()
+        .map(angle)
+        .fold(f64::NEG_INFINITY, f64::max);
     let peak_voltage = run.inputs.iter().map(|u| u[0].abs()).fold(0.0, f64::max);
     let estimate_error = controller
         .estimates

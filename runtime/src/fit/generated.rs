@@ -1,15 +1,24 @@
 //! A model of fixed size (a generated model, or any [`ContinuousModel`] with [`Parametric`]) as a [`FitModel`].
+//! [`ParamJacobians`] is here with or without the `ode` feature (every generated `Model` implements it);
+//! [`Generated`] needs the feature.
 //!
 //! `∂f/∂x` and `∂h/∂x` come from the model's `jac_x` and `output_jac_x` (symbolic in generated models). The
 //! parameter Jacobians come from [`ParamJacobians`] when the model implements it ([`Generated::exact`]; every
 //! generated `Model` does, from its symbolic `jac_p_into` and `output_jac_p_into`, which follow the derived
 //! parameters and solve the model's loops and mass matrices), else from central differences over
 //! [`Parametric::set_param`] ([`Generated::new`], for a hand-written model).
+//!
+//! [`ContinuousModel`]: crate::model::ContinuousModel
+//! [`Parametric`]: crate::model::Parametric
+//! [`Parametric::set_param`]: crate::model::Parametric::set_param
+//! [`FitModel`]: crate::fit::FitModel
 
-use nalgebra::{DMatrix, SMatrix, SVector};
+use nalgebra::SVector;
 
-use super::sensitivity::FitModel;
-use crate::model::{ContinuousModel, Parametric};
+#[cfg(feature = "ode")]
+mod adapter;
+#[cfg(feature = "ode")]
+pub use adapter::Generated;
 
 /// The derivatives of the rates and outputs with respect to one parameter.
 pub trait ParamJacobians<const NX: usize, const NU: usize, const NY: usize> {
@@ -32,201 +41,4 @@ pub trait ParamJacobians<const NX: usize, const NU: usize, const NY: usize> {
         index: usize,
         col: &mut SVector<f64, NY>,
     ) -> bool;
-}
-
-type RateColumn<M, const NX: usize, const NU: usize> =
-    fn(&M, f64, &SVector<f64, NX>, &SVector<f64, NU>, usize, &mut SVector<f64, NX>) -> bool;
-type OutputColumn<M, const NX: usize, const NU: usize, const NY: usize> =
-    fn(&M, f64, &SVector<f64, NX>, &SVector<f64, NU>, usize, &mut SVector<f64, NY>) -> bool;
-
-/// A fixed-size model adapted to [`FitModel`].
-pub struct Generated<M, const NX: usize, const NU: usize, const NY: usize> {
-    model: M,
-    exact: Option<(RateColumn<M, NX, NU>, OutputColumn<M, NX, NU, NY>)>,
-    linear: bool,
-}
-
-impl<M, const NX: usize, const NU: usize, const NY: usize> Generated<M, NX, NU, NY>
-where
-    M: ContinuousModel<NX, NU, NY> + Parametric + Clone,
-{
-    /// Parameter Jacobians by central differences.
-    pub fn new(model: M) -> Self {
-        Generated {
-            model,
-            exact: None,
-            linear: false,
-        }
-    }
-
-    /// Parameter Jacobians from the model's own derivatives.
-    pub fn exact(model: M) -> Self
-    where
-        M: ParamJacobians<NX, NU, NY>,
-    {
-        Generated {
-            model,
-            exact: Some((M::jac_p, M::output_jac_p)),
-            linear: false,
-        }
-    }
-
-    /// Declares the model linear time-invariant (a generated model with a `state_space` function is): fits with
-    /// held inputs then use the exact discretisation of [`super::linear`] (checked at a probe point).
-    pub fn declared_linear(mut self) -> Self {
-        self.linear = true;
-        self
-    }
-
-    /// The model with its current parameters.
-    pub fn model(&self) -> &M {
-        &self.model
-    }
-
-    /// Column `index` of `(∂f/∂p, ∂h/∂p)` by central differences.
-    fn difference(
-        &self,
-        t: f64,
-        x: &SVector<f64, NX>,
-        u: &SVector<f64, NU>,
-        index: usize,
-    ) -> Result<(SVector<f64, NX>, SVector<f64, NY>), String> {
-        let p = self
-            .model
-            .param(index)
-            .ok_or_else(|| format!("no parameter {index}"))?;
-        // ∛ε relative to the value (a tiny positive inertia is stepped in proportion, never across zero).
-        let h = 6.0554544523933395e-6 * if p == 0.0 { 1.0 } else { p.abs() };
-        let eval = |v: f64| -> Result<(SVector<f64, NX>, SVector<f64, NY>), String> {
-            let mut m = self.model.clone();
-            m.set_param(index, v).map_err(|e| e.to_string())?;
-            let mut f = SVector::zeros();
-            let mut y = SVector::zeros();
-            m.rhs(t, x, u, &mut f);
-            m.outputs(t, x, u, &mut y);
-            Ok((f, y))
-        };
-        // A bound of the parameter's physical range (a positive inertia at a tiny value) falls back to one side.
-        match (eval(p + h), eval(p - h)) {
-            (Ok(a), Ok(b)) => Ok(((a.0 - b.0) / (2.0 * h), (a.1 - b.1) / (2.0 * h))),
-            (Ok(a), Err(_)) => {
-                let c = eval(p)?;
-                Ok(((a.0 - c.0) / h, (a.1 - c.1) / h))
-            }
-            (Err(e), _) => Err(e),
-        }
-    }
-}
-
-impl<M, const NX: usize, const NU: usize, const NY: usize> Generated<M, NX, NU, NY> {
-    /// The matrix whose columns are `column(k)` for the free parameters `k`.
-    fn param_columns<const R: usize>(
-        &self,
-        free: &[usize],
-        column: impl Fn(usize) -> Result<SVector<f64, R>, String>,
-    ) -> Result<DMatrix<f64>, String> {
-        let mut m = DMatrix::zeros(R, free.len());
-        for (c, &k) in free.iter().enumerate() {
-            m.column_mut(c).copy_from(&column(k)?);
-        }
-        Ok(m)
-    }
-}
-
-/// A column filled by a [`ParamJacobians`] method, which answers `false` for an index that is no parameter.
-fn exact_column<const R: usize>(
-    fill: impl FnOnce(&mut SVector<f64, R>) -> bool,
-    k: usize,
-) -> Result<SVector<f64, R>, String> {
-    let mut col = SVector::zeros();
-    if fill(&mut col) {
-        Ok(col)
-    } else {
-        Err(format!("no parameter {k}"))
-    }
-}
-
-fn fixed<const N: usize>(v: &[f64]) -> SVector<f64, N> {
-    SVector::from_fn(|i, _| v[i])
-}
-
-impl<M, const NX: usize, const NU: usize, const NY: usize> FitModel for Generated<M, NX, NU, NY>
-where
-    M: ContinuousModel<NX, NU, NY> + Parametric + Clone,
-{
-    fn state_count(&self) -> usize {
-        NX
-    }
-    fn input_count(&self) -> usize {
-        NU
-    }
-    fn output_count(&self) -> usize {
-        NY
-    }
-    fn param_count(&self) -> usize {
-        self.model.param_names().len()
-    }
-
-    fn is_linear(&self) -> bool {
-        self.linear
-    }
-
-    fn set_params(&mut self, p: &[f64]) -> Result<(), String> {
-        for (k, &v) in p.iter().enumerate() {
-            if self.model.param(k) != Some(v) {
-                self.model.set_param(k, v).map_err(|e| e.to_string())?;
-            }
-        }
-        Ok(())
-    }
-
-    fn rhs(&self, t: f64, x: &[f64], u: &[f64], dx: &mut [f64]) -> Result<(), String> {
-        let mut d = SVector::<f64, NX>::zeros();
-        self.model.rhs(t, &fixed(x), &fixed(u), &mut d);
-        dx.copy_from_slice(d.as_slice());
-        Ok(())
-    }
-
-    fn outputs(&self, t: f64, x: &[f64], u: &[f64], y: &mut [f64]) -> Result<(), String> {
-        let mut o = SVector::<f64, NY>::zeros();
-        self.model.outputs(t, &fixed(x), &fixed(u), &mut o);
-        y.copy_from_slice(o.as_slice());
-        Ok(())
-    }
-
-    fn rate_jacobians(
-        &self,
-        t: f64,
-        x: &[f64],
-        u: &[f64],
-        free: &[usize],
-    ) -> Result<(DMatrix<f64>, DMatrix<f64>), String> {
-        let (x, u) = (fixed::<NX>(x), fixed::<NU>(u));
-        let mut a = SMatrix::<f64, NX, NX>::zeros();
-        self.model.jac_x(t, &x, &u, &mut a);
-        let fp = self.param_columns(free, |k| match self.exact {
-            Some((jac_p, _)) => exact_column(|col| jac_p(&self.model, t, &x, &u, k, col), k),
-            None => Ok(self.difference(t, &x, &u, k)?.0),
-        })?;
-        Ok((DMatrix::from_column_slice(NX, NX, a.as_slice()), fp))
-    }
-
-    fn output_jacobians(
-        &self,
-        t: f64,
-        x: &[f64],
-        u: &[f64],
-        free: &[usize],
-    ) -> Result<(DMatrix<f64>, DMatrix<f64>), String> {
-        let (x, u) = (fixed::<NX>(x), fixed::<NU>(u));
-        let mut c_mat = SMatrix::<f64, NY, NX>::zeros();
-        self.model.output_jac_x(t, &x, &u, &mut c_mat);
-        let hp = self.param_columns(free, |k| match self.exact {
-            Some((_, output_jac_p)) => {
-                exact_column(|col| output_jac_p(&self.model, t, &x, &u, k, col), k)
-            }
-            None => Ok(self.difference(t, &x, &u, k)?.1),
-        })?;
-        Ok((DMatrix::from_column_slice(NY, NX, c_mat.as_slice()), hp))
-    }
 }

@@ -2,6 +2,7 @@
 
 use nalgebra::SVector;
 
+use super::check_initial;
 use super::error::SimError;
 use super::integrate::{Segment, SolverOptions, integrate_segment};
 use crate::model::ContinuousModel;
@@ -97,25 +98,4 @@ where
         inputs,
         outputs,
     })
-}
-
-pub(crate) fn check_initial<const NX: usize>(
-    t0: f64,
-    x0: &SVector<f64, NX>,
-) -> Result<(), SimError> {
-    if !t0.is_finite() {
-        return Err(SimError::BadSetting {
-            name: "t0",
-            value: t0,
-            reason: "the initial time must be finite",
-        });
-    }
-    if let Some(v) = x0.iter().find(|v| !v.is_finite()) {
-        return Err(SimError::BadSetting {
-            name: "x0",
-            value: *v,
-            reason: "the initial state must be finite",
-        });
-    }
-    Ok(())
 }

@@ -24,10 +24,12 @@ use std::ops::ControlFlow;
 
 use nalgebra::SVector;
 
+use super::check_initial;
 use super::error::SimError;
-use super::integrate::{Segment, SolverOptions, integrate_segment};
+#[cfg(feature = "ode")]
+use super::integrate::{Segment, integrate_segment};
 use super::linear::{LinearPlant, ZohStep};
-use super::open_loop::check_initial;
+use super::options::SolverOptions;
 use crate::model::ContinuousModel;
 use crate::noise::Rng;
 
@@ -188,6 +190,7 @@ pub struct Sample<const NX: usize, const NU: usize, const NY: usize> {
 }
 
 /// Runs the sampled-data loop described in the module documentation, integrating the model by ODE solves.
+#[cfg(feature = "ode")]
 pub fn simulate_sampled_loop<Mdl, Ctl, const NX: usize, const NU: usize, const NY: usize>(
     model: &Mdl,
     controller: &mut Ctl,
@@ -205,6 +208,7 @@ where
 
 /// [`simulate_sampled_loop`] handing each sample to `sink` (in order, `k = 0 … N`) instead of recording it;
 /// the run stops early when `sink` breaks. Returns the number of samples handed over.
+#[cfg(feature = "ode")]
 pub fn simulate_sampled_loop_streaming<
     Mdl,
     Ctl,

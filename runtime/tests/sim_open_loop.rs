@@ -227,3 +227,70 @@ fn bad_settings_are_refused() {
     let traj = run(&[0.0, 1.0], Vector2::new(0.3, 0.0), ok).unwrap();
     assert_eq!(traj.states[0], Vector2::new(0.3, 0.0));
 }
+
+/// The heat equation on a line of `N` cells with cold ends, `ẋᵢ = xᵢ₋₁ − 2 xᵢ + xᵢ₊₁`: a model whose `N × N`
+/// Jacobian (1.3 MB at `N = 400`) does not fit a test thread's stack twice.
+struct HeatLine<const N: usize>;
+
+impl<const N: usize> ContinuousModel<N, 1, 1> for HeatLine<N> {
+    fn rhs(&self, _t: f64, x: &SVector<f64, N>, _u: &Vector1<f64>, dx: &mut SVector<f64, N>) {
+        for i in 0..N {
+            let left = if i > 0 { x[i - 1] } else { 0.0 };
+            let right = if i + 1 < N { x[i + 1] } else { 0.0 };
+            dx[i] = left - 2.0 * x[i] + right;
+        }
+    }
+    fn outputs(&self, _t: f64, x: &SVector<f64, N>, _u: &Vector1<f64>, y: &mut Vector1<f64>) {
+        y[0] = x[N / 2];
+    }
+    fn jac_x(
+        &self,
+        _t: f64,
+        _x: &SVector<f64, N>,
+        _u: &Vector1<f64>,
+        jac: &mut nalgebra::SMatrix<f64, N, N>,
+    ) {
+        jac.fill(0.0);
+        for i in 0..N {
+            jac[(i, i)] = -2.0;
+            if i > 0 {
+                jac[(i, i - 1)] = 1.0;
+            }
+            if i + 1 < N {
+                jac[(i, i + 1)] = 1.0;
+            }
+        }
+    }
+}
+
+#[test]
+fn a_model_of_400_states_runs_on_an_implicit_method_in_a_test_thread_and_decays_as_its_slowest_mode()
+ {
+    const N: usize = 400;
+    // The slowest mode xᵢ = sin(iπ/(N+1)) decays as exp(λ t), λ = −2 + 2 cos(π/(N+1)) (the eigenpair of the
+    // tridiagonal matrix).
+    let angle = std::f64::consts::PI / (N as f64 + 1.0);
+    let lambda = -2.0 + 2.0 * angle.cos();
+    let x0 = SVector::<f64, N>::from_fn(|i, _| ((i + 1) as f64 * angle).sin());
+    let times = [0.5, 1.0, 2.0];
+    let opts = SolverOptions {
+        method: Method::Bdf,
+        rtol: 1e-9,
+        atol: 1e-12,
+        ..SolverOptions::default()
+    };
+    let traj = simulate_open_loop(
+        &HeatLine::<N>,
+        0.0,
+        &x0,
+        |_t| Vector1::zeros(),
+        &times,
+        &opts,
+    )
+    .expect("the heat line runs");
+    for (t, x) in traj.times.iter().zip(&traj.states) {
+        let expected = x0 * (lambda * t).exp();
+        let err = (x - expected).amax();
+        assert!(err < 1e-6, "t = {t}: largest error {err:e}");
+    }
+}

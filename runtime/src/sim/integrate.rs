@@ -22,8 +22,24 @@ use crate::model::ContinuousModel;
 type M = NalgebraMat<f64>;
 type Ls = NalgebraLU<f64>;
 
-/// The model's Jacobian `∂f/∂x` at `(t, x)`, kept for the next column product at the same point.
-type JacobianAt<const NX: usize> = (f64, SVector<f64, NX>, SMatrix<f64, NX, NX>);
+/// The model's Jacobian `∂f/∂x` and the point `(t, x)` it was evaluated at, kept for the next column product.
+struct JacobianAt<const NX: usize> {
+    at: Option<(f64, SVector<f64, NX>)>,
+    matrix: Box<SMatrix<f64, NX, NX>>,
+}
+
+/// `jv = J v`. diffsol asks for the columns of a dense Jacobian one at a time (`v` a unit vector): then the
+/// product is the column itself, `NX` copies instead of `NX²` multiply-adds per column.
+fn jacobian_product<const NX: usize>(j: &SMatrix<f64, NX, NX>, v: &[f64], jv: &mut [f64]) {
+    let mut nonzero = v.iter().enumerate().filter(|(_, c)| **c != 0.0);
+    if let (Some((col, &1.0)), None) = (nonzero.next(), nonzero.next()) {
+        jv.copy_from_slice(j.column(col).as_slice());
+        return;
+    }
+    for (out, row) in jv.iter_mut().zip(j.row_iter()) {
+        *out = row.iter().zip(v).map(|(a, b)| a * b).sum();
+    }
+}
 
 /// A segment to integrate.
 pub(crate) struct Segment<'a, const NX: usize> {
@@ -72,22 +88,21 @@ where
         dx.copy_from_slice(d.as_slice());
     };
     // diffsol assembles its Jacobian from one product per column, all at the same point: the model's
-    // Jacobian is evaluated once per point and reused for the other columns.
-    let cached: RefCell<Option<JacobianAt<NX>>> = RefCell::new(None);
+    // Jacobian is evaluated once per point, in place, and reused for the other columns. It lives on the heap
+    // (allocated zeroed, never built on the stack): an `NX × NX` matrix takes 8 MB at 1,000 states.
+    let cached: RefCell<JacobianAt<NX>> = RefCell::new(JacobianAt {
+        at: None,
+        matrix: bytemuck::zeroed_box(),
+    });
     let jac = |x: &[f64], t: f64, v: &[f64], jv: &mut [f64]| {
         let xs = SVector::<f64, NX>::from_column_slice(x);
         let mut cache = cached.borrow_mut();
-        let j = match &*cache {
-            Some((tc, xc, j)) if *tc == t && *xc == xs => *j,
-            _ => {
-                let mut j = SMatrix::<f64, NX, NX>::zeros();
-                model.jac_x(t, &xs, &input(t), &mut j);
-                *cache = Some((t, xs, j));
-                j
-            }
-        };
-        let prod = j * SVector::<f64, NX>::from_column_slice(v);
-        jv.copy_from_slice(prod.as_slice());
+        let cache = &mut *cache;
+        if cache.at.as_ref() != Some(&(t, xs)) {
+            model.jac_x(t, &xs, &input(t), &mut cache.matrix);
+            cache.at = Some((t, xs));
+        }
+        jacobian_product(&cache.matrix, v, jv);
     };
     let erased = ErasedSegment {
         t0: seg.t0,

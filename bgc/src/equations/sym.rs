@@ -705,6 +705,26 @@ mod tests {
     }
 
     #[test]
+    fn remembered_expansions_are_those_from_scratch() {
+        // A chain as the resolver builds it: each value holds the previous one, multiplied by a sum; some levels
+        // multiply out, the deeper ones are too large to.
+        let n = add(vec![
+            Ex::one(),
+            mul(vec![Ex::Num(0.1), call(Func::Cos, vec![x()])]),
+        ]);
+        let mut expander = Expander::default();
+        let mut value = y();
+        for k in 0..12 {
+            let term = mul(vec![Ex::Num(f64::from(k)), call(Func::Sin, vec![x()]), y()]);
+            value = add(vec![term, mul(vec![n.clone(), value])]);
+            let remembered = expander.expand(&value);
+            assert_eq!(remembered, expand(&value), "level {k}");
+            // Asked again, the memory answers with the same.
+            assert_eq!(expander.expand(&value), remembered, "level {k}");
+        }
+    }
+
+    #[test]
     fn affine_split() {
         let e = add(vec![mul(vec![x(), y()]), Ex::Num(3.0)]);
         let (a, b) = affine_in(&e, Sym::Param(0)).unwrap_or((Ex::zero(), Ex::zero()));

@@ -281,11 +281,21 @@ pub fn mul(factors: Vec<Ex>) -> Ex {
     let mut out: Vec<Ex> = Vec::new();
     let mut parts = parts.into_iter().peekable();
     while let Some((base, first)) = parts.next() {
-        let mut exps = vec![first];
-        while let Some((_, more)) = parts.next_if(|(b, _)| key_cmp(b, &base).is_eq()) {
-            exps.push(more);
-        }
-        match pow(base, add(exps)) {
+        let exponent = if parts.peek().is_some_and(|(b, _)| key_cmp(b, &base).is_eq()) {
+            let mut exps = vec![first];
+            while let Some((_, more)) = parts.next_if(|(b, _)| key_cmp(b, &base).is_eq()) {
+                exps.push(more);
+            }
+            add(exps)
+        } else {
+            match first {
+                // What `add` makes of one number (`-0` becomes `0`), without its vectors: most bases come once
+                // with a numeric exponent.
+                Ex::Num(v) => Ex::Num(if v == 0.0 { 0.0 } else { v }),
+                other => add(vec![other]),
+            }
+        };
+        match pow(base, exponent) {
             Ex::Num(v) => constant *= v,
             Ex::Mul(inner) => {
                 // A power that distributed over a product: fold it in again (its factors are already canonical).

@@ -12,7 +12,7 @@
 //!   solve ([`super::tear`]). A nonlinear loop through a storage in derivative causality is refused.
 
 use super::build::{Built, Def};
-use super::sym::{self, Ex, Sym, add, div, mul};
+use super::sym::{self, Ex, Expander, Sym, add, div, mul};
 use crate::ir::Func;
 
 /// Why a variable could not be resolved.
@@ -51,6 +51,8 @@ pub(crate) struct Resolver<'a> {
     /// The torn variables kept implicit, with their residuals `E(Tear(v)) − Tear(v)`, in the order they closed.
     implicit: Vec<(usize, Ex)>,
     depth: usize,
+    /// Multiplies out the values; it remembers the expansions of earlier values, which later values hold.
+    expander: Expander,
 }
 
 /// Dependency chains longer than this are refused rather than overflowing the stack.
@@ -68,6 +70,7 @@ impl<'a> Resolver<'a> {
             torn: vec![false; n],
             implicit: Vec::new(),
             depth: 0,
+            expander: Expander::default(),
         }
     }
 
@@ -104,7 +107,7 @@ impl<'a> Resolver<'a> {
         let result = self.compute(v);
         self.depth -= 1;
         let value = match result.and_then(|value| self.close_loop(v, value)) {
-            Ok(value) => compact(value),
+            Ok(value) => compact(&mut self.expander, value),
             Err(e) => {
                 self.forget(v);
                 return Err(e);
@@ -134,12 +137,16 @@ impl<'a> Resolver<'a> {
         if gain.is_zero() {
             return Err(ResolveError::SingularLoop(v));
         }
-        let solved = compact(div(b, gain));
+        let solved = compact(&mut self.expander, div(b, gain));
         // Values computed inside the loop, and the residuals of implicit loops inside it, hold the tear: replace it
         // everywhere.
+        let expander = &mut self.expander;
         let mut replace = |e: &mut Ex| {
             if e.contains(tear) {
-                *e = compact(sym::subst(e, &mut |s| (s == tear).then(|| solved.clone())));
+                *e = compact(
+                    expander,
+                    sym::subst(e, &mut |s| (s == tear).then(|| solved.clone())),
+                );
             }
         };
         self.cache.iter_mut().flatten().for_each(&mut replace);
@@ -243,8 +250,8 @@ impl<'a> Resolver<'a> {
 /// `e` multiplied out when that makes it no larger. A value is copied into every variable that uses it: in a chain
 /// of algebraic loops each rung's solution `b / (1 − a)` holds the previous ones as nested products of sums, which
 /// grow geometrically; multiplied out, the like terms collect and the size stays that of the model's symbols.
-fn compact(e: Ex) -> Ex {
-    let expanded = sym::expand(&e);
+fn compact(expander: &mut Expander, e: Ex) -> Ex {
+    let expanded = expander.expand(&e);
     if expanded == e {
         return e;
     }

@@ -8,8 +8,12 @@
 //!
 //! Nothing here knows about bond graphs: leaves are [`Sym`] symbols that the stage names.
 
+mod expand;
+mod order;
+
 use crate::ir::Func;
-use std::collections::BTreeMap;
+pub use expand::Expander;
+pub use order::key_cmp;
 use std::fmt::Write;
 
 /// A leaf symbol.
@@ -189,8 +193,8 @@ impl Write for KeyLength {
 /// `a + b + ...` in canonical form.
 pub fn add(terms: Vec<Ex>) -> Ex {
     let mut constant = 0.0;
-    // Non-numeric part key -> (coefficient, part).
-    let mut groups: BTreeMap<String, (f64, Ex)> = BTreeMap::new();
+    // (non-numeric part, coefficient), in the order met.
+    let mut parts: Vec<(Ex, f64)> = Vec::new();
     let mut stack = terms;
     while let Some(t) = stack.pop() {
         match t {
@@ -198,16 +202,22 @@ pub fn add(terms: Vec<Ex>) -> Ex {
             Ex::Add(inner) => stack.extend(inner),
             other => {
                 let (c, rest) = split_coefficient(other);
-                let entry = groups.entry(rest.key()).or_insert((0.0, rest));
-                entry.0 += c;
+                parts.push((rest, c));
             }
         }
     }
+    // Like terms are neighbours after a stable sort, in the order met: their coefficients add up in that order.
+    parts.sort_by(|a, b| key_cmp(&a.0, &b.0));
     let mut out: Vec<Ex> = Vec::new();
     if constant != 0.0 {
         out.push(Ex::Num(constant));
     }
-    for (_, (c, rest)) in groups {
+    let mut parts = parts.into_iter().peekable();
+    while let Some((rest, first)) = parts.next() {
+        let mut c = 0.0 + first;
+        while let Some((_, more)) = parts.next_if(|(r, _)| key_cmp(r, &rest).is_eq()) {
+            c += more;
+        }
         if c != 0.0 {
             out.push(scale(c, rest));
         }
@@ -252,29 +262,40 @@ fn scale(c: f64, rest: Ex) -> Ex {
 /// `a · b · ...` in canonical form.
 pub fn mul(factors: Vec<Ex>) -> Ex {
     let mut constant = 1.0;
-    // Base key -> (base, exponent terms).
-    let mut groups: BTreeMap<String, (Ex, Vec<Ex>)> = BTreeMap::new();
+    // (base, exponent), in the order met.
+    let mut parts: Vec<(Ex, Ex)> = Vec::new();
     let mut stack = factors;
     while let Some(f) = stack.pop() {
         match f {
             Ex::Num(v) => constant *= v,
             Ex::Mul(inner) => stack.extend(inner),
-            Ex::Pow(b, e) => {
-                let entry = groups.entry(b.key()).or_insert((*b, Vec::new()));
-                entry.1.push(*e);
-            }
-            other => {
-                let entry = groups.entry(other.key()).or_insert((other, Vec::new()));
-                entry.1.push(Ex::one());
-            }
+            Ex::Pow(b, e) => parts.push((*b, *e)),
+            other => parts.push((other, Ex::one())),
         }
     }
     if constant == 0.0 {
         return Ex::zero();
     }
+    // Equal bases are neighbours after a stable sort, their exponents in the order met.
+    parts.sort_by(|a, b| key_cmp(&a.0, &b.0));
     let mut out: Vec<Ex> = Vec::new();
-    for (_, (base, exps)) in groups {
-        match pow(base, add(exps)) {
+    let mut parts = parts.into_iter().peekable();
+    while let Some((base, first)) = parts.next() {
+        let exponent = if parts.peek().is_some_and(|(b, _)| key_cmp(b, &base).is_eq()) {
+            let mut exps = vec![first];
+            while let Some((_, more)) = parts.next_if(|(b, _)| key_cmp(b, &base).is_eq()) {
+                exps.push(more);
+            }
+            add(exps)
+        } else {
+            match first {
+                // What `add` makes of one number (`-0` becomes `0`), without its vectors: most bases come once
+                // with a numeric exponent.
+                Ex::Num(v) => Ex::Num(if v == 0.0 { 0.0 } else { v }),
+                other => add(vec![other]),
+            }
+        };
+        match pow(base, exponent) {
             Ex::Num(v) => constant *= v,
             Ex::Mul(inner) => {
                 // A power that distributed over a product: fold it in again (its factors are already canonical).
@@ -291,8 +312,7 @@ pub fn mul(factors: Vec<Ex>) -> Ex {
     if constant == 0.0 {
         return Ex::zero();
     }
-    // One key per factor (a comparison-based sort would build each key many times).
-    out.sort_by_cached_key(Ex::key);
+    out.sort_by(key_cmp);
     if constant != 1.0 {
         out.insert(0, Ex::Num(constant));
     }
@@ -357,40 +377,10 @@ pub fn call(f: Func, args: Vec<Ex>) -> Ex {
     Ex::Call(f, args)
 }
 
-/// Products of sums multiplied out (`a (b + c)` → `a b + a c`), unless that would make more than 64 terms, in
-/// which case the expression is returned as it is.
+/// Products of sums multiplied out (`a (b + c)` → `a b + a c`), except a product that would make more than 64
+/// terms, which stays as it is. To expand many expressions that share parts, keep one [`Expander`].
 pub fn expand(e: &Ex) -> Ex {
-    const MAX_TERMS: usize = 64;
-    if !has_product_of_sum(e) {
-        // Nothing to multiply out: the expression is already in canonical form (most resolved values are).
-        return e.clone();
-    }
-    match e {
-        Ex::Add(ts) => add(ts.iter().map(expand).collect()),
-        Ex::Mul(fs) => {
-            let mut terms = vec![Ex::one()];
-            for f in fs.iter().map(expand) {
-                match f {
-                    Ex::Add(inner) => {
-                        if terms.len() * inner.len() > MAX_TERMS {
-                            return e.clone();
-                        }
-                        terms = terms
-                            .iter()
-                            .flat_map(|t| {
-                                inner.iter().map(move |i| mul(vec![t.clone(), i.clone()]))
-                            })
-                            .collect();
-                    }
-                    other => terms
-                        .iter_mut()
-                        .for_each(|t| *t = mul(vec![t.clone(), other.clone()])),
-                }
-            }
-            add(terms)
-        }
-        _ => e.clone(),
-    }
+    Expander::default().expand(e)
 }
 
 /// True when a product with a sum among its factors is reachable through sums and products (what [`expand`]
@@ -655,6 +645,92 @@ mod tests {
         ] {
             assert_eq!(Ex::S(s).key(), format!("{s:?}"));
             assert_eq!(Ex::S(s).key_len(), format!("{s:?}").len());
+        }
+    }
+
+    /// Raw trees (not canonical: every shape the order must handle) from a small generator.
+    fn random_tree(seed: &mut u64, depth: usize) -> Ex {
+        let mut next = |n: u64| {
+            *seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (*seed >> 33) % n
+        };
+        // Numbers whose keys are prefixes of each other (`#1e1`, `#1e10`), signs, fractions.
+        const NUMS: [f64; 9] = [1.0, 10.0, 1e10, -1.0, 0.5, 1.5, 15.0, -0.0, 2.0];
+        let syms = [
+            Sym::Param(1),
+            Sym::Param(12),
+            Sym::Param(2),
+            Sym::Input(0),
+            Sym::InputDot(0),
+            Sym::State(3),
+            Sym::StateDot(3),
+            Sym::Tear(1),
+            Sym::Time,
+            Sym::Output(0),
+            Sym::Var(7),
+        ];
+        let funcs = [Func::Sin, Func::Sinh, Func::Atan, Func::Atan2, Func::Ln];
+        let kind = if depth == 0 { next(2) } else { next(6) };
+        match kind {
+            0 => Ex::Num(NUMS[next(NUMS.len() as u64) as usize]),
+            1 => Ex::S(syms[next(syms.len() as u64) as usize]),
+            2 | 3 => {
+                let n = next(3) as usize;
+                let items = (0..n).map(|_| random_tree(seed, depth - 1)).collect();
+                if kind == 2 {
+                    Ex::Add(items)
+                } else {
+                    Ex::Mul(items)
+                }
+            }
+            4 => Ex::Pow(
+                Box::new(random_tree(seed, depth - 1)),
+                Box::new(random_tree(seed, depth - 1)),
+            ),
+            _ => {
+                let f = funcs[next(funcs.len() as u64) as usize];
+                let n = 1 + next(2) as usize;
+                Ex::Call(f, (0..n).map(|_| random_tree(seed, depth - 1)).collect())
+            }
+        }
+    }
+
+    #[test]
+    fn order_is_that_of_the_keys() {
+        let mut seed = 7;
+        let trees: Vec<Ex> = (0..400).map(|i| random_tree(&mut seed, i % 4)).collect();
+        for a in &trees {
+            for b in &trees {
+                assert_eq!(
+                    key_cmp(a, b),
+                    a.key().cmp(&b.key()),
+                    "{} vs {}",
+                    a.key(),
+                    b.key()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn remembered_expansions_are_those_from_scratch() {
+        // A chain as the resolver builds it: each value holds the previous one, multiplied by a sum; some levels
+        // multiply out, the deeper ones are too large to.
+        let n = add(vec![
+            Ex::one(),
+            mul(vec![Ex::Num(0.1), call(Func::Cos, vec![x()])]),
+        ]);
+        let mut expander = Expander::default();
+        let mut value = y();
+        for k in 0..12 {
+            let term = mul(vec![Ex::Num(f64::from(k)), call(Func::Sin, vec![x()]), y()]);
+            value = add(vec![term, mul(vec![n.clone(), value])]);
+            let remembered = expander.expand(&value);
+            assert_eq!(remembered, expand(&value), "level {k}");
+            // Asked again, the memory answers with the same.
+            assert_eq!(expander.expand(&value), remembered, "level {k}");
         }
     }
 

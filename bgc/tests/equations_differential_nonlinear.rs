@@ -17,7 +17,8 @@
 //! Graphs with a storage in derivative causality are skipped (its state is not free, so the point would have to
 //! satisfy its constraint), as are graphs bgc rightly refuses. `most_modulated_graphs_are_compared` checks that a
 //! good fraction is compared, and `a_flipped_sign_in_the_reference_is_caught` that the comparison notices a sign
-//! error of every element kind and of a junction's sum.
+//! error of every element kind, of a junction's sum and of the own flow of a C, I or R whose bond is drawn out of
+//! it.
 
 // Index loops read like the textbook elimination they implement.
 #![allow(clippy::needless_range_loop)]
@@ -164,9 +165,11 @@ enum Flip {
     Kind(K),
     /// The first bond of every junction's sum counted the wrong way.
     JunctionSum,
+    /// The flow of a C, I or R counted along its bond whichever way the bond is drawn (`f(x)` is the flow into it).
+    OwnFlow,
 }
 
-const FLIPS: [Flip; 10] = [
+const FLIPS: [Flip; 11] = [
     Flip::Kind(K::C),
     Flip::Kind(K::I),
     Flip::Kind(K::R),
@@ -177,16 +180,19 @@ const FLIPS: [Flip; 10] = [
     Flip::Kind(K::MTF),
     Flip::Kind(K::MGY),
     Flip::JunctionSum,
+    Flip::OwnFlow,
 ];
 
 /// A one-port's bond and the sign of its own flow relative to the bond's flow (docs/language.md).
-fn own(model: &Model, n: NodeIndex) -> Option<(usize, f64)> {
+fn own(model: &Model, n: NodeIndex, flip: Flip) -> Option<(usize, f64)> {
     let source = matches!(model.graph[n].kind, K::Se | K::Sf);
     if let Some(b) = model.graph.edges_directed(n, Direction::Incoming).next() {
         return Some((b.id().index(), if source { -1.0 } else { 1.0 }));
     }
     let b = model.graph.edges_directed(n, Direction::Outgoing).next()?;
-    Some((b.id().index(), if source { 1.0 } else { -1.0 }))
+    // A C, I or R drawn with its bond pointing out of it: its own flow is minus the bond's.
+    let wrong = flip == Flip::OwnFlow && !source;
+    Some((b.id().index(), if source || wrong { 1.0 } else { -1.0 }))
 }
 
 /// The effort or the flow unknown of a bond.
@@ -200,6 +206,7 @@ struct At<'a> {
     u: &'a [f64],
     t: f64,
     z: &'a [f64],
+    flip: Flip,
 }
 
 impl At<'_> {
@@ -211,9 +218,9 @@ impl At<'_> {
             Expr::Param(i) => *self.params.get(*i)?,
             Expr::Input(i) => *self.u.get(*i)?,
             Expr::Displacement(n) | Expr::Momentum(n) => self.states.iter().find(|s| s.0 == *n)?.1,
-            Expr::Effort(Target::Node(n)) => self.z[2 * own(self.model, *n)?.0],
+            Expr::Effort(Target::Node(n)) => self.z[2 * own(self.model, *n, self.flip)?.0],
             Expr::Flow(Target::Node(n)) => {
-                let (b, sign) = own(self.model, *n)?;
+                let (b, sign) = own(self.model, *n, self.flip)?;
                 sign * self.z[2 * b + 1]
             }
             Expr::Neg(a) => -v(a)?,
@@ -234,7 +241,8 @@ impl At<'_> {
     }
 
     /// The residuals of all node equations; `None` for an element the reference does not model.
-    fn residuals(&self, flip: Flip) -> Option<Vec<f64>> {
+    fn residuals(&self) -> Option<Vec<f64>> {
+        let flip = self.flip;
         let (ef, fl): (BondVar, BondVar) = (|b| 2 * b, |b| 2 * b + 1);
         let z = self.z;
         let mut rows = Vec::with_capacity(z.len());
@@ -257,8 +265,8 @@ impl At<'_> {
                         .map(|b| (b.id().index(), -1.0)),
                 )
                 .collect();
-            let own_flow = || own(self.model, n).map(|(b, so)| so * z[fl(b)]);
-            let own_effort = || own(self.model, n).map(|(b, _)| z[ef(b)]);
+            let own_flow = || own(self.model, n, self.flip).map(|(b, so)| so * z[fl(b)]);
+            let own_effort = || own(self.model, n, self.flip).map(|(b, _)| z[ef(b)]);
             match (&node.kind, &node.relation) {
                 (K::Zero | K::One, _) => {
                     let (common, summed) = if node.kind == K::Zero {
@@ -461,9 +469,10 @@ fn reference(case: &Case, point: &Point, flip: Flip) -> Option<(Vec<f64>, Vec<f6
         u: &point.u,
         t: point.t,
         z,
+        flip,
     };
     let z = newton(2 * case.model.graph.edge_count(), |z| {
-        At { z, ..at(&[]) }.residuals(flip)
+        At { z, ..at(&[]) }.residuals()
     })?;
     let at = At { z: &z, ..at(&[]) };
     let rates = case

@@ -274,6 +274,57 @@ impl Cx {
     }
 }
 
+/// Solves `a x = b` by Gaussian elimination with partial pivoting; `None` when singular.
+pub fn solve(mut a: Vec<Vec<Cx>>, mut b: Vec<Cx>) -> Option<Vec<Cx>> {
+    let n = b.len();
+    for col in 0..n {
+        let pivot = (col..n).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if a[pivot][col].abs() < 1e-12 {
+            return None;
+        }
+        a.swap(col, pivot);
+        b.swap(col, pivot);
+        for r in col + 1..n {
+            let factor = a[r][col].div(a[col][col]);
+            let pivot_row = a[col].clone();
+            for (x, p) in a[r].iter_mut().zip(&pivot_row).skip(col) {
+                *x = x.sub(factor.mul(*p));
+            }
+            b[r] = b[r].sub(factor.mul(b[col]));
+        }
+    }
+    let mut x = vec![Cx::re(0.0); n];
+    for r in (0..n).rev() {
+        let mut acc = b[r];
+        for c in r + 1..n {
+            acc = acc.sub(a[r][c].mul(x[c]));
+        }
+        x[r] = acc.div(a[r][r]);
+    }
+    Some(x)
+}
+
+/// A small deterministic generator driven by proptest's seed.
+pub struct Gen(pub u64);
+impl Gen {
+    pub fn next(&mut self) -> u64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        self.0 >> 33
+    }
+    pub fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
+    }
+    pub fn coin(&mut self) -> bool {
+        self.below(2) == 0
+    }
+    pub fn value(&mut self) -> f64 {
+        0.5 + (self.below(1000) as f64) / 400.0
+    }
+}
+
 /// `G(jω) = C (jωI - A)⁻¹ B + D` by Gaussian elimination with partial pivoting in complex arithmetic.
 pub fn freq_response(
     a: &[Vec<f64>],

@@ -255,13 +255,15 @@ fn operating_point(
     verbose: bool,
 ) -> Result<(Vec<f64>, Vec<f64>), String> {
     let all_states = quantities::states(model, eqs);
+    // By name, so that a model of many states is not searched once per state.
+    let by_name: std::collections::HashMap<&str, &Declared> =
+        all_states.iter().map(|d| (d.name.as_str(), d)).collect();
     let mut declared: Vec<Declared> = state_names
         .iter()
         .map(|n| {
-            all_states
-                .iter()
-                .find(|d| d.name == *n)
-                .cloned()
+            by_name
+                .get(n.as_str())
+                .map(|d| (*d).clone())
                 .unwrap_or(Declared {
                     name: n.clone(),
                     unit: bgc::units::Unit::ONE,

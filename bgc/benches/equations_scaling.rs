@@ -6,6 +6,9 @@
 //! - the benchmark chain: `Se` drives mass 1; each 1-junction has `I` (m = 1) and `R` (b = 0.5); a `C` to the
 //!   wall at the first; a 0-junction and a `C` between neighbours; `2N` states.
 //!
+//! The `rust/...` groups time what `bgc rust` does after parsing (equations, Jacobians, code generation) on the
+//! benchmark chain and the output chain: sparse Jacobians and shared subexpressions keep both linear in the model.
+//!
 //! Run with `cargo bench -p bgc --bench equations_scaling`. The same generators, at small sizes, are checked against
 //! hand-derived values in `tests/equations_scaling.rs`.
 
@@ -85,6 +88,33 @@ fn derive(text: &str) -> usize {
         .sum()
 }
 
+/// Compiles and generates the Rust module (without the runtime); returns its length.
+fn generate_rust(text: &str) -> usize {
+    let mut sources = SourceMap::new();
+    let root = sources.add("bench.bg".to_string(), text.to_string());
+    match bgc::codegen::compile(&mut sources, root, &mut MemoryLoader::new()) {
+        Ok(compiled) => bgc::codegen::rust::generate_with(
+            &compiled,
+            "bench.bg",
+            bgc::codegen::rust::Options { runtime: false },
+        )
+        .len(),
+        Err(_) => 0,
+    }
+}
+
+fn rust_family(c: &mut Criterion, name: &str, sizes: &[usize], generate: fn(usize) -> String) {
+    let mut group = c.benchmark_group(format!("rust/{name}"));
+    group.sample_size(10);
+    for &n in sizes {
+        let text = generate(n);
+        group.bench_with_input(BenchmarkId::from_parameter(n), &text, |b, t| {
+            b.iter(|| generate_rust(black_box(t)))
+        });
+    }
+    group.finish();
+}
+
 fn family(c: &mut Criterion, name: &str, sizes: &[usize], generate: fn(usize) -> String) {
     let mut group = c.benchmark_group(format!("equations/{name}"));
     group.sample_size(10);
@@ -103,6 +133,8 @@ fn bench(c: &mut Criterion) {
     // Each value of the MTF chain holds the next junction's: the expressions, and so the cost, grow as N².
     family(c, "mtf_chain", &[25, 50, 100], mtf_chain);
     family(c, "benchmark_chain", &[1000, 10_000], benchmark_chain);
+    rust_family(c, "output_chain", &[6, 12, 24], output_chain);
+    rust_family(c, "benchmark_chain", &[100, 1000, 10000], benchmark_chain);
 }
 
 criterion_group!(benches, bench);

@@ -350,9 +350,9 @@ fn write_if_changed(path: &Path, text: &str) -> Result<bool, Error> {
     Ok(true)
 }
 
-/// The largest source file read (16 MiB): a model is text written by people; anything larger is a mistake or an
-/// attack, and is refused before it fills the memory.
-pub const MAX_SOURCE_BYTES: u64 = 16 << 20;
+/// The largest source file read (64 MiB): a model is text written by people or generated (a chain of 100,000
+/// elements takes 24 MB); anything larger is a mistake or an attack, and is refused before it fills the memory.
+pub const MAX_SOURCE_BYTES: u64 = 64 << 20;
 
 /// Reads a source file: a `.bg` file (by the name it resolves to, so a link named `x.bg` to another file is
 /// refused too) that is a regular file (not a FIFO, a device or a directory, which could block or never end) of at

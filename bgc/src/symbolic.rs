@@ -50,6 +50,7 @@
 //!   [`Expr::expand`], [`Expr::linear_form`];
 //! - sparsity: [`Expr::symbols_read`] (which symbols each expression reads) and [`Expr::sparse_jacobian`]
 //!   (entries only where a variable occurs); [`Expr::distinct_nodes`], the stored size;
+//!   [`Expr::symbols_under_calls`] (the symbols read inside `min`/`max` or other calls);
 //! - [`cse`] names the subexpressions used more than once, [`to_text_cse`] and [`to_rust_cse`] print them as
 //!   definitions (the default printers do not);
 //! - [`solve_linear`] for small linear systems;

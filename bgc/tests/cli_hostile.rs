@@ -220,13 +220,13 @@ fn special_files_are_refused_without_reading_them() {
     }
 }
 
-/// A source file above the 16 MiB bound is refused before it is read whole.
+/// A source file above the 64 MiB bound is refused before it is read whole.
 #[test]
 fn an_oversized_source_is_refused() {
     let dir = scratch("big");
     let mut text = String::from("model m { }\n");
     text.push_str(
-        &"// padding padding padding padding padding padding padding padding\n".repeat(260_000),
+        &"// padding padding padding padding padding padding padding padding\n".repeat(1_100_000),
     );
     assert!(text.len() as u64 > bgc::build::MAX_SOURCE_BYTES);
     write(&dir.join("big.bg"), &text);
@@ -234,7 +234,7 @@ fn an_oversized_source_is_refused() {
     assert_eq!(run.status, 2, "{}", run.transcript());
     assert!(
         run.stderr.contains(
-            "cannot read big.bg: the file is larger than the 16 MiB a source file may have"
+            "cannot read big.bg: the file is larger than the 64 MiB a source file may have"
         ),
         "{}",
         run.transcript()

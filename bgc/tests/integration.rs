@@ -41,6 +41,7 @@ mod equations_robustness;
 mod equations_scaling;
 mod equations_sensitivity;
 mod equations_signs;
+mod equations_sparse;
 mod equations_state_space;
 mod fmu_cli;
 mod fmu_description;

@@ -9,9 +9,7 @@ use super::sparse;
 use super::{Coords, EquationsFormat, ReportFormat, Status};
 use bgc::diagnostic::{has_errors, render};
 use bgc::equations::sym::{self, Ex, Sym};
-use bgc::equations::{
-    self, CoordsError, Equations, Jacobians, LinearError, NumericStateSpace, StateSelection,
-};
+use bgc::equations::{self, CoordsError, Equations, Jacobians, LinearError, NumericStateSpace};
 use serde_json::{Value, json};
 use std::path::Path;
 
@@ -175,14 +173,14 @@ fn energy_coords(
     params: &[f64],
     args: &StateSpaceArgs<'_>,
 ) -> Result<Value, String> {
-    let selection = match equations::jacobians(eqs, StateSelection::Energy) {
-        Err(LinearError::NeedsIntegratedState { .. }) => StateSelection::All,
-        _ => StateSelection::Energy,
-    };
+    // The rates and outputs converted once; a large model (or one whose outputs, inlined, would be huge trees) is
+    // differentiated and evaluated sparse, a small one by the dense path as always.
+    let rows = equations::ModelRows::new(eqs);
+    let selection = equations::state_selection(eqs, &rows);
     let n = eqs.state_count(selection);
     let state_names: Vec<String> = (0..n).map(|i| eqs.sym_name(Sym::State(i))).collect();
     let (x0, u0) = operating_point(model, eqs, &state_names, args.at, args.verbose)?;
-    let linear = match equations::linear_state_space(eqs, selection) {
+    let linear = match equations::sparse_linear_state_space(eqs, &rows, selection) {
         Ok(j) => Ok(j),
         Err(
             e @ (LinearError::NotLinear { .. }
@@ -207,7 +205,7 @@ fn energy_coords(
             return Err(format!("no symbolic state space: {e}"));
         }
         let j = match linear {
-            Ok(j) => j,
+            Ok(_) => equations::linear_state_space(eqs, selection).map_err(|e| e.to_string())?,
             Err(_) => {
                 let j = equations::jacobians(eqs, selection).map_err(|e| e.to_string())?;
                 at_point(&j, &x0, &u0)
@@ -215,11 +213,27 @@ fn energy_coords(
         };
         return Ok(symbolic_json(eqs, &j, &fixed));
     }
+    let no_state_space = |e: LinearError| format!("no state space: {e}");
+    let plain = eqs.tear_blocks.is_empty() && eqs.mass.is_empty();
+    if !equations::dense_is_cheap(eqs, &rows) && (linear.is_ok() || plain) {
+        let j = match linear {
+            Ok(j) => j,
+            Err(_) => equations::sparse_jacobians(eqs, &rows, selection).map_err(no_state_space)?,
+        };
+        let ss =
+            equations::evaluate_sparse(eqs, &j, params, &x0, &u0, 0.0).map_err(no_state_space)?;
+        return Ok(if args.sparse {
+            sparse::numeric_triplets(&ss)
+        } else {
+            numeric_json(&ss.to_dense())
+        });
+    }
     let ss = match linear {
-        Ok(j) => equations::evaluate_at(eqs, &j, params, &x0, &u0, 0.0),
+        Ok(_) => equations::linear_state_space(eqs, selection)
+            .and_then(|j| equations::evaluate_at(eqs, &j, params, &x0, &u0, 0.0)),
         Err(_) => equations::linearise(eqs, selection, params, &x0, &u0, 0.0),
     }
-    .map_err(|e| format!("no state space: {e}"))?;
+    .map_err(no_state_space)?;
     Ok(numeric_json(&ss))
 }
 
@@ -241,13 +255,15 @@ fn operating_point(
     verbose: bool,
 ) -> Result<(Vec<f64>, Vec<f64>), String> {
     let all_states = quantities::states(model, eqs);
+    // By name, so that a model of many states is not searched once per state.
+    let by_name: std::collections::HashMap<&str, &Declared> =
+        all_states.iter().map(|d| (d.name.as_str(), d)).collect();
     let mut declared: Vec<Declared> = state_names
         .iter()
         .map(|n| {
-            all_states
-                .iter()
-                .find(|d| d.name == *n)
-                .cloned()
+            by_name
+                .get(n.as_str())
+                .map(|d| (*d).clone())
                 .unwrap_or(Declared {
                     name: n.clone(),
                     unit: bgc::units::Unit::ONE,

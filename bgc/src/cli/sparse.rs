@@ -3,8 +3,34 @@
 
 use serde_json::{Value, json};
 
+/// The triplet form of a numeric state space evaluated sparse (what [`triplets`] makes of its dense form), marked
+/// so that [`json`] and [`text`] take it as it is.
+pub fn numeric_triplets(ss: &bgc::equations::SparseNumericStateSpace) -> Value {
+    let matrix = |m: &bgc::equations::NumericSparse| {
+        let entries: Vec<Value> = m
+            .entries
+            .iter()
+            .map(|&(r, c, v)| json!([r, c, v]))
+            .collect();
+        // As the dense form counts them: a matrix without rows has no columns either.
+        let cols = if m.rows == 0 { 0 } else { m.cols };
+        json!({ "rows": m.rows, "cols": cols, "entries": entries })
+    };
+    json!({
+        "states": ss.states, "inputs": ss.inputs, "outputs": ss.outputs,
+        "A": matrix(&ss.a), "B": matrix(&ss.b), "C": matrix(&ss.c), "D": matrix(&ss.d),
+        SPARSE_MARK: true,
+    })
+}
+
+/// The key that marks a value already in triplet form.
+const SPARSE_MARK: &str = "sparse";
+
 /// The names and matrices of a state-space value, each matrix as `{"rows", "cols", "entries"}`.
 fn triplets(v: &Value) -> Value {
+    if v.get(SPARSE_MARK).is_some_and(|m| m == &Value::Bool(true)) {
+        return v.clone();
+    }
     let mut out = serde_json::Map::new();
     for k in ["states", "inputs", "outputs"] {
         out.insert(k.into(), v.get(k).cloned().unwrap_or(Value::Null));

@@ -12,13 +12,14 @@
 //! against the stage's own evaluation of `f`.
 
 use super::adapter::{AdaptError, explicit_outputs, to_symbolic};
+use super::shared::{Lets, share};
 use crate::equations::sym::Ex;
 use crate::equations::{
-    EnergyKind, Equations, LinearError, ParamChain, StateSelection, declared_state_space_symbolic,
-    jacobians, linear_state_space,
+    EnergyKind, Equations, ModelRows, ParamChain, SparseMatrix, StateSelection,
+    declared_state_space_symbolic, sparse_linear_state_space, state_selection,
 };
 use crate::symbolic::{Expr, Symbol, SymbolKind};
-use std::collections::{BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 /// Let-bindings then results.
 #[derive(Clone, Debug)]
@@ -27,14 +28,14 @@ pub(crate) struct Block {
     pub results: Vec<Expr>,
 }
 
-/// A state space with symbolic entries (free of states, inputs and time).
+/// A state space with symbolic entries (free of states, inputs and time), sparse.
 #[derive(Clone, Debug)]
 pub(crate) struct StateSpace {
     pub states: Vec<String>,
-    pub a: Vec<Vec<Expr>>,
-    pub b: Vec<Vec<Expr>>,
-    pub c: Vec<Vec<Expr>>,
-    pub d: Vec<Vec<Expr>>,
+    pub a: SparseMatrix,
+    pub b: SparseMatrix,
+    pub c: SparseMatrix,
+    pub d: SparseMatrix,
 }
 
 /// The `(element, value)` terms of one kind of energy, or the elements without a closed form.
@@ -47,14 +48,18 @@ pub(crate) struct Plan {
     pub inputs: Vec<Symbol>,
     pub rhs: Block,
     pub outputs: Block,
-    pub dfdx: Vec<Vec<Expr>>,
-    pub dfdu: Vec<Vec<Expr>>,
-    pub dhdx: Vec<Vec<Expr>>,
-    pub dhdu: Vec<Vec<Expr>>,
+    /// The Jacobians, sparse: each row differentiated only by the variables it reads.
+    pub dfdx: SparseMatrix,
+    pub dfdu: SparseMatrix,
+    pub dhdx: SparseMatrix,
+    pub dhdu: SparseMatrix,
     /// `∂f/∂p` and `∂h/∂p` with respect to the free parameters (`PARAM_NAMES` order), total through the derived
     /// parameters ([`ParamChain`]); partial at fixed tears, and the mass-matrix rows hold `∂F/∂p`, as in `dfdx`.
     pub dfdp: Vec<Vec<Expr>>,
     pub dhdp: Vec<Vec<Expr>>,
+    /// For each Jacobian function (`jac_x_into`, ..., `output_jac_p_into`), the shared subexpressions its
+    /// entries are written over ([`super::shared`]): empty unless an entry would print as a huge tree.
+    pub shared: BTreeMap<&'static str, Lets>,
     /// `A, B, C, D` in the energy states, or (when the rates or outputs read an integrated flow) in all states,
     /// or why there is none.
     pub linear_ss: Result<StateSpace, String>,
@@ -69,11 +74,6 @@ pub(crate) struct Plan {
     pub loops: Option<super::loops::LoopPlan>,
     /// The I-fields' mass-matrix blocks (their rows of `rhs`, `dfdx` and `dfdu` hold the forces `F`).
     pub mass: Vec<super::mass::MassPlan>,
-}
-
-/// Checks that the equations are complete and convertible (what [`plan`] needs).
-pub(crate) fn check(eqs: &Equations) -> Result<(), String> {
-    plan(eqs).map(|_| ())
 }
 
 fn convert_all(eqs: &Equations, es: &[Ex]) -> Result<Vec<Expr>, AdaptError> {
@@ -113,10 +113,17 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
     let rhs = block(eqs, &eqs.rates, &f);
     let readable_outputs: Vec<Ex> = eqs.outputs.iter().map(|o| o.value.clone()).collect();
     let outputs = block(eqs, &readable_outputs, &h);
-    let linear_selection = linear_selection(eqs);
-    let linear_ss = linear_state_space(eqs, linear_selection)
-        .map_err(|e| e.to_string())
-        .and_then(|j| state_space(eqs, j.states, &j.dfdx, &j.dfdu, &j.dhdx, &j.dhdu));
+    let rows = ModelRows::new(eqs);
+    let linear_selection = state_selection(eqs, &rows);
+    let linear_ss = sparse_linear_state_space(eqs, &rows, linear_selection)
+        .map(|j| StateSpace {
+            states: j.states,
+            a: j.dfdx,
+            b: j.dfdu,
+            c: j.dhdx,
+            d: j.dhdu,
+        })
+        .map_err(|e| e.to_string());
     let declared_ss = eqs.coords.as_ref().map(|_| {
         declared_state_space_symbolic(eqs)
             .map_err(|e| e.to_string())
@@ -165,15 +172,45 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
             );
         }
     }
+    let mut dfdx = SparseMatrix::jacobian(&f, &states);
+    let mut dfdu = SparseMatrix::jacobian(&f, &inputs);
+    let mut dhdx = SparseMatrix::jacobian(&h, &states);
+    let mut dhdu = SparseMatrix::jacobian(&h, &inputs);
+    let mut dfdp = chain.jacobian(&f);
+    let mut dhdp = chain.jacobian(&h);
+    let shared = BTreeMap::from([
+        (
+            "jac_x_into",
+            share("dfdx_", sparse_entries(&mut dfdx).into_iter()),
+        ),
+        (
+            "jac_u_into",
+            share("dfdu_", sparse_entries(&mut dfdu).into_iter()),
+        ),
+        (
+            "output_jac_x_into",
+            share("dhdx_", sparse_entries(&mut dhdx).into_iter()),
+        ),
+        (
+            "output_jac_u_into",
+            share("dhdu_", sparse_entries(&mut dhdu).into_iter()),
+        ),
+        ("jac_p_into", share("dfdp_", dfdp.iter_mut().flatten())),
+        (
+            "output_jac_p_into",
+            share("dhdp_", dhdp.iter_mut().flatten()),
+        ),
+    ]);
     Ok(Plan {
         loops,
         mass,
-        dfdx: Expr::jacobian(&f, &states),
-        dfdu: Expr::jacobian(&f, &inputs),
-        dhdx: Expr::jacobian(&h, &states),
-        dhdu: Expr::jacobian(&h, &inputs),
-        dfdp: chain.jacobian(&f),
-        dhdp: chain.jacobian(&h),
+        dfdx,
+        dfdu,
+        dhdx,
+        dhdu,
+        dfdp,
+        dhdp,
+        shared,
         states,
         inputs,
         rhs,
@@ -185,15 +222,6 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
     })
 }
 
-/// The states of the generated `state_space`: the energy states, unless a rate or an output reads an integrated
-/// flow (`var theta = int(f(load))` as an output); then the integrated flows join them, as in `bgc statespace`.
-fn linear_selection(eqs: &Equations) -> StateSelection {
-    match jacobians(eqs, StateSelection::Energy) {
-        Err(LinearError::NeedsIntegratedState { .. }) => StateSelection::All,
-        _ => StateSelection::Energy,
-    }
-}
-
 fn state_space(
     eqs: &Equations,
     states: Vec<String>,
@@ -202,14 +230,27 @@ fn state_space(
     c: &[Vec<Ex>],
     d: &[Vec<Ex>],
 ) -> Result<StateSpace, String> {
-    let m = |x: &[Vec<Ex>]| convert_matrix(eqs, x).map_err(|e| e.to_string());
+    let m = |x: &[Vec<Ex>], cols: usize| {
+        convert_matrix(eqs, x)
+            .map(|dense| SparseMatrix::from_dense(&dense, cols))
+            .map_err(|e| e.to_string())
+    };
+    let (n, inputs) = (states.len(), eqs.inputs.len());
     Ok(StateSpace {
+        a: m(a, n)?,
+        b: m(b, inputs)?,
+        c: m(c, n)?,
+        d: m(d, inputs)?,
         states,
-        a: m(a)?,
-        b: m(b)?,
-        c: m(c)?,
-        d: m(d)?,
     })
+}
+
+/// The entries of a sparse matrix, to rewrite in place.
+fn sparse_entries(m: &mut SparseMatrix) -> Vec<&mut Expr> {
+    m.entries
+        .iter_mut()
+        .flat_map(|row| row.iter_mut().map(|(_, e)| e))
+        .collect()
 }
 
 /// The most `let`s a generated function gets. rustc's stack grows with the number of nested `let` scopes of one

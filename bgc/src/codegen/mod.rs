@@ -24,6 +24,7 @@ mod loops;
 pub(crate) mod mass;
 mod names;
 pub mod rust;
+mod shared;
 #[cfg(test)]
 mod test_support;
 
@@ -46,6 +47,8 @@ pub mod codes {
 pub struct CompiledModel {
     pub model: ir::Model,
     pub equations: Equations,
+    /// What the generators print, computed once when the model is checked.
+    pub(crate) plan: std::sync::Arc<emit::Plan>,
 }
 
 /// The models of one file, ready for generation.
@@ -93,15 +96,22 @@ pub fn compile(
         if has_errors(&diags) {
             return Err(diags);
         }
-        if let Err(why) = emit::check(&equations) {
-            let d = Diagnostic::error(
-                codes::NOT_GENERATABLE,
-                format!("cannot generate code for `{}`: {why}", model.name),
-            );
-            diags.push(d.with_primary(model.spans.model, "this model"));
-            return Err(diags);
-        }
-        compiled.push(CompiledModel { model, equations });
+        let plan = match emit::plan(&equations) {
+            Ok(plan) => std::sync::Arc::new(plan),
+            Err(why) => {
+                let d = Diagnostic::error(
+                    codes::NOT_GENERATABLE,
+                    format!("cannot generate code for `{}`: {why}", model.name),
+                );
+                diags.push(d.with_primary(model.spans.model, "this model"));
+                return Err(diags);
+            }
+        };
+        compiled.push(CompiledModel {
+            model,
+            equations,
+            plan,
+        });
     }
     Ok(CompiledFile {
         models: compiled,

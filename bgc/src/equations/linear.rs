@@ -369,7 +369,7 @@ pub fn linear_state_space(
 }
 
 /// The elements whose values use `t`, as a phrase: "`mains`", "`a`, `b`".
-fn time_elements_text(eqs: &Equations) -> String {
+pub(super) fn time_elements_text(eqs: &Equations) -> String {
     if eqs.time_signals.is_empty() {
         return "a value that uses `t`".into();
     }

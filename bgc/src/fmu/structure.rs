@@ -8,8 +8,7 @@
 //! state and input"): its rates depend on the states also through the tears' solution.
 
 use crate::codegen::emit;
-use crate::equations::Equations;
-use crate::symbolic::Expr;
+use crate::equations::{Equations, SparseMatrix};
 use std::collections::BTreeSet;
 
 /// Per state derivative and per output, the columns it depends on: `k < n_states` the state `k`, else the input
@@ -28,20 +27,13 @@ pub fn dependencies(eqs: &Equations) -> Dependencies {
         return Dependencies::default();
     }
     let nx = plan.states.len();
-    let pattern = |dx: &[Vec<Expr>], du: &[Vec<Expr>]| -> Vec<BTreeSet<usize>> {
-        dx.iter()
-            .zip(du)
+    let pattern = |dx: &SparseMatrix, du: &SparseMatrix| -> Vec<BTreeSet<usize>> {
+        dx.entries
+            .iter()
+            .zip(&du.entries)
             .map(|(rx, ru)| {
-                let states = rx
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, e)| !e.is_zero())
-                    .map(|(k, _)| k);
-                let inputs = ru
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, e)| !e.is_zero())
-                    .map(|(k, _)| nx + k);
+                let states = rx.iter().filter(|(_, e)| !e.is_zero()).map(|(k, _)| *k);
+                let inputs = ru.iter().filter(|(_, e)| !e.is_zero()).map(|(k, _)| nx + k);
                 states.chain(inputs).collect()
             })
             .collect()

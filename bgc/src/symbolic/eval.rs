@@ -149,6 +149,26 @@ impl Expr {
             .collect()
     }
 
+    /// The symbols read inside the calls of `funcs` (`min`, `max`, ...), with the first such call met that reads
+    /// any: one walk of the distinct nodes, and one more of each such call. `None` when no such call reads a
+    /// symbol.
+    pub fn symbols_under_calls(&self, funcs: &[Func]) -> Option<(Func, BTreeSet<Symbol>)> {
+        let mut found: Option<(Func, BTreeSet<Symbol>)> = None;
+        for e in Dag::new([self]).order {
+            if let Node::Call(f, _) = e.node()
+                && funcs.contains(f)
+            {
+                let read = e.free_symbols();
+                match &mut found {
+                    Some((_, all)) => all.extend(read),
+                    None if !read.is_empty() => found = Some((*f, read)),
+                    None => {}
+                }
+            }
+        }
+        found
+    }
+
     /// Whether `symbol` occurs in the expression.
     pub fn depends_on(&self, symbol: &Symbol) -> bool {
         self.depends_on_any(std::slice::from_ref(symbol))

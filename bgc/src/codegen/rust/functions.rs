@@ -10,7 +10,7 @@ use super::super::names::{Namer, comment};
 use super::calls::{call_depth, call_name, early_calls, with_bound_calls};
 use super::terms::term_field;
 use super::{Arg, Function, Uses, Writer, output_names};
-use crate::equations::{EnergyKind, StateSelection};
+use crate::equations::{EnergyKind, SparseMatrix, StateSelection};
 use crate::symbolic::{Expr, RustCode, Symbol, SymbolKind};
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -37,7 +37,7 @@ impl Draft {
     }
 }
 
-impl Writer<'_> {
+impl<'a> Writer<'a> {
     /// A body that binds the states and inputs `exprs` use, and what it uses.
     pub(in crate::codegen) fn draft(&self, exprs: &[&Expr]) -> Draft {
         self.draft_with(exprs, false)
@@ -100,10 +100,11 @@ impl Writer<'_> {
                 }
             }
         }
-        // The names available from the start: states and inputs bound above, parameters, time.
+        // The names available from the start: states and inputs bound above, parameters, time (not the
+        // intermediates and earlier outputs, computed in the body).
         let early: BTreeSet<String> = used
             .iter()
-            .filter(|s| s.kind() != SymbolKind::Intermediate)
+            .filter(|s| !matches!(s.kind(), SymbolKind::Intermediate | SymbolKind::Output))
             .map(|s| self.name(s))
             .collect();
         let mut calls = BTreeMap::new();
@@ -382,12 +383,12 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
     fn matrix_fn(
         &mut self,
         (name, doc, ty): (&str, &str, &'static str),
-        m: &[Vec<Expr>],
+        m: &SparseMatrix,
         rows: &[String],
         cols: &[String],
         row_prefix: &str,
     ) {
-        let mut nonzero: Vec<&Expr> = m.iter().flatten().filter(|e| !e.is_zero()).collect();
+        let mut nonzero: Vec<&Expr> = m.iter().map(|(_, _, e)| e).collect();
         if name == "jac_x_into" {
             // The mass-matrix correction uses ∂M/∂x as well.
             let plan = self.plan;
@@ -407,9 +408,12 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         };
         let correction = self.loop_correction_exprs(g_z, r_v);
         nonzero.extend(correction.iter());
+        let shared = self.shared_lets(name);
+        nonzero.extend(shared.iter().map(|(_, v)| v));
         let mut d = self.draft_cached(&nonzero);
         self.solve_tears(&mut d, &nonzero);
-        self.matrix_entries(&mut d, m, (rows, cols, row_prefix));
+        self.shared_statements(&mut d, shared);
+        self.matrix_entries(&mut d, m.iter(), (rows, cols, row_prefix));
         self.loop_correction(&mut d, g_z, r_v, size);
         match name {
             "jac_x_into" => self.mass_solve_in_jacobian(&mut d, MassColumns::States),
@@ -429,27 +433,44 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         }
     }
 
-    /// `jac.fill(0.0)` and one assignment per entry of `m` that is not identically zero, under a comment
-    /// naming it (`∂(d/dt p_mass)/∂q_spring = …`): rows and columns named by `names`, the rows with a prefix.
-    pub(super) fn matrix_entries(
+    /// The shared subexpressions the entries of the Jacobian function `name` are written over.
+    pub(super) fn shared_lets(&self, name: &str) -> &'a [(Symbol, Expr)] {
+        let plan = self.plan;
+        plan.shared.get(name).map_or(&[], Vec::as_slice)
+    }
+
+    /// One `let` per shared subexpression, in order (each after those it reads).
+    pub(super) fn shared_statements(&self, d: &mut Draft, lets: &[(Symbol, Expr)]) {
+        for (s, v) in lets {
+            let local = self.name(s);
+            self.statement(
+                d,
+                &format!("{} = ", s.name()),
+                v,
+                &format!("let {local} = "),
+                ";",
+            );
+            d.locals.push(local);
+        }
+    }
+
+    /// `jac.fill(0.0)` and one assignment per entry `(row, column, value)` that is not identically zero, in the
+    /// order given, under a comment naming it (`∂(d/dt p_mass)/∂q_spring = …`): rows and columns named by
+    /// `names`, the rows with a prefix.
+    pub(super) fn matrix_entries<'e>(
         &self,
         d: &mut Draft,
-        m: &[Vec<Expr>],
+        entries: impl Iterator<Item = (usize, usize, &'e Expr)>,
         (rows, cols, row_prefix): (&[String], &[String], &str),
     ) {
         d.lines.push("    jac.fill(0.0);".into());
-        for (r, row) in m.iter().enumerate() {
-            for (c, e) in row.iter().enumerate() {
-                if e.is_zero() {
-                    continue;
-                }
-                let lhs = format!(
-                    "∂({row_prefix}{})/∂{} = ",
-                    rows.get(r).cloned().unwrap_or_default(),
-                    cols.get(c).cloned().unwrap_or_default()
-                );
-                self.statement(d, &lhs, e, &format!("jac[({r}, {c})] = "), ";");
-            }
+        for (r, c, e) in entries.filter(|(_, _, e)| !e.is_zero()) {
+            let lhs = format!(
+                "∂({row_prefix}{})/∂{} = ",
+                rows.get(r).map_or("", String::as_str),
+                cols.get(c).map_or("", String::as_str)
+            );
+            self.statement(d, &lhs, e, &format!("jac[({r}, {c})] = "), ";");
         }
     }
 
@@ -459,6 +480,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
     fn wants_sparse_jac_x(&self) -> bool {
         let n = self.plan.states.len();
         n.saturating_mul(n).saturating_mul(8) > super::model::MAX_CONSTANT_JACOBIAN_BYTES
+            && self.shared_lets("jac_x_into").is_empty()
             && self.plan.loops.is_none()
             && self.plan.mass.is_empty()
     }
@@ -467,19 +489,15 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
     /// identically zero, column by column, without an `N_STATES × N_STATES` matrix.
     fn sparse_jac_x(
         &mut self,
-        m: &[Vec<Expr>],
+        m: &SparseMatrix,
         rows: &[String],
         cols: &[String],
         row_prefix: &str,
     ) {
-        let mut entries: Vec<(usize, usize, &Expr)> = Vec::new();
-        for c in 0..cols.len() {
-            for (r, row) in m.iter().enumerate() {
-                if let Some(e) = row.get(c).filter(|e| !e.is_zero()) {
-                    entries.push((r, c, e));
-                }
-            }
-        }
+        // Column by column.
+        let mut entries: Vec<(usize, usize, &Expr)> =
+            m.iter().filter(|(_, c, _)| *c < cols.len()).collect();
+        entries.sort_by_key(|&(r, c, _)| (c, r));
         self.out.push('\n');
         self.doc(
             0,
@@ -604,11 +622,14 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             ("c", &ss.c, "N_OUTPUTS", size),
             ("d", &ss.d, "N_OUTPUTS", "N_INPUTS"),
         ];
-        let all: Vec<&Expr> = matrices.iter().flat_map(|m| m.1.iter().flatten()).collect();
+        let all: Vec<&Expr> = matrices
+            .iter()
+            .flat_map(|m| m.1.iter().map(|(_, _, e)| e))
+            .collect();
         // Entries are free of states, inputs and time: the draft binds nothing.
         let mut d = self.draft(&all);
         for (var, m, rows, cols) in matrices {
-            let mutable = if m.iter().flatten().any(|e| !e.is_zero()) {
+            let mutable = if m.iter().any(|(_, _, e)| !e.is_zero()) {
                 "mut "
             } else {
                 ""
@@ -625,19 +646,14 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             ("c", &ss.c, &ys, &ss.states),
             ("d", &ss.d, &ys, &us),
         ] {
-            for (r, row) in m.iter().enumerate() {
-                for (col, e) in row.iter().enumerate() {
-                    if e.is_zero() {
-                        continue;
-                    }
-                    let lhs = format!(
-                        "{}[{}, {}] = ",
-                        var.to_uppercase(),
-                        rows.get(r).cloned().unwrap_or_default(),
-                        cols.get(col).cloned().unwrap_or_default()
-                    );
-                    self.statement(&mut d, &lhs, e, &format!("{var}[({r}, {col})] = "), ";");
-                }
+            for (r, col, e) in m.iter().filter(|(_, _, e)| !e.is_zero()) {
+                let lhs = format!(
+                    "{}[{}, {}] = ",
+                    var.to_uppercase(),
+                    rows.get(r).map_or("", String::as_str),
+                    cols.get(col).map_or("", String::as_str)
+                );
+                self.statement(&mut d, &lhs, e, &format!("{var}[({r}, {col})] = "), ";");
             }
         }
         d.lines.push("    (a, b, c, d)".into());

@@ -60,7 +60,7 @@ mod terms;
 
 pub(super) use functions::Draft;
 
-use super::emit::{self, Plan};
+use super::emit::Plan;
 use super::format::{self, Wrap};
 use super::layout::MAX_WIDTH;
 use super::names::{Namer, comment, string_literal};
@@ -156,17 +156,7 @@ pub fn generate_with(file: &CompiledFile, source_name: &str, options: Options) -
 /// The code of one model (items at the top level), for lines of `MAX_WIDTH - base_indent` columns.
 fn model_code(m: &CompiledModel, options: Options, base_indent: usize) -> String {
     let width = MAX_WIDTH - base_indent;
-    match emit::plan(&m.equations) {
-        Ok(plan) => allow_dead_code(&Writer::new(m, &plan, options, width).write()),
-        Err(why) => {
-            let message = format!("bgc cannot generate `{}`: {why}", m.model.name);
-            let head = "compile_error!(";
-            format!(
-                "{head}{});\n",
-                format::string_literal(&message, head.len(), 2, 4, width)
-            )
-        }
-    }
+    allow_dead_code(&Writer::new(m, &m.plan, options, width).write())
 }
 
 /// The item keywords that start a line of a model's code at the top level.
@@ -336,6 +326,13 @@ impl<'a> Writer<'a> {
         }
         for s in plan.loops.iter().flat_map(|l| &l.tears) {
             names.insert(s.clone(), namer.ident(s.name()));
+        }
+        for (s, _) in plan.shared.values().flatten() {
+            names.insert(s.clone(), namer.ident(s.name()));
+        }
+        // An output that reads an earlier one (in the readable outputs) reads it from `y`, written before.
+        for (k, o) in eqs.outputs.iter().enumerate() {
+            names.insert(Symbol::output(o.name.as_str()), format!("y[{k}]"));
         }
         names.insert(Symbol::time(), "t".into());
         Writer {

@@ -81,9 +81,16 @@ pub type OutJacP = SMatrix<f64, N_OUTPUTS, N_PARAMS>;
         }
         let correction = self.loop_correction_exprs(g_z, r_p);
         needed.extend(correction.iter());
+        let shared = self.shared_lets(name);
+        needed.extend(shared.iter().map(|(_, v)| v));
         let mut d = self.draft(&needed);
         self.solve_tears(&mut d, &needed);
-        self.matrix_entries(&mut d, m, (rows, cols, row_prefix));
+        self.shared_statements(&mut d, shared);
+        let entries = m
+            .iter()
+            .enumerate()
+            .flat_map(|(r, row)| row.iter().enumerate().map(move |(c, e)| (r, c, e)));
+        self.matrix_entries(&mut d, entries, (rows, cols, row_prefix));
         let size = if mass { "N_STATES" } else { "N_OUTPUTS" };
         self.loop_correction(&mut d, g_z, r_p, (size, "N_PARAMS"));
         if solve_mass {

@@ -197,8 +197,7 @@ impl Writer<'_> {
             .chain(
                 [&plan.dfdx, &plan.dfdu, &plan.dhdx, &plan.dhdu]
                     .into_iter()
-                    .flatten()
-                    .flatten(),
+                    .flat_map(|m| m.iter().map(|(_, _, e)| e)),
             );
         for e in exprs {
             terms.rewrite(e);

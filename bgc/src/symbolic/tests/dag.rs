@@ -277,6 +277,25 @@ fn random_shared(rng: &mut Rng) -> Vec<Expr> {
 }
 
 #[test]
+fn symbols_under_min_and_max_calls() {
+    use crate::ir::Func;
+    let inner = Expr::call(Func::Max, &[s("x"), p("k")]).expect("two arguments");
+    let e = s("y") * inner.sin() + s("z");
+    let (func, read) = e
+        .symbols_under_calls(&[Func::Min, Func::Max])
+        .expect("a max reads symbols");
+    assert_eq!(func, Func::Max);
+    assert_eq!(
+        read.iter().map(Symbol::name).collect::<Vec<_>>(),
+        ["k", "x"]
+    );
+    assert_eq!(
+        (s("y") * s("x").sin()).symbols_under_calls(&[Func::Min, Func::Max]),
+        None
+    );
+}
+
+#[test]
 fn symbols_read_and_sparse_jacobian() {
     let (x, y, z) = (Symbol::state("x"), Symbol::state("y"), Symbol::state("z"));
     let rows = vec![s("x") * s("y"), s("z").sin(), p("k") + 0.0 * s("x")];

@@ -11,7 +11,8 @@ use bgc::lower::{MemoryLoader, lower};
 use bgc::simulate::System;
 use bgc::span::SourceMap;
 
-fn equations(text: &str) -> Equations {
+/// Lowers, analyses and derives one model from source text; any error fails the test.
+pub fn equations(text: &str) -> Equations {
     let mut sources = SourceMap::new();
     let root = sources.add("scaling.bg".to_string(), text.to_string());
     let (models, mut diags) = lower(&mut sources, root, &mut MemoryLoader::new());

@@ -6,7 +6,7 @@
 use crate::equations_support;
 
 use bgc::causality::analyse;
-use bgc::equations::{Equations, derive};
+use bgc::equations::{Equations, Rows, derive};
 use bgc::ir::Model;
 use bgc::lower::{MemoryLoader, lower};
 use bgc::span::SourceMap;
@@ -358,4 +358,25 @@ fn a_parameter_index_out_of_range_is_an_error() {
         eqs.param_jacobian_at(&[None; 3], &[0.0], &[0.0], 0.0, &[0])
             .is_err()
     );
+}
+
+/// Outputs defined through earlier outputs (`y_i = sin(y_{i-1}²) + cos(y_{i-1})`, 24 levels): each output reads the
+/// previous one three times, so written out as a tree `y_24` has about 3²⁴ nodes. The sensitivity keeps each
+/// earlier output as one shared node; its `∂y/∂p` agree with differences of the outputs.
+#[test]
+fn outputs_through_earlier_outputs_are_differentiated_as_shared_nodes() {
+    let eqs = equations_of_text(&crate::equations_scaling::output_chain(24));
+    let given = vec![None; eqs.params.len()];
+    let free = [index(&eqs, "q0"), index(&eqs, "k")];
+    let point: (&[f64], &[f64], f64) = (&[0.3, 0.7], &[], 0.0);
+    let jac = eqs
+        .sensitivity(&given, &free)
+        .expect("sensitivity")
+        .at(&eqs.param_values(&given), point, Rows::Outputs)
+        .expect("at the point");
+    let (_, hp) = differences(&eqs, &given, point, &free);
+    assert_eq!(jac.hp.len(), 24);
+    agree("∂h/∂p", &jac.hp, &hp, 1e-6);
+    // Not a vacuous agreement: q0 scales the first output's arguments, and it reaches the last one.
+    assert!(hp[23][0].abs() > 1e-6, "∂y_24/∂q0 = {}", hp[23][0]);
 }

@@ -2,29 +2,15 @@
 //! large models): outputs defined through earlier outputs stay a small DAG, their derivatives match central
 //! differences, and on ordinary models the sparse path agrees with the dense one, errors included.
 
-use bgc::causality::analyse;
-use bgc::diagnostic::Diagnostic;
 use bgc::equations::{
-    Equations, ModelRows, StateSelection, derive, evaluate_at, evaluate_sparse, jacobians,
-    linear_state_space, sparse_jacobians, sparse_linear_state_space,
+    ModelRows, StateSelection, evaluate_at, evaluate_sparse, jacobians, linear_state_space,
+    sparse_jacobians, sparse_linear_state_space,
 };
-use bgc::lower::{MemoryLoader, lower};
+use bgc::lower::MemoryLoader;
 use bgc::span::SourceMap;
 use bgc::symbolic::{Expr, Symbol};
 
-fn equations(text: &str) -> Equations {
-    let mut sources = SourceMap::new();
-    let root = sources.add("sparse.bg".to_string(), text.to_string());
-    let (models, mut diags) = lower(&mut sources, root, &mut MemoryLoader::new());
-    assert_eq!(models.len(), 1, "{diags:?}");
-    let (causality, cdiags) = analyse(&models[0]);
-    diags.extend(cdiags);
-    let (eqs, ediags) = derive(&models[0], &causality);
-    diags.extend(ediags);
-    let errors: Vec<&Diagnostic> = diags.iter().filter(|d| d.is_error()).collect();
-    assert!(errors.is_empty(), "{errors:?}");
-    eqs
-}
+use crate::equations_scaling::equations;
 
 /// A mass on a spring with outputs `y_1 = sin((q/q0)²) + cos(q/q0)`, `y_i = sin(y_{i-1}²) + cos(y_{i-1})`.
 fn output_chain(levels: usize) -> String {

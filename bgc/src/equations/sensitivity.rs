@@ -246,14 +246,16 @@ impl Equations {
             .collect()
     }
 
+    /// The outputs on the shared engine, an earlier output read by a later one as one shared node
+    /// ([`super::ModelRows`]): a chain of outputs through outputs stays as small as it is written.
     fn explicit_outputs(&self) -> Result<Vec<Expr>, LinearError> {
         self.outputs
             .iter()
-            .zip(self.outputs_inlined())
+            .zip(super::ModelRows::new(self).h)
             .map(|(o, e)| {
-                let what = || format!("output `{}`", o.name);
-                let e = e.ok_or_else(|| LinearError::Incomplete { what: what() })?;
-                self.convert(&e, what)
+                e.ok_or_else(|| LinearError::Incomplete {
+                    what: format!("output `{}`", o.name),
+                })
             })
             .collect()
     }

@@ -59,6 +59,9 @@ impl<'a> Builder<'a> {
             ..Default::default()
         });
         let sid = self.scopes.len() - 1;
+        // One table of the right size rather than one that rehashes its way up to a hundred thousand names.
+        let declared = decl.body.iter().filter(|s| declares_name(s)).count();
+        self.scopes[sid].names.reserve(declared);
         if let Some(o) = &overrides {
             self.check_override_names(decl, o.instance);
         }
@@ -544,4 +547,17 @@ pub(crate) fn kind_name(kind: ElementKind) -> &'static str {
         ElementKind::One => "1-junction",
         k => k.keyword(),
     }
+}
+
+/// Whether a statement declares a name in its scope (bond labels, rare, are left to grow the table).
+fn declares_name(stmt: &Stmt) -> bool {
+    matches!(
+        stmt,
+        Stmt::Param(_)
+            | Stmt::Input(_)
+            | Stmt::Output(_)
+            | Stmt::Var(_)
+            | Stmt::Element(_)
+            | Stmt::Instance(_)
+    )
 }

@@ -8,6 +8,7 @@ use crate::ir::{Domain, InputId, OutputId, ParamId, VarId};
 use crate::span::Span;
 use petgraph::graph::{EdgeIndex, NodeIndex};
 use std::collections::HashMap;
+use std::collections::hash_map::Entry;
 
 /// What a name in a scope stands for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -48,9 +49,9 @@ pub(crate) struct End {
 pub(crate) struct Scope {
     /// `""` for the model, `"sensor."` for instance `sensor`, `"arm.sensor."` nested.
     pub prefix: String,
-    pub names: HashMap<String, (Entity, Span)>,
-    /// Names in declaration order (for suggestions that do not depend on hashing order).
-    pub order: Vec<String>,
+    /// Each name's entity, declaration span and rank in declaration order (so that suggestions do not depend on
+    /// hashing order without keeping a second copy of every name).
+    pub names: HashMap<String, (Entity, Span, u32)>,
     pub ports: HashMap<String, (End, Span)>,
     pub port_order: Vec<String>,
     pub default_domain: Option<(Domain, Span)>,
@@ -70,26 +71,30 @@ pub(crate) struct Scope {
 impl Scope {
     /// Declares a name, or returns the duplicate-name diagnostic (BG0202).
     pub fn declare(&mut self, name: &str, span: Span, entity: Entity) -> Result<(), Diagnostic> {
-        if let Some((_, first)) = self.names.get(name) {
-            return Err(duplicate(name, span, *first));
+        let rank = self.names.len() as u32;
+        match self.names.entry(name.to_string()) {
+            Entry::Occupied(first) => Err(duplicate(name, span, first.get().1)),
+            Entry::Vacant(slot) => {
+                slot.insert((entity, span, rank));
+                Ok(())
+            }
         }
-        self.names.insert(name.to_string(), (entity, span));
-        self.order.push(name.to_string());
-        Ok(())
     }
 
     pub fn get(&self, name: &str) -> Option<Entity> {
-        self.names.get(name).map(|(e, _)| *e)
+        self.names.get(name).map(|(e, _, _)| *e)
     }
 
     /// The closest declared name accepted by `filter`, for "did you mean" help.
     pub fn suggest(&self, name: &str, filter: impl Fn(Entity) -> bool) -> Option<String> {
-        let candidates = self
-            .order
+        let mut candidates: Vec<(u32, &str)> = self
+            .names
             .iter()
-            .filter(|n| self.get(n).is_some_and(&filter))
-            .map(String::as_str);
-        closest(name, candidates)
+            .filter(|(_, (e, _, _))| filter(*e))
+            .map(|(n, (_, _, rank))| (*rank, n.as_str()))
+            .collect();
+        candidates.sort_unstable_by_key(|(rank, _)| *rank);
+        closest(name, candidates.into_iter().map(|(_, n)| n))
     }
 }
 

@@ -392,7 +392,7 @@ pub fn sparse_linear_state_space(
     Ok(j)
 }
 
-/// Whether the dense path of [`super::linear`] is cheap for this model: small trees (outputs inlined) and few
+/// Whether the dense path of `equations::linear` is cheap for this model: small trees (outputs inlined) and few
 /// entries. `bgc statespace` keeps that path (and its numbers, bit for bit) for such models and evaluates the sparse
 /// entries for the others.
 pub fn dense_is_cheap(eqs: &Equations, rows: &ModelRows) -> bool {

@@ -613,3 +613,39 @@ fn a_tiny_t_end_is_refused_in_its_own_name() {
         assert!(!run.stderr.contains("dt_out"), "{}", run.transcript());
     }
 }
+
+/// A dense state space of 4,002 states (16 million entries in `A`) is refused before any matrix is formed, with the
+/// way out named; `--sparse` gives the same model's non-zero entries.
+#[test]
+fn a_dense_state_space_too_large_to_print_is_refused_and_sparse_is_offered() {
+    let dir = scratch("dense-limit");
+    write(&dir.join("chain.bg"), &crate::equations_sparse::chain(2001));
+    for extra in [&[][..], &["--symbolic"][..]] {
+        let mut args = vec!["statespace", "chain.bg"];
+        args.extend_from_slice(extra);
+        let run = bgc(&dir, &args);
+        assert_eq!(run.status, 1, "{}", run.transcript());
+        assert!(run.stderr.contains("4002 states"), "{}", run.transcript());
+        assert!(run.stderr.contains("--sparse"), "{}", run.transcript());
+        assert!(run.stdout.is_empty(), "{}", run.transcript());
+    }
+    // Standard output to a file: the triplets are larger than a pipe holds while the reader drains stderr first.
+    let out = dir.join("ss.json");
+    let file = std::fs::File::create(&out).unwrap_or_else(|e| panic!("{}: {e}", out.display()));
+    let run = bgc_to(
+        &dir,
+        &["statespace", "chain.bg", "--sparse"],
+        Stdio::from(file),
+    );
+    assert_eq!(run.status, 0, "{}", run.transcript());
+    let text = std::fs::read_to_string(&out).unwrap_or_else(|e| panic!("{}: {e}", out.display()));
+    let v: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+    assert_eq!(v["A"]["rows"], 4002);
+    // Each mass reads its own momentum and both neighbouring springs (at most three entries), each spring the
+    // two masses beside it: about 5 per pair of states, not 4002² = 1.6e7.
+    let nonzero = v["A"]["entries"].as_array().map_or(0, Vec::len);
+    assert!(
+        (6_000..12_000).contains(&nonzero),
+        "{nonzero} non-zero entries"
+    );
+}

@@ -25,7 +25,7 @@ fn output_chain(levels: usize) -> String {
 }
 
 /// A chain of `n` masses with dampers, joined by springs, driven by a force `u`.
-fn chain(n: usize) -> String {
+pub fn chain(n: usize) -> String {
     let mut s = String::from(
         "model chain {\n    domain translational;\n    param m = 1.5 [kg];\n    param b = 0.5 [N s/m];\n    param k = 3 [N/m];\n    input u [N];\n    Se drive = u;\n    C wall = 1/k;\n    bond drive -> v1;\n    bond v1 -> wall;\n",
     );

@@ -180,6 +180,9 @@ fn energy_coords(
     let n = eqs.state_count(selection);
     let state_names: Vec<String> = (0..n).map(|i| eqs.sym_name(Sym::State(i))).collect();
     let (x0, u0) = operating_point(model, eqs, &state_names, args.at, args.verbose)?;
+    if !args.sparse || args.symbolic {
+        dense_fits(n, args.symbolic)?;
+    }
     let linear = match equations::sparse_linear_state_space(eqs, &rows, selection) {
         Ok(j) => Ok(j),
         Err(
@@ -235,6 +238,30 @@ fn energy_coords(
     }
     .map_err(no_state_space)?;
     Ok(numeric_json(&ss))
+}
+
+/// The most states a dense state space is printed for: `A` then has 16 million entries (some 300 MB of JSON), and
+/// a larger one would exhaust memory before it is printed.
+const MAX_DENSE_STATES: usize = 4_000;
+
+/// Refuses dense matrices for a model too large for them, before any are formed.
+fn dense_fits(states: usize, symbolic: bool) -> Result<(), String> {
+    if states <= MAX_DENSE_STATES {
+        return Ok(());
+    }
+    let entries = states as f64 * states as f64;
+    Err(if symbolic {
+        format!(
+            "the model has {states} states: its symbolic A would have {entries:.1e} entries, more than the \
+             {MAX_DENSE_STATES}² printed densely; use --sparse without --symbolic for the non-zero entries at the \
+             parameters' values"
+        )
+    } else {
+        format!(
+            "the model has {states} states: its dense A would have {entries:.1e} entries, more than the \
+             {MAX_DENSE_STATES}² printed densely; use --sparse for the non-zero entries as coordinate triplets"
+        )
+    })
 }
 
 fn list(names: &[String]) -> String {

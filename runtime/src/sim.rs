@@ -15,6 +15,8 @@
 //! Solver failures, non-finite states, derivatives, outputs or inputs are returned as [`SimError`] values
 //! carrying the simulated time at which they happened; nothing panics.
 
+use nalgebra::SVector;
+
 pub mod error;
 #[cfg(feature = "ode")]
 pub mod integrate;
@@ -35,8 +37,6 @@ pub use sampled::{
 };
 #[cfg(feature = "ode")]
 pub use sampled::{simulate_sampled_loop, simulate_sampled_loop_streaming};
-
-use nalgebra::SVector;
 
 /// Refuses a non-finite start time or initial state, before any run.
 pub(crate) fn check_initial<const NX: usize>(

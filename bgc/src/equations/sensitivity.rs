@@ -160,8 +160,7 @@ impl Equations {
                 })
                 .collect()
         };
-        let f = self.explicit_rates()?;
-        let h = self.explicit_outputs()?;
+        let (f, h) = self.explicit_rows()?;
         let loops = self.loop_partials(&f, &h, &partials, &matrix)?;
         let tears = loops.as_ref().map_or(&[][..], |l| &l.tears[..]);
         let mut mass = Vec::with_capacity(self.mass.len());
@@ -232,32 +231,31 @@ impl Equations {
         to_symbolic(self, e).ok_or_else(|| LinearError::Incomplete { what: what() })
     }
 
-    fn explicit_rates(&self) -> Result<Vec<Expr>, LinearError> {
-        self.f
-            .iter()
+    /// The rates and outputs on the shared engine, converted once ([`super::ModelRows`]): an earlier output read
+    /// by a later one is one shared node, so a chain of outputs through outputs stays as small as it is written.
+    fn explicit_rows(&self) -> Result<(Vec<Expr>, Vec<Expr>), LinearError> {
+        let rows = super::ModelRows::new(self);
+        let f = rows
+            .f
+            .into_iter()
             .enumerate()
-            .map(|(i, f)| {
-                let what = || format!("the rate of `{}`", self.sym_name(Sym::State(i)));
-                let e = f
-                    .as_ref()
-                    .ok_or_else(|| LinearError::Incomplete { what: what() })?;
-                self.convert(e, what)
+            .map(|(i, e)| {
+                e.ok_or_else(|| LinearError::Incomplete {
+                    what: format!("the rate of `{}`", self.sym_name(Sym::State(i))),
+                })
             })
-            .collect()
-    }
-
-    /// The outputs on the shared engine, an earlier output read by a later one as one shared node
-    /// ([`super::ModelRows`]): a chain of outputs through outputs stays as small as it is written.
-    fn explicit_outputs(&self) -> Result<Vec<Expr>, LinearError> {
-        self.outputs
+            .collect::<Result<_, _>>()?;
+        let h = self
+            .outputs
             .iter()
-            .zip(super::ModelRows::new(self).h)
+            .zip(rows.h)
             .map(|(o, e)| {
                 e.ok_or_else(|| LinearError::Incomplete {
                     what: format!("output `{}`", o.name),
                 })
             })
-            .collect()
+            .collect::<Result<_, _>>()?;
+        Ok((f, h))
     }
 
     fn loop_partials(

@@ -36,9 +36,7 @@ fn jacobian_product<const NX: usize>(j: &SMatrix<f64, NX, NX>, v: &[f64], jv: &m
         jv.copy_from_slice(j.column(col).as_slice());
         return;
     }
-    for (out, row) in jv.iter_mut().zip(j.row_iter()) {
-        *out = row.iter().zip(v).map(|(a, b)| a * b).sum();
-    }
+    jv.copy_from_slice((j * SVector::<f64, NX>::from_column_slice(v)).as_slice());
 }
 
 /// A segment to integrate.

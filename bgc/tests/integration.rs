@@ -16,6 +16,7 @@ mod cli_hostile;
 mod cli_messages;
 mod cli_root_files;
 mod cli_simulate;
+mod cli_simulate_large;
 mod cli_solver_long;
 mod cli_units;
 mod codegen_build;

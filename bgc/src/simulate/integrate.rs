@@ -20,14 +20,19 @@ use std::ops::ControlFlow;
 
 use diffsol::error::DiffsolError;
 use diffsol::{
-    NalgebraLU, NalgebraMat, NalgebraVec, OdeBuilder, OdeEquations, OdeSolverMethod,
-    OdeSolverStopReason, Vector,
+    FaerSparseLU, FaerSparseMat, NalgebraLU, NalgebraMat, OdeBuilder, OdeEquations,
+    OdeSolverMethod, OdeSolverStopReason, Vector,
 };
 
+use super::sparse_ode::SparseOde;
 use super::{SimError, System};
 
 type M = NalgebraMat<f64>;
 type Ls = NalgebraLU<f64>;
+
+/// From this many states on, a model with a symbolic Jacobian is solved with a sparse Jacobian and LU
+/// ([`SparseOde`]). Below it the dense LU is cheap and needs no symbolic analysis.
+pub const SPARSE_FROM: usize = 200;
 
 /// The integration method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -435,6 +440,48 @@ fn segment_once(
             *j = (b - a) / h;
         }
     };
+    let ctx = Drive {
+        system,
+        bad: &bad,
+        loop_failure: &loop_failure,
+        from: a,
+        to: b,
+        wanted,
+        max_steps: opts.max_steps,
+        may_stall: opts.method == Method::Bdf,
+    };
+    if let Some(full) = system.jacobian_pattern().filter(|_| dim >= SPARSE_FROM) {
+        // The rows of the energy quadratures (dissipated, supplied) are left out of the sparse Jacobian: a
+        // dissipation summed over every resistor is a dense row, and with it the sparse LU fills in (a 20,000-state
+        // chain took 205 s instead of 3 s). Nothing reads those states, so Newton's iteration still converges.
+        let model = system.state_count();
+        let kept: Vec<usize> = (0..full.len()).filter(|&k| full[k].0 < model).collect();
+        let pattern: Vec<(usize, usize)> = kept.iter().map(|&k| full[k]).collect();
+        let all_values = RefCell::new(vec![0.0; full.len()]);
+        let rates = |y: &[f64], t: f64, dy: &mut [f64]| rhs(y, &[], t, dy);
+        let values = |y: &[f64], t: f64, out: &mut [f64]| {
+            let mut s = scratch.borrow_mut();
+            let (u, stack, _, _) = &mut *s;
+            let mut all = all_values.borrow_mut();
+            system.inputs_at(t.min(t_max), u);
+            if system.jacobian_values(y, u, t, &mut all, stack).is_none() {
+                all.iter_mut().for_each(|v| *v = f64::NAN);
+            }
+            for (slot, &k) in out.iter_mut().zip(&kept) {
+                *slot = all[k];
+            }
+        };
+        let ode = SparseOde::new(&rates, &values, y0, &pattern)
+            .map_err(|message| SimError::Solver { time: a, message })?;
+        let mut problem = OdeBuilder::<FaerSparseMat<f64>>::new()
+            .t0(a)
+            .rtol(opts.rtol)
+            .atol([opts.atol])
+            .build_from_eqn(ode)
+            .map_err(|e| solver_error(a, e))?;
+        problem.ode_options.max_nonlinear_solver_failures = opts.max_steps;
+        return run_method!(&problem, FaerSparseLU<f64>, opts.method, &ctx, out);
+    }
     let init_state = y0.to_vec();
     let init = move |_p: &[f64], _t: f64, y: &mut [f64]| {
         for (d, s) in y.iter_mut().zip(&init_state) {
@@ -454,35 +501,35 @@ fn segment_once(
     // or cutting the step, so a long run of a linear oscillator failed at t ≈ 600 (BDF) or 118 (ESDIRK34). A run
     // that really cannot go on still ends: the step becomes too small, or `max_steps` is reached.
     problem.ode_options.max_nonlinear_solver_failures = opts.max_steps;
-    let ctx = Drive {
-        system,
-        bad: &bad,
-        loop_failure: &loop_failure,
-        from: a,
-        to: b,
-        wanted,
-        max_steps: opts.max_steps,
-        may_stall: opts.method == Method::Bdf,
-    };
-    match opts.method {
-        Method::Bdf => {
-            let s = problem.bdf::<Ls>().map_err(|e| ctx.failure(a, e))?;
-            ctx.drive(s, out)
-        }
-        Method::Esdirk34 => {
-            let s = problem.esdirk34::<Ls>().map_err(|e| ctx.failure(a, e))?;
-            ctx.drive(s, out)
-        }
-        Method::TrBdf2 => {
-            let s = problem.tr_bdf2::<Ls>().map_err(|e| ctx.failure(a, e))?;
-            ctx.drive(s, out)
-        }
-        Method::Tsit45 => {
-            let s = problem.tsit45().map_err(|e| ctx.failure(a, e))?;
-            ctx.drive(s, out)
-        }
-    }
+    run_method!(&problem, Ls, opts.method, &ctx, out)
 }
+
+/// Drives `problem` with the chosen method and the linear solver `$ls` of the implicit ones. A macro: the
+/// methods' bounds on the problem's vector and matrix types are diffsol's and too many to restate generically.
+macro_rules! run_method {
+    ($problem:expr, $ls:ty, $method:expr, $ctx:expr, $out:expr) => {{
+        let (problem, ctx, a) = ($problem, $ctx, $ctx.from);
+        match $method {
+            Method::Bdf => {
+                let s = problem.bdf::<$ls>().map_err(|e| ctx.failure(a, e))?;
+                ctx.drive(s, $out)
+            }
+            Method::Esdirk34 => {
+                let s = problem.esdirk34::<$ls>().map_err(|e| ctx.failure(a, e))?;
+                ctx.drive(s, $out)
+            }
+            Method::TrBdf2 => {
+                let s = problem.tr_bdf2::<$ls>().map_err(|e| ctx.failure(a, e))?;
+                ctx.drive(s, $out)
+            }
+            Method::Tsit45 => {
+                let s = problem.tsit45().map_err(|e| ctx.failure(a, e))?;
+                ctx.drive(s, $out)
+            }
+        }
+    }};
+}
+use run_method;
 
 /// The latest time before the breakpoint `b` at which the inputs are evaluated in the segment that ends there.
 fn just_before(b: f64) -> f64 {
@@ -541,7 +588,7 @@ impl Drive<'_> {
 
     fn drive<'a, Eqn, S>(&self, mut solver: S, out: &mut Deliver<'_>) -> Result<Outcome, SimError>
     where
-        Eqn: OdeEquations<T = f64, V = NalgebraVec<f64>> + 'a,
+        Eqn: OdeEquations<T = f64> + 'a,
         S: OdeSolverMethod<'a, Eqn>,
     {
         solver

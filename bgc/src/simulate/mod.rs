@@ -40,6 +40,8 @@ pub mod input_rate;
 pub mod integrate;
 pub mod newton;
 pub mod program;
+#[cfg(feature = "cli")]
+mod sparse_ode;
 
 use crate::equations::sym::{self, Ex, Sym, add};
 use crate::equations::{EnergyKind, Equations, block_jacobian, residual_scale};
@@ -420,6 +422,31 @@ impl System {
         Some(())
     }
 
+    /// The positions `(row, column)` of the symbolic Jacobian's entries over the model states; `None` when it has no
+    /// symbolic form (see [`System::jacobian_times`]).
+    pub fn jacobian_pattern(&self) -> Option<Vec<(usize, usize)>> {
+        let entries = self.jacobian.as_ref()?;
+        Some(entries.iter().map(|(r, c, _)| (*r, *c)).collect())
+    }
+
+    /// The values of the Jacobian's entries at `(y, u, t)`, in the order of [`System::jacobian_pattern`]; `None`
+    /// when it has no symbolic form.
+    pub fn jacobian_values(
+        &self,
+        y: &[f64],
+        u: &[f64],
+        t: f64,
+        out: &mut [f64],
+        stack: &mut Vec<f64>,
+    ) -> Option<()> {
+        let entries = self.jacobian.as_ref()?;
+        let vals = self.values(y, u, t);
+        for (slot, (_, _, p)) in out.iter_mut().zip(entries) {
+            *slot = p.eval(&vals, stack);
+        }
+        Some(())
+    }
+
     /// One row of output: the states, the outputs, the stored energy, then the dissipated and supplied energy.
     pub fn row(
         &self,
@@ -525,6 +552,9 @@ fn compile_loops(
 }
 
 /// The nonzero entries of `∂rate/∂x` over the model states (the quadrature states enter no rate).
+///
+/// A sum is differentiated term by term, each term only by the states it reads: the dissipated power sums a term
+/// per resistor, and differentiating the whole sum by every state it reads would be quadratic in the model.
 fn symbolic_jacobian(
     rates: &[(Ex, String)],
     n: usize,
@@ -532,12 +562,38 @@ fn symbolic_jacobian(
 ) -> Option<Vec<(usize, usize, Program)>> {
     let mut entries = Vec::new();
     for (r, (e, what)) in rates.iter().enumerate() {
-        for c in 0..n {
-            let d = sym::diff(e, Sym::State(c)).ok()?;
+        let terms = match e {
+            Ex::Add(terms) => terms.as_slice(),
+            _ => std::slice::from_ref(e),
+        };
+        let mut parts: std::collections::BTreeMap<usize, Vec<Ex>> = Default::default();
+        for term in terms {
+            for c in states_read(term, n) {
+                let d = sym::diff(term, Sym::State(c)).ok()?;
+                parts.entry(c).or_default().push(d);
+            }
+        }
+        for (c, part) in parts {
+            let d = add(part);
             if !d.is_zero() {
                 entries.push((r, c, compile(&d, what).ok()?));
             }
         }
     }
     Some(entries)
+}
+
+/// The model states (below `n`) that `e` reads, each once, in order.
+fn states_read(e: &Ex, n: usize) -> Vec<usize> {
+    let mut read = Vec::new();
+    e.for_each_sym(&mut |s| {
+        if let Sym::State(c) = s
+            && c < n
+        {
+            read.push(c);
+        }
+    });
+    read.sort_unstable();
+    read.dedup();
+    read
 }

@@ -245,11 +245,12 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         }
         let mut p = SMatrix::zeros();
         congruence_plus(&m.a, &self.fixed.at, &self.p, &self.q, &mut p);
+        // A certificate also bounds every entry of `p` far below overflow; without one, `repair_covariance`
+        // checks that they are finite.
         let certified = self
             .fixed
             .definite_prediction
-            .eigenvalue_floor(self.p.trace())
-            .filter(|_| all_finite(&p));
+            .eigenvalue_floor(self.p.trace());
         let repair = match certified {
             Some(_) => None,
             None => repair_covariance(&mut p, self.policy.eigen_floor, FILTER)?,
@@ -320,7 +321,6 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         let mut p = SMatrix::zeros();
         let w = joseph(&self.p, &k, &pct, &s, &mut p);
         let certified = self.eigenvalue_floor > 0.0
-            && all_finite(&p)
             && self.fixed.definite_update.holds(
                 self.eigenvalue_floor,
                 &UpdateNorms {
@@ -587,6 +587,26 @@ mod tests {
         kf.predict(&u).unwrap();
         kf.set_state(SVector::zeros(), SMatrix::identity()).unwrap();
         assert_eq!(kf.eigenvalue_floor, 0.0);
+    }
+
+    /// A prediction whose covariance overflows (`A = 10²⁰⁰ I`, so `A P Aᵀ = 10⁴⁰⁰ I`) is not certified, even
+    /// with a definite `Q`: it is an error and the filter keeps its estimate.
+    #[test]
+    fn a_prediction_that_overflows_is_an_error_with_a_definite_q() {
+        let model = LinearDiscreteModel {
+            a: SMatrix::<f64, 2, 2>::identity() * 1e200,
+            b: SMatrix::<f64, 2, 1>::zeros(),
+            c: SMatrix::<f64, 1, 2>::new(1.0, 0.0),
+            d: SMatrix::<f64, 1, 1>::zeros(),
+        };
+        let q = SMatrix::<f64, 2, 2>::identity() * 1e-4;
+        let r = SMatrix::<f64, 1, 1>::new(1e-2);
+        let mut kf = KalmanFilter::new(model, q, r, SVector::zeros(), SMatrix::identity()).unwrap();
+        assert_eq!(
+            kf.predict(&SVector::zeros()),
+            Err(EstimationError::NonFiniteCovariance { filter: FILTER })
+        );
+        assert_eq!(*kf.covariance(), SMatrix::<f64, 2, 2>::identity());
     }
 
     /// `A` singular: a predictor gain cannot be turned back into a filter gain.

@@ -11,6 +11,10 @@
 use super::super::dense::symmetric_eigen;
 use nalgebra::{SMatrix, SVector};
 
+/// A magnitude whose sums of a few terms, rounded up, stay far below `f64::MAX`: a certificate whose bound on the
+/// entries of the result is below it also certifies that every entry is finite.
+const NO_OVERFLOW: f64 = f64::MAX / 16.0;
+
 /// `γₖ = k ε / (1 − k ε)` (Higham's bound for a sum of `k` rounded terms), rounded up to `(k + 1) ε`.
 fn gamma(k: usize) -> f64 {
     (k as f64 + 1.0) * f64::EPSILON
@@ -47,10 +51,14 @@ impl DefinitePrediction {
     }
 
     /// A lower bound on `λ_min(fl(A P Aᵀ + Q))` for every positive-definite `P` with trace `trace_p`, when
-    /// it is positive with the margin of the definiteness test; `None` when the test must run.
+    /// it is positive with the margin of the definiteness test; `None` when the test must run. A bound also
+    /// means that every entry of the computed `P⁻` is finite: each partial sum of `T = P Aᵀ` is at most about
+    /// `‖A‖_F tr P` and each of `A T + Q` about `‖A‖_F² tr P + ‖Q‖_F`, both below
+    /// `(‖A‖_F² + 1) tr P + ‖Q‖_F`, which is required to be far below `f64::MAX`.
     pub(super) fn eigenvalue_floor(&self, trace_p: f64) -> Option<f64> {
         let bound = self.gamma * (self.a_frobenius_sq * trace_p + self.q_frobenius);
-        (self.q_min > 2.0 * bound).then_some(self.q_min - bound)
+        let size = (self.a_frobenius_sq + 1.0) * trace_p + self.q_frobenius;
+        (size < NO_OVERFLOW && self.q_min > 2.0 * bound).then_some(self.q_min - bound)
     }
 }
 
@@ -121,8 +129,11 @@ impl DefiniteUpdate {
         let e3 = gamma(self.ny + 1) * (n.pct + n.k * n.s);
         let e4 = gamma(2 * self.ny + 1) * (n.trace_p + n.k * (n.pct + n.w));
         let bound = 2.0 * n.k * e1 + n.k * n.k * f + sqrt2 * (e3 * n.k + e4);
-        // NaN norms (a non-finite quantity) fail the comparison: the test then runs and reports them.
-        mu > 2.0 * bound
+        // Every partial sum of an entry of the result is at most `tr P + ‖K‖ (‖P Cᵀ‖ + ‖W‖)` (Cauchy–Schwarz
+        // over the measurements), so below `NO_OVERFLOW` every entry is finite. NaN norms (a non-finite
+        // quantity) fail both comparisons: the test then runs and reports them.
+        let size = n.trace_p + n.k * (n.pct + n.w);
+        size < NO_OVERFLOW && mu > 2.0 * bound
     }
 }
 

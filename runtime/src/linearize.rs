@@ -10,8 +10,15 @@
 //! `δẋ = A δx + B δu + f(x₀, u₀)`. Linear designs assume `f(x₀, u₀) = 0` (an equilibrium); [`linearize`] does not
 //! require it (a linearisation along a trajectory is legitimate), so check `rhs` at the point when the design
 //! needs an equilibrium.
+//!
+//! # Large models
+//!
+//! An `NX × NX` matrix takes `8 NX²` bytes: 2 MiB (a spawned thread's default stack) at 512 states, 8 MB at
+//! 1,000. [`linearize`], [`linearize_at`] and [`boxed_jacobians_at`] allocate each Jacobian on the heap,
+//! zeroed, and let the model write into it there, so they run at any size on any thread. [`jacobians_at`]
+//! returns the matrices by value, on the caller's stack: for a control loop or filter of a small model.
 
-use crate::matrix::{self, FixedStateSpace};
+use crate::matrix::{FixedStateSpace, dynamic};
 use crate::model::ContinuousModel;
 use crate::statespace::{StateSpace, StateSpaceError};
 use nalgebra::{SMatrix, SVector};
@@ -63,11 +70,18 @@ pub fn linearize_at<M, const NX: usize, const NU: usize, const NY: usize>(
 where
     M: ContinuousModel<NX, NU, NY>,
 {
-    Ok(matrix::state_space(&jacobians_at(model, t, x0, u0)?)?)
+    let j = boxed_jacobians_at(model, t, x0, u0)?;
+    Ok(StateSpace::new(
+        dynamic(&j.a),
+        dynamic(&j.b),
+        dynamic(&j.c),
+        dynamic(&j.d),
+    )?)
 }
 
 /// The Jacobians `(A, B, C, D)` of `model` at `(t, x0, u0)` as fixed-size matrices (for a control loop or a
-/// filter that works on `SMatrix` directly); every entry is checked to be finite.
+/// filter that works on `SMatrix` directly); every entry is checked to be finite. They are returned on the
+/// stack; for a model of a few hundred states or more use [`boxed_jacobians_at`] (see the module docs).
 pub fn jacobians_at<M, const NX: usize, const NU: usize, const NY: usize>(
     model: &M,
     t: f64,
@@ -84,15 +98,70 @@ where
     let mut b = SMatrix::<f64, NX, NU>::zeros();
     let mut c = SMatrix::<f64, NY, NX>::zeros();
     let mut d = SMatrix::<f64, NY, NU>::zeros();
-    model.jac_x(t, x0, u0, &mut a);
-    model.jac_u(t, x0, u0, &mut b);
-    model.output_jac_x(t, x0, u0, &mut c);
-    model.output_jac_u(t, x0, u0, &mut d);
-    check_jacobian("A", &a)?;
-    check_jacobian("B", &b)?;
-    check_jacobian("C", &c)?;
-    check_jacobian("D", &d)?;
+    evaluate(model, t, x0, u0, (&mut a, &mut b, &mut c, &mut d))?;
     Ok((a, b, c, d))
+}
+
+/// The Jacobians `A = ∂f/∂x`, `B = ∂f/∂u`, `C = ∂h/∂x`, `D = ∂h/∂u` of a model at a point, each on the heap.
+#[derive(Debug, PartialEq)]
+pub struct BoxedJacobians<const NX: usize, const NU: usize, const NY: usize> {
+    pub a: Box<SMatrix<f64, NX, NX>>,
+    pub b: Box<SMatrix<f64, NX, NU>>,
+    pub c: Box<SMatrix<f64, NY, NX>>,
+    pub d: Box<SMatrix<f64, NY, NU>>,
+}
+
+/// [`jacobians_at`] for a model of any size: each matrix is allocated on the heap, zeroed, and written there by
+/// the model, so nothing of size `NX²` is ever on the stack.
+pub fn boxed_jacobians_at<M, const NX: usize, const NU: usize, const NY: usize>(
+    model: &M,
+    t: f64,
+    x0: &SVector<f64, NX>,
+    u0: &SVector<f64, NU>,
+) -> Result<BoxedJacobians<NX, NU, NY>, LinearizeError>
+where
+    M: ContinuousModel<NX, NU, NY>,
+{
+    check_point("t", std::slice::from_ref(&t))?;
+    check_point("x", x0.as_slice())?;
+    check_point("u", u0.as_slice())?;
+    let mut j = BoxedJacobians {
+        a: bytemuck::zeroed_box(),
+        b: bytemuck::zeroed_box(),
+        c: bytemuck::zeroed_box(),
+        d: bytemuck::zeroed_box(),
+    };
+    evaluate(model, t, x0, u0, (&mut j.a, &mut j.b, &mut j.c, &mut j.d))?;
+    Ok(j)
+}
+
+/// The four matrices a linearisation writes.
+type JacobiansMut<'a, const NX: usize, const NU: usize, const NY: usize> = (
+    &'a mut SMatrix<f64, NX, NX>,
+    &'a mut SMatrix<f64, NX, NU>,
+    &'a mut SMatrix<f64, NY, NX>,
+    &'a mut SMatrix<f64, NY, NU>,
+);
+
+/// Writes the model's Jacobians at `(t, x0, u0)` into `(a, b, c, d)` and checks that every entry is finite.
+fn evaluate<M, const NX: usize, const NU: usize, const NY: usize>(
+    model: &M,
+    t: f64,
+    x0: &SVector<f64, NX>,
+    u0: &SVector<f64, NU>,
+    (a, b, c, d): JacobiansMut<'_, NX, NU, NY>,
+) -> Result<(), LinearizeError>
+where
+    M: ContinuousModel<NX, NU, NY>,
+{
+    model.jac_x(t, x0, u0, a);
+    model.jac_u(t, x0, u0, b);
+    model.output_jac_x(t, x0, u0, c);
+    model.output_jac_u(t, x0, u0, d);
+    check_jacobian("A", a)?;
+    check_jacobian("B", b)?;
+    check_jacobian("C", c)?;
+    check_jacobian("D", d)
 }
 
 fn check_jacobian<const R: usize, const C: usize>(

@@ -23,6 +23,7 @@ mod linalg_expm;
 mod linalg_lyapunov;
 mod linalg_pbh;
 mod linalg_sylvester;
+mod linearize_large;
 mod sim_linear;
 mod sim_open_loop;
 mod sim_sampled;

@@ -27,14 +27,26 @@ pub fn symmetrise<const N: usize>(m: &mut SMatrix<f64, N, N>) {
     }
 }
 
-/// True when every entry is finite.
+/// True when every entry is finite: `v · 0` is `±0` for a finite `v` and NaN for an infinite or NaN one, and a NaN
+/// survives any sum, so the sum of those products is zero exactly when all entries are finite. The products are
+/// summed row by row across the columns (whole columns at a time, in vector registers) and the row sums added
+/// at the end: no branch per entry, as a search that stops at the first non-finite entry would compile to.
 pub fn all_finite<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> bool {
-    m.iter().all(|v| v.is_finite())
+    let mut row_sums = [0.0_f64; R];
+    for column in &m.data.0 {
+        for (sum, v) in row_sums.iter_mut().zip(column) {
+            *sum += v * 0.0;
+        }
+    }
+    row_sums.iter().sum::<f64>() == 0.0
 }
 
 /// Index of the first non-finite entry of a vector.
 pub fn first_non_finite<const N: usize>(v: &SVector<f64, N>) -> Option<usize> {
-    v.iter().position(|x| !x.is_finite())
+    if all_finite(v) {
+        return None;
+    }
+    v.as_slice().iter().position(|x| !x.is_finite())
 }
 
 /// Lower Cholesky factor of a symmetric positive-definite matrix (only the lower triangle is read), or `None`
@@ -371,6 +383,26 @@ mod tests {
 
     fn spd() -> Matrix3<f64> {
         Matrix3::new(4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 2.0)
+    }
+
+    /// Every position and every kind of non-finite value is found, and the largest finite values are not
+    /// mistaken for one (`f64::MAX · 0 = 0`).
+    #[test]
+    fn finiteness_is_decided_at_every_entry() {
+        let m = nalgebra::Matrix3x2::new(f64::MAX, -f64::MAX, 1e-300, -0.0, 5e-324, 1.0);
+        assert!(all_finite(&m));
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            for k in 0..6 {
+                let mut b = m;
+                b[k] = bad;
+                assert!(!all_finite(&b), "{bad} at {k}");
+                let v = Vector3::new(1.0, 2.0, 3.0);
+                let mut w = v;
+                w[k % 3] = bad;
+                assert_eq!(first_non_finite(&w), Some(k % 3));
+                assert_eq!(first_non_finite(&v), None);
+            }
+        }
     }
 
     #[test]

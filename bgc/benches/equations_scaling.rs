@@ -12,9 +12,13 @@
 //! Run with `cargo bench -p bgc --bench equations_scaling`. The same generators, at small sizes, are checked against
 //! hand-derived values in `tests/equations_scaling.rs`.
 
+#[path = "support/chain.rs"]
+mod chain;
+
 use bgc::causality::analyse;
 use bgc::lower::{MemoryLoader, lower};
 use bgc::span::SourceMap;
+use chain::benchmark_chain;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 
@@ -52,24 +56,6 @@ fn mtf_chain(n: usize) -> String {
         s += &format!(
             "    1 j{k};\n    I i{k} = J;\n    MTF g{k} = 1 + 0.1*cos(theta);\n    bond j{p} -> g{k} -> j{k};\n    bond j{k} -> i{k};\n"
         );
-    }
-    s + "}\n"
-}
-
-fn benchmark_chain(n: usize) -> String {
-    let mut s = String::from(
-        "model chain {\n    domain translational;\n    param m = 1 [kg];\n    param b = 0.5 [N s/m];\n    param k = 1 [N/m];\n    input u [N];\n    Se drive = u;\n    C wall = 1/k;\n    bond drive -> v1;\n    bond v1 -> wall;\n",
-    );
-    for i in 1..=n {
-        s += &format!(
-            "    1 v{i};\n    I mass{i} = m;\n    R damp{i} = b;\n    bond v{i} -> mass{i};\n    bond v{i} -> damp{i};\n"
-        );
-        if i < n {
-            let j = i + 1;
-            s += &format!(
-                "    0 x{i};\n    C spring{i} = 1/k;\n    bond v{i} -> x{i};\n    bond x{i} -> v{j};\n    bond x{i} -> spring{i};\n"
-            );
-        }
     }
     s + "}\n"
 }

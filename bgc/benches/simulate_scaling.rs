@@ -1,0 +1,57 @@
+//! `bgc simulate`'s integration (what the command runs after deriving: the compiled system and diffsol) on the
+//! benchmark chain of `N` masses (`2N` states), `u = sin(3t)`, 0.01 s on BDF. From 200 states on the implicit
+//! methods factorise a sparse Jacobian, so the time grows with the number of non-zeros.
+//!
+//! Run with `cargo bench -p bgc --bench simulate_scaling`.
+
+#[path = "support/chain.rs"]
+mod chain;
+
+use bgc::causality::analyse;
+use bgc::lower::{MemoryLoader, lower};
+use bgc::simulate::System;
+use bgc::simulate::input::Signal;
+use bgc::simulate::integrate::{Method, RunOptions, run};
+use bgc::span::SourceMap;
+use chain::benchmark_chain;
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
+
+/// The compiled system of the chain of `n` masses, driven by `u = sin(3t)`.
+fn system(n: usize) -> Option<System> {
+    let mut sources = SourceMap::new();
+    let root = sources.add("bench.bg".to_string(), benchmark_chain(n));
+    let (models, _) = lower(&mut sources, root, &mut MemoryLoader::new());
+    let model = models.first()?;
+    let (causality, _) = analyse(model);
+    let (eqs, _) = bgc::equations::derive(model, &causality);
+    let drive = Signal::parse("sin(3*t)").ok()?;
+    let (system, _) = System::new(&eqs, eqs.default_params(), vec![drive]).ok()?;
+    Some(system)
+}
+
+fn bench(c: &mut Criterion) {
+    let opts = RunOptions {
+        t_end: 0.01,
+        dt_out: 0.01,
+        method: Method::Bdf,
+        rtol: 1e-6,
+        atol: 1e-9,
+        max_steps: 100_000,
+    };
+    let mut group = c.benchmark_group("simulate/benchmark_chain");
+    group.sample_size(10);
+    for n in [100, 1000, 10_000] {
+        let Some(system) = system(n) else {
+            continue;
+        };
+        let x0 = vec![0.0; system.state_count()];
+        group.bench_with_input(BenchmarkId::from_parameter(n), &system, |b, s| {
+            b.iter(|| run(black_box(s), &x0, &opts).map(|t| t.times.len()))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

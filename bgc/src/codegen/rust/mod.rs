@@ -15,7 +15,9 @@
 //!   `N_OUTPUTS × N_PARAMS`): full matrices, a column per free parameter in `PARAM_NAMES` order, total through the
 //!   derived parameters, with the loops' and mass matrices' contributions as in `jac_x_into`
 //!   (`param_jacobians.rs`);
-//! - for a linear model `state_space(&Params) -> (A, B, C, D)` whenever `bgc statespace` prints one: in the energy
+//! - for a linear model `state_space(&Params) -> (A, B, C, D)` whenever `bgc statespace` prints one (above 181
+//!   states, where `A` takes more than 256 KiB, `state_space_entries(&Params, &mut dyn FnMut(char, usize, usize,
+//!   f64))` instead, which passes each entry that is not identically zero and declares no matrix): in the energy
 //!   states (type `EnergyStateSpace`), or, when the outputs or rates read an integrated flow (`var`), in all states,
 //!   energy states then integrated flows (type `FullStateSpace`); and, when the model declares coordinates,
 //!   `state_space_declared` (type `DeclaredStateSpace`, sizes `N_COORDS`, names `COORD_NAMES`);
@@ -26,6 +28,9 @@
 //! - `Model` (the parameters, validated) and, with [`Options::runtime`], its implementations of
 //!   `bgc_runtime::model::ContinuousModel`, `Parametric` and `bgc_runtime::fit::generated::ParamJacobians` (a column of
 //!   `jac_p_into` or `output_jac_p_into` by index, for `Generated::exact`).
+//!
+//! Bodies of more than `parts::MAX_PART_STATEMENTS` independent statements are split into private parts (see
+//! `parts`), and `validate` checks each distinct (element value, rule) once.
 //!
 //! # What the code needs
 //! The functions of the model take fixed-size values, allocate nothing, never panic (indices are constants within
@@ -56,6 +61,7 @@ mod functions;
 mod model;
 mod param_jacobians;
 mod params;
+mod parts;
 mod terms;
 
 pub(super) use functions::Draft;
@@ -264,6 +270,8 @@ pub(in crate::codegen) struct Writer<'a> {
     options: Options,
     /// Rust text of each symbol inside a model function (`p.J_m`, `p_rotor`, `t`).
     names: HashMap<Symbol, String>,
+    /// Where each state and input is read from: `(0, i)` for `x[i]`, `(1, i)` for `u[i]`.
+    positions: HashMap<Symbol, (u8, usize)>,
     /// Every local name of the model functions taken (states, inputs, intermediates); cloned for each function.
     namer: Namer,
     /// Field names of the free parameters, in parameter order (the fields of `Params`).
@@ -335,7 +343,21 @@ impl<'a> Writer<'a> {
             names.insert(Symbol::output(o.name.as_str()), format!("y[{k}]"));
         }
         names.insert(Symbol::time(), "t".into());
+        let namer = namer.frozen();
+        let positions = (plan
+            .states
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (s.clone(), (0, i))))
+        .chain(
+            plan.inputs
+                .iter()
+                .enumerate()
+                .map(|(i, s)| (s.clone(), (1, i))),
+        )
+        .collect();
         Writer {
+            positions,
             m,
             plan,
             options,
@@ -421,19 +443,26 @@ impl<'a> Writer<'a> {
     }
 
     fn function(&mut self, f: Function) {
+        let inline = if f.inline { Some("#[inline]") } else { None };
+        self.write_function(f, inline, "pub fn");
+    }
+
+    /// Writes `f` with the attribute `inline` (instead of `f.inline`'s) as `{keyword} name(...)`.
+    fn write_function(&mut self, f: Function, inline: Option<&str>, keyword: &str) {
         self.out.push('\n');
         self.doc(0, &f.doc);
         if let Some(attr) = Self::allows(&f.locals, &f.body) {
             self.out.push_str(&attr);
             self.out.push('\n');
         }
-        if f.inline {
-            self.out.push_str("#[inline]\n");
+        if let Some(inline) = inline {
+            self.out.push_str(inline);
+            self.out.push('\n');
         }
         let args: Vec<String> = f.args.iter().map(Arg::text).collect();
         let sig = format::signature(
             0,
-            &format!("pub fn {}", f.name),
+            &format!("{keyword} {}", f.name),
             &args,
             &f.ret,
             f.body.is_empty(),

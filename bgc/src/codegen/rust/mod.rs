@@ -108,36 +108,8 @@ pub fn generate(file: &CompiledFile, source_name: &str) -> String {
 
 /// The Rust module of a compiled file; `source_name` names the file in the header.
 pub fn generate_with(file: &CompiledFile, source_name: &str, options: Options) -> String {
-    let mut body = String::new();
-    match file.models.as_slice() {
-        [single] => {
-            body.push('\n');
-            body.push_str(&model_code(single, options, 0));
-        }
-        many => {
-            let mut namer = Namer::with_reserved();
-            for m in many {
-                let name = namer.ident(&m.model.name);
-                let _ = writeln!(
-                    body,
-                    "\n/// The generated code of model `{}`.",
-                    comment(&m.model.name)
-                );
-                if !format::is_snake_case(&name) {
-                    body.push_str("#[allow(non_snake_case)]\n");
-                }
-                let _ = writeln!(body, "pub mod {name} {{");
-                for line in model_code(m, options, 4).lines() {
-                    if line.is_empty() {
-                        body.push('\n');
-                    } else {
-                        let _ = writeln!(body, "    {line}");
-                    }
-                }
-                body.push_str("}\n");
-            }
-        }
-    }
+    // The header first, then each model's code appended: a large model's text (250 MB for 200,000 states) is
+    // not copied again.
     let mut out = header(source_name, file.hash);
     out.push_str(
         "\n// Do not edit: this file is regenerated from the .bg source when it changes.\n",
@@ -155,7 +127,35 @@ pub fn generate_with(file: &CompiledFile, source_name: &str, options: Options) -
         out.push_str(&line);
         out.push('\n');
     }
-    out.push_str(&body);
+    match file.models.as_slice() {
+        [single] => {
+            out.push('\n');
+            out.push_str(&model_code(single, options, 0));
+        }
+        many => {
+            let mut namer = Namer::with_reserved();
+            for m in many {
+                let name = namer.ident(&m.model.name);
+                let _ = writeln!(
+                    out,
+                    "\n/// The generated code of model `{}`.",
+                    comment(&m.model.name)
+                );
+                if !format::is_snake_case(&name) {
+                    out.push_str("#[allow(non_snake_case)]\n");
+                }
+                let _ = writeln!(out, "pub mod {name} {{");
+                for line in model_code(m, options, 4).lines() {
+                    if line.is_empty() {
+                        out.push('\n');
+                    } else {
+                        let _ = writeln!(out, "    {line}");
+                    }
+                }
+                out.push_str("}\n");
+            }
+        }
+    }
     out
 }
 
@@ -187,20 +187,29 @@ const ITEM_STARTS: &[&str] = &[
 /// (below its documentation and other attributes; joined to an `#[allow(...)]` line already there), so that a
 /// crate that uses some of them builds without warnings.
 fn allow_dead_code(code: &str) -> String {
-    let mut lines: Vec<String> = Vec::with_capacity(code.lines().count() * 2);
+    let mut out = String::with_capacity(code.len() + code.len() / 8);
+    // Where the last line written starts (lines are joined by `\n`, the last one without).
+    let mut last = 0;
+    let mut first = true;
+    let mut push_line = |out: &mut String, last: &mut usize, line: &str| {
+        if !std::mem::take(&mut first) {
+            out.push('\n');
+        }
+        *last = out.len();
+        out.push_str(line);
+    };
     for line in code.lines() {
         if ITEM_STARTS.iter().any(|k| line.starts_with(k)) {
-            match lines.last_mut() {
-                Some(prev) if prev.starts_with("#[allow(") && prev.ends_with(")]") => {
-                    prev.truncate(prev.len() - 2);
-                    prev.push_str(", dead_code)]");
-                }
-                _ => lines.push("#[allow(dead_code)]".into()),
+            let prev = out.get(last..).unwrap_or("");
+            if prev.starts_with("#[allow(") && prev.ends_with(")]") {
+                out.truncate(out.len() - 2);
+                out.push_str(", dead_code)]");
+            } else {
+                push_line(&mut out, &mut last, "#[allow(dead_code)]");
             }
         }
-        lines.push(line.to_string());
+        push_line(&mut out, &mut last, line);
     }
-    let mut out = lines.join("\n");
     if code.ends_with('\n') {
         out.push('\n');
     }
@@ -483,14 +492,19 @@ impl<'a> Writer<'a> {
         self.param_terms_struct();
         self.model();
         // The helpers the code calls (comments and documentation, the model's text, left out).
-        let code: String = self
+        let mut code = String::with_capacity(self.out.len());
+        for line in self
             .out
             .lines()
             .filter(|l| !l.trim_start().starts_with("//"))
-            .collect::<Vec<_>>()
-            .join("\n");
+        {
+            code.push_str(line);
+            code.push('\n');
+        }
         let helpers = rust_helpers_used(&code);
-        let mut out = String::from("use nalgebra::{SMatrix, SVector};\n");
+        drop(code);
+        let mut out = String::with_capacity(self.out.len() + 4096);
+        out.push_str("use nalgebra::{SMatrix, SVector};\n");
         if !helpers.is_empty() {
             out.push('\n');
             out.push_str(helpers.trim_end());

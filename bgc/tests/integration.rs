@@ -22,6 +22,7 @@ mod cli_units;
 mod codegen_build;
 mod codegen_generate;
 mod codegen_hostile_names;
+mod codegen_large;
 mod codegen_no_std;
 mod codegen_param_terms;
 mod codegen_rustfmt;

@@ -7,6 +7,7 @@
 //! `_` suffix, and a name already taken gets `_2`, `_3`, ... appended.
 
 use std::collections::HashSet;
+use std::sync::Arc;
 
 /// The identifiers the generated functions use for themselves, and the constants of the module (a `let` cannot
 /// shadow a constant).
@@ -75,6 +76,8 @@ pub const RESERVED: &[&str] = &[
     "OUTPUT_NAMES",
     "PARAM_NAMES",
     "COORD_NAMES",
+    "entry",
+    "total",
 ];
 
 const KEYWORDS: &[&str] = &[
@@ -106,6 +109,9 @@ pub fn sanitize(name: &str) -> String {
 /// Hands out unique identifiers.
 #[derive(Clone, Debug, Default)]
 pub struct Namer {
+    /// Names taken before [`Namer::frozen`], shared by the clones (a model of 10,000 masses has 80,000 names,
+    /// and each function body clones the namer of the module).
+    frozen: Arc<HashSet<String>>,
     taken: HashSet<String>,
 }
 
@@ -113,8 +119,23 @@ impl Namer {
     /// A namer with the generated code's own names already taken.
     pub fn with_reserved() -> Namer {
         Namer {
+            frozen: Arc::default(),
             taken: RESERVED.iter().map(|s| s.to_string()).collect(),
         }
+    }
+
+    /// The same namer, its names kept where clones share them: cloning it then costs only the names taken since.
+    pub fn frozen(self) -> Namer {
+        let mut all = Arc::unwrap_or_clone(self.frozen);
+        all.extend(self.taken);
+        Namer {
+            frozen: Arc::new(all),
+            taken: HashSet::new(),
+        }
+    }
+
+    fn is_taken(&self, name: &str) -> bool {
+        self.taken.contains(name) || self.frozen.contains(name)
     }
 
     /// A unique identifier for `name`.
@@ -125,7 +146,7 @@ impl Namer {
         }
         let mut candidate = base.clone();
         let mut k = 2;
-        while self.taken.contains(&candidate) {
+        while self.is_taken(&candidate) {
             candidate = format!("{base}_{k}");
             k += 1;
         }

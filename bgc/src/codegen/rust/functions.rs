@@ -8,6 +8,7 @@ use super::super::layout::Body;
 use super::super::mass::MassColumns;
 use super::super::names::{Namer, comment};
 use super::calls::{call_depth, call_name, early_calls, with_bound_calls};
+use super::parts::{Out, Statement};
 use super::terms::term_field;
 use super::{Arg, Function, Uses, Writer, output_names};
 use crate::equations::{EnergyKind, SparseMatrix, StateSelection};
@@ -16,9 +17,9 @@ use std::collections::{BTreeMap, BTreeSet};
 
 /// The lines and facts of a function body being written.
 pub(in crate::codegen) struct Draft {
-    namer: Namer,
+    pub(super) namer: Namer,
     pub(in crate::codegen) lines: Vec<String>,
-    locals: Vec<String>,
+    pub(super) locals: Vec<String>,
     pub(in crate::codegen) uses: Uses,
     /// The number of the next temporary.
     next_temp: usize,
@@ -27,7 +28,7 @@ pub(in crate::codegen) struct Draft {
     /// Whether the body reads its parameter-only subexpressions from `c: &ParamTerms` ([`super::terms`]).
     cache: bool,
     /// Whether it reads any.
-    reads_terms: bool,
+    pub(super) reads_terms: bool,
 }
 
 impl Draft {
@@ -44,7 +45,7 @@ impl<'a> Writer<'a> {
     }
 
     /// A body as [`Self::draft`] whose statements read parameter-only subexpressions from `c: &ParamTerms`.
-    fn draft_cached(&self, exprs: &[&Expr]) -> Draft {
+    pub(super) fn draft_cached(&self, exprs: &[&Expr]) -> Draft {
         self.draft_with(exprs, self.terms_enabled)
     }
 
@@ -86,19 +87,23 @@ impl<'a> Writer<'a> {
             cache,
             reads_terms: used.iter().any(|s| term_field(s).is_some()),
         };
-        for (vector, symbols) in [("x", &self.plan.states), ("u", &self.plan.inputs)] {
-            for (i, s) in symbols.iter().enumerate() {
-                if used.contains(s) {
-                    let name = self.name(s);
-                    d.lines.push(format!("    let {name} = {vector}[{i}];"));
-                    d.locals.push(name);
-                    if vector == "x" {
-                        d.uses.x = true;
-                    } else {
-                        d.uses.u = true;
-                    }
-                }
-            }
+        // The states, then the inputs, in order (looked up: a large model has many, a part reads few).
+        let mut read: Vec<((u8, usize), &Symbol)> = used
+            .iter()
+            .filter_map(|s| self.positions.get(s).map(|&at| (at, s)))
+            .collect();
+        read.sort_by_key(|&(at, _)| at);
+        for ((vector, i), s) in read {
+            let name = self.name(s);
+            let vector = if vector == 0 {
+                d.uses.x = true;
+                "x"
+            } else {
+                d.uses.u = true;
+                "u"
+            };
+            d.lines.push(format!("    let {name} = {vector}[{i}];"));
+            d.locals.push(name);
         }
         // The names available from the start: states and inputs bound above, parameters, time (not the
         // intermediates and earlier outputs, computed in the body).
@@ -169,12 +174,12 @@ impl<'a> Writer<'a> {
         d.lines.extend(body.finish().lines().map(str::to_string));
     }
 
-    fn body_text(lines: &[String]) -> String {
+    pub(super) fn body_text(lines: &[String]) -> String {
         lines.iter().map(|l| format!("{l}\n")).collect()
     }
 
     /// The model arguments `p, t, x, u` as `d` uses them.
-    fn model_args(uses: Uses) -> Vec<Arg> {
+    pub(super) fn model_args(uses: Uses) -> Vec<Arg> {
         vec![
             Arg::new("p", "&Params", uses.p),
             Arg::new("t", "f64", uses.t),
@@ -192,6 +197,29 @@ impl<'a> Writer<'a> {
         target: (&'static str, &'static str),
         lhs: &[String],
     ) {
+        let with_mass = target.0 == "dx" && !self.plan.mass.is_empty();
+        if b.lets.is_empty() && !with_mass && self.splits(b.results.len()) {
+            let statements: Vec<Statement> = b
+                .results
+                .iter()
+                .enumerate()
+                .map(|(i, r)| Statement {
+                    label: format!("{} = ", lhs.get(i).map_or("", String::as_str)),
+                    expr: r,
+                    head: format!("{}[{i}] = ", target.0),
+                    tail: ";".into(),
+                })
+                .collect();
+            let out = Out {
+                name: target.0,
+                ty: target.1,
+                passed: target.0,
+            };
+            let stem = name.strip_suffix("_into").unwrap_or(name);
+            let d = self.parts(stem, &statements, out, self.terms_enabled, Vec::new());
+            self.model_function(name, doc, d, Arg::new(target.0, target.1, true));
+            return;
+        }
         let mut all: Vec<&Expr> = b.lets.iter().map(|l| &l.1).collect();
         all.extend(b.results.iter());
         let mut d = self.draft_cached(&all);
@@ -409,6 +437,29 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         let correction = self.loop_correction_exprs(g_z, r_v);
         nonzero.extend(correction.iter());
         let shared = self.shared_lets(name);
+        let corrected = !correction.is_empty()
+            || !shared.is_empty()
+            || (matches!(name, "jac_x_into" | "jac_u_into") && !plan.mass.is_empty());
+        if !corrected && self.splits(m.iter().filter(|e| !e.2.is_zero()).count()) {
+            let statements = self.entry_statements(m.iter(), (rows, cols, row_prefix));
+            let out = Out {
+                name: "jac",
+                ty,
+                passed: "jac",
+            };
+            let stem = name.strip_suffix("_into").unwrap_or(name);
+            let prologue = vec!["    jac.fill(0.0);".to_string()];
+            let d = self.parts(stem, &statements, out, self.terms_enabled, prologue);
+            if !(d.uses.t || d.uses.x || d.uses.u) {
+                self.constant_jacobian(name, ty);
+            }
+            let sparse = name == "jac_x_into" && self.wants_sparse_jac_x();
+            self.model_function(name, doc, d, Arg::new("jac", ty, true));
+            if sparse {
+                self.sparse_jac_x(m, rows, cols, row_prefix);
+            }
+            return;
+        }
         nonzero.extend(shared.iter().map(|(_, v)| v));
         let mut d = self.draft_cached(&nonzero);
         self.solve_tears(&mut d, &nonzero);
@@ -452,6 +503,28 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             );
             d.locals.push(local);
         }
+    }
+
+    /// One assignment `jac[(r, c)] = value;` per entry that is not identically zero, as
+    /// [`Self::matrix_entries`] writes them.
+    pub(super) fn entry_statements<'e>(
+        &self,
+        entries: impl Iterator<Item = (usize, usize, &'e Expr)>,
+        (rows, cols, row_prefix): (&[String], &[String], &str),
+    ) -> Vec<Statement<'e>> {
+        entries
+            .filter(|(_, _, e)| !e.is_zero())
+            .map(|(r, c, e)| Statement {
+                label: format!(
+                    "∂({row_prefix}{})/∂{} = ",
+                    rows.get(r).map_or("", String::as_str),
+                    cols.get(c).map_or("", String::as_str)
+                ),
+                expr: e,
+                head: format!("jac[({r}, {c})] = "),
+                tail: ";".into(),
+            })
+            .collect()
     }
 
     /// `jac.fill(0.0)` and one assignment per entry `(row, column, value)` that is not identically zero, in the
@@ -523,16 +596,35 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             ));
             self.out.push('\n');
         }
-        let exprs: Vec<&Expr> = entries.iter().map(|e| e.2).collect();
-        let mut d = self.draft(&exprs);
-        for (k, &(r, c, e)) in entries.iter().enumerate() {
-            let lhs = format!(
-                "∂({row_prefix}{})/∂{} = ",
-                rows.get(r).cloned().unwrap_or_default(),
-                cols.get(c).cloned().unwrap_or_default()
-            );
-            self.statement(&mut d, &lhs, e, &format!("values[{k}] = "), ";");
-        }
+        let statements: Vec<Statement> = entries
+            .iter()
+            .enumerate()
+            .map(|(k, &(r, c, e))| Statement {
+                label: format!(
+                    "∂({row_prefix}{})/∂{} = ",
+                    rows.get(r).map_or("", String::as_str),
+                    cols.get(c).map_or("", String::as_str)
+                ),
+                expr: e,
+                head: format!("values[{k}] = "),
+                tail: ";".into(),
+            })
+            .collect();
+        let d = if self.splits(statements.len()) {
+            let out = Out {
+                name: "values",
+                ty: "&mut [f64; JAC_X_NNZ]",
+                passed: "values",
+            };
+            self.parts("jac_x_sparse", &statements, out, false, Vec::new())
+        } else {
+            let exprs: Vec<&Expr> = entries.iter().map(|e| e.2).collect();
+            let mut d = self.draft(&exprs);
+            for s in &statements {
+                self.statement(&mut d, &s.label, s.expr, &s.head, &s.tail);
+            }
+            d
+        };
         let mut args = Self::model_args(d.uses);
         args.push(Arg::new(
             "values",
@@ -607,6 +699,11 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
     }
 
     fn state_space_fn(&mut self, (name, ty): (&str, &str), size: &str, ss: &StateSpace, doc: &str) {
+        let n = ss.states.len();
+        if n.saturating_mul(n).saturating_mul(8) > super::model::MAX_CONSTANT_JACOBIAN_BYTES {
+            self.state_space_entries(name, ss, doc);
+            return;
+        }
         self.out.push('\n');
         self.doc(
             0,
@@ -662,6 +759,68 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             name: name.to_string(),
             args: vec![Arg::new("p", "&Params", d.uses.p)],
             ret: format!(" -> {ty}"),
+            body: Self::body_text(&d.lines),
+            locals: d.locals,
+            inline: false,
+        });
+    }
+
+    /// `{name}_entries(p, entry)`, the state space of a model whose `A` would take more than
+    /// [`super::model::MAX_CONSTANT_JACOBIAN_BYTES`]: each entry that is not identically zero passed to `entry`,
+    /// so that no `N²` matrix is declared (a thread's stack holds few).
+    fn state_space_entries(&mut self, name: &str, ss: &StateSpace, doc: &str) {
+        let ys: Vec<String> = output_names(&self.m.equations);
+        let us: Vec<String> = self.m.equations.inputs.clone();
+        let mut statements = Vec::new();
+        for (var, m, rows, cols) in [
+            ('A', &ss.a, &ss.states, &ss.states),
+            ('B', &ss.b, &ss.states, &us),
+            ('C', &ss.c, &ys, &ss.states),
+            ('D', &ss.d, &ys, &us),
+        ] {
+            for (r, col, e) in m.iter().filter(|(_, _, e)| !e.is_zero()) {
+                statements.push(Statement {
+                    label: format!(
+                        "{var}[{}, {}] = ",
+                        rows.get(r).map_or("", String::as_str),
+                        cols.get(col).map_or("", String::as_str)
+                    ),
+                    expr: e,
+                    head: format!("entry('{var}', {r}, {col}, "),
+                    tail: ");".into(),
+                });
+            }
+        }
+        let function = format!("{name}_entries");
+        let ty = "&mut dyn FnMut(char, usize, usize, f64)";
+        let d = if self.splits(statements.len()) {
+            let out = Out {
+                name: "entry",
+                ty,
+                passed: "entry",
+            };
+            self.parts(&function, &statements, out, false, Vec::new())
+        } else {
+            let exprs: Vec<&Expr> = statements.iter().map(|s| s.expr).collect();
+            let mut d = self.draft(&exprs);
+            for s in &statements {
+                self.statement(&mut d, &s.label, s.expr, &s.head, &s.tail);
+            }
+            d
+        };
+        self.function(Function {
+            doc: format!(
+                "The linear state space `ẋ = A x + B u`, `y = C x + D u` {doc}, at the parameters `p`, as the \
+                 entries that are not identically zero: `entry(matrix, row, column, value)` for each, `matrix` \
+                 being `'A'`, `'B'`, `'C'` or `'D'` (in that order). A model this large gets no dense \
+                 `{name}`: its `A` would not fit a thread's stack."
+            ),
+            name: function,
+            args: vec![
+                Arg::new("p", "&Params", d.uses.p),
+                Arg::new("entry", ty, !statements.is_empty()),
+            ],
+            ret: String::new(),
             body: Self::body_text(&d.lines),
             locals: d.locals,
             inline: false,
@@ -745,6 +904,10 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
                     continue;
                 }
             };
+            if self.splits(terms.len()) {
+                self.energy_in_parts(name, doc, &terms);
+                continue;
+            }
             let exprs: Vec<&Expr> = terms.iter().map(|t| &t.1).collect();
             let mut d = self.draft(&exprs);
             self.solve_tears(&mut d, &exprs);
@@ -771,7 +934,8 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
                 // One `let` per element would nest too many scopes for rustc (see `MAX_LETS`): a running total
                 // instead, added in the same order.
                 many => {
-                    let total = d.namer.ident("total");
+                    // Reserved: no state, input or intermediate takes it.
+                    let total = "total";
                     for (k, (element, e)) in many.iter().enumerate() {
                         let head = if k == 0 {
                             format!("let mut {total} = ")
@@ -793,6 +957,39 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
                 inline: false,
             });
         }
+    }
+}
+
+impl Writer<'_> {
+    /// The energy or power function `name` of many terms: parts that add their terms to a running total, in
+    /// order.
+    fn energy_in_parts(&mut self, name: &str, doc: &str, terms: &[(String, Expr)]) {
+        let statements: Vec<Statement> = terms
+            .iter()
+            .map(|(element, e)| Statement {
+                label: format!("{element}: "),
+                expr: e,
+                head: "*total += ".into(),
+                tail: ";".into(),
+            })
+            .collect();
+        let out = Out {
+            name: "total",
+            ty: "&mut f64",
+            passed: "&mut total",
+        };
+        let prologue = vec!["    let mut total = 0.0;".to_string()];
+        let mut d = self.parts(name, &statements, out, false, prologue);
+        d.lines.push("    total".into());
+        self.function(Function {
+            doc: doc.to_string(),
+            name: name.to_string(),
+            args: Self::model_args(d.uses),
+            ret: " -> f64".into(),
+            body: Self::body_text(&d.lines),
+            locals: d.locals,
+            inline: false,
+        });
     }
 }
 

@@ -15,7 +15,9 @@
 //!   `N_OUTPUTS × N_PARAMS`): full matrices, a column per free parameter in `PARAM_NAMES` order, total through the
 //!   derived parameters, with the loops' and mass matrices' contributions as in `jac_x_into`
 //!   (`param_jacobians.rs`);
-//! - for a linear model `state_space(&Params) -> (A, B, C, D)` whenever `bgc statespace` prints one: in the energy
+//! - for a linear model `state_space(&Params) -> (A, B, C, D)` whenever `bgc statespace` prints one (above 181
+//!   states, where `A` takes more than 256 KiB, `state_space_entries(&Params, &mut dyn FnMut(char, usize, usize,
+//!   f64))` instead, which passes each entry that is not identically zero and declares no matrix): in the energy
 //!   states (type `EnergyStateSpace`), or, when the outputs or rates read an integrated flow (`var`), in all states,
 //!   energy states then integrated flows (type `FullStateSpace`); and, when the model declares coordinates,
 //!   `state_space_declared` (type `DeclaredStateSpace`, sizes `N_COORDS`, names `COORD_NAMES`);
@@ -26,6 +28,9 @@
 //! - `Model` (the parameters, validated) and, with [`Options::runtime`], its implementations of
 //!   `bgc_runtime::model::ContinuousModel`, `Parametric` and `bgc_runtime::fit::generated::ParamJacobians` (a column of
 //!   `jac_p_into` or `output_jac_p_into` by index, for `Generated::exact`).
+//!
+//! Bodies of more than `parts::MAX_PART_STATEMENTS` independent statements are split into private parts (see
+//! `parts`), and `validate` checks each distinct (element value, rule) once.
 //!
 //! # What the code needs
 //! The functions of the model take fixed-size values, allocate nothing, never panic (indices are constants within
@@ -56,6 +61,7 @@ mod functions;
 mod model;
 mod param_jacobians;
 mod params;
+mod parts;
 mod terms;
 
 pub(super) use functions::Draft;
@@ -102,36 +108,8 @@ pub fn generate(file: &CompiledFile, source_name: &str) -> String {
 
 /// The Rust module of a compiled file; `source_name` names the file in the header.
 pub fn generate_with(file: &CompiledFile, source_name: &str, options: Options) -> String {
-    let mut body = String::new();
-    match file.models.as_slice() {
-        [single] => {
-            body.push('\n');
-            body.push_str(&model_code(single, options, 0));
-        }
-        many => {
-            let mut namer = Namer::with_reserved();
-            for m in many {
-                let name = namer.ident(&m.model.name);
-                let _ = writeln!(
-                    body,
-                    "\n/// The generated code of model `{}`.",
-                    comment(&m.model.name)
-                );
-                if !format::is_snake_case(&name) {
-                    body.push_str("#[allow(non_snake_case)]\n");
-                }
-                let _ = writeln!(body, "pub mod {name} {{");
-                for line in model_code(m, options, 4).lines() {
-                    if line.is_empty() {
-                        body.push('\n');
-                    } else {
-                        let _ = writeln!(body, "    {line}");
-                    }
-                }
-                body.push_str("}\n");
-            }
-        }
-    }
+    // The header first, then each model's code appended: a large model's text (250 MB for 200,000 states) is
+    // not copied again.
     let mut out = header(source_name, file.hash);
     out.push_str(
         "\n// Do not edit: this file is regenerated from the .bg source when it changes.\n",
@@ -149,7 +127,35 @@ pub fn generate_with(file: &CompiledFile, source_name: &str, options: Options) -
         out.push_str(&line);
         out.push('\n');
     }
-    out.push_str(&body);
+    match file.models.as_slice() {
+        [single] => {
+            out.push('\n');
+            out.push_str(&model_code(single, options, 0));
+        }
+        many => {
+            let mut namer = Namer::with_reserved();
+            for m in many {
+                let name = namer.ident(&m.model.name);
+                let _ = writeln!(
+                    out,
+                    "\n/// The generated code of model `{}`.",
+                    comment(&m.model.name)
+                );
+                if !format::is_snake_case(&name) {
+                    out.push_str("#[allow(non_snake_case)]\n");
+                }
+                let _ = writeln!(out, "pub mod {name} {{");
+                for line in model_code(m, options, 4).lines() {
+                    if line.is_empty() {
+                        out.push('\n');
+                    } else {
+                        let _ = writeln!(out, "    {line}");
+                    }
+                }
+                out.push_str("}\n");
+            }
+        }
+    }
     out
 }
 
@@ -181,20 +187,29 @@ const ITEM_STARTS: &[&str] = &[
 /// (below its documentation and other attributes; joined to an `#[allow(...)]` line already there), so that a
 /// crate that uses some of them builds without warnings.
 fn allow_dead_code(code: &str) -> String {
-    let mut lines: Vec<String> = Vec::with_capacity(code.lines().count() * 2);
+    let mut out = String::with_capacity(code.len() + code.len() / 8);
+    // Where the last line written starts (lines are joined by `\n`, the last one without).
+    let mut last = 0;
+    let mut first = true;
+    let mut push_line = |out: &mut String, last: &mut usize, line: &str| {
+        if !std::mem::take(&mut first) {
+            out.push('\n');
+        }
+        *last = out.len();
+        out.push_str(line);
+    };
     for line in code.lines() {
         if ITEM_STARTS.iter().any(|k| line.starts_with(k)) {
-            match lines.last_mut() {
-                Some(prev) if prev.starts_with("#[allow(") && prev.ends_with(")]") => {
-                    prev.truncate(prev.len() - 2);
-                    prev.push_str(", dead_code)]");
-                }
-                _ => lines.push("#[allow(dead_code)]".into()),
+            let prev = out.get(last..).unwrap_or("");
+            if prev.starts_with("#[allow(") && prev.ends_with(")]") {
+                out.truncate(out.len() - 2);
+                out.push_str(", dead_code)]");
+            } else {
+                push_line(&mut out, &mut last, "#[allow(dead_code)]");
             }
         }
-        lines.push(line.to_string());
+        push_line(&mut out, &mut last, line);
     }
-    let mut out = lines.join("\n");
     if code.ends_with('\n') {
         out.push('\n');
     }
@@ -264,6 +279,8 @@ pub(in crate::codegen) struct Writer<'a> {
     options: Options,
     /// Rust text of each symbol inside a model function (`p.J_m`, `p_rotor`, `t`).
     names: HashMap<Symbol, String>,
+    /// Where each state and input is read from: `(0, i)` for `x[i]`, `(1, i)` for `u[i]`.
+    positions: HashMap<Symbol, (u8, usize)>,
     /// Every local name of the model functions taken (states, inputs, intermediates); cloned for each function.
     namer: Namer,
     /// Field names of the free parameters, in parameter order (the fields of `Params`).
@@ -335,7 +352,21 @@ impl<'a> Writer<'a> {
             names.insert(Symbol::output(o.name.as_str()), format!("y[{k}]"));
         }
         names.insert(Symbol::time(), "t".into());
+        let namer = namer.frozen();
+        let positions = (plan
+            .states
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (s.clone(), (0, i))))
+        .chain(
+            plan.inputs
+                .iter()
+                .enumerate()
+                .map(|(i, s)| (s.clone(), (1, i))),
+        )
+        .collect();
         Writer {
+            positions,
             m,
             plan,
             options,
@@ -421,19 +452,26 @@ impl<'a> Writer<'a> {
     }
 
     fn function(&mut self, f: Function) {
+        let inline = if f.inline { Some("#[inline]") } else { None };
+        self.write_function(f, inline, "pub fn");
+    }
+
+    /// Writes `f` with the attribute `inline` (instead of `f.inline`'s) as `{keyword} name(...)`.
+    fn write_function(&mut self, f: Function, inline: Option<&str>, keyword: &str) {
         self.out.push('\n');
         self.doc(0, &f.doc);
         if let Some(attr) = Self::allows(&f.locals, &f.body) {
             self.out.push_str(&attr);
             self.out.push('\n');
         }
-        if f.inline {
-            self.out.push_str("#[inline]\n");
+        if let Some(inline) = inline {
+            self.out.push_str(inline);
+            self.out.push('\n');
         }
         let args: Vec<String> = f.args.iter().map(Arg::text).collect();
         let sig = format::signature(
             0,
-            &format!("pub fn {}", f.name),
+            &format!("{keyword} {}", f.name),
             &args,
             &f.ret,
             f.body.is_empty(),
@@ -454,14 +492,19 @@ impl<'a> Writer<'a> {
         self.param_terms_struct();
         self.model();
         // The helpers the code calls (comments and documentation, the model's text, left out).
-        let code: String = self
+        let mut code = String::with_capacity(self.out.len());
+        for line in self
             .out
             .lines()
             .filter(|l| !l.trim_start().starts_with("//"))
-            .collect::<Vec<_>>()
-            .join("\n");
+        {
+            code.push_str(line);
+            code.push('\n');
+        }
         let helpers = rust_helpers_used(&code);
-        let mut out = String::from("use nalgebra::{SMatrix, SVector};\n");
+        drop(code);
+        let mut out = String::with_capacity(self.out.len() + 4096);
+        out.push_str("use nalgebra::{SMatrix, SVector};\n");
         if !helpers.is_empty() {
             out.push('\n');
             out.push_str(helpers.trim_end());

@@ -9,6 +9,7 @@
 
 use super::super::format;
 use super::super::mass::MassColumns;
+use super::parts::Out;
 use super::{Arg, Writer, output_names};
 use crate::symbolic::Expr;
 
@@ -82,14 +83,28 @@ pub type OutJacP = SMatrix<f64, N_OUTPUTS, N_PARAMS>;
         let correction = self.loop_correction_exprs(g_z, r_p);
         needed.extend(correction.iter());
         let shared = self.shared_lets(name);
-        needed.extend(shared.iter().map(|(_, v)| v));
-        let mut d = self.draft(&needed);
-        self.solve_tears(&mut d, &needed);
-        self.shared_statements(&mut d, shared);
         let entries = m
             .iter()
             .enumerate()
             .flat_map(|(r, row)| row.iter().enumerate().map(move |(c, e)| (r, c, e)));
+        let with_mass = solve_mass && !plan.mass.is_empty();
+        if !with_mass && shared.is_empty() && self.splits(needed.len()) {
+            let statements = self.entry_statements(entries, (rows, cols, row_prefix));
+            let out = Out {
+                name: "jac",
+                ty,
+                passed: "jac",
+            };
+            let stem = name.strip_suffix("_into").unwrap_or(name);
+            let prologue = vec!["    jac.fill(0.0);".to_string()];
+            let d = self.parts(stem, &statements, out, false, prologue);
+            self.model_function(name, doc, d, Arg::new("jac", ty, true));
+            return;
+        }
+        needed.extend(shared.iter().map(|(_, v)| v));
+        let mut d = self.draft(&needed);
+        self.solve_tears(&mut d, &needed);
+        self.shared_statements(&mut d, shared);
         self.matrix_entries(&mut d, entries, (rows, cols, row_prefix));
         let size = if mass { "N_STATES" } else { "N_OUTPUTS" };
         self.loop_correction(&mut d, g_z, r_p, (size, "N_PARAMS"));

@@ -353,6 +353,79 @@ pub type OutJacU = SMatrix<f64, N_OUTPUTS, N_INPUTS>;
             .iter()
             .map(|p| (p.name.clone(), self.param_access(&p.name)))
             .collect();
+        for check in self.element_checks(&field_of) {
+            let (cond, what) = match check.rule {
+                Rule::Positive(what) => ("!v.is_finite() || v <= 0.0", (what, "positive")),
+                Rule::NonNegative => ("!v.is_finite() || v < 0.0", ("resistance", "non-negative")),
+                Rule::NonZero => ("!v.is_finite() || v == 0.0", ("modulus", "non-zero")),
+            };
+            let text = &check.text;
+            let (elements, of) = match check.others {
+                0 => (
+                    check.element.clone(),
+                    format!("`{}` ({text})", check.element),
+                ),
+                n => (
+                    format!("{} and {n} {}", check.element, others(n)),
+                    format!(
+                        "`{}` ({text}) and of {n} {} with the same value",
+                        check.element,
+                        others(n)
+                    ),
+                ),
+            };
+            let reason = format!("the {} of {of} must be {} and finite", what.0, what.1);
+            body.lines(format::comment(
+                8,
+                "//",
+                &format!("{elements}: {text}"),
+                Wrap::Equation,
+                self.width,
+            ));
+            body.statement("let v = ", &check.code, ";");
+            let reason_head = "                reason: ";
+            let reason = format::string_literal(&reason, reason_head.len(), 1, 16, self.width);
+            body.lines(
+                format!(
+                    "        if {cond} {{
+            return Err(ParamError::NonPhysical {{
+                name: {},
+                value: {},
+{reason_head}{reason},
+            }});
+        }}",
+                    string_literal(&check.param),
+                    check.field,
+                )
+                .lines()
+                .map(str::to_string),
+            );
+        }
+        body.line("Ok(())");
+        let text = body.finish();
+        self.doc(
+            4,
+            "Checks that the parameters are physical: all finite, inertias and compliances positive, resistances \
+             non-negative, transformer and gyrator moduli non-zero.",
+        );
+        if format::may_look_like_a_constant(&text) {
+            self.out.push_str("    #[allow(clippy::approx_constant)]\n");
+        }
+        self.out
+            .push_str("    pub fn validate(&self) -> Result<(), ParamError> {\n");
+        self.out.push_str(&text);
+        self.out.push_str("    }\n");
+    }
+}
+
+impl Writer<'_> {
+    /// The checks of the elements whose value is an expression of parameters, each distinct (value, rule)
+    /// once, in the order of the first element that needs it: a chain of 10,000 masses of inertia `m` checks `m`
+    /// once, not 10,000 times, and the message names the first mass and counts the others.
+    fn element_checks(&self, field_of: &HashMap<String, String>) -> Vec<ElementCheck> {
+        let model = &self.m.model;
+        let mut checks: Vec<ElementCheck> = Vec::new();
+        let mut index: HashMap<(String, &'static str), usize> = HashMap::new();
         for node in model.graph.node_weights() {
             let (expr, rule) = match (&node.kind, &node.relation) {
                 (ElementKind::I, ir::Relation::Linear(e)) => (e, Rule::Positive("inertia")),
@@ -383,69 +456,57 @@ pub type OutJacU = SMatrix<f64, N_OUTPUTS, N_INPUTS>;
                     .cloned()
                     .unwrap_or_else(|| "f64::NAN".into())
             });
-            let text = to_text(&value);
-            let (cond, reason) = match rule {
-                Rule::Positive(what) => (
-                    "!v.is_finite() || v <= 0.0",
-                    format!(
-                        "the {what} of `{}` ({text}) must be positive and finite",
-                        node.name
-                    ),
-                ),
-                Rule::NonNegative => (
-                    "!v.is_finite() || v < 0.0",
-                    format!(
-                        "the resistance of `{}` ({text}) must be non-negative and finite",
-                        node.name
-                    ),
-                ),
-                Rule::NonZero => (
-                    "!v.is_finite() || v == 0.0",
-                    format!(
-                        "the modulus of `{}` ({text}) must be non-zero and finite",
-                        node.name
-                    ),
-                ),
-            };
-            body.lines(format::comment(
-                8,
-                "//",
-                &format!("{}: {text}", node.name),
-                Wrap::Equation,
-                self.width,
-            ));
-            body.statement("let v = ", &code, ";");
-            let reason_head = "                reason: ";
-            let reason = format::string_literal(&reason, reason_head.len(), 1, 16, self.width);
-            body.lines(
-                format!(
-                    "        if {cond} {{
-            return Err(ParamError::NonPhysical {{
-                name: {},
-                value: {first_field},
-{reason_head}{reason},
-            }});
-        }}",
-                    string_literal(first.name()),
-                )
-                .lines()
-                .map(str::to_string),
-            );
+            let key = (format!("{code:?}"), rule.key());
+            if let Some(&k) = index.get(&key) {
+                if let Some(check) = checks.get_mut(k) {
+                    check.others += 1;
+                }
+                continue;
+            }
+            index.insert(key, checks.len());
+            checks.push(ElementCheck {
+                element: node.name.clone(),
+                others: 0,
+                text: to_text(&value),
+                code,
+                rule,
+                param: first.name().to_string(),
+                field: first_field.clone(),
+            });
         }
-        body.line("Ok(())");
-        let text = body.finish();
-        self.doc(
-            4,
-            "Checks that the parameters are physical: all finite, inertias and compliances positive, resistances \
-             non-negative, transformer and gyrator moduli non-zero.",
-        );
-        if format::may_look_like_a_constant(&text) {
-            self.out.push_str("    #[allow(clippy::approx_constant)]\n");
+        checks
+    }
+}
+
+/// One check of `validate`: the value of `element` (and of `others` more elements with the same value and rule)
+/// must satisfy `rule`; a failure names parameter `param` (read as `field`).
+struct ElementCheck {
+    element: String,
+    others: usize,
+    text: String,
+    code: crate::symbolic::RustCode,
+    rule: Rule,
+    param: String,
+    field: String,
+}
+
+impl Rule {
+    /// What tells two rules apart, for finding equal checks.
+    fn key(self) -> &'static str {
+        match self {
+            Rule::Positive(what) => what,
+            Rule::NonNegative => "non-negative",
+            Rule::NonZero => "non-zero",
         }
-        self.out
-            .push_str("    pub fn validate(&self) -> Result<(), ParamError> {\n");
-        self.out.push_str(&text);
-        self.out.push_str("    }\n");
+    }
+}
+
+/// "other element" or "other elements".
+fn others(n: usize) -> &'static str {
+    if n == 1 {
+        "other element"
+    } else {
+        "other elements"
     }
 }
 

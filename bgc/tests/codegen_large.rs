@@ -1,0 +1,257 @@
+//! A large model's generated module: its long bodies split into parts of bounded size, its state space as
+//! entries rather than `N²` matrices on the stack, and `validate` checking each distinct element value once. The
+//! module of a 600-state chain is compiled and run on a thread with the default 2 MiB stack, on which its
+//! `state_space` (an `A` of 600² · 8 bytes = 2.9 MB) used to overflow.
+
+use crate::codegen_support::rustc::build_and_run;
+use crate::codegen_support::{generate_text, scratch};
+use crate::loops_globalised::LIBM_STD;
+use bgc::codegen::rust::Options;
+
+/// A chain of `n` masses `m` with dampers `b` to ground, joined by springs `1/k`, the first held to a wall by a
+/// spring `1/k` and driven by the force `u`: `2n` states `q_wall, p_mass1, q_spring1, ..., p_mass<n>`, every
+/// element sharing one of the three parameters.
+fn shared_chain(n: usize) -> String {
+    let mut s = String::from(
+        "model chain {\n    domain translational;\n    param m = 1 [kg];\n    param b = 0.5 [N s/m];\n    \
+         param k = 1 [N/m];\n    input u [N];\n    Se drive = u;\n    C wall = 1/k;\n    bond drive -> v1;\n    \
+         bond v1 -> wall;\n",
+    );
+    for i in 1..=n {
+        s.push_str(&format!(
+            "    1 v{i};\n    I mass{i} = m;\n    R damp{i} = b;\n    bond v{i} -> mass{i};\n    \
+             bond v{i} -> damp{i};\n"
+        ));
+        if i < n {
+            let j = i + 1;
+            s.push_str(&format!(
+                "    0 x{i};\n    C spring{i} = 1/k;\n    bond v{i} -> x{i};\n    bond x{i} -> v{j};\n    \
+                 bond x{i} -> spring{i};\n"
+            ));
+        }
+    }
+    s.push_str("}\n");
+    s
+}
+
+const MASSES: usize = 300;
+const STATES: usize = 2 * MASSES;
+/// The parameters and the point the program evaluates at.
+const M: f64 = 2.0;
+const B: f64 = 0.3;
+const K: f64 = 5.0;
+const U: f64 = 1.5;
+
+/// The state of the program: `x_i = 0.01 (i + 1) (-1)^i`.
+fn state(i: usize) -> f64 {
+    let sign = if i.is_multiple_of(2) { 1.0 } else { -1.0 };
+    0.01 * (i + 1) as f64 * sign
+}
+
+const MAIN: &str = r#"
+#[allow(dead_code, unused_imports, clippy::all)]
+mod model {
+    include!("chain.module");
+}
+
+fn state(i: usize) -> f64 {
+    let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
+    0.01 * (i + 1) as f64 * sign
+}
+
+fn run() {
+    let p = model::Params { m: 2.0, b: 0.3, k: 5.0 };
+    let mut x = model::State::zeros();
+    for i in 0..model::N_STATES {
+        x[i] = state(i);
+    }
+    let mut u = model::Inputs::zeros();
+    u[0] = 1.5;
+    let dx = model::rhs(&p, 0.0, &x, &u);
+    // A x + B u from the entries, and how many each matrix has.
+    let mut ax = vec![0.0; model::N_STATES];
+    let mut counts = [0usize; 4];
+    model::state_space_entries(&p, &mut |m, r, c, v| {
+        let k = (m as u8 - b'A') as usize;
+        counts[k] += 1;
+        match m {
+            'A' => ax[r] += v * x[c],
+            'B' => ax[r] += v * u[c],
+            _ => {}
+        }
+    });
+    // ∂f/∂x x from the triplets.
+    let mut values: Box<[f64; model::JAC_X_NNZ]> =
+        vec![0.0; model::JAC_X_NNZ].into_boxed_slice().try_into().unwrap();
+    model::jac_x_sparse_into(&p, 0.0, &x, &u, &mut values);
+    let mut jx = vec![0.0; model::N_STATES];
+    for k in 0..model::JAC_X_NNZ {
+        jx[model::JAC_X_ROWS[k]] += values[k] * x[model::JAC_X_COLS[k]];
+    }
+    for i in 0..model::N_STATES {
+        println!("{:e} {:e} {:e}", dx[i], ax[i], jx[i]);
+    }
+    println!("counts {} {} {} {}", counts[0], counts[1], counts[2], counts[3]);
+    println!("energy {:e} {:e}", model::stored_energy(&p, 0.0, &x, &u), model::dissipated_power(&p, 0.0, &x, &u));
+    let bad = model::Params { m: -1.0, ..p };
+    match bad.validate() {
+        Err(e) => println!("error {e}"),
+        Ok(()) => println!("error none"),
+    }
+}
+
+fn main() {
+    // A spawned thread's default stack, whatever `RUST_MIN_STACK` says.
+    let worker = std::thread::Builder::new().stack_size(2 << 20).spawn(run).unwrap();
+    worker.join().unwrap();
+}
+"#;
+
+/// `f(x, u)` of [`shared_chain`] by hand: `v_i = p_i/m`; `q̇_wall = v_1`, `q̇_spring_i = v_i − v_{i+1}`;
+/// `ṗ_i = (u − k q_wall for i = 1, else k q_spring_{i−1}) − b v_i − (k q_spring_i for i < n)`.
+fn hand_rates(x: &[f64]) -> Vec<f64> {
+    let p = |i: usize| x[2 * i - 1];
+    let q_spring = |i: usize| x[2 * i];
+    let v = |i: usize| p(i) / M;
+    let mut f = vec![0.0; STATES];
+    f[0] = v(1);
+    for i in 1..=MASSES {
+        let incoming = if i == 1 {
+            U - K * x[0]
+        } else {
+            K * q_spring(i - 1)
+        };
+        let outgoing = if i < MASSES { K * q_spring(i) } else { 0.0 };
+        f[2 * i - 1] = incoming - B * v(i) - outgoing;
+        if i < MASSES {
+            f[2 * i] = v(i) - v(i + 1);
+        }
+    }
+    f
+}
+
+#[test]
+fn a_large_chain_runs_on_a_default_thread_stack_with_the_hand_derived_rates() {
+    let code = generate_text(
+        "chain.bg",
+        &shared_chain(MASSES),
+        Options { runtime: false },
+    );
+    assert!(code.contains(&format!("pub const N_STATES: usize = {STATES};")));
+    // No `N²` matrix is declared: the state space comes as entries.
+    assert!(!code.contains("pub fn state_space("), "a dense state space");
+    assert!(code.contains("pub fn state_space_entries("));
+    // Bodies are split: the Jacobian calls its parts, and no function is longer than a few hundred statements.
+    assert!(code.contains("fn jac_x_part_1("), "jac_x_into is not split");
+    let longest = longest_function(&code);
+    assert!(longest.1 < 1500, "`{}` has {} lines", longest.0, longest.1);
+
+    let dir = scratch("large-chain");
+    let printed = build_and_run(&dir, "chain", &code, MAIN, LIBM_STD);
+    let _ = std::fs::remove_dir_all(&dir);
+    let lines: Vec<&str> = printed.lines().collect();
+    assert_eq!(
+        lines.len(),
+        STATES + 3,
+        "the program stopped early:\n{printed}"
+    );
+    let x: Vec<f64> = (0..STATES).map(state).collect();
+    let expected = hand_rates(&x);
+    for (i, (line, e)) in lines.iter().zip(&expected).enumerate() {
+        let values: Vec<f64> = line
+            .split_whitespace()
+            .map(|v| v.parse().unwrap_or(f64::NAN))
+            .collect();
+        assert_eq!(values.len(), 3, "{line}");
+        // rhs, A x + B u, and ∂f/∂x x (the model is linear and `u` enters only ṗ_1).
+        let jx_expected = if i == 1 { e - U } else { *e };
+        for (v, want) in values.iter().zip([*e, *e, jx_expected]) {
+            assert!(
+                (v - want).abs() <= 1e-13 * want.abs().max(1.0),
+                "state {i}: {v} vs {want} in {line}"
+            );
+        }
+    }
+    // A: 1 entry in the row of q_wall, 2 per spring, 3 per mass but the last (2): 5n − 2. B: u in ṗ_1 alone.
+    // No outputs: C and D are empty.
+    assert_eq!(
+        lines[STATES],
+        format!("counts {} 1 0 0", 5 * MASSES - 2),
+        "{printed}"
+    );
+    let energy: Vec<f64> = lines[STATES + 1]
+        .split_whitespace()
+        .skip(1)
+        .map(|v| v.parse().unwrap_or(f64::NAN))
+        .collect();
+    let stored: f64 = x[0] * x[0] * K / 2.0
+        + (1..=MASSES)
+            .map(|i| x[2 * i - 1].powi(2) / (2.0 * M))
+            .sum::<f64>()
+        + (1..MASSES).map(|i| K * x[2 * i].powi(2) / 2.0).sum::<f64>();
+    let dissipated: f64 = (1..=MASSES).map(|i| B * (x[2 * i - 1] / M).powi(2)).sum();
+    assert_eq!(energy.len(), 2, "{}", lines[STATES + 1]);
+    assert!(
+        (energy[0] - stored).abs() <= 1e-12 * stored,
+        "{energy:?} vs {stored}"
+    );
+    assert!(
+        (energy[1] - dissipated).abs() <= 1e-12 * dissipated,
+        "{energy:?} vs {dissipated}"
+    );
+    // `validate` checks `m` once and names the first mass and how many share it.
+    assert_eq!(
+        lines[STATES + 2],
+        format!(
+            "error parameter `m` = -1 is not physical: the inertia of `mass1` (m) and of {} other \
+             elements with the same value must be positive and finite",
+            MASSES - 1
+        )
+    );
+}
+
+#[test]
+fn validate_checks_each_distinct_value_once_and_names_its_first_element() {
+    let code = generate_text("chain.bg", &shared_chain(40), Options { runtime: false });
+    let start = code.find("pub fn validate").unwrap_or_default();
+    let end = code[start..]
+        .find("\n    }\n")
+        .map_or(code.len(), |e| start + e);
+    let validate = &code[start..end];
+    // Three checks: the wall's and the springs' `1/k`, the masses' `m`, the dampers' `b`.
+    assert_eq!(validate.matches("let v = ").count(), 3, "{validate}");
+    for comment in [
+        "        // wall and 39 other elements: 1/k\n",
+        "        // mass1 and 39 other elements: m\n",
+        "        // damp1 and 39 other elements: b\n",
+    ] {
+        assert!(validate.contains(comment), "{comment}\n{validate}");
+    }
+    // A value alone keeps its element's message.
+    let one = generate_text("chain.bg", &shared_chain(1), Options { runtime: false });
+    assert!(
+        one.contains("reason: \"the inertia of `mass1` (m) must be positive and finite\","),
+        "{one}"
+    );
+}
+
+/// The function of `code` with the most lines, and that number.
+fn longest_function(code: &str) -> (String, usize) {
+    let mut longest = (String::new(), 0);
+    let mut current: Option<(String, usize)> = None;
+    for line in code.lines() {
+        if line.starts_with("pub fn ") || line.starts_with("fn ") {
+            current = Some((line.to_string(), 0));
+        }
+        if let Some((name, count)) = current.as_mut() {
+            *count += 1;
+            if line == "}" {
+                if *count > longest.1 {
+                    longest = (name.clone(), *count);
+                }
+                current = None;
+            }
+        }
+    }
+    longest
+}

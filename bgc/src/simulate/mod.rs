@@ -41,8 +41,9 @@ pub mod integrate;
 pub mod newton;
 pub mod program;
 
-use crate::equations::sym::{self, Ex, Sym, add};
+use crate::equations::symbols::{self, Sym, SymExt, add};
 use crate::equations::{EnergyKind, Equations, block_jacobian, residual_scale};
+use crate::symbolic::Expr;
 use input::Signal;
 use newton::{BlockPrograms, Loops};
 use program::{CompileError, Layout, Program, Values};
@@ -169,7 +170,7 @@ impl System {
             Sym::Input(j) if j >= n_inputs => eqs.sym_name(Sym::InputDot(j - n_inputs)),
             other => eqs.sym_name(other),
         };
-        let compile = |e: &Ex, what: &str| {
+        let compile = |e: &Expr, what: &str| {
             Program::compile(&exogenous(e, n_inputs, &tears), layout, &name).map_err(|reason| {
                 SimError::Compile {
                     what: what.to_string(),
@@ -242,8 +243,8 @@ impl System {
                 .explicit
                 .as_ref()
                 .ok_or_else(|| SimError::Incomplete { what: what.clone() })?;
-            let e = sym::subst(e, &mut |s| match s {
-                Sym::Output(j) => Some(Ex::S(Sym::Input(ext_len + j))),
+            let e = symbols::subst(e, &mut |s| match s {
+                Sym::Output(j) => Some(symbols::leaf(Sym::Input(ext_len + j))),
                 _ => None,
             });
             let program = Program::compile(&exogenous(&e, n_inputs, &tears), output_layout, &name)
@@ -471,16 +472,16 @@ fn check_len(what: &'static str, expected: usize, got: usize) -> Result<(), SimE
 
 /// `e` with each [`Sym::InputDot`]`(j)` renamed to the input `n_inputs + j` and each tear `tears[k]` to the input
 /// `2 n_inputs + k` (the programs' `[u, u̇, z]` layout).
-fn exogenous(e: &Ex, n_inputs: usize, tears: &[Sym]) -> Ex {
+fn exogenous(e: &Expr, n_inputs: usize, tears: &[Sym]) -> Expr {
     if !e.any_sym(&|s| matches!(s, Sym::InputDot(_) | Sym::Tear(_))) {
         return e.clone();
     }
-    sym::subst(e, &mut |s| match s {
-        Sym::InputDot(j) => Some(Ex::S(Sym::Input(n_inputs + j))),
+    symbols::subst(e, &mut |s| match s {
+        Sym::InputDot(j) => Some(symbols::leaf(Sym::Input(n_inputs + j))),
         Sym::Tear(_) => tears
             .iter()
             .position(|&z| z == s)
-            .map(|k| Ex::S(Sym::Input(2 * n_inputs + k))),
+            .map(|k| symbols::leaf(Sym::Input(2 * n_inputs + k))),
         _ => None,
     })
 }
@@ -489,7 +490,7 @@ fn exogenous(e: &Ex, n_inputs: usize, tears: &[Sym]) -> Ex {
 fn compile_loops(
     eqs: &Equations,
     offset: usize,
-    compile: &dyn Fn(&Ex, &str) -> Result<Program, SimError>,
+    compile: &dyn Fn(&Expr, &str) -> Result<Program, SimError>,
 ) -> Result<Loops, SimError> {
     let mut loops = Loops::default();
     let mut k = offset;
@@ -501,12 +502,12 @@ fn compile_loops(
             reason: "its residuals use a function without a derivative (min or max), which Newton's method needs"
                 .into(),
         })?;
-        let all = |es: &[Ex]| {
+        let all = |es: &[Expr]| {
             es.iter()
                 .map(|e| compile(e, &what))
                 .collect::<Result<Vec<_>, _>>()
         };
-        let scales: Vec<Ex> = block
+        let scales: Vec<Expr> = block
             .residuals
             .iter()
             .zip(&block.tears)
@@ -526,14 +527,14 @@ fn compile_loops(
 
 /// The nonzero entries of `∂rate/∂x` over the model states (the quadrature states enter no rate).
 fn symbolic_jacobian(
-    rates: &[(Ex, String)],
+    rates: &[(Expr, String)],
     n: usize,
-    compile: &dyn Fn(&Ex, &str) -> Result<Program, SimError>,
+    compile: &dyn Fn(&Expr, &str) -> Result<Program, SimError>,
 ) -> Option<Vec<(usize, usize, Program)>> {
     let mut entries = Vec::new();
     for (r, (e, what)) in rates.iter().enumerate() {
         for c in 0..n {
-            let d = sym::diff(e, Sym::State(c)).ok()?;
+            let d = symbols::diff(e, Sym::State(c)).ok()?;
             if !d.is_zero() {
                 entries.push((r, c, compile(&d, what).ok()?));
             }

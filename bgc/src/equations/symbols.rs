@@ -16,29 +16,30 @@ use crate::symbolic::{Expr, Node, Symbol, SymbolKind};
 use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 
-/// A leaf of the stage's expressions.
+/// A leaf of the stage's expressions. The variants are declared in the order of their [`SymbolKind`]s, so that
+/// `Sym`'s order is that of its symbols.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Sym {
     /// A model parameter.
     Param(usize),
     /// A model input.
     Input(usize),
-    /// The time derivative of an input. Kept only in the power of an element next to a storage in derivative
-    /// causality (energy terms); a rate or output that keeps one is refused.
-    InputDot(usize),
-    /// A state (index into the equations' state list).
-    State(usize),
-    /// The time derivative of a state (an unknown while derivative causality is resolved).
-    StateDot(usize),
-    /// An intermediate bond variable (index into the equations' variable table).
-    Var(usize),
-    /// A tear variable of an algebraic loop (the variable index it stands for).
-    Tear(usize),
     /// Time.
     Time,
+    /// A state (index into the equations' state list).
+    State(usize),
+    /// An intermediate bond variable (index into the equations' variable table).
+    Var(usize),
     /// The value of an earlier output (index into the equations' outputs): an output defined through earlier
     /// outputs refers to them instead of copying their expressions, and consumers evaluate outputs in order.
     Output(usize),
+    /// A tear variable of an algebraic loop (the variable index it stands for).
+    Tear(usize),
+    /// The time derivative of a state (an unknown while derivative causality is resolved).
+    StateDot(usize),
+    /// The time derivative of an input. Kept only in the power of an element next to a storage in derivative
+    /// causality (energy terms); a rate or output that keeps one is refused.
+    InputDot(usize),
 }
 
 impl Sym {
@@ -84,6 +85,10 @@ impl Sym {
     }
 }
 
+/// Expressions of at most this many nodes as trees are walked as trees (their depth is at most this), larger ones
+/// over their distinct nodes.
+const SMALL: usize = 64;
+
 /// Reading the stage's symbols out of an expression.
 pub trait SymExt {
     /// The stage's symbol if this is a bare one.
@@ -110,6 +115,22 @@ impl SymExt for Expr {
     }
 
     fn syms(&self) -> Vec<Sym> {
+        if self.node_count() <= SMALL {
+            // A small tree: walked as a tree, without the bookkeeping of a walk of distinct nodes.
+            let mut out = Vec::new();
+            let mut stack = vec![self];
+            while let Some(e) = stack.pop() {
+                match e.node() {
+                    Node::Const(_) => {}
+                    Node::Sym(s) => out.extend(Sym::of(s)),
+                    Node::Add(xs) | Node::Mul(xs) | Node::Call(_, xs) => stack.extend(xs),
+                    Node::Pow(b, x) => stack.extend([b, x]),
+                }
+            }
+            out.sort_unstable();
+            out.dedup();
+            return out;
+        }
         self.free_symbols().iter().filter_map(Sym::of).collect()
     }
 
@@ -122,6 +143,9 @@ impl SymExt for Expr {
     }
 
     fn contains(&self, s: Sym) -> bool {
+        if self.node_count() <= SMALL {
+            return self.syms().contains(&s);
+        }
         self.depends_on(&s.symbol())
     }
 }
@@ -213,8 +237,34 @@ pub fn call(f: Func, args: Vec<Expr>) -> Expr {
 /// Replaces symbols: `f(s)` gives the replacement or `None` to keep `s`. Each distinct symbol is asked once and
 /// each distinct node rebuilt once.
 pub fn subst(e: &Expr, f: &mut dyn FnMut(Sym) -> Option<Expr>) -> Expr {
+    if e.node_count() <= SMALL {
+        return subst_small(e, f);
+    }
     let f = RefCell::new(f);
     e.substitute_with(&|s: &Symbol| Sym::of(s).and_then(|t| (f.borrow_mut())(t)))
+}
+
+/// [`subst`] of a small tree (depth at most [`SMALL`]), rebuilding only what changes.
+fn subst_small(e: &Expr, f: &mut dyn FnMut(Sym) -> Option<Expr>) -> Expr {
+    let all = |xs: &[Expr], f: &mut dyn FnMut(Sym) -> Option<Expr>| -> Option<Vec<Expr>> {
+        let ys: Vec<Expr> = xs.iter().map(|x| subst_small(x, f)).collect();
+        (ys.as_slice() != xs).then_some(ys)
+    };
+    match e.node() {
+        Node::Const(_) => e.clone(),
+        Node::Sym(s) => Sym::of(s).and_then(&mut *f).unwrap_or_else(|| e.clone()),
+        Node::Add(xs) => all(xs, f).map_or_else(|| e.clone(), Expr::sum),
+        Node::Mul(xs) => all(xs, f).map_or_else(|| e.clone(), Expr::product),
+        Node::Pow(b, x) => {
+            let (b2, x2) = (subst_small(b, f), subst_small(x, f));
+            if b2 == *b && x2 == *x {
+                e.clone()
+            } else {
+                b2.pow(&x2)
+            }
+        }
+        Node::Call(func, xs) => all(xs, f).map_or_else(|| e.clone(), |ys| call(*func, ys)),
+    }
 }
 
 /// Why an expression could not be differentiated.
@@ -308,6 +358,25 @@ pub fn expand(e: &Expr) -> Expr {
     Expander::default().expand(e)
 }
 
+/// True when a product with a sum among its factors is reachable through sums and products (what [`expand`]
+/// multiplies out). A walk of the tree: for small expressions only.
+fn has_product_of_sum(e: &Expr) -> bool {
+    let mut stack = vec![e];
+    while let Some(n) = stack.pop() {
+        match n.node() {
+            Node::Add(ts) => stack.extend(ts),
+            Node::Mul(fs) => {
+                if fs.iter().any(|f| matches!(f.node(), Node::Add(_))) {
+                    return true;
+                }
+                stack.extend(fs);
+            }
+            _ => {}
+        }
+    }
+    false
+}
+
 /// Products whose expansion would have more terms than this are left as they are.
 const MAX_TERMS: usize = 64;
 
@@ -324,6 +393,10 @@ pub struct Expander {
 
 impl Expander {
     pub fn expand(&mut self, e: &Expr) -> Expr {
+        if e.node_count() <= SMALL && !has_product_of_sum(e) {
+            // Nothing to multiply out (most values): no need to remember anything.
+            return e.clone();
+        }
         if self.memo.len() > MEMO_MAX {
             self.memo.clear();
         }

@@ -168,9 +168,9 @@ fn stored_energy_is_the_kinetic_energy_of_the_chain() {
         let q = Vector3::from_fn(|_, _| 1.5 * rng.normal());
         let qd = Vector3::from_fn(|_, _| 4.0 * rng.normal());
         let x: Vec<f64> = q.iter().chain(qd.iter()).copied().collect();
-        let v = bgc::equations::sym::eval(&term, &|s| match s {
-            bgc::equations::sym::Sym::Param(i) => p.get(i).copied(),
-            bgc::equations::sym::Sym::State(i) => x.get(i).copied(),
+        let v = bgc::equations::symbols::eval(&term, &|s| match s {
+            bgc::equations::symbols::Sym::Param(i) => p.get(i).copied(),
+            bgc::equations::symbols::Sym::State(i) => x.get(i).copied(),
             _ => None,
         })
         .unwrap_or_else(|e| panic!("{e:?}"));

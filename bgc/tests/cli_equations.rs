@@ -313,8 +313,8 @@ fn declared_coordinates_symbolically_and_their_errors() {
     assert_eq!(a.as_array().map(Vec::len), Some(7));
     assert_eq!(a[0], serde_json::json!(["0", "1", "0", "0", "0", "0", "0"]));
     // d(f_rotor)/dt: the gearbox spring acts through k_g/r_g on the merged inertia J_m + J_g.
-    assert_eq!(a[1][0], "-k_g/((J_m + J_g)*r_g^2)");
-    assert_eq!(a[1][2], "k_g/((J_m + J_g)*r_g)");
+    assert_eq!(a[1][0], "-k_g/(r_g^2*(J_m + J_g))");
+    assert_eq!(a[1][2], "k_g/(r_g*(J_m + J_g))");
     let (code, _, err) = bgc(&[
         "statespace",
         &corpus("oscillator.bg"),

@@ -217,7 +217,7 @@ fn symbolic_matrices_in_declared_coordinates() {
         assert_close("D", &num.d, &d, 1e-9);
     }
     let text = |e| bgc::equations::expr_text(&eqs, e);
-    assert_eq!(text(&ss.dfdx[1][0]), "-k_g/((J_m + J_g)*r_g^2)");
+    assert_eq!(text(&ss.dfdx[1][0]), "-k_g/(r_g^2*(J_m + J_g))");
     assert_eq!(text(&ss.dfdu[1][0]), "1/(J_m + J_g)");
     let mut printed = String::new();
     for (name, m) in [

@@ -3,7 +3,7 @@
 use crate::equations_support;
 
 use bgc::causality::analyse;
-use bgc::equations::sym::{self, Sym};
+use bgc::equations::symbols::{self as sym, Sym};
 use bgc::equations::{StateSelection, derive, numeric_state_space, solve_all, to_text};
 use bgc::ir::Relation;
 use bgc::syntax::ast::ElementKind as K;

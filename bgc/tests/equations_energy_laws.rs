@@ -8,7 +8,7 @@
 
 use bgc::causality::analyse;
 use bgc::diagnostic::Diagnostic;
-use bgc::equations::sym::{self, Sym};
+use bgc::equations::symbols::{self as sym, Sym};
 use bgc::equations::{EnergyKind, Equations, derive};
 use bgc::lower::{MemoryLoader, lower};
 use bgc::span::SourceMap;

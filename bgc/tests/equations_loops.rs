@@ -3,7 +3,7 @@
 //! refuses it (symbolic state spaces) and code generation, which solves it in the generated module.
 
 use bgc::causality::analyse;
-use bgc::equations::sym::{self, Sym};
+use bgc::equations::symbols::{self as sym, Sym};
 use bgc::equations::{
     Equations, LinearError, StateSelection, derive, jacobians, linear_state_space, linearise,
     numeric_state_space, solve_all, to_json, to_latex, to_text,
@@ -37,7 +37,7 @@ fn the_diode_loop_is_one_tear_block_in_the_loop_current() {
     let z = block.tears[0];
     assert_eq!(eqs.sym_name(z), "loop_f_diode");
     // The rate of q is the loop current itself.
-    assert_eq!(eqs.f[0].as_ref(), Some(&sym::Ex::S(z)));
+    assert_eq!(eqs.f[0].as_ref(), Some(&z.expr()));
     // r(z) = I_s (exp((u - q/C - R_s z)/V_t) - 1) - z, checked at a point against that formula.
     let (q, u, zv) = (3e-4, 1.2, 2e-3);
     let value = |s: Sym| match s {

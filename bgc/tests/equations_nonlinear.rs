@@ -5,7 +5,7 @@ use crate::equations_support;
 
 use bgc::causality::analyse;
 use bgc::diagnostic::Diagnostic;
-use bgc::equations::sym::{self, Ex, Sym};
+use bgc::equations::symbols::{self as sym, Sym};
 use bgc::equations::{
     CoordsError, EnergyKind, Equations, LinearError, StateSelection, declared_state_space, derive,
     jacobians, linear_state_space, linearise, numeric_state_space, to_json,
@@ -78,10 +78,10 @@ fn hardening_spring_jacobians_and_linearisation() {
         }
     };
     assert_eq!(sym::eval(entry, &at(0.1)), Ok(-(800.0 + 3.0 * 5e4 * 0.01)));
-    // The same rate through the shared expression engine evaluates to the same number.
+    // The same rate named for code generation evaluates to the same number.
     for (i, f) in eqs.f.iter().enumerate() {
         let f = f.as_ref().expect("rate");
-        let shared = bgc::equations::to_symbolic(&eqs, f).expect("convertible");
+        let shared = bgc::codegen::to_symbolic(&eqs, f).expect("convertible");
         let env = |s: &bgc::symbolic::Symbol| match s.name() {
             "m" => Some(2.0),
             "k" => Some(800.0),
@@ -92,7 +92,8 @@ fn hardening_spring_jacobians_and_linearisation() {
             "p_mass" => Some(0.4),
             _ => None,
         };
-        let ours = sym::eval(f, &|s| env(&bgc::equations::symbol(&eqs, s))).expect("eval");
+        let ours =
+            sym::eval(f, &|s| env(&bgc::symbolic::Symbol::param(eqs.sym_name(s)))).expect("eval");
         let theirs = shared.eval(env).expect("eval");
         assert!(
             (ours - theirs).abs() <= 1e-12 * ours.abs().max(1.0),
@@ -258,7 +259,7 @@ model coulomb {
     };
     let slip = sym::eval(eqs.outputs[0].explicit.as_ref().expect("output"), &value).expect("eval");
     assert!((slip - (1.5 - 0.2) / 0.1).abs() < 1e-12, "{slip}");
-    assert_eq!(eqs.f[0], Some(Ex::S(Sym::Input(0))));
+    assert_eq!(eqs.f[0], Some(Sym::Input(0).expr()));
 }
 
 #[test]

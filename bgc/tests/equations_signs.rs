@@ -13,7 +13,7 @@
 use crate::equations_support;
 
 use bgc::causality::analyse;
-use bgc::equations::sym::{self, Sym};
+use bgc::equations::symbols::{self as sym, Sym};
 use bgc::equations::{EnergyKind, Equations, derive};
 use bgc::ir::Model;
 use bgc::syntax::ast::ElementKind as K;

@@ -8,8 +8,9 @@ use super::quantities::{self, Declared};
 use super::sparse;
 use super::{Coords, EquationsFormat, ReportFormat, Status};
 use bgc::diagnostic::{has_errors, render};
-use bgc::equations::sym::{self, Ex, Sym};
+use bgc::equations::symbols::{self, Sym};
 use bgc::equations::{self, CoordsError, Equations, Jacobians, LinearError, NumericStateSpace};
+use bgc::symbolic::Expr;
 use serde_json::{Value, json};
 use std::path::Path;
 
@@ -314,15 +315,15 @@ fn operating_point(
 
 /// The Jacobians with the operating point put in for the states, inputs and time.
 fn at_point(j: &Jacobians, x0: &[f64], u0: &[f64]) -> Jacobians {
-    let put = |m: &[Vec<Ex>]| -> Vec<Vec<Ex>> {
+    let put = |m: &[Vec<Expr>]| -> Vec<Vec<Expr>> {
         m.iter()
             .map(|row| {
                 row.iter()
                     .map(|e| {
-                        sym::subst(e, &mut |s| match s {
-                            Sym::State(i) => x0.get(i).map(|v| Ex::Num(*v)),
-                            Sym::Input(i) => u0.get(i).map(|v| Ex::Num(*v)),
-                            Sym::Time => Some(Ex::zero()),
+                        symbols::subst(e, &mut |s| match s {
+                            Sym::State(i) => x0.get(i).map(|v| symbols::num(*v)),
+                            Sym::Input(i) => u0.get(i).map(|v| symbols::num(*v)),
+                            Sym::Time => Some(Expr::zero()),
                             _ => None,
                         })
                     })
@@ -359,16 +360,16 @@ fn fixed_params(eqs: &Equations, given: &[Assignment], values: &[f64]) -> Vec<Op
 /// `e` in the free parameters: those given with `--param` as numbers, and each derived parameter replaced by its
 /// expression, so that an instance parameter set by an override (`dc_motor mot(R_a = R)`) reads as the user's `R`,
 /// not as `mot.R_a`.
-fn in_free_params(eqs: &Equations, e: &Ex, fixed: &[Option<f64>]) -> Ex {
+fn in_free_params(eqs: &Equations, e: &Expr, fixed: &[Option<f64>]) -> Expr {
     // Derived parameters refer only to earlier ones, so the substitution ends; the bound guards a malformed table.
     let mut e = e.clone();
     for _ in 0..=eqs.params.len() {
         let mut changed = false;
-        e = sym::subst(&e, &mut |s| match s {
+        e = symbols::subst(&e, &mut |s| match s {
             Sym::Param(i) => match (fixed.get(i).copied().flatten(), eqs.derived.get(i)) {
                 (Some(v), _) => {
                     changed = true;
-                    Some(Ex::Num(v))
+                    Some(symbols::num(v))
                 }
                 (None, Some(Some(d))) => {
                     changed = true;
@@ -386,7 +387,7 @@ fn in_free_params(eqs: &Equations, e: &Ex, fixed: &[Option<f64>]) -> Ex {
 }
 
 fn symbolic_json(eqs: &Equations, j: &Jacobians, fixed: &[Option<f64>]) -> Value {
-    let render = |m: &[Vec<Ex>]| -> Vec<Vec<String>> {
+    let render = |m: &[Vec<Expr>]| -> Vec<Vec<String>> {
         m.iter()
             .map(|row| {
                 row.iter()

@@ -1,15 +1,15 @@
-//! The one place where the equations stage's expressions ([`Ex`]) become the symbolic engine's ([`Expr`]).
+//! The one place where the equations' symbols get the names code generation prints.
 //!
-//! The equations stage still carries its own expression type; code generation prints through
-//! [`crate::symbolic::to_rust`], so every expression crosses over here. The conversion is structural (sums,
-//! products, powers and calls rebuilt with the engine's simplifying constructors), so the value is unchanged up to
-//! the engine's canonical reordering. Leaves become named [`Symbol`]s: parameters, inputs, states, intermediates
-//! (bond variables of the readable form), the tear variables of nonlinear algebraic loops (intermediates named
-//! `loop_<variable>`, which the generated functions bind from the loops' solution, see [`super::loops`]) and time.
-//! Derivatives of inputs or states have no meaning in generated code and are refused. When the two expression types are unified this module goes away.
+//! The equations stage builds its expressions in the shared engine with numbered symbols
+//! ([`crate::equations::symbols`]); code generation prints through [`crate::symbolic::to_rust`], which prints a
+//! symbol's name, so every expression is renamed here (one memoised substitution, linear in its distinct nodes).
+//! Leaves become named [`Symbol`]s: parameters, inputs, states, intermediates (bond variables of the readable form),
+//! the tear variables of nonlinear algebraic loops (intermediates named `loop_<variable>`, which the generated
+//! functions bind from the loops' solution, see [`super::loops`]) and time. Derivatives of inputs or states have no
+//! meaning in generated code and are refused.
 
 use crate::equations::Equations;
-use crate::equations::sym::{Ex, Sym};
+use crate::equations::symbols::{Sym, SymExt};
 use crate::symbolic::{Expr, Symbol, SymbolKind};
 
 /// An expression that cannot be generated.
@@ -17,8 +17,6 @@ use crate::symbolic::{Expr, Symbol, SymbolKind};
 pub enum AdaptError {
     #[error("`{symbol}` (a derivative) has no value in generated code")]
     Unsupported { symbol: String },
-    #[error("`{func}` is called with the wrong number of arguments")]
-    Arity { func: &'static str },
 }
 
 /// The symbol a leaf of the equations stands for, named as the equations name it.
@@ -39,7 +37,7 @@ pub fn symbol(eqs: &Equations, s: Sym) -> Result<Symbol, AdaptError> {
 }
 
 /// `e` as a symbolic-engine expression.
-pub fn to_symbolic(eqs: &Equations, e: &Ex) -> Result<Expr, AdaptError> {
+pub fn to_symbolic(eqs: &Equations, e: &Expr) -> Result<Expr, AdaptError> {
     convert(eqs, e, &[])
 }
 
@@ -69,33 +67,68 @@ fn s_output(outputs: &[Option<Expr>], s: Sym) -> Option<&Expr> {
     }
 }
 
-/// `e` with the earlier outputs `outputs[j]` in place of [`Sym::Output`]`(j)` where they are given.
-fn convert(eqs: &Equations, e: &Ex, outputs: &[Option<Expr>]) -> Result<Expr, AdaptError> {
-    Ok(match e {
-        // The zeros of dense matrices skip the interning table.
-        Ex::Num(v) if *v == 0.0 => Expr::zero(),
-        Ex::Num(v) => Expr::constant(*v),
-        Ex::S(s) => match s_output(outputs, *s) {
-            Some(shared) => shared.clone(),
-            None => Expr::symbol(symbol(eqs, *s)?),
-        },
-        Ex::Add(ts) => Expr::sum(
-            ts.iter()
-                .map(|t| convert(eqs, t, outputs))
-                .collect::<Result<Vec<_>, _>>()?,
-        ),
-        Ex::Mul(fs) => Expr::product(
-            fs.iter()
-                .map(|f| convert(eqs, f, outputs))
-                .collect::<Result<Vec<_>, _>>()?,
-        ),
-        Ex::Pow(b, x) => convert(eqs, b, outputs)?.pow(&convert(eqs, x, outputs)?),
-        Ex::Call(f, args) => {
-            let args = args
-                .iter()
-                .map(|a| convert(eqs, a, outputs))
-                .collect::<Result<Vec<_>, _>>()?;
-            Expr::call(*f, &args).ok_or(AdaptError::Arity { func: f.name() })?
+/// `e` with the earlier outputs `outputs[j]` in place of [`Sym::Output`]`(j)` where they are given, and every other
+/// symbol of the equations by its named symbol: one substitution, each distinct node rebuilt once.
+fn convert(eqs: &Equations, e: &Expr, outputs: &[Option<Expr>]) -> Result<Expr, AdaptError> {
+    // The first refused symbol; the substitution keeps it and the error is returned after.
+    let refused = std::cell::RefCell::new(None);
+    let out = e.substitute_with(&|s: &Symbol| {
+        let stage = Sym::of(s)?;
+        if let Some(shared) = s_output(outputs, stage) {
+            return Some(shared.clone());
         }
+        match symbol(eqs, stage) {
+            Ok(named) => Some(Expr::symbol(named)),
+            Err(err) => {
+                refused.borrow_mut().get_or_insert(err);
+                None
+            }
+        }
+    });
+    match refused.into_inner() {
+        Some(err) => Err(err),
+        None => Ok(out),
+    }
+}
+
+/// A matrix of the equations' expressions with every entry named ([`to_symbolic`]).
+pub fn named_matrix(
+    eqs: &Equations,
+    m: crate::equations::SparseMatrix,
+) -> Result<crate::equations::SparseMatrix, AdaptError> {
+    let entries = m
+        .entries
+        .into_iter()
+        .map(|row| {
+            row.into_iter()
+                .map(|(j, e)| Ok((j, to_symbolic(eqs, &e)?)))
+                .collect::<Result<Vec<_>, AdaptError>>()
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(crate::equations::SparseMatrix { entries, ..m })
+}
+
+/// The parameter chain with its symbols and links named as the generated code names them.
+pub fn named_chain(
+    eqs: &Equations,
+    chain: crate::equations::ParamChain,
+) -> Result<crate::equations::ParamChain, AdaptError> {
+    let symbols = chain
+        .symbols
+        .iter()
+        .map(|s| match Sym::of(s) {
+            Some(t) => symbol(eqs, t),
+            None => Ok(s.clone()),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let links = chain
+        .links
+        .iter()
+        .map(|row| row.iter().map(|e| to_symbolic(eqs, e)).collect())
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(crate::equations::ParamChain {
+        symbols,
+        links,
+        ..chain
     })
 }

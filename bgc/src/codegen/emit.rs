@@ -11,9 +11,8 @@
 //! stage always provides for a complete model, and also when it would need more than [`MAX_LETS`] intermediates. Both are the same function; the tests check the generated code
 //! against the stage's own evaluation of `f`.
 
-use super::adapter::{AdaptError, explicit_outputs, to_symbolic};
+use super::adapter::{AdaptError, explicit_outputs, named_chain, named_matrix, to_symbolic};
 use super::shared::{Lets, share};
-use crate::equations::sym::Ex;
 use crate::equations::{
     EnergyKind, Equations, ModelRows, ParamChain, SparseMatrix, StateSelection,
     declared_state_space_symbolic, sparse_linear_state_space, state_selection,
@@ -76,11 +75,11 @@ pub(crate) struct Plan {
     pub mass: Vec<super::mass::MassPlan>,
 }
 
-fn convert_all(eqs: &Equations, es: &[Ex]) -> Result<Vec<Expr>, AdaptError> {
+fn convert_all(eqs: &Equations, es: &[Expr]) -> Result<Vec<Expr>, AdaptError> {
     es.iter().map(|e| to_symbolic(eqs, e)).collect()
 }
 
-fn convert_matrix(eqs: &Equations, m: &[Vec<Ex>]) -> Result<Vec<Vec<Expr>>, AdaptError> {
+fn convert_matrix(eqs: &Equations, m: &[Vec<Expr>]) -> Result<Vec<Vec<Expr>>, AdaptError> {
     m.iter().map(|row| convert_all(eqs, row)).collect()
 }
 
@@ -111,19 +110,22 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
         .map(|i| Symbol::input(i.as_str()))
         .collect();
     let rhs = block(eqs, &eqs.rates, &f);
-    let readable_outputs: Vec<Ex> = eqs.outputs.iter().map(|o| o.value.clone()).collect();
+    let readable_outputs: Vec<Expr> = eqs.outputs.iter().map(|o| o.value.clone()).collect();
     let outputs = block(eqs, &readable_outputs, &h);
     let rows = ModelRows::new(eqs);
     let linear_selection = state_selection(eqs, &rows);
     let linear_ss = sparse_linear_state_space(eqs, &rows, linear_selection)
-        .map(|j| StateSpace {
-            states: j.states,
-            a: j.dfdx,
-            b: j.dfdu,
-            c: j.dhdx,
-            d: j.dhdu,
-        })
-        .map_err(|e| e.to_string());
+        .map_err(|e| e.to_string())
+        .and_then(|j| {
+            let named = |m| named_matrix(eqs, m).map_err(|e| e.to_string());
+            Ok(StateSpace {
+                states: j.states,
+                a: named(j.dfdx)?,
+                b: named(j.dfdu)?,
+                c: named(j.dhdx)?,
+                d: named(j.dhdu)?,
+            })
+        });
     let declared_ss = eqs.coords.as_ref().map(|_| {
         declared_state_space_symbolic(eqs)
             .map_err(|e| e.to_string())
@@ -159,6 +161,7 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
         .filter(|&k| eqs.derived.get(k).is_none_or(Option::is_none))
         .collect();
     let chain = ParamChain::new(eqs, &free, &[]).map_err(|e| e.to_string())?;
+    let chain = named_chain(eqs, chain).map_err(|e| e.to_string())?;
     let mass = super::mass::plan(eqs, &states, &chain)?;
     let loops = super::loops::plan(eqs, &f, &h, (&states, &inputs), &chain)?;
     if let Some(l) = &loops {
@@ -225,12 +228,12 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
 fn state_space(
     eqs: &Equations,
     states: Vec<String>,
-    a: &[Vec<Ex>],
-    b: &[Vec<Ex>],
-    c: &[Vec<Ex>],
-    d: &[Vec<Ex>],
+    a: &[Vec<Expr>],
+    b: &[Vec<Expr>],
+    c: &[Vec<Expr>],
+    d: &[Vec<Expr>],
 ) -> Result<StateSpace, String> {
-    let m = |x: &[Vec<Ex>], cols: usize| {
+    let m = |x: &[Vec<Expr>], cols: usize| {
         convert_matrix(eqs, x)
             .map(|dense| SparseMatrix::from_dense(&dense, cols))
             .map_err(|e| e.to_string())
@@ -260,7 +263,7 @@ pub(crate) const MAX_LETS: usize = 256;
 
 /// The readable block for `roots` (in intermediates), or the explicit expressions when the readable form cannot be
 /// computed in order.
-fn block(eqs: &Equations, roots: &[Ex], explicit: &[Expr]) -> Block {
+fn block(eqs: &Equations, roots: &[Expr], explicit: &[Expr]) -> Block {
     readable_block(eqs, roots)
         .filter(|b| b.lets.len() <= MAX_LETS)
         .unwrap_or_else(|| Block {
@@ -275,7 +278,7 @@ fn intermediates_of(e: &Expr) -> impl Iterator<Item = Symbol> {
         .filter(|s| s.kind() == SymbolKind::Intermediate)
 }
 
-fn readable_block(eqs: &Equations, roots: &[Ex]) -> Option<Block> {
+fn readable_block(eqs: &Equations, roots: &[Expr]) -> Option<Block> {
     let results = convert_all(eqs, roots).ok()?;
     let position: HashMap<&str, usize> = eqs
         .intermediates

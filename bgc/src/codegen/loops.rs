@@ -64,7 +64,7 @@ pub(crate) fn plan(
     if eqs.tear_blocks.is_empty() {
         return Ok(None);
     }
-    let convert = |e: &crate::equations::sym::Ex| to_symbolic(eqs, e).map_err(|e| e.to_string());
+    let convert = |e: &Expr| to_symbolic(eqs, e).map_err(|e| e.to_string());
     let mut tears = Vec::new();
     let mut blocks = Vec::new();
     let mut residuals = Vec::new();

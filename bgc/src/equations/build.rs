@@ -27,11 +27,12 @@
 //!
 //! A nonlinear law is inverted only when it is affine in the unknown (`BG0601` otherwise).
 
-use super::sym::{self, Ex, Sym, add, div, mul, neg};
+use super::symbols::{self, Sym, add, div, mul, neg};
 use super::{StateKind, StateSpec, codes};
 use crate::causality::{Causality, StorageForm};
 use crate::diagnostic::Diagnostic;
-use crate::ir::{Expr, Law, Model, PortVar, Relation, Target};
+use crate::ir::{Expr as IrExpr, Law, Model, PortVar, Relation, Target};
+use crate::symbolic::Expr;
 use crate::syntax::ast::{BinOp, ElementKind};
 use petgraph::Direction;
 use petgraph::graph::{EdgeIndex, NodeIndex};
@@ -41,9 +42,9 @@ use std::collections::HashMap;
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) enum Def {
     /// `v = expr`.
-    Plain(Ex),
+    Plain(Expr),
     /// `v = d/dt(expr)`: the output of a storage in derivative causality.
-    Rate(Ex),
+    Rate(Expr),
 }
 
 /// Index of the effort variable of a bond.
@@ -71,7 +72,7 @@ pub(crate) struct Built {
     pub states: Vec<StateSpec>,
     /// Per state: its rate in terms of bond variables (`ṗ = e`, `q̇ = s·f`, `θ̇ = integrand`); for the flow states
     /// of an I-field, the generalised force of its mass-matrix row.
-    pub rates: Vec<Ex>,
+    pub rates: Vec<Expr>,
     /// The inertia matrices of the I-fields.
     pub mass: Vec<super::field::MassBlock>,
     /// Per state: true when its rate equation is the implicit `0 = rates[i]` (the effort balance of a velocity
@@ -88,7 +89,7 @@ pub(crate) struct Ctx<'a> {
     /// Per node: the state of its energy variable when in integral causality.
     pub node_state: Vec<Option<usize>>,
     /// Per node: the energy variable of a storage in derivative causality, in bond variables.
-    pub energy_expr: Vec<Option<Ex>>,
+    pub energy_expr: Vec<Option<Expr>>,
     /// Per `var`: its state.
     pub var_state: Vec<usize>,
     /// Per multiport field with states: the displacement state of each port.
@@ -119,12 +120,12 @@ impl Ctx<'_> {
     }
 
     /// The effort variable of a target.
-    fn effort_of(&self, t: Target) -> Result<Ex, ConvertError> {
+    fn effort_of(&self, t: Target) -> Result<Expr, ConvertError> {
         match t {
-            Target::Bond(b) => Ok(Ex::S(Sym::Var(effort_var(b)))),
+            Target::Bond(b) => Ok(symbols::leaf(Sym::Var(effort_var(b)))),
             Target::Node(n) => {
                 if let Some((b, _)) = self.port.get(n.index()).copied().flatten() {
-                    return Ok(Ex::S(Sym::Var(effort_var(b))));
+                    return Ok(symbols::leaf(Sym::Var(effort_var(b))));
                 }
                 let kind = self.model.graph.node_weight(n).map(|w| w.kind);
                 match kind {
@@ -134,7 +135,9 @@ impl Ctx<'_> {
                         .edges_directed(n, Direction::Incoming)
                         .chain(self.model.graph.edges_directed(n, Direction::Outgoing))
                         .next()
-                        .map(|e| Ex::S(Sym::Var(effort_var(petgraph::visit::EdgeRef::id(&e)))))
+                        .map(|e| {
+                            symbols::leaf(Sym::Var(effort_var(petgraph::visit::EdgeRef::id(&e))))
+                        })
                         .ok_or_else(|| {
                             ConvertError::Unsupported(format!(
                                 "e({}) of a junction without bonds",
@@ -151,12 +154,15 @@ impl Ctx<'_> {
     }
 
     /// The flow variable of a target (a 1-port element's flow into it).
-    fn flow_of(&self, t: Target) -> Result<Ex, ConvertError> {
+    fn flow_of(&self, t: Target) -> Result<Expr, ConvertError> {
         match t {
-            Target::Bond(b) => Ok(Ex::S(Sym::Var(flow_var(b)))),
+            Target::Bond(b) => Ok(symbols::leaf(Sym::Var(flow_var(b)))),
             Target::Node(n) => {
                 if let Some((b, s)) = self.port.get(n.index()).copied().flatten() {
-                    return Ok(mul(vec![Ex::Num(s), Ex::S(Sym::Var(flow_var(b)))]));
+                    return Ok(mul(vec![
+                        symbols::num(s),
+                        symbols::leaf(Sym::Var(flow_var(b))),
+                    ]));
                 }
                 let kind = self.model.graph.node_weight(n).map(|w| w.kind);
                 match kind {
@@ -166,7 +172,9 @@ impl Ctx<'_> {
                         .edges_directed(n, Direction::Incoming)
                         .chain(self.model.graph.edges_directed(n, Direction::Outgoing))
                         .next()
-                        .map(|e| Ex::S(Sym::Var(flow_var(petgraph::visit::EdgeRef::id(&e)))))
+                        .map(|e| {
+                            symbols::leaf(Sym::Var(flow_var(petgraph::visit::EdgeRef::id(&e))))
+                        })
                         .ok_or_else(|| {
                             ConvertError::Unsupported(format!(
                                 "f({}) of a junction without bonds",
@@ -182,9 +190,9 @@ impl Ctx<'_> {
         }
     }
 
-    fn energy_of(&self, n: NodeIndex, what: &str) -> Result<Ex, ConvertError> {
+    fn energy_of(&self, n: NodeIndex, what: &str) -> Result<Expr, ConvertError> {
         if let Some(s) = self.node_state.get(n.index()).copied().flatten() {
-            return Ok(Ex::S(Sym::State(s)));
+            return Ok(symbols::leaf(Sym::State(s)));
         }
         if let Some(e) = self.energy_expr.get(n.index()).cloned().flatten() {
             return Ok(e);
@@ -196,7 +204,7 @@ impl Ctx<'_> {
     }
 
     /// A port variable of a multiport field: its displacement or (I-field) flow state, or its bond's variable.
-    fn field_port(&self, node: NodeIndex, var: PortVar, port: u32) -> Result<Ex, ConvertError> {
+    fn field_port(&self, node: NodeIndex, var: PortVar, port: u32) -> Result<Expr, ConvertError> {
         let k = port as usize;
         let state =
             |m: &HashMap<NodeIndex, Vec<usize>>| m.get(&node).and_then(|v| v.get(k)).copied();
@@ -216,46 +224,46 @@ impl Ctx<'_> {
         };
         match var {
             PortVar::Displacement => state(&self.field_q)
-                .map(|s| Ex::S(Sym::State(s)))
+                .map(|s| symbols::leaf(Sym::State(s)))
                 .ok_or_else(missing),
             PortVar::Flow => match state(&self.field_f) {
-                Some(s) => Ok(Ex::S(Sym::State(s))),
+                Some(s) => Ok(symbols::leaf(Sym::State(s))),
                 None => bond
-                    .map(|(b, s)| mul(vec![Ex::Num(s), Ex::S(Sym::Var(flow_var(b)))]))
+                    .map(|(b, s)| mul(vec![symbols::num(s), symbols::leaf(Sym::Var(flow_var(b)))]))
                     .ok_or_else(missing),
             },
             PortVar::Effort => bond
-                .map(|(b, _)| Ex::S(Sym::Var(effort_var(b))))
+                .map(|(b, _)| symbols::leaf(Sym::Var(effort_var(b))))
                 .ok_or_else(missing),
             PortVar::Momentum => Err(missing()),
         }
     }
 
     /// Converts an IR expression; `outputs_seen` guards against outputs defined through each other.
-    pub fn convert(&self, e: &Expr) -> Result<Ex, ConvertError> {
+    pub fn convert(&self, e: &IrExpr) -> Result<Expr, ConvertError> {
         self.convert_guarded(e, &mut Vec::new(), 0)
     }
 
     /// Converts the value of output `k`: earlier outputs stay references ([`Sym::Output`]), evaluated once before
     /// it, so that a chain of outputs defined through each other is shared, not copied into every use.
-    pub fn convert_output(&self, e: &Expr, k: usize) -> Result<Ex, ConvertError> {
+    pub fn convert_output(&self, e: &IrExpr, k: usize) -> Result<Expr, ConvertError> {
         self.convert_guarded(e, &mut vec![k], k)
     }
 
     /// `shared_below`: outputs with a smaller index are kept as references.
     fn convert_guarded(
         &self,
-        e: &Expr,
+        e: &IrExpr,
         outputs_seen: &mut Vec<usize>,
         shared_below: usize,
-    ) -> Result<Ex, ConvertError> {
+    ) -> Result<Expr, ConvertError> {
         Ok(match e {
-            Expr::Const(v) => Ex::Num(*v),
-            Expr::Time => Ex::S(Sym::Time),
-            Expr::Param(p) => Ex::S(Sym::Param(*p)),
-            Expr::Input(i) => Ex::S(Sym::Input(*i)),
-            Expr::Output(o) if *o < shared_below => Ex::S(Sym::Output(*o)),
-            Expr::Output(o) => {
+            IrExpr::Const(v) => symbols::num(*v),
+            IrExpr::Time => symbols::leaf(Sym::Time),
+            IrExpr::Param(p) => symbols::leaf(Sym::Param(*p)),
+            IrExpr::Input(i) => symbols::leaf(Sym::Input(*i)),
+            IrExpr::Output(o) if *o < shared_below => symbols::leaf(Sym::Output(*o)),
+            IrExpr::Output(o) => {
                 if outputs_seen.contains(o) {
                     return Err(ConvertError::Unsupported(
                         "an output defined through itself".into(),
@@ -271,29 +279,30 @@ impl Ctx<'_> {
                 outputs_seen.pop();
                 v
             }
-            Expr::Var(v) => {
-                Ex::S(Sym::State(*self.var_state.get(*v).ok_or_else(|| {
-                    ConvertError::Unsupported(format!("var #{v}"))
-                })?))
-            }
-            Expr::Effort(t) => self.effort_of(*t)?,
-            Expr::Flow(t) => self.flow_of(*t)?,
-            Expr::Momentum(n) => self.energy_of(*n, "p")?,
-            Expr::Displacement(n) => self.energy_of(*n, "q")?,
-            Expr::FieldPort { node, var, port } => self.field_port(*node, *var, *port)?,
-            Expr::Neg(a) => neg(self.convert_guarded(a, outputs_seen, shared_below)?),
-            Expr::Binary(op, a, b) => {
+            IrExpr::Var(v) => symbols::leaf(Sym::State(
+                *self
+                    .var_state
+                    .get(*v)
+                    .ok_or_else(|| ConvertError::Unsupported(format!("var #{v}")))?,
+            )),
+            IrExpr::Effort(t) => self.effort_of(*t)?,
+            IrExpr::Flow(t) => self.flow_of(*t)?,
+            IrExpr::Momentum(n) => self.energy_of(*n, "p")?,
+            IrExpr::Displacement(n) => self.energy_of(*n, "q")?,
+            IrExpr::FieldPort { node, var, port } => self.field_port(*node, *var, *port)?,
+            IrExpr::Neg(a) => neg(self.convert_guarded(a, outputs_seen, shared_below)?),
+            IrExpr::Binary(op, a, b) => {
                 let a = self.convert_guarded(a, outputs_seen, shared_below)?;
                 let b = self.convert_guarded(b, outputs_seen, shared_below)?;
                 match op {
                     BinOp::Add => add(vec![a, b]),
-                    BinOp::Sub => sym::sub(a, b),
+                    BinOp::Sub => symbols::sub(a, b),
                     BinOp::Mul => mul(vec![a, b]),
                     BinOp::Div => div(a, b),
-                    BinOp::Pow => sym::pow(a, b),
+                    BinOp::Pow => symbols::pow(a, b),
                 }
             }
-            Expr::Call(f, args) => sym::call(
+            IrExpr::Call(f, args) => symbols::call(
                 *f,
                 args.iter()
                     .map(|a| self.convert_guarded(a, outputs_seen, shared_below))
@@ -463,12 +472,12 @@ fn law(laws: &[Law], lhs: PortVar) -> Option<&Law> {
 }
 
 /// Solves `known = g(unknown)` for `unknown` when `g` is affine in it.
-fn invert(known: Ex, g: &Ex, unknown: Sym) -> Option<Ex> {
-    let (a, b) = sym::affine_in(g, unknown)?;
+fn invert(known: Expr, g: &Expr, unknown: Sym) -> Option<Expr> {
+    let (a, b) = symbols::affine_in(g, unknown)?;
     if a.is_zero() {
         return None;
     }
-    Some(div(sym::sub(known, b), a))
+    Some(div(symbols::sub(known, b), a))
 }
 
 /// Writes the definitions of every bond variable. Storages in derivative causality also record their energy
@@ -491,8 +500,11 @@ pub(crate) fn build(
         let Some((b, sign)) = ctx.port.get(s.node.index()).copied().flatten() else {
             continue;
         };
-        let own_e = Ex::S(Sym::Var(effort_var(b)));
-        let own_f = mul(vec![Ex::Num(sign), Ex::S(Sym::Var(flow_var(b)))]);
+        let own_e = symbols::leaf(Sym::Var(effort_var(b)));
+        let own_f = mul(vec![
+            symbols::num(sign),
+            symbols::leaf(Sym::Var(flow_var(b))),
+        ]);
         let energy = match (&w.kind, &w.relation) {
             (ElementKind::I, Relation::Linear(i)) => {
                 ctx.convert(i).map(|i| Some(mul(vec![i, own_f])))
@@ -559,7 +571,7 @@ pub(crate) fn build(
                 .and_then(|n| ctx.port.get(n).copied().flatten());
             if let Some((b, _)) = bond {
                 implicit_rows[i] = true;
-                rates.push(Ex::S(Sym::Var(effort_var(b))));
+                rates.push(symbols::leaf(Sym::Var(effort_var(b))));
                 continue;
             }
         }
@@ -569,13 +581,13 @@ pub(crate) fn build(
                 .get(n.index())
                 .copied()
                 .flatten()
-                .map(|(b, _)| Ex::S(Sym::Var(effort_var(b)))),
+                .map(|(b, _)| symbols::leaf(Sym::Var(effort_var(b)))),
             (StateKind::Displacement, Some(n), _) => ctx
                 .port
                 .get(n.index())
                 .copied()
                 .flatten()
-                .map(|(b, s)| mul(vec![Ex::Num(s), Ex::S(Sym::Var(flow_var(b)))])),
+                .map(|(b, s)| mul(vec![symbols::num(s), symbols::leaf(Sym::Var(flow_var(b)))])),
             (StateKind::Integrated, _, Some(v)) => {
                 match model.vars.get(v).map(|var| ctx.convert(&var.integrand)) {
                     Some(Ok(e)) => Some(e),
@@ -595,7 +607,7 @@ pub(crate) fn build(
             }
             _ => None,
         };
-        rates.push(rate.unwrap_or(Ex::zero()));
+        rates.push(rate.unwrap_or(Expr::zero()));
     }
     let raw_names = names(model);
     let mut mass = Vec::new();
@@ -626,7 +638,7 @@ fn derivative_law(
     node: NodeIndex,
     own_input: Sym,
     sign: f64,
-) -> Result<Option<Ex>, ConvertError> {
+) -> Result<Option<Expr>, ConvertError> {
     if let Some(l) = law(laws, energy) {
         return ctx.convert(&l.rhs).map(Some);
     }
@@ -646,9 +658,9 @@ fn derivative_law(
         field_ports: ctx.field_ports.clone(),
         velocity: ctx.velocity.clone(),
     };
-    c.energy_expr[node.index()] = Some(Ex::S(placeholder));
+    c.energy_expr[node.index()] = Some(symbols::leaf(placeholder));
     let g = c.convert(&l.rhs)?;
-    let known = mul(vec![Ex::Num(sign), Ex::S(own_input)]);
+    let known = mul(vec![symbols::num(sign), symbols::leaf(own_input)]);
     Ok(invert(known, &g, placeholder))
 }
 
@@ -673,7 +685,7 @@ fn node_defs(
             format!("cannot write the equations of `{}`: {what}", w.name),
         )
     };
-    let conv = |e: &Expr| {
+    let conv = |e: &IrExpr| {
         ctx.convert(e)
             .map_err(|ConvertError::Unsupported(what)| unsupported(what))
     };
@@ -689,8 +701,8 @@ fn node_defs(
                 .map(|e| (petgraph::visit::EdgeRef::id(&e), -1.0)),
         )
         .collect();
-    let e = |b: EdgeIndex| Ex::S(Sym::Var(effort_var(b)));
-    let f = |b: EdgeIndex| Ex::S(Sym::Var(flow_var(b)));
+    let e = |b: EdgeIndex| symbols::leaf(Sym::Var(effort_var(b)));
+    let f = |b: EdgeIndex| symbols::leaf(Sym::Var(flow_var(b)));
     let mut out: DefList = Vec::new();
     match w.kind {
         ElementKind::Zero | ElementKind::One => {
@@ -716,8 +728,11 @@ fn node_defs(
             };
             let mut sum = Vec::new();
             for &(b, sb) in incident.iter().filter(|(b, _)| *b != k) {
-                out.push((common(b), Def::Plain(Ex::S(Sym::Var(common(k))))));
-                sum.push(mul(vec![Ex::Num(-sk * sb), Ex::S(Sym::Var(summed(b)))]));
+                out.push((common(b), Def::Plain(symbols::leaf(Sym::Var(common(k))))));
+                sum.push(mul(vec![
+                    symbols::num(-sk * sb),
+                    symbols::leaf(Sym::Var(summed(b))),
+                ]));
             }
             out.push((summed(k), Def::Plain(add(sum))));
         }
@@ -732,7 +747,7 @@ fn node_defs(
             let def = if matches!(w.kind, ElementKind::Se | ElementKind::MSe) {
                 (effort_var(b), conv(v)?)
             } else {
-                (flow_var(b), mul(vec![Ex::Num(s), conv(v)?]))
+                (flow_var(b), mul(vec![symbols::num(s), conv(v)?]))
             };
             out.push((def.0, Def::Plain(def.1)));
         }
@@ -742,7 +757,7 @@ fn node_defs(
             };
             let sets_e = sets(b);
             let own_e = e(b);
-            let own_f = mul(vec![Ex::Num(s), f(b)]);
+            let own_f = mul(vec![symbols::num(s), f(b)]);
             match (w.kind, sets_e) {
                 (ElementKind::C, true) => {
                     let q = ctx
@@ -773,7 +788,7 @@ fn node_defs(
                         .cloned()
                         .flatten()
                         .ok_or_else(|| unsupported("no energy variable".into()))?;
-                    out.push((flow_var(b), Def::Rate(mul(vec![Ex::Num(s), q]))));
+                    out.push((flow_var(b), Def::Rate(mul(vec![symbols::num(s), q]))));
                 }
                 (ElementKind::I, false) => {
                     let p = ctx
@@ -781,7 +796,7 @@ fn node_defs(
                         .map_err(|ConvertError::Unsupported(what)| unsupported(what))?;
                     if ctx.velocity.get(node.index()).copied().unwrap_or(false) {
                         // A velocity state: the state is the flow itself.
-                        out.push((flow_var(b), Def::Plain(mul(vec![Ex::Num(s), p]))));
+                        out.push((flow_var(b), Def::Plain(mul(vec![symbols::num(s), p]))));
                         return Ok(out);
                     }
                     let def = match &w.relation {
@@ -806,7 +821,7 @@ fn node_defs(
                             return Err(unsupported("a storage without a constitutive law".into()));
                         }
                     };
-                    out.push((flow_var(b), Def::Plain(mul(vec![Ex::Num(s), def]))));
+                    out.push((flow_var(b), Def::Plain(mul(vec![symbols::num(s), def]))));
                 }
                 (ElementKind::I, true) => {
                     let p = ctx
@@ -857,7 +872,7 @@ fn node_defs(
                         }
                         _ => return Err(unsupported("a resistor without a law".into())),
                     };
-                    out.push((flow_var(b), Def::Plain(mul(vec![Ex::Num(s), def]))));
+                    out.push((flow_var(b), Def::Plain(mul(vec![symbols::num(s), def]))));
                 }
             }
         }

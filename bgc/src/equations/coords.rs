@@ -19,10 +19,11 @@ use super::build::{ConvertError, Ctx};
 use super::dense::{self, Mat};
 use super::linear::{LinearError, NumericStateSpace, StateSelection, numeric_state_space};
 use super::resolve::Resolver;
-use super::sym::{self, Ex, Sym};
+use super::symbols::{self, Sym, SymExt};
 use super::{Equations, StateSpec, codes, coord_name};
 use crate::diagnostic::Diagnostic;
-use crate::ir::{Expr, Model};
+use crate::ir::{Expr as IrExpr, Model};
+use crate::symbolic::Expr;
 
 /// Why the state space in declared coordinates could not be formed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -55,11 +56,11 @@ pub(crate) fn derive_coords(
     model: &Model,
     ctx: &Ctx,
     resolver: &mut Resolver,
-    list: &[Expr],
-    rate_of: &dyn Fn(&Ex) -> Ex,
+    list: &[IrExpr],
+    rate_of: &dyn Fn(&Expr) -> Expr,
     states: &[StateSpec],
     diags: &mut Vec<Diagnostic>,
-) -> Option<Vec<(String, Ex)>> {
+) -> Option<Vec<(String, Expr)>> {
     let mut out = Vec::new();
     let mut ok = true;
     let mut names = super::naming::UniqueNames::default();
@@ -102,7 +103,7 @@ pub(crate) fn derive_coords(
 }
 
 /// Why `e` is not a linear function of the states, if it is not.
-fn nonlinear_reason(e: &Ex, states: &[StateSpec]) -> Option<String> {
+fn nonlinear_reason(e: &Expr, states: &[StateSpec]) -> Option<String> {
     let mut bad = None;
     e.for_each_sym(&mut |s| {
         if bad.is_none()
@@ -118,7 +119,7 @@ fn nonlinear_reason(e: &Ex, states: &[StateSpec]) -> Option<String> {
         return Some("depends on inputs or time".into());
     }
     for (j, state) in states.iter().enumerate() {
-        match sym::diff(e, Sym::State(j)) {
+        match symbols::diff(e, Sym::State(j)) {
             Ok(d) if d.any_sym(&|s| matches!(s, Sym::State(_))) => {
                 return Some(format!("is not linear in `{}`", state.name));
             }
@@ -126,7 +127,7 @@ fn nonlinear_reason(e: &Ex, states: &[StateSpec]) -> Option<String> {
             Err(_) => return Some("cannot be differentiated".into()),
         }
     }
-    let offset = sym::subst(e, &mut |s| matches!(s, Sym::State(_)).then(Ex::zero));
+    let offset = symbols::subst(e, &mut |s| matches!(s, Sym::State(_)).then(Expr::zero));
     (!offset.is_zero()).then(|| "has a constant part".into())
 }
 
@@ -204,11 +205,11 @@ pub fn declared_state_space(
     let mut t = dense::zeros(coords.len(), n);
     for (r, (name, e)) in coords.iter().enumerate() {
         for (k, &j) in idx.iter().enumerate() {
-            let d = sym::diff(e, Sym::State(j)).map_err(|_| CoordsError::Eval {
+            let d = symbols::diff(e, Sym::State(j)).map_err(|_| CoordsError::Eval {
                 coord: name.clone(),
                 reason: "not differentiable".into(),
             })?;
-            t[r][k] = sym::eval(&d, &value).map_err(|err| CoordsError::Eval {
+            t[r][k] = symbols::eval(&d, &value).map_err(|err| CoordsError::Eval {
                 coord: name.clone(),
                 reason: format!("{err:?}"),
             })?;

@@ -12,10 +12,11 @@ use super::Equations;
 use super::coords::CoordsError;
 use super::linear::{Jacobians, StateSelection, linear_state_space};
 use super::solve::gauss;
-use super::sym::{self, Ex, Sym, add, mul};
+use super::symbols::{self, Sym, SymExt, add, mul};
+use crate::symbolic::Expr;
 
-fn is_zero(e: &Ex) -> bool {
-    e.is_zero() || sym::expand(e).is_zero()
+fn is_zero(e: &Expr) -> bool {
+    e.is_zero() || symbols::expand(e).is_zero()
 }
 
 /// The state space in the declared coordinates with symbolic entries.
@@ -33,7 +34,7 @@ pub fn declared_state_space_symbolic(eqs: &Equations) -> Result<Jacobians, Coord
     used[..eqs.energy_states.min(n_all)]
         .iter_mut()
         .for_each(|u| *u = true);
-    let mark = |e: &Ex, used: &mut Vec<bool>| {
+    let mark = |e: &Expr, used: &mut Vec<bool>| {
         e.for_each_sym(&mut |s| {
             if let Sym::State(j) = s
                 && let Some(u) = used.get_mut(j)
@@ -73,7 +74,7 @@ pub fn declared_state_space_symbolic(eqs: &Equations) -> Result<Jacobians, Coord
     let mut order: Vec<usize> = (eqs.energy_states..n_all).filter(|&j| used[j]).collect();
     order.extend((0..eqs.energy_states.min(n_all)).filter(|&j| used[j]));
     let n = order.len();
-    let row_of = |i: usize| -> Vec<Ex> {
+    let row_of = |i: usize| -> Vec<Expr> {
         order
             .iter()
             .map(|&j| full.dfdx[i][j].clone())
@@ -82,24 +83,24 @@ pub fn declared_state_space_symbolic(eqs: &Equations) -> Result<Jacobians, Coord
     };
     // Reduced rows with their combination of original rows (indexed by position in `order`).
     // (pivot column, reduced row, combination of original rows)
-    let mut pivots: Vec<(usize, Vec<Ex>, Vec<Ex>)> = Vec::new();
+    let mut pivots: Vec<(usize, Vec<Expr>, Vec<Expr>)> = Vec::new();
     // (position, coefficients of x_pos = Σ coef x_other)
-    let mut eliminated: Vec<(usize, Vec<Ex>)> = Vec::new();
+    let mut eliminated: Vec<(usize, Vec<Expr>)> = Vec::new();
     for (pos, &i) in order.iter().enumerate() {
         let mut row = row_of(i);
-        let mut comb: Vec<Ex> = (0..n)
-            .map(|k| if k == pos { Ex::one() } else { Ex::zero() })
+        let mut comb: Vec<Expr> = (0..n)
+            .map(|k| if k == pos { Expr::one() } else { Expr::zero() })
             .collect();
         for (col, prow, pcomb) in &pivots {
             if is_zero(&row[*col]) {
                 continue;
             }
-            let factor = sym::div(row[*col].clone(), prow[*col].clone());
+            let factor = symbols::div(row[*col].clone(), prow[*col].clone());
             for (r, p) in row.iter_mut().zip(prow) {
-                *r = sym::sub(r.clone(), mul(vec![factor.clone(), p.clone()]));
+                *r = symbols::sub(r.clone(), mul(vec![factor.clone(), p.clone()]));
             }
             for (c, p) in comb.iter_mut().zip(pcomb) {
-                *c = sym::sub(c.clone(), mul(vec![factor.clone(), p.clone()]));
+                *c = symbols::sub(c.clone(), mul(vec![factor.clone(), p.clone()]));
             }
         }
         match row.iter().position(|e| !is_zero(e)) {
@@ -108,14 +109,14 @@ pub fn declared_state_space_symbolic(eqs: &Equations) -> Result<Jacobians, Coord
                 // comb · x is invariant (zero along trajectories from rest): x_pos = -Σ_{k≠pos} comb_k x_k / comb_pos.
                 // The combination involves only pivot rows, never another eliminated state.
                 let lead = comb[pos].clone();
-                let expr: Vec<Ex> = comb
+                let expr: Vec<Expr> = comb
                     .iter()
                     .enumerate()
                     .map(|(k, c)| {
                         if k == pos {
-                            Ex::zero()
+                            Expr::zero()
                         } else {
-                            sym::neg(sym::div(c.clone(), lead.clone()))
+                            symbols::neg(symbols::div(c.clone(), lead.clone()))
                         }
                     })
                     .collect();
@@ -134,9 +135,9 @@ pub fn declared_state_space_symbolic(eqs: &Equations) -> Result<Jacobians, Coord
         });
     }
     // x (in `order` positions) = M_r r: identity on kept positions, S on eliminated ones.
-    let mut m_r: Vec<Vec<Ex>> = vec![vec![Ex::zero(); k]; n];
+    let mut m_r: Vec<Vec<Expr>> = vec![vec![Expr::zero(); k]; n];
     for (c, &p) in kept.iter().enumerate() {
-        m_r[p][c] = Ex::one();
+        m_r[p][c] = Expr::one();
     }
     for (p, expr) in &eliminated {
         for (c, &q) in kept.iter().enumerate() {
@@ -144,10 +145,10 @@ pub fn declared_state_space_symbolic(eqs: &Equations) -> Result<Jacobians, Coord
         }
     }
     let a_pos = |r: usize, c: usize| full.dfdx[order[r]][order[c]].clone();
-    let matmul = |left: &dyn Fn(usize, usize) -> Ex,
+    let matmul = |left: &dyn Fn(usize, usize) -> Expr,
                   rows: usize,
                   inner: usize,
-                  right: &[Vec<Ex>],
+                  right: &[Vec<Expr>],
                   cols: usize| {
         (0..rows)
             .map(|r| {
@@ -159,15 +160,15 @@ pub fn declared_state_space_symbolic(eqs: &Equations) -> Result<Jacobians, Coord
                     })
                     .collect()
             })
-            .collect::<Vec<Vec<Ex>>>()
+            .collect::<Vec<Vec<Expr>>>()
     };
     // T (coords × n in `order` positions).
-    let t_full: Vec<Vec<Ex>> = coords
+    let t_full: Vec<Vec<Expr>> = coords
         .iter()
         .map(|(_, e)| {
             order
                 .iter()
-                .map(|&j| sym::diff(e, Sym::State(j)).unwrap_or_else(|_| Ex::zero()))
+                .map(|&j| symbols::diff(e, Sym::State(j)).unwrap_or_else(|_| Expr::zero()))
                 .collect()
         })
         .collect();
@@ -177,7 +178,7 @@ pub fn declared_state_space_symbolic(eqs: &Equations) -> Result<Jacobians, Coord
     // The elimination gives M_r with T_r invertible: A_z = T A M_r T_r⁻¹, B_z = T B, C_z = C M_r T_r⁻¹.
     let t_a_m = matmul(&|r, c| t_full[r][c].clone(), k, n, &a_x_m, k);
     let a_z = matmul(&|r, c| t_a_m[r][c].clone(), k, k, &inv, k);
-    let b_order: Vec<Vec<Ex>> = order.iter().map(|&j| full.dfdu[j].clone()).collect();
+    let b_order: Vec<Vec<Expr>> = order.iter().map(|&j| full.dfdu[j].clone()).collect();
     let b_z = matmul(&|r, c| t_full[r][c].clone(), k, n, &b_order, m_in);
     let c_order = |r: usize, c: usize| full.dhdx[r][order[c]].clone();
     let c_m = matmul(&c_order, full.outputs.len(), n, &m_r, k);
@@ -194,13 +195,13 @@ pub fn declared_state_space_symbolic(eqs: &Equations) -> Result<Jacobians, Coord
 }
 
 /// The inverse of a square symbolic matrix, column by column.
-fn inverse(a: &[Vec<Ex>]) -> Option<Vec<Vec<Ex>>> {
+fn inverse(a: &[Vec<Expr>]) -> Option<Vec<Vec<Expr>>> {
     let n = a.len();
     let mut cols = Vec::with_capacity(n);
     for c in 0..n {
-        let mut m: Vec<Vec<Ex>> = a.to_vec();
-        let mut e: Vec<Ex> = (0..n)
-            .map(|r| if r == c { Ex::one() } else { Ex::zero() })
+        let mut m: Vec<Vec<Expr>> = a.to_vec();
+        let mut e: Vec<Expr> = (0..n)
+            .map(|r| if r == c { Expr::one() } else { Expr::zero() })
             .collect();
         cols.push(gauss(&mut m, &mut e)?);
     }

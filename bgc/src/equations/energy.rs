@@ -15,9 +15,10 @@
 use super::build::{Ctx, effort_var, flow_var};
 use super::codes;
 use super::resolve::Resolver;
-use super::sym::{self, Ex, Sym, add, div, mul, pow};
+use super::symbols::{self, Sym, SymExt, add, div, mul, pow};
 use crate::diagnostic::Diagnostic;
 use crate::ir::{Model, Relation};
+use crate::symbolic::{Expr, Node};
 use crate::syntax::ast::ElementKind;
 use petgraph::graph::{EdgeIndex, NodeIndex};
 
@@ -50,37 +51,37 @@ pub struct EnergyTerm {
     /// Explicit in states, inputs, parameters and `t`, and, for the power of an element next to a storage in
     /// derivative causality, the inputs' time derivatives ([`Sym::InputDot`]); `None` when it has no closed form
     /// here (a diagnostic says why).
-    pub value: Option<Ex>,
+    pub value: Option<Expr>,
 }
 
 /// `∫ g dq` when `g` is a polynomial in `q` with coefficients free of `q`.
-pub(crate) fn integrate_polynomial(g: &Ex, q: Sym) -> Option<Ex> {
-    let terms: Vec<Ex> = match g {
-        Ex::Add(ts) => ts.clone(),
-        other => vec![other.clone()],
+pub(crate) fn integrate_polynomial(g: &Expr, q: Sym) -> Option<Expr> {
+    let terms: Vec<Expr> = match g.node() {
+        Node::Add(ts) => ts.clone(),
+        _ => vec![g.clone()],
     };
     let mut out = Vec::new();
     for t in terms {
-        let factors: Vec<Ex> = match t {
-            Ex::Mul(fs) => fs,
-            other => vec![other],
+        let factors: Vec<Expr> = match t.node() {
+            Node::Mul(fs) => fs.clone(),
+            _ => vec![t.clone()],
         };
         let mut power = 0.0;
         let mut coef = Vec::new();
         for f in factors {
-            match &f {
-                Ex::S(s) if *s == q => power += 1.0,
-                Ex::Pow(b, x) if **b == Ex::S(q) => match x.num() {
+            match f.node() {
+                _ if f.as_sym() == Some(q) => power += 1.0,
+                Node::Pow(b, x) if b.as_sym() == Some(q) => match x.num() {
                     Some(n) if n.fract() == 0.0 && n >= 0.0 => power += n,
                     _ => return None,
                 },
-                other if other.contains(q) => return None,
+                _ if f.contains(q) => return None,
                 _ => coef.push(f),
             }
         }
         coef.push(div(
-            pow(Ex::S(q), Ex::Num(power + 1.0)),
-            Ex::Num(power + 1.0),
+            pow(symbols::leaf(q), symbols::num(power + 1.0)),
+            symbols::num(power + 1.0),
         ));
         out.push(mul(coef));
     }
@@ -99,14 +100,14 @@ fn stored_energy(
     node: NodeIndex,
     b: EdgeIndex,
     s: f64,
-) -> Result<Ex, &'static str> {
+) -> Result<Expr, &'static str> {
     let w = &ctx.model.graph[node];
     let capacitor = w.kind == ElementKind::C;
     // The own variable conjugate to the energy variable: the effort of a C, the flow of an I.
     let own = if capacitor {
-        Ex::S(Sym::Var(effort_var(b)))
+        symbols::leaf(Sym::Var(effort_var(b)))
     } else {
-        mul(vec![Ex::Num(s), Ex::S(Sym::Var(flow_var(b)))])
+        mul(vec![symbols::num(s), symbols::leaf(Sym::Var(flow_var(b)))])
     };
     if let Some(i) = ctx.node_state.get(node.index()).copied().flatten() {
         let x = Sym::State(i);
@@ -114,12 +115,15 @@ fn stored_energy(
             let p = ctx
                 .convert(param)
                 .map_err(|_| "its value cannot be converted")?;
-            return Ok(div(pow(Ex::S(x), Ex::Num(2.0)), mul(vec![Ex::Num(2.0), p])));
+            return Ok(div(
+                pow(symbols::leaf(x), symbols::num(2.0)),
+                mul(vec![symbols::num(2.0), p]),
+            ));
         }
         let conjugate = resolver
             .expr(&own)
             .map_err(|_| "its effort or flow has no explicit form")?;
-        return integrate_polynomial(&sym::expand(&conjugate), x)
+        return integrate_polynomial(&symbols::expand(&conjugate), x)
             .ok_or("its law is not a polynomial in its energy variable");
     }
     let energy_var = ctx
@@ -133,8 +137,8 @@ fn stored_energy(
             .convert(param)
             .map_err(|_| "its value cannot be converted")?;
         return Ok(div(
-            pow(energy_var, Ex::Num(2.0)),
-            mul(vec![Ex::Num(2.0), p]),
+            pow(energy_var, symbols::num(2.0)),
+            mul(vec![symbols::num(2.0), p]),
         ));
     }
     // x = g(y) with y the own variable: write g in a placeholder for y, integrate, put y back.
@@ -144,17 +148,19 @@ fn stored_energy(
     } else {
         flow_var(b)
     };
-    let in_y = |e: &Ex| {
-        sym::subst(e, &mut |v| match v {
-            Sym::Var(k) if k == bond_var => Some(mul(vec![Ex::Num(s), Ex::S(y)])),
+    let in_y = |e: &Expr| {
+        symbols::subst(e, &mut |v| match v {
+            Sym::Var(k) if k == bond_var => Some(mul(vec![symbols::num(s), symbols::leaf(y)])),
             _ => None,
         })
     };
-    let g = sym::expand(&in_y(&energy_var));
+    let g = symbols::expand(&in_y(&energy_var));
     let integral =
         integrate_polynomial(&g, y).ok_or("its law is not a polynomial in its effort or flow")?;
-    let energy = sym::sub(mul(vec![Ex::S(y), g]), integral);
-    Ok(sym::subst(&energy, &mut |v| (v == y).then(|| own.clone())))
+    let energy = symbols::sub(mul(vec![symbols::leaf(y), g]), integral);
+    Ok(symbols::subst(&energy, &mut |v| {
+        (v == y).then(|| own.clone())
+    }))
 }
 
 /// Every element's energy term.
@@ -162,7 +168,7 @@ pub(crate) fn terms(
     model: &Model,
     ctx: &Ctx,
     resolver: &mut Resolver,
-    rate_of: &dyn Fn(&Ex) -> Ex,
+    rate_of: &dyn Fn(&Expr) -> Expr,
     mass: &[super::field::MassBlock],
     diags: &mut Vec<Diagnostic>,
 ) -> Vec<EnergyTerm> {
@@ -187,8 +193,8 @@ pub(crate) fn terms(
         let Some((b, s)) = ctx.port.get(node.index()).copied().flatten() else {
             continue;
         };
-        let e_b = Ex::S(Sym::Var(effort_var(b)));
-        let f_b = Ex::S(Sym::Var(flow_var(b)));
+        let e_b = symbols::leaf(Sym::Var(effort_var(b)));
+        let f_b = symbols::leaf(Sym::Var(flow_var(b)));
         let warn = |msg: String| {
             let d = Diagnostic::warning(codes::ENERGY, msg);
             match model.spans.nodes.get(node.index()) {
@@ -196,7 +202,7 @@ pub(crate) fn terms(
                 None => d,
             }
         };
-        let (kind, raw): (EnergyKind, Option<Ex>) = match w.kind {
+        let (kind, raw): (EnergyKind, Option<Expr>) = match w.kind {
             ElementKind::C | ElementKind::I => {
                 let stored = stored_energy(ctx, resolver, node, b, s);
                 if let Err(why) = &stored {
@@ -209,11 +215,12 @@ pub(crate) fn terms(
             }
             ElementKind::R => (
                 EnergyKind::Dissipated,
-                Some(mul(vec![Ex::Num(s), e_b, f_b])),
+                Some(mul(vec![symbols::num(s), e_b, f_b])),
             ),
-            ElementKind::Se | ElementKind::Sf | ElementKind::MSe | ElementKind::MSf => {
-                (EnergyKind::Supplied, Some(mul(vec![Ex::Num(s), e_b, f_b])))
-            }
+            ElementKind::Se | ElementKind::Sf | ElementKind::MSe | ElementKind::MSf => (
+                EnergyKind::Supplied,
+                Some(mul(vec![symbols::num(s), e_b, f_b])),
+            ),
             _ => continue,
         };
         // A source or resistor next to a storage in derivative causality keeps the inputs' derivatives
@@ -239,11 +246,14 @@ mod tests {
         // ∫ (k q + k3 q^3) dq = k q^2/2 + k3 q^4/4
         let q = Sym::State(0);
         let g = add(vec![
-            mul(vec![Ex::S(Sym::Param(0)), Ex::S(q)]),
-            mul(vec![Ex::S(Sym::Param(1)), pow(Ex::S(q), Ex::Num(3.0))]),
+            mul(vec![symbols::leaf(Sym::Param(0)), symbols::leaf(q)]),
+            mul(vec![
+                symbols::leaf(Sym::Param(1)),
+                pow(symbols::leaf(q), symbols::num(3.0)),
+            ]),
         ]);
-        let e = integrate_polynomial(&g, q).unwrap_or(Ex::zero());
-        let v = sym::eval(&e, &|s| match s {
+        let e = integrate_polynomial(&g, q).unwrap_or(Expr::zero());
+        let v = symbols::eval(&e, &|s| match s {
             Sym::Param(0) => Some(2.0),
             Sym::Param(1) => Some(4.0),
             Sym::State(0) => Some(3.0),
@@ -251,7 +261,11 @@ mod tests {
         });
         assert_eq!(v, Ok(2.0 * 9.0 / 2.0 + 4.0 * 81.0 / 4.0));
         assert!(
-            integrate_polynomial(&sym::call(crate::ir::Func::Sin, vec![Ex::S(q)]), q).is_none()
+            integrate_polynomial(
+                &symbols::call(crate::ir::Func::Sin, vec![symbols::leaf(q)]),
+                q
+            )
+            .is_none()
         );
     }
 }

@@ -24,11 +24,12 @@
 //! its flows from `f[k] = g_k(e)`. Mixed causalities would need the laws inverted and are refused (BG0605).
 
 use super::build::{ConvertError, Ctx, Def, effort_var, flow_var, sanitize};
-use super::sym::{self, Ex, Sym, add, mul};
+use super::symbols::{self, Sym, SymExt, add, mul};
 use super::{StateKind, StateSpec, codes};
 use crate::causality::{Causality, StorageForm};
 use crate::diagnostic::Diagnostic;
 use crate::ir::{Model, PortVar, Relation};
+use crate::symbolic::Expr;
 use crate::syntax::ast::ElementKind;
 use petgraph::Direction;
 use petgraph::graph::{EdgeIndex, NodeIndex};
@@ -43,7 +44,7 @@ pub struct MassBlock {
     /// The flow states of its ports, in port order.
     pub states: Vec<usize>,
     /// `M(q)`, symmetric, in the field's displacement states and the parameters.
-    pub matrix: Vec<Vec<Ex>>,
+    pub matrix: Vec<Vec<Expr>>,
 }
 
 /// The bonds on a field's ports, in port order, with the sign of the port's own flow.
@@ -147,7 +148,7 @@ pub(crate) fn defs(
             for (&(b, s), &state) in bonds.iter().zip(f) {
                 out.push((
                     flow_var(b),
-                    Def::Plain(mul(vec![Ex::Num(s), Ex::S(Sym::State(state))])),
+                    Def::Plain(mul(vec![symbols::num(s), symbols::leaf(Sym::State(state))])),
                 ));
             }
         }
@@ -202,7 +203,7 @@ pub(crate) fn defs(
                 if all_effort {
                     out.push((effort_var(b), Def::Plain(value)));
                 } else {
-                    out.push((flow_var(b), Def::Plain(mul(vec![Ex::Num(s), value]))));
+                    out.push((flow_var(b), Def::Plain(mul(vec![symbols::num(s), value]))));
                 }
             }
         }
@@ -216,7 +217,7 @@ pub(crate) fn rates(
     model: &Model,
     ctx: &Ctx,
     node: NodeIndex,
-    rates: &mut [Ex],
+    rates: &mut [Expr],
     diags: &mut Vec<Diagnostic>,
 ) -> Option<MassBlock> {
     let w = &model.graph[node];
@@ -225,14 +226,14 @@ pub(crate) fn rates(
         // C-field: q̇_k = s_k f_b.
         for (&(b, s), &state) in bonds.iter().zip(q) {
             if let Some(r) = rates.get_mut(state) {
-                *r = mul(vec![Ex::Num(s), Ex::S(Sym::Var(flow_var(b)))]);
+                *r = mul(vec![symbols::num(s), symbols::leaf(Sym::Var(flow_var(b)))]);
             }
         }
         return None;
     };
     for (&qs, &fs) in q.iter().zip(f) {
         if let Some(r) = rates.get_mut(qs) {
-            *r = Ex::S(Sym::State(fs));
+            *r = symbols::leaf(Sym::State(fs));
         }
     }
     let mut fail = |msg: String| {
@@ -254,7 +255,7 @@ pub(crate) fn rates(
         ));
         return None;
     }
-    let mut m = vec![vec![Ex::zero(); n]; n];
+    let mut m = vec![vec![Expr::zero(); n]; n];
     for (i, row) in m.iter_mut().enumerate() {
         for (j, slot) in row.iter_mut().enumerate() {
             let Some(e) = entries.get(i * n + j) else {
@@ -284,16 +285,16 @@ pub(crate) fn rates(
         fail("its inertia matrix may depend only on the parameters and its own port displacements q[i]".into());
         return None;
     }
-    let fv: Vec<Ex> = f.iter().map(|&s| Ex::S(Sym::State(s))).collect();
+    let fv: Vec<Expr> = f.iter().map(|&s| symbols::leaf(Sym::State(s))).collect();
     // dm[l][i][j] = ∂M_ij/∂q_l.
     let mut dm = Vec::with_capacity(n);
     for &ql in q {
-        let mut d = vec![vec![Ex::zero(); n]; n];
+        let mut d = vec![vec![Expr::zero(); n]; n];
         for (i, row) in d.iter_mut().enumerate() {
             for (j, slot) in row.iter_mut().enumerate() {
-                match sym::diff(&m[i][j], Sym::State(ql)) {
+                match symbols::diff(&m[i][j], Sym::State(ql)) {
                     Ok(v) => *slot = v,
-                    Err(sym::NotDifferentiable(func)) => {
+                    Err(symbols::NotDifferentiable(func)) => {
                         fail(format!(
                             "its inertia matrix uses `{}`, which has no derivative",
                             func.name()
@@ -306,12 +307,12 @@ pub(crate) fn rates(
         dm.push(d);
     }
     for (k, (&(b, _), &state)) in bonds.iter().zip(f).enumerate() {
-        let mut terms = vec![Ex::S(Sym::Var(effort_var(b)))];
+        let mut terms = vec![symbols::leaf(Sym::Var(effort_var(b)))];
         for i in 0..n {
             for j in 0..n {
                 // ½ ∂M_ij/∂q_k f_i f_j − ∂M_kj/∂q_i f_i f_j
-                let coef = sym::sub(
-                    mul(vec![Ex::Num(0.5), dm[k][i][j].clone()]),
+                let coef = symbols::sub(
+                    mul(vec![symbols::num(0.5), dm[k][i][j].clone()]),
                     dm[i][k][j].clone(),
                 );
                 if !coef.is_zero() {
@@ -320,7 +321,7 @@ pub(crate) fn rates(
             }
         }
         if let Some(r) = rates.get_mut(state) {
-            *r = sym::expand(&add(terms));
+            *r = symbols::expand(&add(terms));
         }
     }
     Some(MassBlock {
@@ -339,7 +340,7 @@ pub(crate) fn energy(
     node: NodeIndex,
     mass: &[MassBlock],
     diags: &mut Vec<Diagnostic>,
-) -> Option<(super::EnergyKind, Option<Ex>)> {
+) -> Option<(super::EnergyKind, Option<Expr>)> {
     let w = &model.graph[node];
     let bonds = ports(model, node)?;
     match w.kind {
@@ -349,10 +350,10 @@ pub(crate) fn energy(
             for (i, &si) in block.states.iter().enumerate() {
                 for (j, &sj) in block.states.iter().enumerate() {
                     terms.push(mul(vec![
-                        Ex::Num(0.5),
+                        symbols::num(0.5),
                         block.matrix[i][j].clone(),
-                        Ex::S(Sym::State(si)),
-                        Ex::S(Sym::State(sj)),
+                        symbols::leaf(Sym::State(si)),
+                        symbols::leaf(Sym::State(sj)),
                     ]));
                 }
             }
@@ -365,8 +366,8 @@ pub(crate) fn energy(
             };
             // g_k = Σ_j K_kj q_j + e0_k with K, e0 free of q.
             let n = q.len();
-            let mut k_mat = vec![vec![Ex::zero(); n]; n];
-            let mut e0 = vec![Ex::zero(); n];
+            let mut k_mat = vec![vec![Expr::zero(); n]; n];
+            let mut e0 = vec![Expr::zero(); n];
             let mut ok = true;
             for (k, row) in k_mat.iter_mut().enumerate() {
                 let g = laws
@@ -378,7 +379,7 @@ pub(crate) fn energy(
                     break;
                 };
                 for (slot, &qj) in row.iter_mut().zip(q) {
-                    match sym::affine_in(&rest, Sym::State(qj)) {
+                    match symbols::affine_in(&rest, Sym::State(qj)) {
                         Some((a, b)) if !q.iter().any(|&x| a.contains(Sym::State(x))) => {
                             *slot = a;
                             rest = b;
@@ -393,13 +394,13 @@ pub(crate) fn energy(
             ok = ok && (0..n).all(|i| (0..n).all(|j| k_mat[i][j] == k_mat[j][i]));
             let mut terms = Vec::new();
             for (i, row) in k_mat.iter().enumerate() {
-                let qi = Ex::S(Sym::State(q[i]));
+                let qi = symbols::leaf(Sym::State(q[i]));
                 for (j, kij) in row.iter().enumerate() {
                     terms.push(mul(vec![
-                        Ex::Num(0.5),
+                        symbols::num(0.5),
                         kij.clone(),
                         qi.clone(),
-                        Ex::S(Sym::State(q[j])),
+                        symbols::leaf(Sym::State(q[j])),
                     ]));
                 }
                 terms.push(mul(vec![e0[i].clone(), qi]));
@@ -425,9 +426,9 @@ pub(crate) fn energy(
                 .iter()
                 .map(|&(b, s)| {
                     mul(vec![
-                        Ex::Num(s),
-                        Ex::S(Sym::Var(effort_var(b))),
-                        Ex::S(Sym::Var(flow_var(b))),
+                        symbols::num(s),
+                        symbols::leaf(Sym::Var(effort_var(b))),
+                        symbols::leaf(Sym::Var(flow_var(b))),
                     ])
                 })
                 .collect();

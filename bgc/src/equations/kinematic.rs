@@ -16,9 +16,10 @@
 //! the original graph.
 
 use super::build::{self, Built, Ctx, Def, effort_var, flow_var};
-use super::sym::Sym;
+use super::symbols::{Sym, SymExt};
 use crate::causality::Causality;
-use crate::ir::{Bond, Expr, Hint, Model, Node, Relation};
+use crate::ir::{Bond, Expr as IrExpr, Hint, Model, Node, Relation};
+use crate::symbolic::Expr;
 use crate::syntax::ast::ElementKind;
 use petgraph::Direction;
 use petgraph::graph::{EdgeIndex, NodeIndex};
@@ -250,7 +251,7 @@ fn augment(model: &Model, junctions: &[NodeIndex]) -> (Model, Vec<NodeIndex>) {
         let node = m.graph.add_node(Node {
             name: w.name.clone(),
             kind: ElementKind::I,
-            relation: Relation::Linear(Expr::Const(0.0)),
+            relation: Relation::Linear(IrExpr::Const(0.0)),
             ports: 1,
             doc: Vec::new(),
         });
@@ -306,7 +307,7 @@ pub(crate) fn block(
     model: &Model,
     states: &[super::StateSpec],
     rows: Vec<usize>,
-    matrix: Vec<Vec<super::sym::Ex>>,
+    matrix: Vec<Vec<Expr>>,
 ) -> super::MassBlock {
     let mut names: Vec<String> = rows
         .iter()

@@ -6,7 +6,8 @@
 //! gives `A, B, C, D` exactly. For any model, [`linearise`] evaluates the Jacobians at an operating point.
 
 use super::Equations;
-use super::sym::{self, Ex, Sym};
+use super::symbols::{self, Sym, SymExt};
+use crate::symbolic::Expr;
 use std::collections::{BTreeSet, HashMap};
 
 /// Which states make up the state vector.
@@ -84,13 +85,13 @@ pub struct Jacobians {
     pub inputs: Vec<String>,
     pub outputs: Vec<String>,
     /// `∂f/∂x`, `n × n`.
-    pub dfdx: Vec<Vec<Ex>>,
+    pub dfdx: Vec<Vec<Expr>>,
     /// `∂f/∂u`, `n × m`.
-    pub dfdu: Vec<Vec<Ex>>,
+    pub dfdu: Vec<Vec<Expr>>,
     /// `∂h/∂x`, `p × n`.
-    pub dhdx: Vec<Vec<Ex>>,
+    pub dhdx: Vec<Vec<Expr>>,
     /// `∂h/∂u`, `p × m`.
-    pub dhdu: Vec<Vec<Ex>>,
+    pub dhdu: Vec<Vec<Expr>>,
 }
 
 /// `A, B, C, D` of a linear model as expressions of the parameters.
@@ -124,8 +125,8 @@ impl Equations {
 }
 
 /// The tear variables (names) that the selected rates or the outputs hold, and where the first one is.
-fn implicit_in(eqs: &Equations, f: &[Ex], h: &[Ex]) -> Option<(String, String, String)> {
-    let tear = |e: &Ex| {
+fn implicit_in(eqs: &Equations, f: &[Expr], h: &[Expr]) -> Option<(String, String, String)> {
+    let tear = |e: &Expr| {
         let mut found = None;
         e.for_each_sym(&mut |s| {
             if found.is_none() && matches!(s, Sym::Tear(_)) {
@@ -156,7 +157,10 @@ fn implicit_in(eqs: &Equations, f: &[Ex], h: &[Ex]) -> Option<(String, String, S
 }
 
 /// The selected rates and all outputs, explicit, checked for use of left-out states.
-fn selected(eqs: &Equations, selection: StateSelection) -> Result<(Vec<Ex>, Vec<Ex>), LinearError> {
+fn selected(
+    eqs: &Equations,
+    selection: StateSelection,
+) -> Result<(Vec<Expr>, Vec<Expr>), LinearError> {
     let n = eqs.state_count(selection);
     let mut f = Vec::with_capacity(n);
     for i in 0..n {
@@ -193,7 +197,7 @@ fn selected(eqs: &Equations, selection: StateSelection) -> Result<(Vec<Ex>, Vec<
             eqs.outputs.get(k).map(|o| o.name.as_str()).unwrap_or("?")
         )
     };
-    let check = |e: &Ex, what: String| -> Result<(), LinearError> {
+    let check = |e: &Expr, what: String| -> Result<(), LinearError> {
         // The first left-out state the expression reads, found in one walk.
         let mut first: Option<usize> = None;
         e.for_each_sym(&mut |s| {
@@ -222,10 +226,10 @@ fn selected(eqs: &Equations, selection: StateSelection) -> Result<(Vec<Ex>, Vec<
 }
 
 fn jacobian(
-    rows: &[Ex],
+    rows: &[Expr],
     vars: &[Sym],
     what: &dyn Fn(usize) -> String,
-) -> Result<Vec<Vec<Ex>>, LinearError> {
+) -> Result<Vec<Vec<Expr>>, LinearError> {
     let column: HashMap<Sym, usize> = vars.iter().enumerate().map(|(j, &v)| (v, j)).collect();
     rows.iter()
         .enumerate()
@@ -238,9 +242,9 @@ fn jacobian(
                     read.insert(j);
                 }
             });
-            let mut row = vec![Ex::zero(); vars.len()];
+            let mut row = vec![Expr::zero(); vars.len()];
             for j in read {
-                let d = sym::diff(r, vars[j]).map_err(|sym::NotDifferentiable(f)| {
+                let d = symbols::diff(r, vars[j]).map_err(|symbols::NotDifferentiable(f)| {
                     LinearError::NotDifferentiable {
                         what: what(i),
                         func: f.name(),
@@ -314,7 +318,7 @@ pub fn linear_state_space(
     }
     let mut j = jacobians(eqs, selection)?;
     solve_constant_mass(eqs, &mut j)?;
-    let check = |m: &[Vec<Ex>], name: &str, what: &str| -> Result<(), LinearError> {
+    let check = |m: &[Vec<Expr>], name: &str, what: &str| -> Result<(), LinearError> {
         for (r, row) in m.iter().enumerate() {
             for (c, e) in row.iter().enumerate() {
                 let mut found = None;
@@ -340,12 +344,12 @@ pub fn linear_state_space(
     check(&j.dhdu, "D", "h")?;
     // Linear, not affine: f(0, 0, t) = 0 and h(0, 0, t) = 0 for every t. A term in `t` alone (a signal written into
     // the model) would vanish from A and B, so it is an error of its own.
-    let at_zero = |e: &Ex| {
-        sym::subst(e, &mut |s| {
-            matches!(s, Sym::State(_) | Sym::Input(_)).then(Ex::zero)
+    let at_zero = |e: &Expr| {
+        symbols::subst(e, &mut |s| {
+            matches!(s, Sym::State(_) | Sym::Input(_)).then(Expr::zero)
         })
     };
-    let remainder = |e: &Ex, what: String| -> Result<(), LinearError> {
+    let remainder = |e: &Expr, what: String| -> Result<(), LinearError> {
         let rest = at_zero(e);
         if rest.contains(Sym::Time) {
             return Err(LinearError::TimeDependent {
@@ -394,7 +398,7 @@ fn solve_constant_mass(eqs: &Equations, j: &mut Jacobians) -> Result<(), LinearE
             let columns = m.first().map_or(0, Vec::len);
             for c in 0..columns {
                 let mut a = block.matrix.clone();
-                let mut rhs: Vec<Ex> = block.states.iter().map(|&r| m[r][c].clone()).collect();
+                let mut rhs: Vec<Expr> = block.states.iter().map(|&r| m[r][c].clone()).collect();
                 let solved = super::solve::gauss(&mut a, &mut rhs).ok_or_else(|| {
                     LinearError::SingularMass {
                         element: block.element.clone(),
@@ -427,7 +431,7 @@ pub(crate) fn check_len(
 
 fn evaluate(
     eqs: &Equations,
-    m: &[Vec<Ex>],
+    m: &[Vec<Expr>],
     name: &str,
     value: &dyn Fn(Sym) -> Option<f64>,
 ) -> Result<Vec<Vec<f64>>, LinearError> {
@@ -438,14 +442,14 @@ fn evaluate(
                 .enumerate()
                 .map(|(c, e)| {
                     let what = format!("{name}[{r}][{c}]");
-                    let v = sym::eval(e, value).map_err(|err| match err {
-                        sym::EvalError::Unbound(s) => LinearError::Unbound {
+                    let v = symbols::eval(e, value).map_err(|err| match err {
+                        symbols::EvalError::Unbound(s) => LinearError::Unbound {
                             what: what.clone(),
                             symbol: eqs.sym_name(s),
                         },
-                        sym::EvalError::Arity(f) => LinearError::NotDifferentiable {
+                        symbols::EvalError::Foreign(f) => LinearError::Unbound {
                             what: what.clone(),
-                            func: f.name(),
+                            symbol: f,
                         },
                     })?;
                     if v.is_finite() {

@@ -30,14 +30,17 @@
 //! declared_state_space_symbolic(&eqs)                                 // ... as expressions of the parameters
 //! linear_state_space(&eqs, StateSelection::Energy)                    // symbolic A, B, C, D
 //! jacobians(&eqs, sel) / linearise(&eqs, sel, &p, &x0, &u0, t0)       // nonlinear models
-//! eqs.f[i], eqs.outputs[k].explicit + to_symbolic(&eqs, e)            // `bgc simulate`, code generation
+//! eqs.f[i], eqs.outputs[k].explicit                                  // `bgc simulate`, code generation
 //! eqs.tear_blocks, solve_all(&eqs, &values)                          // nonlinear loops: 0 = r(z, x, u, p, t)
 //! ```
 //! The states are `eqs.states` (energy states first, `eqs.energy_states` of them, then one per `var`); symbols
 //! in expressions are named by [`Equations::sym_name`].
 //!
-//! The expressions are those of [`sym`], a small canonical engine of this stage; [`to_symbolic`] converts them to
-//! the shared engine [`crate::symbolic`] for its printers.
+//! The expressions are those of the shared engine [`crate::symbolic`], a hash-consed DAG (equal subexpressions are
+//! one node), over the stage's indexed symbols ([`symbols::Sym`]: parameters, inputs, states, bond variables,
+//! outputs, tears and rates, each an index into a table of this stage; [`Equations::sym_name`] names them). Nothing
+//! here recurses along the model: the resolver follows dependency chains on an explicit stack and every walk of an
+//! expression is a walk of its distinct nodes, so derivation needs no large stack however long the model's chains.
 //!
 //! Diagnostics of this stage:
 //!
@@ -52,7 +55,6 @@
 //! | BG0606 | declared coordinates that are not a linear, invertible function of the states |
 //! | BG0607 | the stored energy of a law that cannot be integrated symbolically (warning) |
 
-mod bridge;
 mod build;
 mod coords;
 mod coords_symbolic;
@@ -70,11 +72,10 @@ mod resolve;
 mod sensitivity;
 mod solve;
 mod sparse_linear;
-pub mod sym;
+pub mod symbols;
 pub mod tear;
 mod time;
 
-pub use bridge::{symbol, to_symbolic};
 pub use coords::{CoordsError, declared_state_space};
 pub use coords_symbolic::declared_state_space_symbolic;
 pub use energy::{EnergyKind, EnergyTerm};
@@ -95,10 +96,11 @@ pub use tear::{LoopFailure, TearBlock, residual_scale, solve_all};
 
 use crate::causality::Causality;
 use crate::diagnostic::Diagnostic;
-use crate::ir::{Expr, Model, VarId};
+use crate::ir::{Expr as IrExpr, Model, VarId};
+use crate::symbolic::Expr;
 use petgraph::graph::NodeIndex;
 use resolve::{ResolveError, Resolver};
-use sym::{Ex, Sym};
+use symbols::{Sym, SymExt};
 
 /// The diagnostic codes of this stage.
 pub mod codes {
@@ -145,7 +147,7 @@ pub struct Intermediate {
     /// Named after its element, junction or bond: `e_hd_spring`, `f_j_sint`, `e_gear_in`.
     pub name: String,
     /// The right-hand side, in states, inputs, parameters, `t` and earlier intermediates ([`Sym::Var`]).
-    pub value: Ex,
+    pub value: Expr,
     /// True when the intermediate is `d/dt(value)` (the output of a storage in derivative causality).
     pub derivative: bool,
 }
@@ -155,11 +157,11 @@ pub struct Intermediate {
 pub struct OutputEq {
     pub name: String,
     /// In states, inputs, parameters, `t` and intermediates.
-    pub value: Ex,
+    pub value: Expr,
     /// In states, inputs, parameters, `t`, tear variables and earlier outputs ([`Sym::Output`]`(j)`, `j` less
     /// than this output's index, whose values are computed first): `h(x, u, p, t)`. `None` when it could not be
     /// derived (a diagnostic says why, at this output or at the output it is defined through).
-    pub explicit: Option<Ex>,
+    pub explicit: Option<Expr>,
 }
 
 /// The state equations of a model.
@@ -169,7 +171,7 @@ pub struct Equations {
     /// Parameter names and default values (indexed by [`Sym::Param`]).
     pub params: Vec<(String, f64)>,
     /// Per parameter: its expression in earlier parameters when it is derived (see [`crate::ir::Param::derived`]).
-    pub derived: Vec<Option<Ex>>,
+    pub derived: Vec<Option<Expr>>,
     /// Input names (indexed by [`Sym::Input`]).
     pub inputs: Vec<String>,
     /// Energy states first, then one integrated state per `var`.
@@ -177,16 +179,16 @@ pub struct Equations {
     /// The number of energy states (the first entries of `states`).
     pub energy_states: usize,
     /// Readable rates: `ẋ_i = rates[i]` in states, inputs, parameters, `t` and intermediates.
-    pub rates: Vec<Ex>,
+    pub rates: Vec<Expr>,
     /// Explicit rates `f(x, u, p, t)`; `None` for a rate that could not be derived (a diagnostic says why).
-    pub f: Vec<Option<Ex>>,
+    pub f: Vec<Option<Expr>>,
     /// Intermediates in dependency order.
     pub intermediates: Vec<Intermediate>,
     /// Names of the bond variables as intermediates (indexed by [`Sym::Var`]).
     pub var_names: Vec<String>,
     pub outputs: Vec<OutputEq>,
     /// Declared coordinates, explicit in the states (linear, checked), with their names.
-    pub coords: Option<Vec<(String, Ex)>>,
+    pub coords: Option<Vec<(String, Expr)>>,
     /// Stored energy, dissipated and supplied power of each element.
     pub energy: Vec<EnergyTerm>,
     /// The inertia matrices of the I-fields: for the states of a block, `f` and `rates` hold the generalised
@@ -239,15 +241,23 @@ impl Equations {
         }
     }
 
+    /// The printable name of a symbol of the engine: the name of the stage's symbol it is, else its own.
+    pub fn symbol_name(&self, s: &crate::symbolic::Symbol) -> String {
+        match Sym::of(s) {
+            Some(t) => self.sym_name(t),
+            None => s.name().to_string(),
+        }
+    }
+
     /// The explicit outputs with the references to earlier outputs ([`Sym::Output`]) substituted, each in
     /// states, inputs, parameters, `t` and tears only (`None` where an output was not derived). A chain of outputs
     /// defined through each other grows here with every level; evaluating the outputs in order does not.
-    pub fn outputs_inlined(&self) -> Vec<Option<Ex>> {
-        let mut done: Vec<Option<Ex>> = Vec::with_capacity(self.outputs.len());
+    pub fn outputs_inlined(&self) -> Vec<Option<Expr>> {
+        let mut done: Vec<Option<Expr>> = Vec::with_capacity(self.outputs.len());
         for o in &self.outputs {
             let e = o.explicit.as_ref().and_then(|e| {
                 let mut missing = false;
-                let v = sym::subst(e, &mut |s| match s {
+                let v = symbols::subst(e, &mut |s| match s {
                     Sym::Output(j) => {
                         let r = done.get(j).cloned().flatten();
                         missing |= r.is_none();
@@ -273,33 +283,6 @@ fn with_span(d: Diagnostic, span: Option<&crate::span::Span>, label: &str) -> Di
         Some(s) => d.with_primary(*s, label),
         None => d,
     }
-}
-
-/// Derives the state equations of `model` with the causality `causality`.
-///
-/// Returns the equations (as complete as possible) and the findings; an error diagnostic means some rate or output
-/// is missing (`None` in [`Equations::f`] or [`OutputEq::explicit`]).
-pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnostic>) {
-    // Substitution and the expression functions recurse along dependency chains and expression depth. They run on
-    // a thread with a large stack (reserved, not committed) so that long chains of elements end in the resolver's
-    // depth limit (a diagnostic) rather than in a stack overflow.
-    const STACK: usize = 512 << 20;
-    std::thread::scope(|scope| {
-        match std::thread::Builder::new()
-            .name("bgc-equations".into())
-            .stack_size(STACK)
-            .spawn_scoped(scope, || derive_on_this_thread(model, causality))
-        {
-            Ok(handle) => handle.join().unwrap_or_else(|_| {
-                let d = Diagnostic::error(
-                    codes::UNSUPPORTED,
-                    format!("the equations of `{}` could not be derived", model.name),
-                );
-                (empty_equations(model), vec![d])
-            }),
-            Err(_) => derive_on_this_thread(model, causality),
-        }
-    })
 }
 
 fn empty_equations(model: &Model) -> Equations {
@@ -328,7 +311,11 @@ fn empty_equations(model: &Model) -> Equations {
     }
 }
 
-fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnostic>) {
+/// Derives the state equations of `model` with the causality `causality`.
+///
+/// Returns the equations (as complete as possible) and the findings; an error diagnostic means some rate or output
+/// is missing (`None` in [`Equations::f`] or [`OutputEq::explicit`]).
+pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnostic>) {
     let mut diags = Vec::new();
     let mut eqs = empty_equations(model);
     if !causality.consistent {
@@ -380,7 +367,7 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
                     &format!("the rate of state `{}`", built.states[i].name),
                 ));
                 rate_ok[i] = false;
-                implicit.push(Ex::zero());
+                implicit.push(Expr::zero());
             }
         }
     }
@@ -448,7 +435,7 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
         .copied()
         .chain(kinematic_mass.iter().flat_map(|b| b.states.iter().copied()))
         .collect();
-    let needs_mass_rate = |e: &Ex| mass_states.iter().any(|&j| e.contains(Sym::StateDot(j)));
+    let needs_mass_rate = |e: &Expr| mass_states.iter().any(|&j| e.contains(Sym::StateDot(j)));
     if implicit
         .iter()
         .any(|e| field_states.iter().any(|&j| e.contains(Sym::StateDot(j))))
@@ -472,8 +459,8 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
         .iter()
         .flat_map(|b| b.states.iter().copied())
         .collect();
-    let rate_of = |e: &Ex| {
-        sym::subst(e, &mut |s| match s {
+    let rate_of = |e: &Expr| {
+        symbols::subst(e, &mut |s| match s {
             Sym::StateDot(j) if kinematic_rows.contains(&j) => None,
             Sym::StateDot(j) => solved.get(j).cloned(),
             _ => None,
@@ -498,13 +485,13 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
                 diags.push(with_span(d, model.spans.outputs.get(k), "this output"));
                 eqs.outputs.push(OutputEq {
                     name: out.name.clone(),
-                    value: Ex::zero(),
+                    value: Expr::zero(),
                     explicit: None,
                 });
                 continue;
             }
         };
-        let underived = |e: &Ex| {
+        let underived = |e: &Expr| {
             e.any_sym(&|s| matches!(s, Sym::Output(j) if eqs.outputs.get(j).is_none_or(|o| o.explicit.is_none())))
         };
         let explicit = match resolver.expr(&value) {
@@ -595,7 +582,7 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
     }
 
     // Readable forms.
-    let output_values: Vec<Ex> = eqs.outputs.iter().map(|o| o.value.clone()).collect();
+    let output_values: Vec<Expr> = eqs.outputs.iter().map(|o| o.value.clone()).collect();
     let mut taken = naming::user_names(model);
     for s in &built.states {
         taken.reserve(&s.name);
@@ -634,7 +621,7 @@ fn derive_on_this_thread(model: &Model, causality: &Causality) -> (Equations, Ve
 
 /// The rates to show: the readable rate when it needs no solve, the solved explicit rate for rates coupled through
 /// derivative causality.
-fn resolver_rates(built: &build::Built, solved: &[Ex], implicit: &[Ex]) -> Vec<Ex> {
+fn resolver_rates(built: &build::Built, solved: &[Expr], implicit: &[Expr]) -> Vec<Expr> {
     let coupled = solve::rates_appearing(implicit);
     if coupled.is_empty() {
         // No derivative causality: every rate is readable as built.
@@ -642,48 +629,16 @@ fn resolver_rates(built: &build::Built, solved: &[Ex], implicit: &[Ex]) -> Vec<E
     }
     // The coupled rates in intermediates: inline the intermediates that lead to a derivative-causality output,
     // drop those outputs (their ẋ terms are on the left-hand side), and solve the same block.
-    let mut leads = vec![None::<bool>; built.defs.len()];
-    fn lead(built: &build::Built, v: usize, memo: &mut [Option<bool>], depth: usize) -> bool {
-        if let Some(known) = memo.get(v).copied().flatten() {
-            return known;
-        }
-        let result = match built.defs.get(v).and_then(Option::as_ref) {
-            Some(build::Def::Rate(_)) => true,
-            Some(build::Def::Plain(e)) if depth < 10_000 => {
-                let mut vars = Vec::new();
-                e.for_each_sym(&mut |s| {
-                    if let Sym::Var(w) = s {
-                        vars.push(w)
-                    }
-                });
-                if let Some(slot) = memo.get_mut(v) {
-                    // A loop back to `v` does not lead anywhere new.
-                    *slot = Some(false);
-                }
-                vars.into_iter().any(|w| lead(built, w, memo, depth + 1))
-            }
-            _ => false,
-        };
-        if let Some(slot) = memo.get_mut(v) {
-            *slot = Some(result);
-        }
-        result
-    }
-    fn inline(built: &build::Built, e: &Ex, memo: &mut [Option<bool>], depth: usize) -> Ex {
-        sym::subst(e, &mut |s| match s {
-            Sym::Var(v) if depth < 10_000 && lead(built, v, memo, 0) => {
-                match built.defs.get(v).and_then(Option::as_ref) {
-                    Some(build::Def::Plain(d)) => Some(inline(built, d, memo, depth + 1)),
-                    _ => Some(Ex::zero()),
-                }
-            }
-            _ => None,
-        })
-    }
-    let f0: Vec<Ex> = built
+    let inlined = inline_leading(built);
+    let f0: Vec<Expr> = built
         .rates
         .iter()
-        .map(|r| inline(built, r, &mut leads, 0))
+        .map(|r| {
+            symbols::subst(r, &mut |s| match s {
+                Sym::Var(v) => inlined.get(v).cloned().flatten(),
+                _ => None,
+            })
+        })
         .collect();
     let readable = solve::solve_rates_with(implicit, Some(&f0)).unwrap_or_else(|_| solved.to_vec());
     built
@@ -698,6 +653,69 @@ fn resolver_rates(built: &build::Built, solved: &[Ex], implicit: &[Ex]) -> Vec<E
             }
         })
         .collect()
+}
+
+/// Per bond variable that leads to the output of a storage in derivative causality: its definition with every such
+/// variable inlined (and those outputs, whose `ẋ` terms are on the left-hand side, as zero). One depth-first walk
+/// on an explicit stack; a variable met again on its own path (an algebraic loop) is left as it is there.
+fn inline_leading(built: &build::Built) -> Vec<Option<Expr>> {
+    let n = built.defs.len();
+    let deps = |v: usize| -> Vec<usize> {
+        match built.defs.get(v).and_then(Option::as_ref) {
+            Some(build::Def::Plain(e)) => e
+                .syms()
+                .into_iter()
+                .filter_map(|s| match s {
+                    Sym::Var(w) => Some(w),
+                    _ => None,
+                })
+                .collect(),
+            _ => Vec::new(),
+        }
+    };
+    // `leads[v]`: `None` unvisited, `Some(false)` on the path or leading nowhere, `Some(true)` leading.
+    let mut leads: Vec<Option<bool>> = vec![None; n];
+    let mut inlined: Vec<Option<Expr>> = vec![None; n];
+    for root in 0..n {
+        if leads[root].is_some() {
+            continue;
+        }
+        leads[root] = Some(false);
+        let mut stack = vec![(root, deps(root), 0usize)];
+        while let Some((v, ds, next)) = stack.last_mut() {
+            if let Some(&w) = ds.get(*next) {
+                *next += 1;
+                if leads.get(w).is_some_and(Option::is_none) {
+                    leads[w] = Some(false);
+                    let dw = deps(w);
+                    stack.push((w, dw, 0));
+                }
+                continue;
+            }
+            let v = *v;
+            let ds = std::mem::take(ds);
+            stack.pop();
+            let (lead, value) = match built.defs.get(v).and_then(Option::as_ref) {
+                Some(build::Def::Rate(_)) => (true, Expr::zero()),
+                Some(build::Def::Plain(e)) => {
+                    let lead = ds
+                        .iter()
+                        .any(|&w| leads.get(w).copied().flatten() == Some(true));
+                    let value = symbols::subst(e, &mut |s| match s {
+                        Sym::Var(w) => inlined.get(w).cloned().flatten(),
+                        _ => None,
+                    });
+                    (lead, value)
+                }
+                None => (false, Expr::zero()),
+            };
+            leads[v] = Some(lead);
+            if lead {
+                inlined[v] = Some(value);
+            }
+        }
+    }
+    inlined
 }
 
 fn state_span<'m>(model: &'m Model, s: &StateSpec) -> Option<&'m crate::span::Span> {
@@ -765,23 +783,19 @@ fn resolve_diag(model: &Model, built: &build::Built, e: &ResolveError, what: &st
             definer_span(*v),
             "this storage",
         ),
-        ResolveError::TooDeep => Diagnostic::error(
-            codes::UNSUPPORTED,
-            format!("cannot derive {what}: its chain of dependencies is too long"),
-        ),
     }
 }
 
 /// The name of a declared coordinate: a `var`'s name, `f_x`, `p_x`, `q_x`, or `z<k>`.
-pub(crate) fn coord_name(model: &Model, e: &Expr, k: usize) -> String {
+pub(crate) fn coord_name(model: &Model, e: &IrExpr, k: usize) -> String {
     use crate::ir::Target;
     let node = |n: NodeIndex| model.graph.node_weight(n).map(|w| build::sanitize(&w.name));
     let name = match e {
-        Expr::Var(v) => model.vars.get(*v).map(|v| build::sanitize(&v.name)),
-        Expr::Flow(Target::Node(n)) => node(*n).map(|s| format!("f_{s}")),
-        Expr::Effort(Target::Node(n)) => node(*n).map(|s| format!("e_{s}")),
-        Expr::Momentum(n) => node(*n).map(|s| format!("p_{s}")),
-        Expr::Displacement(n) => node(*n).map(|s| format!("q_{s}")),
+        IrExpr::Var(v) => model.vars.get(*v).map(|v| build::sanitize(&v.name)),
+        IrExpr::Flow(Target::Node(n)) => node(*n).map(|s| format!("f_{s}")),
+        IrExpr::Effort(Target::Node(n)) => node(*n).map(|s| format!("e_{s}")),
+        IrExpr::Momentum(n) => node(*n).map(|s| format!("p_{s}")),
+        IrExpr::Displacement(n) => node(*n).map(|s| format!("q_{s}")),
         _ => None,
     };
     name.unwrap_or_else(|| format!("z{k}"))

@@ -6,24 +6,25 @@
 
 use super::dense::{self, Mat};
 use super::linear::{LinearError, NumericStateSpace, check_len as check};
-use super::sym::{self, Ex, Sym};
+use super::symbols::{self, Sym, SymExt};
 use super::{Equations, MassBlock};
+use crate::symbolic::Expr;
 
 /// Evaluates `e`, naming `what` in errors.
 fn value_of(
     eqs: &Equations,
-    e: &Ex,
+    e: &Expr,
     what: &dyn Fn() -> String,
     value: &dyn Fn(Sym) -> Option<f64>,
 ) -> Result<f64, LinearError> {
-    let v = sym::eval(e, value).map_err(|err| match err {
-        sym::EvalError::Unbound(s) => LinearError::Unbound {
+    let v = symbols::eval(e, value).map_err(|err| match err {
+        symbols::EvalError::Unbound(s) => LinearError::Unbound {
             what: what(),
             symbol: eqs.sym_name(s),
         },
-        sym::EvalError::Arity(f) => LinearError::NotDifferentiable {
+        symbols::EvalError::Foreign(f) => LinearError::Unbound {
             what: what(),
-            func: f.name(),
+            symbol: f,
         },
     })?;
     if v.is_finite() {
@@ -75,7 +76,7 @@ impl Equations {
             let derived = self.derived.get(i).and_then(Option::as_ref);
             let v = match (given.get(i).copied().flatten(), derived) {
                 (Some(v), _) => v,
-                (None, Some(e)) => sym::eval(e, &|s| match s {
+                (None, Some(e)) => symbols::eval(e, &|s| match s {
                     Sym::Param(j) => values.get(j).copied(),
                     _ => None,
                 })
@@ -263,13 +264,12 @@ pub(crate) fn correct_mass_rows(
                     if !mij.contains(Sym::State(k)) {
                         continue;
                     }
-                    let d =
-                        sym::diff(mij, Sym::State(k)).map_err(|sym::NotDifferentiable(f)| {
-                            LinearError::NotDifferentiable {
-                                what: format!("M_{}[{},{}]", block.element, i + 1, j + 1),
-                                func: f.name(),
-                            }
-                        })?;
+                    let d = symbols::diff(mij, Sym::State(k)).map_err(
+                        |symbols::NotDifferentiable(f)| LinearError::NotDifferentiable {
+                            what: format!("M_{}[{},{}]", block.element, i + 1, j + 1),
+                            func: f.name(),
+                        },
+                    )?;
                     let what = || format!("∂M_{}[{},{}]/∂x", block.element, i + 1, j + 1);
                     *slot -= value_of(eqs, &d, &what, value)? * xj;
                 }

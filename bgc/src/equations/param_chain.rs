@@ -9,13 +9,13 @@
 //!
 //! [`ParamChain`] holds `dp_j/dp_c` for every parameter `j` as an expression of the parameters (built in parameter
 //! order: a derived parameter refers to earlier ones only), and [`ParamChain::jacobian`] applies it to the partial
-//! derivatives of expressions of the shared engine [`crate::symbolic`] (converted by [`super::to_symbolic`]). The
+//! derivatives of the stage's expressions (those of the shared engine [`crate::symbolic`]). The
 //! derivatives are partial in everything else: states, inputs, time and the tears of nonlinear loops stay fixed;
 //! the callers add the loops' and the mass matrices' contributions by the implicit function theorem.
 
 use super::Equations;
-use super::bridge::to_symbolic;
 use super::linear::LinearError;
+use super::symbols::Sym;
 use crate::symbolic::{Expr, Symbol};
 
 /// `dp_j/dp_c` for every parameter `j` and chosen parameter `c`.
@@ -47,10 +47,8 @@ impl ParamChain {
                 got: bad + 1,
             });
         }
-        let symbols: Vec<Symbol> = eqs
-            .params
-            .iter()
-            .map(|p| Symbol::param(p.0.as_str()))
+        let symbols: Vec<Symbol> = (0..eqs.params.len())
+            .map(|j| Sym::Param(j).symbol())
             .collect();
         let zeros = || vec![Expr::zero(); columns.len()];
         let mut links: Vec<Vec<Expr>> = Vec::with_capacity(n);
@@ -66,9 +64,7 @@ impl ParamChain {
                 match eqs.derived.get(j).and_then(Option::as_ref) {
                     None => zeros(),
                     Some(def) => {
-                        let g = to_symbolic(eqs, def).ok_or_else(|| LinearError::Incomplete {
-                            what: format!("the definition of parameter `{}`", eqs.params[j].0),
-                        })?;
+                        let g = def.clone();
                         // A definition refers to earlier parameters only, whose links are known.
                         combine(
                             &Expr::sparse_jacobian(&[g], &symbols[..j]),

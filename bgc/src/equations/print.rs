@@ -7,13 +7,13 @@
 
 use super::build::{Built, Def};
 use super::naming::UniqueNames;
-use super::sym::{self, Ex, Sym};
+use super::symbols::{self, Sym, SymExt};
 use super::{Equations, Intermediate, StateKind};
-use crate::ir::Func;
+use crate::symbolic::{Expr, Symbol, to_latex_with, to_text_with};
 use serde_json::{Value, json};
 
 pub(crate) struct Readable {
-    pub rates: Vec<Ex>,
+    pub rates: Vec<Expr>,
     pub intermediates: Vec<Intermediate>,
     /// Per bond variable: the printed name of its representative.
     pub names: Vec<String>,
@@ -24,14 +24,14 @@ pub(crate) struct Readable {
 
 impl Readable {
     /// Replaces copies by the variable they copy (a junction's velocity by its state).
-    pub fn alias(&self, e: &Ex) -> Ex {
-        sym::subst(e, &mut |s| match s {
+    pub fn alias(&self, e: &Expr) -> Expr {
+        symbols::subst(e, &mut |s| match s {
             Sym::Var(v) => {
                 self.rep
                     .get(v)
                     .map(|&r| match self.velocity.get(r).copied().flatten() {
-                        Some(k) => Ex::S(Sym::State(k)),
-                        None => Ex::S(Sym::Var(r)),
+                        Some(k) => symbols::leaf(Sym::State(k)),
+                        None => symbols::leaf(Sym::Var(r)),
                     })
             }
             _ => None,
@@ -42,8 +42,8 @@ impl Readable {
 /// `taken` holds the names the intermediates must not take (parameters, inputs, outputs, states).
 pub(crate) fn readable(
     built: &Built,
-    rates: &[Ex],
-    outputs: &[Ex],
+    rates: &[Expr],
+    outputs: &[Expr],
     mut taken: UniqueNames,
 ) -> Readable {
     let n = built.defs.len();
@@ -53,7 +53,10 @@ pub(crate) fn readable(
         // A chain of copies is at most as long as the number of variables.
         for _ in 0..n {
             match built.defs.get(cur).and_then(Option::as_ref) {
-                Some(Def::Plain(Ex::S(Sym::Var(w)))) if *w != cur => cur = *w,
+                Some(Def::Plain(e)) => match e.as_sym() {
+                    Some(Sym::Var(w)) if w != cur => cur = w,
+                    _ => break,
+                },
                 _ => break,
             }
         }
@@ -63,16 +66,21 @@ pub(crate) fn readable(
     let velocity: Vec<Option<usize>> = built
         .defs
         .iter()
-        .map(|d| match d {
-            Some(Def::Plain(Ex::S(Sym::State(k))))
-                if built
-                    .states
-                    .get(*k)
-                    .is_some_and(|s| s.kind == StateKind::Velocity && s.port.is_none()) =>
-            {
-                Some(*k)
+        .map(|d| {
+            match d.as_ref().and_then(|d| match d {
+                Def::Plain(e) => e.as_sym(),
+                Def::Rate(_) => None,
+            }) {
+                Some(Sym::State(k))
+                    if built
+                        .states
+                        .get(k)
+                        .is_some_and(|s| s.kind == StateKind::Velocity && s.port.is_none()) =>
+                {
+                    Some(k)
+                }
+                _ => None,
             }
-            _ => None,
         })
         .collect();
     let mut r = Readable {
@@ -83,7 +91,7 @@ pub(crate) fn readable(
         velocity,
     };
     r.rates = rates.iter().map(|e| r.alias(e)).collect();
-    let defs: Vec<Option<(Ex, bool)>> = built
+    let defs: Vec<Option<(Expr, bool)>> = built
         .defs
         .iter()
         .map(|d| match d {
@@ -95,7 +103,7 @@ pub(crate) fn readable(
     // Depth-first post-order from the roots, on an explicit stack.
     let mut seen = vec![false; n];
     let mut order = Vec::new();
-    let roots: Vec<Ex> = r
+    let roots: Vec<Expr> = r
         .rates
         .iter()
         .cloned()
@@ -109,7 +117,7 @@ pub(crate) fn readable(
             seen[v] = true;
             let mut stack = vec![(
                 v,
-                vars_of(defs[v].as_ref().map(|d| &d.0).unwrap_or(&Ex::zero())),
+                vars_of(defs[v].as_ref().map(|d| &d.0).unwrap_or(&Expr::zero())),
                 0usize,
             )];
             while let Some((node, deps, i)) = stack.last_mut() {
@@ -117,7 +125,7 @@ pub(crate) fn readable(
                     *i += 1;
                     if !seen[w] {
                         seen[w] = true;
-                        let d = vars_of(defs[w].as_ref().map(|d| &d.0).unwrap_or(&Ex::zero()));
+                        let d = vars_of(defs[w].as_ref().map(|d| &d.0).unwrap_or(&Expr::zero()));
                         stack.push((w, d, 0));
                     }
                 } else {
@@ -151,7 +159,7 @@ pub(crate) fn readable(
 }
 
 /// The bond variables of an expression, in first-use order.
-fn vars_of(e: &Ex) -> Vec<usize> {
+fn vars_of(e: &Expr) -> Vec<usize> {
     let mut out = Vec::new();
     e.for_each_sym(&mut |s| {
         if let Sym::Var(v) = s
@@ -168,30 +176,6 @@ fn vars_of(e: &Ex) -> Vec<usize> {
 enum Style {
     Text,
     Latex,
-}
-
-/// Binding strength of what an expression prints as.
-fn precedence(e: &Ex) -> u8 {
-    match e {
-        Ex::Add(_) => 1,
-        Ex::Num(v) if *v < 0.0 => 1,
-        Ex::Mul(fs) if matches!(fs.first(), Some(Ex::Num(c)) if *c < 0.0) => 1,
-        Ex::Mul(_) => 2,
-        Ex::Pow(_, x) if x.num().is_some_and(|v| v < 0.0) => 2,
-        Ex::Pow(..) => 3,
-        _ => 4,
-    }
-}
-
-fn number(v: f64, style: Style) -> String {
-    let s = format!("{v}");
-    if style == Style::Latex
-        && s.len() > 8
-        && let Some((m, e)) = format!("{v:e}").split_once('e')
-    {
-        return format!("{m} \\cdot 10^{{{e}}}");
-    }
-    s
 }
 
 const GREEK: [&str; 24] = [
@@ -232,161 +216,25 @@ fn name_of(eqs: &Equations, s: Sym, style: Style) -> String {
     }
 }
 
-fn wrap(s: String, style: Style) -> String {
+/// Prints `e` with the engine's printers, each symbol named by `eqs`.
+fn expr(eqs: &Equations, e: &Expr, style: Style) -> String {
+    let name = |s: &Symbol| match Sym::of(s) {
+        Some(t) => name_of(eqs, t, style),
+        None => s.name().to_string(),
+    };
     match style {
-        Style::Text => format!("({s})"),
-        Style::Latex => format!("\\left({s}\\right)"),
-    }
-}
-
-/// Prints `e`, in parentheses when it binds less tightly than `min`.
-fn expr_at(eqs: &Equations, e: &Ex, style: Style, min: u8) -> String {
-    let s = expr(eqs, e, style);
-    if precedence(e) < min {
-        wrap(s, style)
-    } else {
-        s
-    }
-}
-
-fn expr(eqs: &Equations, e: &Ex, style: Style) -> String {
-    match e {
-        Ex::Num(v) => number(*v, style),
-        Ex::S(s) => name_of(eqs, *s, style),
-        Ex::Add(ts) => {
-            let mut out = String::new();
-            for (i, t) in ts.iter().enumerate() {
-                let (negative, body) = match t {
-                    Ex::Num(v) if *v < 0.0 => (true, Ex::Num(-v)),
-                    Ex::Mul(fs) if matches!(fs.first(), Some(Ex::Num(c)) if *c < 0.0) => {
-                        (true, sym::neg(t.clone()))
-                    }
-                    _ => (false, t.clone()),
-                };
-                let body = expr_at(eqs, &body, style, 2);
-                match (i, negative) {
-                    (0, false) => out.push_str(&body),
-                    (0, true) => out.push_str(&format!("-{body}")),
-                    (_, false) => out.push_str(&format!(" + {body}")),
-                    (_, true) => out.push_str(&format!(" - {body}")),
-                }
-            }
-            out
-        }
-        Ex::Mul(fs) => {
-            let mut coef = 1.0;
-            let mut num = Vec::new();
-            let mut den = Vec::new();
-            for f in fs {
-                match f {
-                    Ex::Num(v) => coef *= v,
-                    Ex::Pow(b, x) if x.num().is_some_and(|v| v < 0.0) => {
-                        den.push(sym::pow((**b).clone(), Ex::Num(-x.num().unwrap_or(-1.0))))
-                    }
-                    other => num.push(other.clone()),
-                }
-            }
-            let sign = if coef < 0.0 { "-" } else { "" };
-            let coef = coef.abs();
-            let join = |list: &[Ex], min: u8| -> String {
-                let sep = if style == Style::Text { "*" } else { " " };
-                list.iter()
-                    .map(|f| expr_at(eqs, f, style, min))
-                    .collect::<Vec<_>>()
-                    .join(sep)
-            };
-            let mut numerator = join(&num, 3);
-            if coef != 1.0 || num.is_empty() {
-                let c = number(coef, style);
-                numerator = if num.is_empty() {
-                    c
-                } else if style == Style::Text {
-                    format!("{c}*{numerator}")
-                } else {
-                    format!("{c} {numerator}")
-                };
-            }
-            if den.is_empty() {
-                return format!("{sign}{numerator}");
-            }
-            match style {
-                Style::Latex => {
-                    let d = if den.len() == 1 {
-                        expr(eqs, &den[0], style)
-                    } else {
-                        den.iter()
-                            .map(|f| expr_at(eqs, f, style, 3))
-                            .collect::<Vec<_>>()
-                            .join(" ")
-                    };
-                    format!("{sign}\\frac{{{numerator}}}{{{d}}}")
-                }
-                Style::Text => {
-                    let d = if den.len() == 1 {
-                        expr_at(eqs, &den[0], style, 4)
-                    } else {
-                        wrap(join(&den, 3), style)
-                    };
-                    format!("{sign}{numerator}/{d}")
-                }
-            }
-        }
-        Ex::Pow(b, x) => {
-            if let Some(v) = x.num() {
-                if v < 0.0 {
-                    let positive = sym::pow((**b).clone(), Ex::Num(-v));
-                    return match style {
-                        Style::Text => format!("1/{}", expr_at(eqs, &positive, style, 4)),
-                        Style::Latex => format!("\\frac{{1}}{{{}}}", expr(eqs, &positive, style)),
-                    };
-                }
-                if v == 0.5 {
-                    return call(eqs, Func::Sqrt, std::slice::from_ref(b), style);
-                }
-            }
-            let base = expr_at(eqs, b, style, 4);
-            match style {
-                Style::Text => format!("{base}^{}", expr_at(eqs, x, style, 4)),
-                Style::Latex => format!("{base}^{{{}}}", expr(eqs, x, style)),
-            }
-        }
-        Ex::Call(f, args) => call(eqs, *f, args, style),
-    }
-}
-
-fn call(eqs: &Equations, f: Func, args: &[Ex], style: Style) -> String {
-    let list = args
-        .iter()
-        .map(|a| expr(eqs, a, style))
-        .collect::<Vec<_>>()
-        .join(", ");
-    match style {
-        Style::Text => format!("{}({list})", f.name()),
-        Style::Latex => match f {
-            Func::Sqrt => format!("\\sqrt{{{list}}}"),
-            Func::Abs => format!("\\left|{list}\\right|"),
-            Func::Sin
-            | Func::Cos
-            | Func::Tan
-            | Func::Exp
-            | Func::Ln
-            | Func::Tanh
-            | Func::Sinh
-            | Func::Cosh => {
-                format!("\\{}\\left({list}\\right)", f.name())
-            }
-            _ => format!("\\operatorname{{{}}}\\left({list}\\right)", f.name()),
-        },
+        Style::Text => to_text_with(e, &name),
+        Style::Latex => to_latex_with(e, &name),
     }
 }
 
 /// An expression as text, with the symbol names of `eqs`.
-pub fn expr_text(eqs: &Equations, e: &Ex) -> String {
+pub fn expr_text(eqs: &Equations, e: &Expr) -> String {
     expr(eqs, e, Style::Text)
 }
 
 /// An expression in LaTeX.
-pub fn expr_latex(eqs: &Equations, e: &Ex) -> String {
+pub fn expr_latex(eqs: &Equations, e: &Expr) -> String {
     expr(eqs, e, Style::Latex)
 }
 
@@ -587,7 +435,7 @@ pub fn to_latex(eqs: &Equations) -> String {
 
 /// The equations as JSON: readable and explicit forms of every rate and output, as text.
 pub fn to_json(eqs: &Equations) -> Value {
-    let text = |e: &Option<Ex>| e.as_ref().map(|e| expr_text(eqs, e));
+    let text = |e: &Option<Expr>| e.as_ref().map(|e| expr_text(eqs, e));
     json!({
         "model": eqs.model,
         "params": eqs.params.iter().map(|(n, v)| json!({"name": n, "default": v})).collect::<Vec<_>>(),

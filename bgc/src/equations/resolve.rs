@@ -12,8 +12,9 @@
 //!   solve ([`super::tear`]). A nonlinear loop through a storage in derivative causality is refused.
 
 use super::build::{Built, Def};
-use super::sym::{self, Ex, Expander, Sym, add, div, mul};
+use super::symbols::{self, Expander, Sym, SymExt, add, div, mul};
 use crate::ir::Func;
+use crate::symbolic::Expr;
 
 /// Why a variable could not be resolved.
 #[derive(Clone, Debug, PartialEq)]
@@ -29,8 +30,6 @@ pub(crate) enum ResolveError {
     HigherOrder(usize),
     /// A function without a derivative (min, max) under a derivative-causality storage.
     NotDifferentiable(usize, Func),
-    /// The dependency chain is too deep to follow.
-    TooDeep,
 }
 
 #[derive(Clone, Copy, PartialEq)]
@@ -45,18 +44,14 @@ pub(crate) struct Resolver<'a> {
     built: &'a Built,
     nstates: usize,
     ninputs: usize,
-    cache: Vec<Option<Ex>>,
+    cache: Vec<Option<Expr>>,
     mark: Vec<Mark>,
     torn: Vec<bool>,
     /// The torn variables kept implicit, with their residuals `E(Tear(v)) − Tear(v)`, in the order they closed.
-    implicit: Vec<(usize, Ex)>,
-    depth: usize,
+    implicit: Vec<(usize, Expr)>,
     /// Multiplies out the values; it remembers the expansions of earlier values, which later values hold.
     expander: Expander,
 }
-
-/// Dependency chains longer than this are refused rather than overflowing the stack.
-const MAX_DEPTH: usize = 20_000;
 
 impl<'a> Resolver<'a> {
     pub fn new(built: &'a Built, nstates: usize, ninputs: usize) -> Self {
@@ -69,7 +64,6 @@ impl<'a> Resolver<'a> {
             mark: vec![Mark::New; n],
             torn: vec![false; n],
             implicit: Vec::new(),
-            depth: 0,
             expander: Expander::default(),
         }
     }
@@ -84,56 +78,104 @@ impl<'a> Resolver<'a> {
 
     /// The nonlinear loops kept implicit: each torn variable `v` with its residual `r = E − Tear(v)`, `0 = r`, in
     /// states, inputs, parameters, `t` and tear variables (its own and those of other implicit loops).
-    pub fn implicit_loops(&self) -> &[(usize, Ex)] {
+    pub fn implicit_loops(&self) -> &[(usize, Expr)] {
         &self.implicit
     }
 
-    /// The value of bond variable `v`.
-    pub fn var(&mut self, v: usize) -> Result<Ex, ResolveError> {
+    /// The value of bond variable `v`. The variables it depends on are resolved first, depth-first on an explicit
+    /// stack (a chain of elements makes a dependency chain as long as the model, too deep to recurse along).
+    pub fn var(&mut self, v: usize) -> Result<Expr, ResolveError> {
         match self.mark.get(v).copied() {
             None => return Err(ResolveError::Undefined(v)),
             Some(Mark::Done) => return self.cache[v].clone().ok_or(ResolveError::Undefined(v)),
             Some(Mark::Busy) => {
                 self.torn[v] = true;
-                return Ok(Ex::S(Sym::Tear(v)));
+                return Ok(symbols::leaf(Sym::Tear(v)));
             }
             Some(Mark::New) => {}
         }
-        if self.depth > MAX_DEPTH {
-            return Err(ResolveError::TooDeep);
-        }
-        self.depth += 1;
-        self.mark[v] = Mark::Busy;
-        let result = self.compute(v);
-        self.depth -= 1;
-        let value = match result.and_then(|value| self.close_loop(v, value)) {
-            Ok(value) => compact(&mut self.expander, value),
-            Err(e) => {
-                self.forget(v);
-                return Err(e);
+        // Each frame: a variable being computed, the variables its definition reads, and how many are done.
+        let mut stack: Vec<(usize, Vec<usize>, usize)> = vec![self.open(v)];
+        while let Some((w, deps, next)) = stack.last_mut() {
+            let w = *w;
+            if let Some(&d) = deps.get(*next) {
+                *next += 1;
+                match self.mark.get(d).copied() {
+                    None => {
+                        // A variable nothing defines: the whole chain fails.
+                        for (u, _, _) in stack.iter().rev() {
+                            self.forget(*u);
+                        }
+                        return Err(ResolveError::Undefined(d));
+                    }
+                    // A variable on the current path: a loop, torn at `d`.
+                    Some(Mark::Busy) => self.torn[d] = true,
+                    Some(Mark::Done) => {}
+                    Some(Mark::New) => stack.push(self.open(d)),
+                }
+                continue;
             }
+            stack.pop();
+            let value = self
+                .compute(w)
+                .and_then(|value| self.close_loop(w, value))
+                .map(|value| compact(&mut self.expander, value));
+            match value {
+                Ok(value) => {
+                    self.cache[w] = Some(value);
+                    self.mark[w] = Mark::Done;
+                }
+                Err(e) => {
+                    self.forget(w);
+                    for (u, _, _) in stack.iter().rev() {
+                        self.forget(*u);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        self.cache[v].clone().ok_or(ResolveError::Undefined(v))
+    }
+
+    /// Starts computing `v`: marks it busy and lists the variables its definition reads.
+    fn open(&mut self, v: usize) -> (usize, Vec<usize>, usize) {
+        self.mark[v] = Mark::Busy;
+        let deps = match self.built.defs.get(v).and_then(Option::as_ref) {
+            Some(Def::Plain(e) | Def::Rate(e)) => vars_read(e),
+            None => Vec::new(),
         };
-        self.cache[v] = Some(value.clone());
-        self.mark[v] = Mark::Done;
-        Ok(value)
+        (v, deps, 0)
+    }
+
+    /// The value of a variable whose dependencies are resolved: done ones by their value, busy ones (on the path
+    /// of a loop) by their tear.
+    fn resolved(&self, e: &Expr) -> Expr {
+        symbols::subst(e, &mut |s| match s {
+            Sym::Var(w) => match self.mark.get(w) {
+                Some(Mark::Done) => self.cache.get(w).cloned().flatten(),
+                Some(Mark::Busy) => Some(symbols::leaf(Sym::Tear(w))),
+                _ => None,
+            },
+            _ => None,
+        })
     }
 
     /// The value of `v` once computed: unchanged unless a loop was torn at `v`, in which case it is solved exactly
     /// (affine in the tear) or kept implicit (nonlinear).
-    fn close_loop(&mut self, v: usize, value: Ex) -> Result<Ex, ResolveError> {
+    fn close_loop(&mut self, v: usize, value: Expr) -> Result<Expr, ResolveError> {
         if !self.torn[v] {
             return Ok(value);
         }
         let tear = Sym::Tear(v);
-        let Some((a, b)) = sym::affine_in(&value, tear) else {
+        let Some((a, b)) = symbols::affine_in(&value, tear) else {
             if value.any_sym(&|s| matches!(s, Sym::StateDot(_) | Sym::InputDot(_))) {
                 return Err(ResolveError::NonlinearLoop(v));
             }
-            let residual = sym::sub(value, Ex::S(tear));
+            let residual = symbols::sub(value, symbols::leaf(tear));
             self.implicit.push((v, residual));
-            return Ok(Ex::S(tear));
+            return Ok(symbols::leaf(tear));
         };
-        let gain = sym::sub(Ex::one(), a);
+        let gain = symbols::sub(Expr::one(), a);
         if gain.is_zero() {
             return Err(ResolveError::SingularLoop(v));
         }
@@ -141,11 +183,11 @@ impl<'a> Resolver<'a> {
         // Values computed inside the loop, and the residuals of implicit loops inside it, hold the tear: replace it
         // everywhere.
         let expander = &mut self.expander;
-        let mut replace = |e: &mut Ex| {
+        let mut replace = |e: &mut Expr| {
             if e.contains(tear) {
                 *e = compact(
                     expander,
-                    sym::subst(e, &mut |s| (s == tear).then(|| solved.clone())),
+                    symbols::subst(e, &mut |s| (s == tear).then(|| solved.clone())),
                 );
             }
         };
@@ -182,37 +224,28 @@ impl<'a> Resolver<'a> {
         }
     }
 
-    fn compute(&mut self, v: usize) -> Result<Ex, ResolveError> {
+    fn compute(&mut self, v: usize) -> Result<Expr, ResolveError> {
         let built = self.built;
         match built.defs.get(v).and_then(Option::as_ref) {
             None => Err(ResolveError::Undefined(v)),
-            Some(Def::Plain(e)) => self.expr(e),
+            Some(Def::Plain(e)) => Ok(self.resolved(e)),
             Some(Def::Rate(p)) => {
-                let p = self.expr(p)?;
+                let p = self.resolved(p);
                 self.time_derivative(&p, v)
             }
         }
     }
 
     /// Substitutes every bond variable of `e`.
-    pub fn expr(&mut self, e: &Ex) -> Result<Ex, ResolveError> {
-        Ok(match e {
-            Ex::S(Sym::Var(w)) => self.var(*w)?,
-            Ex::Num(_) | Ex::S(_) => e.clone(),
-            Ex::Add(ts) => add(ts.iter().map(|t| self.expr(t)).collect::<Result<_, _>>()?),
-            Ex::Mul(fs) => mul(fs.iter().map(|t| self.expr(t)).collect::<Result<_, _>>()?),
-            Ex::Pow(b, x) => sym::pow(self.expr(b)?, self.expr(x)?),
-            Ex::Call(f, args) => sym::call(
-                *f,
-                args.iter()
-                    .map(|a| self.expr(a))
-                    .collect::<Result<_, _>>()?,
-            ),
-        })
+    pub fn expr(&mut self, e: &Expr) -> Result<Expr, ResolveError> {
+        for w in vars_read(e) {
+            self.var(w)?;
+        }
+        Ok(self.resolved(e))
     }
 
     /// `d/dt e` for `e` in states, inputs, parameters and time.
-    fn time_derivative(&self, e: &Ex, v: usize) -> Result<Ex, ResolveError> {
+    fn time_derivative(&self, e: &Expr, v: usize) -> Result<Expr, ResolveError> {
         if e.any_sym(&|s| {
             matches!(
                 s,
@@ -222,8 +255,8 @@ impl<'a> Resolver<'a> {
             return Err(ResolveError::HigherOrder(v));
         }
         let d = |s: Sym| {
-            sym::diff(e, s)
-                .map_err(|sym::NotDifferentiable(f)| ResolveError::NotDifferentiable(v, f))
+            symbols::diff(e, s)
+                .map_err(|symbols::NotDifferentiable(f)| ResolveError::NotDifferentiable(v, f))
         };
         // The symbols `e` reads, in one walk (not one walk per state of the model), in the order of the sum.
         let mut read = std::collections::BTreeSet::new();
@@ -238,8 +271,8 @@ impl<'a> Resolver<'a> {
         let mut terms = Vec::new();
         for s in read {
             terms.push(match s {
-                Sym::State(i) => mul(vec![d(s)?, Ex::S(Sym::StateDot(i))]),
-                Sym::Input(j) => mul(vec![d(s)?, Ex::S(Sym::InputDot(j))]),
+                Sym::State(i) => mul(vec![d(s)?, symbols::leaf(Sym::StateDot(i))]),
+                Sym::Input(j) => mul(vec![d(s)?, symbols::leaf(Sym::InputDot(j))]),
                 _ => d(s)?,
             });
         }
@@ -247,15 +280,26 @@ impl<'a> Resolver<'a> {
     }
 }
 
+/// The bond variables `e` reads, in the engine's symbol order.
+fn vars_read(e: &Expr) -> Vec<usize> {
+    e.syms()
+        .into_iter()
+        .filter_map(|s| match s {
+            Sym::Var(w) => Some(w),
+            _ => None,
+        })
+        .collect()
+}
+
 /// `e` multiplied out when that makes it no larger. A value is copied into every variable that uses it: in a chain
 /// of algebraic loops each rung's solution `b / (1 − a)` holds the previous ones as nested products of sums, which
 /// grow geometrically; multiplied out, the like terms collect and the size stays that of the model's symbols.
-fn compact(expander: &mut Expander, e: Ex) -> Ex {
+fn compact(expander: &mut Expander, e: Expr) -> Expr {
     let expanded = expander.expand(&e);
     if expanded == e {
         return e;
     }
-    if expanded.key_len() <= e.key_len() {
+    if expanded.node_count() <= e.node_count() {
         expanded
     } else {
         e

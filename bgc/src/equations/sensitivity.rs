@@ -2,7 +2,7 @@
 //! the forward sensitivities of `bgc fit`.
 //!
 //! They are symbolic derivatives of the explicit rates `f` and outputs `h` (in the shared engine
-//! [`crate::symbolic`], after [`super::to_symbolic`]), evaluated at the point. The derivative with respect to a
+//! [`crate::symbolic`]), evaluated at the point. The derivative with respect to a
 //! parameter is total through the derived parameters ([`ParamChain`]). Where the rates are not explicit the
 //! implicit function theorem supplies the rest, so no derivative is taken by differences:
 //! - nonlinear algebraic loops, `0 = r(z, x, u, p, t)` for the tears `z` ([`super::tear`]):
@@ -15,12 +15,11 @@
 //! every step); [`Equations::param_jacobian_at`] is the one-off form.
 
 use super::Equations;
-use super::bridge::{symbol, to_symbolic};
 use super::dense::{self, Mat};
 use super::linear::{LinearError, check_len};
 use super::numeric::point;
 use super::param_chain::ParamChain;
-use super::sym::Sym;
+use super::symbols::Sym;
 use super::tear::solve_all;
 use crate::symbolic::{Compiled, Expr, Symbol};
 
@@ -135,18 +134,18 @@ impl Equations {
             .collect();
         let chain = ParamChain::new(self, free, &pinned)?;
         let states: Vec<Symbol> = (0..self.states.len())
-            .map(|i| symbol(self, Sym::State(i)))
+            .map(|i| Sym::State(i).symbol())
             .collect();
         let symbols: Vec<Symbol> = (0..self.params.len())
             .map(Sym::Param)
-            .map(|s| symbol(self, s))
+            .map(Sym::symbol)
             .chain(states.iter().cloned())
-            .chain((0..self.inputs.len()).map(|i| symbol(self, Sym::Input(i))))
-            .chain(std::iter::once(symbol(self, Sym::Time)))
+            .chain((0..self.inputs.len()).map(|i| Sym::Input(i).symbol()))
+            .chain(std::iter::once(Sym::Time.symbol()))
             .chain(
                 self.tear_blocks
                     .iter()
-                    .flat_map(|b| b.tears.iter().map(|&z| symbol(self, z))),
+                    .flat_map(|b| b.tears.iter().map(|&z| z.symbol())),
             )
             .collect();
         let matrix = |m: Vec<Vec<Expr>>| Matrix::new(m, &symbols);
@@ -227,8 +226,8 @@ impl Equations {
             .at(&self.param_values(given), (x, u, t), Rows::Rates)
     }
 
-    fn convert(&self, e: &super::sym::Ex, what: impl Fn() -> String) -> Result<Expr, LinearError> {
-        to_symbolic(self, e).ok_or_else(|| LinearError::Incomplete { what: what() })
+    fn convert(&self, e: &Expr, _what: impl Fn() -> String) -> Result<Expr, LinearError> {
+        Ok(e.clone())
     }
 
     /// The rates and outputs on the shared engine, converted once ([`super::ModelRows`]): an earlier output read
@@ -271,7 +270,7 @@ impl Equations {
         let mut tears = Vec::new();
         let mut residuals = Vec::new();
         for b in &self.tear_blocks {
-            tears.extend(b.tears.iter().map(|&z| symbol(self, z)));
+            tears.extend(b.tears.iter().map(|&z| z.symbol()));
             for (r, name) in b.residuals.iter().zip(&b.names) {
                 residuals.push(self.convert(r, || format!("the algebraic loop for `{name}`"))?);
             }
@@ -338,7 +337,7 @@ impl Point<'_> {
             .unwrap_or((0, 0));
         LinearError::Unbound {
             what: what(i, j),
-            symbol: s.name().to_string(),
+            symbol: self.eqs.symbol_name(s),
         }
     }
 
@@ -446,7 +445,7 @@ impl Sensitivity<'_> {
         let names = l
             .tears
             .iter()
-            .map(|z| z.name().to_string())
+            .map(|z| eqs.symbol_name(z))
             .collect::<Vec<_>>()
             .join("`, `");
         let what = |_: usize, _: usize| format!("the algebraic loop for `{names}`");

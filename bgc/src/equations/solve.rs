@@ -9,7 +9,8 @@
 // Index loops read like the textbook elimination they implement.
 #![allow(clippy::needless_range_loop)]
 
-use super::sym::{self, Ex, Sym, div, mul};
+use super::symbols::{self, Sym, SymExt, div, mul};
+use crate::symbolic::{Expr, Node};
 
 /// Why the rates could not be solved.
 #[derive(Clone, Debug, PartialEq)]
@@ -23,13 +24,16 @@ pub(crate) enum SolveError {
 }
 
 /// Solves `ẋ = F(x, u, ẋ)` for `ẋ`; returns the explicit rates.
-pub(crate) fn solve_rates(f: &[Ex]) -> Result<Vec<Ex>, SolveError> {
+pub(crate) fn solve_rates(f: &[Expr]) -> Result<Vec<Expr>, SolveError> {
     solve_rates_with(f, None)
 }
 
 /// As [`solve_rates`], with the right-hand sides `F0` of the coupled rows given (in another form of the same
 /// values, such as intermediates) instead of computed from `f`.
-pub(crate) fn solve_rates_with(f: &[Ex], f0_given: Option<&[Ex]>) -> Result<Vec<Ex>, SolveError> {
+pub(crate) fn solve_rates_with(
+    f: &[Expr],
+    f0_given: Option<&[Expr]>,
+) -> Result<Vec<Expr>, SolveError> {
     let n = f.len();
     let coupled = rates_appearing(f);
     if coupled.is_empty() {
@@ -37,27 +41,27 @@ pub(crate) fn solve_rates_with(f: &[Ex], f0_given: Option<&[Ex]>) -> Result<Vec<
     }
     let is_rate = |s: Sym| matches!(s, Sym::StateDot(_));
     // g[i][k] = ∂F_i/∂ẋ_{coupled[k]}, f0 = F with ẋ = 0.
-    let mut g = vec![vec![Ex::zero(); coupled.len()]; n];
+    let mut g = vec![vec![Expr::zero(); coupled.len()]; n];
     let mut f0 = Vec::with_capacity(n);
     for (i, fi) in f.iter().enumerate() {
         for (k, &j) in coupled.iter().enumerate() {
-            let d =
-                sym::diff(fi, Sym::StateDot(j)).map_err(|_| SolveError::NotDifferentiable(i))?;
+            let d = symbols::diff(fi, Sym::StateDot(j))
+                .map_err(|_| SolveError::NotDifferentiable(i))?;
             if d.any_sym(&is_rate) {
                 return Err(SolveError::Nonlinear(i));
             }
             g[i][k] = d;
         }
-        f0.push(sym::subst(fi, &mut |s| is_rate(s).then(Ex::zero)));
+        f0.push(symbols::subst(fi, &mut |s| is_rate(s).then(Expr::zero)));
     }
     // The coupled block: (I - G_cc) ẋ_c = F0_c.
     let m = coupled.len();
-    let mut a: Vec<Vec<Ex>> = (0..m)
+    let mut a: Vec<Vec<Expr>> = (0..m)
         .map(|r| {
             (0..m)
                 .map(|c| {
-                    let identity = if r == c { Ex::one() } else { Ex::zero() };
-                    sym::sub(identity, g[coupled[r]][c].clone())
+                    let identity = if r == c { Expr::one() } else { Expr::zero() };
+                    symbols::sub(identity, g[coupled[r]][c].clone())
                 })
                 .collect()
         })
@@ -66,7 +70,7 @@ pub(crate) fn solve_rates_with(f: &[Ex], f0_given: Option<&[Ex]>) -> Result<Vec<
         Some(given) if given.len() == n => given.to_vec(),
         _ => f0,
     };
-    let mut rhs: Vec<Ex> = coupled.iter().map(|&j| f0[j].clone()).collect();
+    let mut rhs: Vec<Expr> = coupled.iter().map(|&j| f0[j].clone()).collect();
     let xc = gauss(&mut a, &mut rhs).ok_or(SolveError::Singular)?;
     let mut out = Vec::with_capacity(n);
     for i in 0..n {
@@ -77,14 +81,14 @@ pub(crate) fn solve_rates_with(f: &[Ex], f0_given: Option<&[Ex]>) -> Result<Vec<
             for (k, x) in xc.iter().enumerate() {
                 terms.push(mul(vec![g[i][k].clone(), x.clone()]));
             }
-            out.push(sym::add(terms));
+            out.push(symbols::add(terms));
         }
     }
     Ok(out)
 }
 
 /// The rates (generalised forces in the block rows), the block's rows and its matrix `M`.
-pub(crate) type MassForm = (Vec<Ex>, Vec<usize>, Vec<Vec<Ex>>);
+pub(crate) type MassForm = (Vec<Expr>, Vec<usize>, Vec<Vec<Expr>>);
 
 /// The rates of a system with implicit rows (`0 = F_i(x, u, ẋ)` for the velocity states of
 /// [`super::kinematic`]) in the mass-matrix form: rows whose rate is explicit and free of `ẋ` are substituted
@@ -92,7 +96,7 @@ pub(crate) type MassForm = (Vec<Ex>, Vec<usize>, Vec<Vec<Ex>>);
 /// `M ẋ_U = F` with `M_ab = δ_ab − ∂F_a/∂ẋ_b` for an explicit row, `−∂F_a/∂ẋ_b` for an implicit one, and
 /// `F = F(ẋ = 0)`. No symbolic division: the consumers solve `M` numerically, so a pivot that vanishes at some
 /// configuration is never divided by. Returns the rates (the generalised forces in the rows `U`), `U` and `M`.
-pub(crate) fn mass_form(f: &[Ex], implicit_rows: &[bool]) -> Result<MassForm, SolveError> {
+pub(crate) fn mass_form(f: &[Expr], implicit_rows: &[bool]) -> Result<MassForm, SolveError> {
     let n = f.len();
     let is_rate = |s: Sym| matches!(s, Sym::StateDot(_));
     let implicit = |i: usize| implicit_rows.get(i).copied().unwrap_or(false);
@@ -107,11 +111,11 @@ pub(crate) fn mass_form(f: &[Ex], implicit_rows: &[bool]) -> Result<MassForm, So
             break;
         }
         fresh.iter().for_each(|&i| known[i] = true);
-        let values: Vec<Option<Ex>> = (0..n)
+        let values: Vec<Option<Expr>> = (0..n)
             .map(|i| fresh.contains(&i).then(|| f[i].clone()))
             .collect();
         for fi in f.iter_mut().filter(|fi| fi.any_sym(&is_rate)) {
-            *fi = sym::subst(fi, &mut |s| match s {
+            *fi = symbols::subst(fi, &mut |s| match s {
                 Sym::StateDot(j) => values.get(j).cloned().flatten(),
                 _ => None,
             });
@@ -134,33 +138,33 @@ pub(crate) fn mass_form(f: &[Ex], implicit_rows: &[bool]) -> Result<MassForm, So
     for &i in &rows {
         let mut row = Vec::with_capacity(rows.len());
         for &j in &rows {
-            let d =
-                sym::diff(&f[i], Sym::StateDot(j)).map_err(|_| SolveError::NotDifferentiable(i))?;
+            let d = symbols::diff(&f[i], Sym::StateDot(j))
+                .map_err(|_| SolveError::NotDifferentiable(i))?;
             if d.any_sym(&is_rate) {
                 return Err(SolveError::Nonlinear(i));
             }
             let identity = if i == j && !implicit(i) {
-                Ex::one()
+                Expr::one()
             } else {
-                Ex::zero()
+                Expr::zero()
             };
             // −d term by term, so that `M + m` prints as such rather than `-(-M - m)`.
-            let minus_d = match d {
-                Ex::Add(terms) => sym::add(terms.into_iter().map(sym::neg).collect()),
-                other => sym::neg(other),
+            let minus_d = match d.node() {
+                Node::Add(terms) => symbols::add(terms.iter().cloned().map(symbols::neg).collect()),
+                _ => symbols::neg(d),
             };
-            row.push(sym::add(vec![identity, minus_d]));
+            row.push(symbols::add(vec![identity, minus_d]));
         }
         matrix.push(row);
     }
     for &i in &rows {
-        f[i] = sym::subst(&f[i], &mut |s| is_rate(s).then(Ex::zero));
+        f[i] = symbols::subst(&f[i], &mut |s| is_rate(s).then(Expr::zero));
     }
     Ok((f, rows, matrix))
 }
 
 /// The states whose rate `ẋ_j` appears in some of `f`, in increasing order (one walk over each expression).
-pub(crate) fn rates_appearing(f: &[Ex]) -> Vec<usize> {
+pub(crate) fn rates_appearing(f: &[Expr]) -> Vec<usize> {
     let mut seen = std::collections::BTreeSet::new();
     for fi in f {
         fi.for_each_sym(&mut |s| {
@@ -174,14 +178,14 @@ pub(crate) fn rates_appearing(f: &[Ex]) -> Vec<usize> {
 
 /// Symbolic Gaussian elimination of `a x = b`; pivots on numeric entries first, then on any structurally non-zero
 /// entry. `None` when a column has no non-zero pivot.
-pub(crate) fn gauss(a: &mut [Vec<Ex>], b: &mut [Ex]) -> Option<Vec<Ex>> {
+pub(crate) fn gauss(a: &mut [Vec<Expr>], b: &mut [Expr]) -> Option<Vec<Expr>> {
     let m = b.len();
     for col in 0..m {
         let candidates = (col..m).filter(|&r| !a[r][col].is_zero());
         let pivot = candidates
             .clone()
             .find(|&r| a[r][col].num().is_some())
-            .or_else(|| candidates.min_by_key(|&r| a[r][col].key_len()))?;
+            .or_else(|| candidates.min_by_key(|&r| a[r][col].node_count()))?;
         a.swap(col, pivot);
         b.swap(col, pivot);
         for r in col + 1..m {
@@ -190,25 +194,25 @@ pub(crate) fn gauss(a: &mut [Vec<Ex>], b: &mut [Ex]) -> Option<Vec<Ex>> {
             }
             let factor = div(a[r][col].clone(), a[col][col].clone());
             for c in col..m {
-                let v = sym::sub(
+                let v = symbols::sub(
                     a[r][c].clone(),
                     mul(vec![factor.clone(), a[col][c].clone()]),
                 );
                 a[r][c] = v;
             }
-            b[r] = sym::sub(b[r].clone(), mul(vec![factor, b[col].clone()]));
+            b[r] = symbols::sub(b[r].clone(), mul(vec![factor, b[col].clone()]));
         }
     }
-    let mut x = vec![Ex::zero(); m];
+    let mut x = vec![Expr::zero(); m];
     for r in (0..m).rev() {
         let mut acc = vec![b[r].clone()];
         for c in r + 1..m {
-            acc.push(sym::neg(mul(vec![a[r][c].clone(), x[c].clone()])));
+            acc.push(symbols::neg(mul(vec![a[r][c].clone(), x[c].clone()])));
         }
         if a[r][r].is_zero() {
             return None;
         }
-        x[r] = over_common_denominator(sym::add(acc), a[r][r].clone());
+        x[r] = over_common_denominator(symbols::add(acc), a[r][r].clone());
     }
     Some(x)
 }
@@ -216,17 +220,23 @@ pub(crate) fn gauss(a: &mut [Vec<Ex>], b: &mut [Ex]) -> Option<Vec<Ex>> {
 /// `num / den`, with the reciprocals in the terms of `den` cleared first: `u / (1 + J_2/J_1)` becomes
 /// `J_1 u / (J_1 + J_2)`, which shows the merged inertia. A denominator that is a product with one sum in it is
 /// handled through that sum.
-fn over_common_denominator(num: Ex, den: Ex) -> Ex {
-    let den = sym::expand(&den);
-    let (num, terms) = match &den {
-        Ex::Add(terms) => (num, terms.clone()),
-        Ex::Mul(fs) if fs.iter().filter(|f| matches!(f, Ex::Add(_))).count() == 1 => {
+fn over_common_denominator(num: Expr, den: Expr) -> Expr {
+    let den = symbols::expand(&den);
+    let (num, terms) = match den.node() {
+        Node::Add(terms) => (num, terms.clone()),
+        Node::Mul(fs)
+            if fs
+                .iter()
+                .filter(|f| matches!(f.node(), Node::Add(_)))
+                .count()
+                == 1 =>
+        {
             let mut others = Vec::new();
             let mut sum = Vec::new();
             for f in fs {
-                match f {
-                    Ex::Add(ts) => sum = ts.clone(),
-                    other => others.push(other.clone()),
+                match f.node() {
+                    Node::Add(ts) => sum = ts.clone(),
+                    _ => others.push(f.clone()),
                 }
             }
             (div(num, mul(others)), sum)
@@ -234,31 +244,31 @@ fn over_common_denominator(num: Ex, den: Ex) -> Ex {
         _ => return div(num, den),
     };
     // Each base with the largest power it is divided by in any term.
-    let mut clear: Vec<(Ex, f64)> = Vec::new();
+    let mut clear: Vec<(Expr, f64)> = Vec::new();
     for t in &terms {
-        let factors: Vec<&Ex> = match t {
-            Ex::Mul(fs) => fs.iter().collect(),
-            other => vec![other],
+        let factors: Vec<&Expr> = match t.node() {
+            Node::Mul(fs) => fs.iter().collect(),
+            _ => vec![t],
         };
         for f in factors {
-            if let Ex::Pow(b, x) = f
+            if let Node::Pow(b, x) = f.node()
                 && let Some(v) = x.num().filter(|v| *v < 0.0)
             {
-                match clear.iter_mut().find(|(c, _)| c == &**b) {
+                match clear.iter_mut().find(|(c, _)| c == b) {
                     Some(entry) => entry.1 = entry.1.max(-v),
-                    None => clear.push(((**b).clone(), -v)),
+                    None => clear.push((b.clone(), -v)),
                 }
             }
         }
     }
     if clear.is_empty() {
-        return div(num, sym::add(terms));
+        return div(num, symbols::add(terms));
     }
     let l = mul(clear
         .into_iter()
-        .map(|(b, k)| sym::pow(b, Ex::Num(k)))
+        .map(|(b, k)| symbols::pow(b, symbols::num(k)))
         .collect());
-    let den = sym::add(
+    let den = symbols::add(
         terms
             .iter()
             .map(|t| mul(vec![t.clone(), l.clone()]))
@@ -271,19 +281,19 @@ fn over_common_denominator(num: Ex, den: Ex) -> Ex {
 mod tests {
     use super::*;
 
-    fn p(i: usize) -> Ex {
-        Ex::S(Sym::Param(i))
+    fn p(i: usize) -> Expr {
+        symbols::leaf(Sym::Param(i))
     }
 
     #[test]
     fn merged_inertia() {
         // ṗ = u - (J2/J1) ṗ  =>  ṗ = u / (1 + J2/J1)
-        let f = vec![sym::sub(
-            Ex::S(Sym::Input(0)),
-            mul(vec![div(p(1), p(0)), Ex::S(Sym::StateDot(0))]),
+        let f = vec![symbols::sub(
+            symbols::leaf(Sym::Input(0)),
+            mul(vec![div(p(1), p(0)), symbols::leaf(Sym::StateDot(0))]),
         )];
         let x = solve_rates(&f).unwrap_or_default();
-        let v = sym::eval(&x[0], &|s| match s {
+        let v = symbols::eval(&x[0], &|s| match s {
             Sym::Param(0) => Some(2.0),
             Sym::Param(1) => Some(3.0),
             Sym::Input(0) => Some(10.0),
@@ -297,13 +307,13 @@ mod tests {
     fn two_by_two() {
         // ẋ0 = 1 + ẋ1 / 2, ẋ1 = 2 + ẋ0 / 4  =>  ẋ0 = (1 + 1)/(1 - 1/8) = 16/7, ẋ1 = 2 + 4/7 = 18/7
         let f = vec![
-            sym::add(vec![
-                Ex::one(),
-                mul(vec![Ex::Num(0.5), Ex::S(Sym::StateDot(1))]),
+            symbols::add(vec![
+                Expr::one(),
+                mul(vec![symbols::num(0.5), symbols::leaf(Sym::StateDot(1))]),
             ]),
-            sym::add(vec![
-                Ex::Num(2.0),
-                mul(vec![Ex::Num(0.25), Ex::S(Sym::StateDot(0))]),
+            symbols::add(vec![
+                symbols::num(2.0),
+                mul(vec![symbols::num(0.25), symbols::leaf(Sym::StateDot(0))]),
             ]),
         ];
         let x = solve_rates(&f).unwrap_or_default();

@@ -12,9 +12,8 @@
 //! or the symbolic elimination of a mass matrix) are small: they take the dense path and are converted.
 
 use super::Equations;
-use super::bridge::to_symbolic;
 use super::linear::{self, LinearError, StateSelection};
-use super::sym::{Ex, Sym};
+use super::symbols::{Sym, SymExt};
 use crate::ir::Func;
 use crate::symbolic::{Expr, Symbol, SymbolKind};
 use std::collections::{BTreeSet, HashMap};
@@ -119,39 +118,18 @@ impl ModelRows {
     /// Converts the rates and outputs once. An output that reads an earlier output ([`Sym::Output`]) gets that
     /// output's expression substituted: one shared node however often it is read.
     pub fn new(eqs: &Equations) -> ModelRows {
-        let f = eqs
-            .f
-            .iter()
-            .map(|e| e.as_ref().and_then(|e| to_symbolic(eqs, e)))
-            .collect();
-        let position: HashMap<&str, usize> = eqs
-            .outputs
-            .iter()
-            .enumerate()
-            .map(|(k, o)| (o.name.as_str(), k))
-            .collect();
+        let f = eqs.f.to_vec();
         let mut h: Vec<Option<Expr>> = Vec::with_capacity(eqs.outputs.len());
         for o in &eqs.outputs {
-            let reads_missing = |e: &Ex| {
+            let reads_missing = |e: &Expr| {
                 e.any_sym(&|s| matches!(s, Sym::Output(j) if h.get(j).is_none_or(Option::is_none)))
             };
-            let value = o
-                .explicit
-                .as_ref()
-                .filter(|e| !reads_missing(e))
-                .and_then(|e| to_symbolic(eqs, e))
-                .map(|e| {
-                    e.substitute_with(&|s: &Symbol| {
-                        if s.kind() != SymbolKind::Output {
-                            return None;
-                        }
-                        position
-                            .get(s.name())
-                            .and_then(|&j| h.get(j))
-                            .cloned()
-                            .flatten()
-                    })
-                });
+            let value = o.explicit.as_ref().filter(|e| !reads_missing(e)).map(|e| {
+                e.substitute_with(&|s: &Symbol| match Sym::of(s) {
+                    Some(Sym::Output(j)) => h.get(j).cloned().flatten(),
+                    _ => None,
+                })
+            });
             h.push(value);
         }
         ModelRows { f, h }
@@ -169,11 +147,9 @@ pub fn state_selection(eqs: &Equations, rows: &ModelRows) -> StateSelection {
 
 /// The state and input symbols of the selection, as the rows name them.
 fn variables(eqs: &Equations, n: usize) -> (Vec<Symbol>, Vec<Symbol>) {
-    let xs = (0..n)
-        .map(|i| Symbol::state(eqs.sym_name(Sym::State(i))))
-        .collect();
+    let xs = (0..n).map(|i| Sym::State(i).symbol()).collect();
     let us = (0..eqs.inputs.len())
-        .map(|i| Symbol::input(eqs.sym_name(Sym::Input(i))))
+        .map(|i| Sym::Input(i).symbol())
         .collect();
     (xs, us)
 }
@@ -221,7 +197,7 @@ fn selected(
     }
     if n < eqs.states.len() {
         let left_out: HashMap<Symbol, usize> = (n..eqs.states.len())
-            .map(|j| (Symbol::state(eqs.sym_name(Sym::State(j))), j))
+            .map(|j| (Sym::State(j).symbol(), j))
             .collect();
         let first_left_out = |e: &Expr| {
             e.free_symbols()
@@ -293,22 +269,19 @@ pub fn sparse_jacobians(
 }
 
 /// Dense Jacobians of the equations stage, converted.
-fn from_dense(eqs: &Equations, j: &linear::Jacobians) -> Result<SparseJacobians, LinearError> {
-    let convert = |m: &[Vec<Ex>], cols: usize, name: &str| -> Result<SparseMatrix, LinearError> {
-        let dense = m
-            .iter()
-            .map(|row| {
-                row.iter()
-                    .map(|e| {
-                        to_symbolic(eqs, e).ok_or_else(|| LinearError::Incomplete {
-                            what: format!("an entry of {name}"),
-                        })
-                    })
-                    .collect::<Result<Vec<_>, _>>()
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok(SparseMatrix::from_dense(&dense, cols))
-    };
+fn from_dense(_eqs: &Equations, j: &linear::Jacobians) -> Result<SparseJacobians, LinearError> {
+    let convert =
+        |m: &[Vec<Expr>], cols: usize, _name: &str| -> Result<SparseMatrix, LinearError> {
+            let dense = m
+                .iter()
+                .map(|row| {
+                    row.iter()
+                        .map(|e| Ok::<Expr, LinearError>(e.clone()))
+                        .collect::<Result<Vec<_>, _>>()
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok(SparseMatrix::from_dense(&dense, cols))
+        };
     let (n, m) = (j.states.len(), j.inputs.len());
     Ok(SparseJacobians {
         states: j.states.clone(),
@@ -364,7 +337,7 @@ pub fn sparse_linear_state_space(
             return Err(LinearError::NotLinear {
                 what: what.to_string(),
                 entry: format!("{name}[{r}][{c}]"),
-                symbol: symbol.name().to_string(),
+                symbol: eqs.symbol_name(&symbol),
             });
         }
     }
@@ -461,13 +434,13 @@ pub fn evaluate_sparse(
     linear::check_len("input", eqs.inputs.len(), u0.len())?;
     let mut values: HashMap<Symbol, f64> = HashMap::new();
     for (k, v) in params.iter().enumerate() {
-        values.insert(super::bridge::symbol(eqs, Sym::Param(k)), *v);
+        values.insert(Sym::Param(k).symbol(), *v);
     }
     for (i, v) in x0.iter().enumerate() {
-        values.insert(Symbol::state(eqs.sym_name(Sym::State(i))), *v);
+        values.insert(Sym::State(i).symbol(), *v);
     }
     for (i, v) in u0.iter().enumerate() {
-        values.insert(Symbol::input(eqs.sym_name(Sym::Input(i))), *v);
+        values.insert(Sym::Input(i).symbol(), *v);
     }
     values.insert(Symbol::time(), t0);
     let evaluate = |m: &SparseMatrix, name: &str| -> Result<NumericSparse, LinearError> {

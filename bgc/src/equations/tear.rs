@@ -22,7 +22,8 @@ use super::Equations;
 use super::dense::{self, Mat};
 use super::linear::{LinearError, NumericStateSpace};
 use super::newton::{self, Failure, Problem, Settings};
-use super::sym::{self, Ex, Sym};
+use super::symbols::{self, Sym, SymExt};
+use crate::symbolic::{Expr, Node};
 use petgraph::graph::DiGraph;
 
 /// One block of nonlinear algebraic equations solved together: `0 = r(z, x, u, p, t)` for its tear variables `z`.
@@ -34,11 +35,11 @@ pub struct TearBlock {
     /// The tears' printable names (`loop_<variable>`, as [`Equations::sym_name`] gives them).
     pub names: Vec<String>,
     /// One residual per tear, in states, inputs, parameters, `t`, this block's tears and earlier blocks' tears.
-    pub residuals: Vec<Ex>,
+    pub residuals: Vec<Expr>,
 }
 
 /// The blocks of the implicit loops `(v, r)` (tear variable `v`, residual `r`), in solving order.
-pub(crate) fn blocks(implicit: &[(usize, Ex)], name: &dyn Fn(Sym) -> String) -> Vec<TearBlock> {
+pub(crate) fn blocks(implicit: &[(usize, Expr)], name: &dyn Fn(Sym) -> String) -> Vec<TearBlock> {
     // Edge i -> j: residual i refers to the tear of loop j. Tarjan's algorithm lists the strongly connected
     // components in reverse topological order of the edges, that is each block after the blocks it refers to.
     let mut graph = DiGraph::<usize, ()>::new();
@@ -60,7 +61,7 @@ pub(crate) fn blocks(implicit: &[(usize, Ex)], name: &dyn Fn(Sym) -> String) -> 
                 .filter_map(|n| graph.node_weight(n).copied())
                 .collect();
             members.sort_unstable();
-            let chosen: Vec<&(usize, Ex)> =
+            let chosen: Vec<&(usize, Expr)> =
                 members.iter().filter_map(|&k| implicit.get(k)).collect();
             let tears: Vec<Sym> = chosen.iter().map(|(v, _)| Sym::Tear(*v)).collect();
             TearBlock {
@@ -75,28 +76,28 @@ pub(crate) fn blocks(implicit: &[(usize, Ex)], name: &dyn Fn(Sym) -> String) -> 
 /// The scale of residual `r` for the convergence test of [`super::newton`]: the sum of the magnitudes of its
 /// terms (`|a| + |b| + |z|` for `r = a + b − z`), plus the magnitude of its own tear `z`. A residual cannot be
 /// computed more accurately than about `ε` times this.
-pub fn residual_scale(r: &Ex, own: Sym) -> Ex {
-    let abs = |e: &Ex| sym::call(crate::ir::Func::Abs, vec![e.clone()]);
-    let mut terms: Vec<Ex> = match r {
-        Ex::Add(ts) => ts.iter().map(abs).collect(),
-        other => vec![abs(other)],
+pub fn residual_scale(r: &Expr, own: Sym) -> Expr {
+    let abs = |e: &Expr| symbols::call(crate::ir::Func::Abs, vec![e.clone()]);
+    let mut terms: Vec<Expr> = match r.node() {
+        Node::Add(ts) => ts.iter().map(abs).collect(),
+        _ => vec![abs(r)],
     };
-    terms.push(abs(&Ex::S(own)));
-    sym::add(terms)
+    terms.push(abs(&symbols::leaf(own)));
+    symbols::add(terms)
 }
 
 /// A block's residuals evaluated by the tree evaluator, the other symbols' values given.
 struct TreeBlock<'a> {
     block: &'a TearBlock,
-    scales: Vec<Ex>,
-    jacobian: Vec<Ex>,
+    scales: Vec<Expr>,
+    jacobian: Vec<Expr>,
     value: &'a dyn Fn(Sym) -> Option<f64>,
 }
 
 impl TreeBlock<'_> {
-    fn at(&self, z: &[f64], e: &Ex) -> f64 {
+    fn at(&self, z: &[f64], e: &Expr) -> f64 {
         let tears = &self.block.tears;
-        sym::eval(e, &|s| match tears.iter().position(|&t| t == s) {
+        symbols::eval(e, &|s| match tears.iter().position(|&t| t == s) {
             Some(k) => z.get(k).copied(),
             None => (self.value)(s),
         })
@@ -126,11 +127,11 @@ impl Problem for TreeBlock<'_> {
 }
 
 /// `∂r_i/∂z_j` of a block, row-major; `None` when a residual uses a function without a derivative.
-pub(crate) fn block_jacobian(block: &TearBlock) -> Option<Vec<Ex>> {
+pub(crate) fn block_jacobian(block: &TearBlock) -> Option<Vec<Expr>> {
     let mut out = Vec::with_capacity(block.tears.len().pow(2));
     for r in &block.residuals {
         for &z in &block.tears {
-            out.push(sym::diff(r, z).ok()?);
+            out.push(symbols::diff(r, z).ok()?);
         }
     }
     Some(out)
@@ -200,8 +201,8 @@ pub fn solve_all(
 #[allow(clippy::too_many_arguments)]
 pub(super) fn linearise_implicit(
     eqs: &Equations,
-    f: &[Ex],
-    h: &[Ex],
+    f: &[Expr],
+    h: &[Expr],
     params: &[f64],
     x0: &[f64],
     u0: &[f64],
@@ -239,7 +240,7 @@ pub(super) fn linearise_implicit(
     let zs: Vec<Sym> = tears.iter().map(|(t, _)| *t).collect();
     let xs: Vec<Sym> = (0..n).map(Sym::State).collect();
     let us: Vec<Sym> = (0..eqs.inputs.len()).map(Sym::Input).collect();
-    let residuals: Vec<Ex> = eqs
+    let residuals: Vec<Expr> = eqs
         .tear_blocks
         .iter()
         .flat_map(|b| b.residuals.iter().cloned())
@@ -249,25 +250,26 @@ pub(super) fn linearise_implicit(
         .map(|&z| eqs.sym_name(z))
         .collect::<Vec<_>>()
         .join("`, `");
-    let numeric = |rows: &[Ex], vars: &[Sym], what: &str| -> Result<Mat, LinearError> {
+    let numeric = |rows: &[Expr], vars: &[Sym], what: &str| -> Result<Mat, LinearError> {
         rows.iter()
             .map(|e| {
                 vars.iter()
                     .map(|&v| {
-                        let d = sym::diff(e, v).map_err(|sym::NotDifferentiable(func)| {
-                            LinearError::NotDifferentiable {
-                                what: what.to_string(),
-                                func: func.name(),
-                            }
-                        })?;
-                        let x = sym::eval(&d, &value).map_err(|err| match err {
-                            sym::EvalError::Unbound(s) => LinearError::Unbound {
+                        let d =
+                            symbols::diff(e, v).map_err(|symbols::NotDifferentiable(func)| {
+                                LinearError::NotDifferentiable {
+                                    what: what.to_string(),
+                                    func: func.name(),
+                                }
+                            })?;
+                        let x = symbols::eval(&d, &value).map_err(|err| match err {
+                            symbols::EvalError::Unbound(s) => LinearError::Unbound {
                                 what: what.to_string(),
                                 symbol: eqs.sym_name(s),
                             },
-                            sym::EvalError::Arity(func) => LinearError::NotDifferentiable {
+                            symbols::EvalError::Foreign(func) => LinearError::Unbound {
                                 what: what.to_string(),
-                                func: func.name(),
+                                symbol: func,
                             },
                         })?;
                         if x.is_finite() {
@@ -288,7 +290,7 @@ pub(super) fn linearise_implicit(
     rxu.iter_mut().flatten().for_each(|v| *v = -*v);
     // [dz/dx, dz/du] = −(∂r/∂z)⁻¹ [∂r/∂x, ∂r/∂u]
     let dz = dense::solve(&rz, &rxu).ok_or(LinearError::SingularLoop { tears: names })?;
-    let total = |rows: &[Ex], what: &str| -> Result<(Mat, Mat), LinearError> {
+    let total = |rows: &[Expr], what: &str| -> Result<(Mat, Mat), LinearError> {
         let direct = numeric(rows, &[xs.clone(), us.clone()].concat(), what)?;
         let through = dense::mul(&numeric(rows, &zs, what)?, &dz);
         let sum: Mat = direct
@@ -318,19 +320,19 @@ pub(super) fn linearise_implicit(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::equations::sym::{add, mul, pow, sub};
+    use crate::equations::symbols::{add, mul, pow, sub};
 
-    fn z(v: usize) -> Ex {
-        Ex::S(Sym::Tear(v))
+    fn z(v: usize) -> Expr {
+        symbols::leaf(Sym::Tear(v))
     }
 
     #[test]
     fn coupled_loops_form_one_block_after_the_blocks_they_use() {
         // Loop 7 refers to loop 3 only; loops 3 and 5 refer to each other.
         let implicit = vec![
-            (7, sub(mul(vec![Ex::Num(2.0), z(3)]), z(7))),
-            (3, sub(pow(z(5), Ex::Num(2.0)), z(3))),
-            (5, sub(add(vec![z(3), Ex::S(Sym::State(0))]), z(5))),
+            (7, sub(mul(vec![symbols::num(2.0), z(3)]), z(7))),
+            (3, sub(pow(z(5), symbols::num(2.0)), z(3))),
+            (5, sub(add(vec![z(3), symbols::leaf(Sym::State(0))]), z(5))),
         ];
         let b = blocks(&implicit, &|s| format!("{s:?}"));
         assert_eq!(b.len(), 2);
@@ -348,8 +350,11 @@ mod tests {
             tears: vec![Sym::Tear(3), Sym::Tear(5)],
             names: vec!["a".into(), "b".into()],
             residuals: vec![
-                sub(pow(z(5), Ex::Num(2.0)), z(3)),
-                sub(add(vec![z(3), Ex::S(Sym::State(0)), Ex::Num(-1.0)]), z(5)),
+                sub(pow(z(5), symbols::num(2.0)), z(3)),
+                sub(
+                    add(vec![z(3), symbols::leaf(Sym::State(0)), symbols::num(-1.0)]),
+                    z(5),
+                ),
             ],
         };
         let value = |s: Sym| (s == Sym::State(0)).then_some(0.75);
@@ -377,13 +382,13 @@ mod tests {
         // r = 3 - 5 x - z at x = 1, z = -2: |3| + |-5| + |2| + |z| = 12.
         let r = sub(
             add(vec![
-                Ex::Num(3.0),
-                mul(vec![Ex::Num(-5.0), Ex::S(Sym::State(0))]),
+                symbols::num(3.0),
+                mul(vec![symbols::num(-5.0), symbols::leaf(Sym::State(0))]),
             ]),
             z(1),
         );
         let s = residual_scale(&r, Sym::Tear(1));
-        let v = sym::eval(&s, &|s| match s {
+        let v = symbols::eval(&s, &|s| match s {
             Sym::State(0) => Some(1.0),
             Sym::Tear(1) => Some(-2.0),
             _ => None,

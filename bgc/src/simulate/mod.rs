@@ -43,8 +43,9 @@ pub mod program;
 #[cfg(feature = "cli")]
 mod sparse_ode;
 
-use crate::equations::sym::{self, Ex, Sym, add};
+use crate::equations::symbols::{self, Sym, SymExt, add};
 use crate::equations::{EnergyKind, Equations, block_jacobian, residual_scale};
+use crate::symbolic::{Expr, Node};
 use input::Signal;
 use newton::{BlockPrograms, Loops};
 use program::{CompileError, Layout, Program, Values};
@@ -171,7 +172,7 @@ impl System {
             Sym::Input(j) if j >= n_inputs => eqs.sym_name(Sym::InputDot(j - n_inputs)),
             other => eqs.sym_name(other),
         };
-        let compile = |e: &Ex, what: &str| {
+        let compile = |e: &Expr, what: &str| {
             Program::compile(&exogenous(e, n_inputs, &tears), layout, &name).map_err(|reason| {
                 SimError::Compile {
                     what: what.to_string(),
@@ -244,8 +245,8 @@ impl System {
                 .explicit
                 .as_ref()
                 .ok_or_else(|| SimError::Incomplete { what: what.clone() })?;
-            let e = sym::subst(e, &mut |s| match s {
-                Sym::Output(j) => Some(Ex::S(Sym::Input(ext_len + j))),
+            let e = symbols::subst(e, &mut |s| match s {
+                Sym::Output(j) => Some(symbols::leaf(Sym::Input(ext_len + j))),
                 _ => None,
             });
             let program = Program::compile(&exogenous(&e, n_inputs, &tears), output_layout, &name)
@@ -498,16 +499,16 @@ fn check_len(what: &'static str, expected: usize, got: usize) -> Result<(), SimE
 
 /// `e` with each [`Sym::InputDot`]`(j)` renamed to the input `n_inputs + j` and each tear `tears[k]` to the input
 /// `2 n_inputs + k` (the programs' `[u, u̇, z]` layout).
-fn exogenous(e: &Ex, n_inputs: usize, tears: &[Sym]) -> Ex {
+fn exogenous(e: &Expr, n_inputs: usize, tears: &[Sym]) -> Expr {
     if !e.any_sym(&|s| matches!(s, Sym::InputDot(_) | Sym::Tear(_))) {
         return e.clone();
     }
-    sym::subst(e, &mut |s| match s {
-        Sym::InputDot(j) => Some(Ex::S(Sym::Input(n_inputs + j))),
+    symbols::subst(e, &mut |s| match s {
+        Sym::InputDot(j) => Some(symbols::leaf(Sym::Input(n_inputs + j))),
         Sym::Tear(_) => tears
             .iter()
             .position(|&z| z == s)
-            .map(|k| Ex::S(Sym::Input(2 * n_inputs + k))),
+            .map(|k| symbols::leaf(Sym::Input(2 * n_inputs + k))),
         _ => None,
     })
 }
@@ -516,7 +517,7 @@ fn exogenous(e: &Ex, n_inputs: usize, tears: &[Sym]) -> Ex {
 fn compile_loops(
     eqs: &Equations,
     offset: usize,
-    compile: &dyn Fn(&Ex, &str) -> Result<Program, SimError>,
+    compile: &dyn Fn(&Expr, &str) -> Result<Program, SimError>,
 ) -> Result<Loops, SimError> {
     let mut loops = Loops::default();
     let mut k = offset;
@@ -528,12 +529,12 @@ fn compile_loops(
             reason: "its residuals use a function without a derivative (min or max), which Newton's method needs"
                 .into(),
         })?;
-        let all = |es: &[Ex]| {
+        let all = |es: &[Expr]| {
             es.iter()
                 .map(|e| compile(e, &what))
                 .collect::<Result<Vec<_>, _>>()
         };
-        let scales: Vec<Ex> = block
+        let scales: Vec<Expr> = block
             .residuals
             .iter()
             .zip(&block.tears)
@@ -556,20 +557,20 @@ fn compile_loops(
 /// A sum is differentiated term by term, each term only by the states it reads: the dissipated power sums a term
 /// per resistor, and differentiating the whole sum by every state it reads would be quadratic in the model.
 fn symbolic_jacobian(
-    rates: &[(Ex, String)],
+    rates: &[(Expr, String)],
     n: usize,
-    compile: &dyn Fn(&Ex, &str) -> Result<Program, SimError>,
+    compile: &dyn Fn(&Expr, &str) -> Result<Program, SimError>,
 ) -> Option<Vec<(usize, usize, Program)>> {
     let mut entries = Vec::new();
     for (r, (e, what)) in rates.iter().enumerate() {
-        let terms = match e {
-            Ex::Add(terms) => terms.as_slice(),
+        let terms = match e.node() {
+            Node::Add(terms) => terms.as_slice(),
             _ => std::slice::from_ref(e),
         };
-        let mut parts: std::collections::BTreeMap<usize, Vec<Ex>> = Default::default();
+        let mut parts: std::collections::BTreeMap<usize, Vec<Expr>> = Default::default();
         for term in terms {
             for c in states_read(term, n) {
-                let d = sym::diff(term, Sym::State(c)).ok()?;
+                let d = symbols::diff(term, Sym::State(c)).ok()?;
                 parts.entry(c).or_default().push(d);
             }
         }
@@ -584,7 +585,7 @@ fn symbolic_jacobian(
 }
 
 /// The model states (below `n`) that `e` reads, each once, in order.
-fn states_read(e: &Ex, n: usize) -> Vec<usize> {
+fn states_read(e: &Expr, n: usize) -> Vec<usize> {
     let mut read = Vec::new();
     e.for_each_sym(&mut |s| {
         if let Sym::State(c) = s

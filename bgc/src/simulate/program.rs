@@ -1,13 +1,14 @@
 //! Symbolic expressions compiled into flat stack programs for fast repeated evaluation.
 //!
-//! An [`Ex`] tree of the equations stage is walked once into a postfix list of `Op`s; evaluating it is then a
+//! An [`Expr`] tree of the equations stage is walked once into a postfix list of `Op`s; evaluating it is then a
 //! loop over that list with a small value stack and no allocation per call (the stack is reused). Only the symbols
 //! a simulation has values for are accepted: parameters, states, inputs and time. Every index is checked when the
 //! program is compiled, and evaluation uses checked access anyway, so a program never panics: a missing value reads
 //! as NaN, which the integrator reports as a non-finite derivative.
 
-use crate::equations::sym::{Ex, Sym};
+use crate::equations::symbols::Sym;
 use crate::ir::Func;
+use crate::symbolic::{Expr, Node};
 
 /// One instruction of a program.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -65,7 +66,7 @@ pub struct Program {
 impl Program {
     /// Compiles `e` for values laid out as `layout`; `name` is used to print unsupported symbols.
     pub fn compile(
-        e: &Ex,
+        e: &Expr,
         layout: Layout,
         name: &dyn Fn(Sym) -> String,
     ) -> Result<Program, CompileError> {
@@ -132,7 +133,7 @@ impl Program {
 }
 
 fn emit(
-    e: &Ex,
+    e: &Expr,
     layout: Layout,
     name: &dyn Fn(Sym) -> String,
     ops: &mut Vec<Op>,
@@ -144,10 +145,13 @@ fn emit(
         *depth += 1;
         *max_depth = (*max_depth).max(*depth);
     };
-    match e {
-        Ex::Num(x) => push(ops, Op::Num(*x), depth, max_depth),
-        Ex::S(s) => {
-            let (op, ok) = match *s {
+    match e.node() {
+        Node::Const(x) => push(ops, Op::Num(*x), depth, max_depth),
+        Node::Sym(symbol) => {
+            let Some(s) = Sym::of(symbol) else {
+                return Err(CompileError::Unsupported(symbol.to_string()));
+            };
+            let (op, ok) = match s {
                 Sym::Param(i) => (Op::Param(i), i < layout.params),
                 Sym::State(i) => (Op::State(i), i < layout.states),
                 Sym::Input(i) => (Op::Input(i), i < layout.inputs),
@@ -155,16 +159,16 @@ fn emit(
                 other => return Err(CompileError::Unsupported(name(other))),
             };
             if !ok {
-                return Err(CompileError::OutOfRange(name(*s)));
+                return Err(CompileError::OutOfRange(name(s)));
             }
             push(ops, op, depth, max_depth);
         }
-        Ex::Add(ts) | Ex::Mul(ts) => {
+        Node::Add(ts) | Node::Mul(ts) => {
             for t in ts {
                 emit(t, layout, name, ops, depth, max_depth)?;
             }
             let n = ts.len();
-            ops.push(if matches!(e, Ex::Add(_)) {
+            ops.push(if matches!(e.node(), Node::Add(_)) {
                 Op::Add(n)
             } else {
                 Op::Mul(n)
@@ -174,13 +178,13 @@ fn emit(
                 *max_depth = (*max_depth).max(*depth);
             }
         }
-        Ex::Pow(b, x) => {
+        Node::Pow(b, x) => {
             emit(b, layout, name, ops, depth, max_depth)?;
             emit(x, layout, name, ops, depth, max_depth)?;
             ops.push(Op::Pow);
             *depth = depth.saturating_sub(1);
         }
-        Ex::Call(f, args) => {
+        Node::Call(f, args) => {
             if args.is_empty() || args.len() > 2 {
                 return Err(CompileError::Unsupported(format!(
                     "{} with {} arguments",
@@ -201,7 +205,7 @@ fn emit(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::equations::sym::{self, add, call, div, mul, pow};
+    use crate::equations::symbols::{self, add, call, div, mul, pow};
 
     fn name(s: Sym) -> String {
         format!("{s:?}")
@@ -216,19 +220,22 @@ mod tests {
     #[test]
     fn agrees_with_the_tree_evaluator() {
         // (k x0^2)/2 + sin(u t) * atan2(x1, c) - x1^3 / k
-        let k = Ex::S(Sym::Param(0));
-        let c = Ex::S(Sym::Param(1));
-        let x0 = Ex::S(Sym::State(0));
-        let x1 = Ex::S(Sym::State(1));
-        let u = Ex::S(Sym::Input(0));
-        let t = Ex::S(Sym::Time);
+        let k = symbols::leaf(Sym::Param(0));
+        let c = symbols::leaf(Sym::Param(1));
+        let x0 = symbols::leaf(Sym::State(0));
+        let x1 = symbols::leaf(Sym::State(1));
+        let u = symbols::leaf(Sym::Input(0));
+        let t = symbols::leaf(Sym::Time);
         let e = add(vec![
-            div(mul(vec![k.clone(), pow(x0, Ex::Num(2.0))]), Ex::Num(2.0)),
+            div(
+                mul(vec![k.clone(), pow(x0, symbols::num(2.0))]),
+                symbols::num(2.0),
+            ),
             mul(vec![
                 call(Func::Sin, vec![mul(vec![u, t])]),
                 call(Func::Atan2, vec![x1.clone(), c]),
             ]),
-            mul(vec![Ex::Num(-1.0), div(pow(x1, Ex::Num(3.0)), k)]),
+            mul(vec![symbols::num(-1.0), div(pow(x1, symbols::num(3.0)), k)]),
         ]);
         let p = Program::compile(&e, LAYOUT, &name).unwrap();
         let (params, states, inputs) = ([3.0, 0.5], [1.5, -0.7], [2.0]);
@@ -245,7 +252,7 @@ mod tests {
             Sym::Time => Some(0.3),
             _ => None,
         };
-        let expected = sym::eval(&e, &value).unwrap();
+        let expected = symbols::eval(&e, &value).unwrap();
         let hand = 3.0 * 1.5f64.powi(2) / 2.0 + (0.6f64).sin() * (-0.7f64).atan2(0.5)
             - (-0.7f64).powi(3) / 3.0;
         let mut stack = Vec::new();
@@ -255,12 +262,12 @@ mod tests {
 
     #[test]
     fn refuses_symbols_without_values() {
-        let e = add(vec![Ex::S(Sym::InputDot(0)), Ex::Num(1.0)]);
+        let e = add(vec![symbols::leaf(Sym::InputDot(0)), symbols::num(1.0)]);
         assert!(matches!(
             Program::compile(&e, LAYOUT, &name),
             Err(CompileError::Unsupported(_))
         ));
-        let e = Ex::S(Sym::State(5));
+        let e = symbols::leaf(Sym::State(5));
         assert!(matches!(
             Program::compile(&e, LAYOUT, &name),
             Err(CompileError::OutOfRange(_))

@@ -18,6 +18,9 @@ use std::sync::Arc;
 
 /// What a symbol stands for. The declaration order is the sort order, so in a product parameters come before
 /// inputs, time and states (`k*q_spring`, not `q_spring*k`).
+///
+/// The last three kinds are the equations stage's unknowns while it derives: the tear variable of a nonlinear
+/// algebraic loop, and the time derivatives of states and inputs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum SymbolKind {
     Param,
@@ -26,13 +29,20 @@ pub enum SymbolKind {
     State,
     Intermediate,
     Output,
+    Tear,
+    StateRate,
+    InputRate,
 }
 
-/// A named variable of an expression. Two symbols are the same when both name and kind agree.
+/// A variable of an expression: a kind and either a name, or an index into a table of its kind that its user keeps
+/// (the equations stage numbers its parameters, states, bond variables, ... and names them when it prints).
+/// Two symbols are the same when kind, name and index agree; they sort by kind, then name, then index.
 #[derive(Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Symbol {
     kind: SymbolKind,
     name: Arc<str>,
+    /// `None` for a named symbol.
+    index: Option<usize>,
 }
 
 impl Symbol {
@@ -40,7 +50,24 @@ impl Symbol {
         Symbol {
             kind,
             name: name.into(),
+            index: None,
         }
+    }
+
+    /// The symbol numbered `index` among those of `kind`, without a name (it prints as `kind#index`, so its user
+    /// prints it with its own names, e.g. through [`crate::symbolic::to_text_with`]).
+    pub fn indexed(kind: SymbolKind, index: usize) -> Symbol {
+        static EMPTY: std::sync::LazyLock<Arc<str>> = std::sync::LazyLock::new(|| Arc::from(""));
+        Symbol {
+            kind,
+            name: EMPTY.clone(),
+            index: Some(index),
+        }
+    }
+
+    /// The index of a symbol made by [`Symbol::indexed`].
+    pub fn index(&self) -> Option<usize> {
+        self.index
     }
 
     pub fn param(name: impl Into<Arc<str>>) -> Symbol {
@@ -79,13 +106,19 @@ impl Symbol {
 
 impl fmt::Debug for Symbol {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{:?}", self.name, self.kind)
+        match self.index() {
+            Some(i) => write!(f, "{:?}#{i}", self.kind),
+            None => write!(f, "{}:{:?}", self.name, self.kind),
+        }
     }
 }
 
 impl fmt::Display for Symbol {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.name)
+        match self.index() {
+            Some(i) => write!(f, "{:?}#{i}", self.kind),
+            None => f.write_str(&self.name),
+        }
     }
 }
 

@@ -1,14 +1,15 @@
 //! Checks of a generated model against the compiler's own evaluation of the derived equations
-//! (`bgc::equations`, evaluated by `bgc::equations::sym::eval`, a path that shares no code with the generated Rust)
+//! (`bgc::equations`, evaluated by `bgc::equations::symbols::eval`, a path that shares no code with the generated Rust)
 //! and against finite differences and the power balance.
 #![allow(dead_code)]
 
-use bgc::equations::sym::{self, Ex, Sym};
+use bgc::equations::symbols::{self as sym, Sym};
 use bgc::equations::{
     Equations, StateSelection, declared_state_space, jacobians, linearise, numeric_state_space,
 };
 use bgc::lower::{MemoryLoader, lower};
 use bgc::span::SourceMap;
+use bgc::symbolic::Expr;
 use bgc_runtime::model::{ContinuousModel, Parametric};
 use nalgebra::{SMatrix, SVector};
 
@@ -44,7 +45,7 @@ impl Rng {
     }
 }
 
-pub fn eval(e: &Ex, params: &[f64], x: &[f64], u: &[f64], t: f64) -> f64 {
+pub fn eval(e: &Expr, params: &[f64], x: &[f64], u: &[f64], t: f64) -> f64 {
     sym::eval(e, &|s| match s {
         Sym::Param(i) => params.get(i).copied(),
         Sym::State(i) => x.get(i).copied(),
@@ -129,7 +130,7 @@ pub fn check_agreement_in<M, const NX: usize, const NU: usize, const NY: usize>(
     assert_eq!(eqs.states.len(), NX, "{path}: states");
     assert_eq!(eqs.inputs.len(), NU, "{path}: inputs");
     assert_eq!(eqs.outputs.len(), NY, "{path}: outputs");
-    let f: Vec<Ex> = eqs.f.iter().map(|e| e.clone().expect("rate")).collect();
+    let f: Vec<Expr> = eqs.f.iter().map(|e| e.clone().expect("rate")).collect();
     // The generated `Params` has the free parameters as fields (in `Parametric` order); derived ones follow them.
     let free: Vec<usize> = (0..eqs.params.len())
         .filter(|&k| eqs.derived.get(k).is_none_or(Option::is_none))
@@ -140,7 +141,7 @@ pub fn check_agreement_in<M, const NX: usize, const NU: usize, const NY: usize>(
         free_names.as_slice(),
         "{path}: parameters"
     );
-    let h: Vec<Ex> = eqs
+    let h: Vec<Expr> = eqs
         .outputs
         .iter()
         .map(|o| o.explicit.clone().expect("output"))

@@ -12,7 +12,7 @@ use std::fmt;
 
 /// `e` as text, symbols by their names.
 pub fn to_text(e: &Expr) -> String {
-    to_text_with(e, &|s: &Symbol| s.name().to_string())
+    to_text_with(e, &|s: &Symbol| s.to_string())
 }
 
 /// `e` as text, each symbol printed as `names` says.

@@ -31,7 +31,7 @@ type M = NalgebraMat<f64>;
 type Ls = NalgebraLU<f64>;
 
 /// From this many states on, a model with a symbolic Jacobian is solved with a sparse Jacobian and LU
-/// ([`SparseOde`]). Below it the dense LU is cheap and needs no symbolic analysis.
+/// (`simulate/sparse_ode.rs`). Below it the dense LU is cheap.
 pub const SPARSE_FROM: usize = 200;
 
 /// The integration method.

@@ -454,21 +454,18 @@ fn segment_once(
         // The rows of the energy quadratures (dissipated, supplied) are left out of the sparse Jacobian: a
         // dissipation summed over every resistor is a dense row, and with it the sparse LU fills in (a 20,000-state
         // chain took 205 s instead of 3 s). Nothing reads those states, so Newton's iteration still converges.
+        // The pattern runs row by row, so the model's rows are its first entries, and the values are evaluated
+        // for those alone.
         let model = system.state_count();
-        let kept: Vec<usize> = (0..full.len()).filter(|&k| full[k].0 < model).collect();
-        let pattern: Vec<(usize, usize)> = kept.iter().map(|&k| full[k]).collect();
-        let all_values = RefCell::new(vec![0.0; full.len()]);
+        let pattern: Vec<(usize, usize)> =
+            full.into_iter().take_while(|&(r, _)| r < model).collect();
         let rates = |y: &[f64], t: f64, dy: &mut [f64]| rhs(y, &[], t, dy);
         let values = |y: &[f64], t: f64, out: &mut [f64]| {
             let mut s = scratch.borrow_mut();
             let (u, stack, _, _) = &mut *s;
-            let mut all = all_values.borrow_mut();
             system.inputs_at(t.min(t_max), u);
-            if system.jacobian_values(y, u, t, &mut all, stack).is_none() {
-                all.iter_mut().for_each(|v| *v = f64::NAN);
-            }
-            for (slot, &k) in out.iter_mut().zip(&kept) {
-                *slot = all[k];
+            if system.jacobian_values(y, u, t, out, stack).is_none() {
+                out.iter_mut().for_each(|v| *v = f64::NAN);
             }
         };
         let ode = SparseOde::new(&rates, &values, y0, &pattern)

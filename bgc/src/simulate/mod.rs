@@ -423,15 +423,15 @@ impl System {
         Some(())
     }
 
-    /// The positions `(row, column)` of the symbolic Jacobian's entries over the model states; `None` when it has no
-    /// symbolic form (see [`System::jacobian_times`]).
+    /// The positions `(row, column)` of the symbolic Jacobian's entries over the model states, row by row (the
+    /// energy quadratures' rows last); `None` when it has no symbolic form (see [`System::jacobian_times`]).
     pub fn jacobian_pattern(&self) -> Option<Vec<(usize, usize)>> {
         let entries = self.jacobian.as_ref()?;
         Some(entries.iter().map(|(r, c, _)| (*r, *c)).collect())
     }
 
-    /// The values of the Jacobian's entries at `(y, u, t)`, in the order of [`System::jacobian_pattern`]; `None`
-    /// when it has no symbolic form.
+    /// The values of the Jacobian's first `out.len()` entries at `(y, u, t)`, in the order of
+    /// [`System::jacobian_pattern`]; `None` when it has no symbolic form.
     pub fn jacobian_values(
         &self,
         y: &[f64],
@@ -584,17 +584,11 @@ fn symbolic_jacobian(
     Some(entries)
 }
 
-/// The model states (below `n`) that `e` reads, each once, in order.
+/// The model states (below `n`) that `e` reads, each once.
 fn states_read(e: &Expr, n: usize) -> Vec<usize> {
-    let mut read = Vec::new();
-    e.for_each_sym(&mut |s| {
-        if let Sym::State(c) = s
-            && c < n
-        {
-            read.push(c);
-        }
+    let states = e.syms().into_iter().filter_map(|s| match s {
+        Sym::State(c) if c < n => Some(c),
+        _ => None,
     });
-    read.sort_unstable();
-    read.dedup();
-    read
+    states.collect()
 }

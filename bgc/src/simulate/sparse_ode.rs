@@ -98,8 +98,9 @@ impl<'a> SparseOde<'a> {
     }
 }
 
+/// diffsol's `Op` for a type that reaches the ODE through `ode()`: square, `dim` states, no parameters.
 macro_rules! op_of_ode {
-    ($ty:ty, $nout:expr) => {
+    ($ty:ty) => {
         impl Op for $ty {
             type T = f64;
             type V = V;
@@ -112,7 +113,7 @@ macro_rules! op_of_ode {
                 self.ode().dim()
             }
             fn nout(&self) -> usize {
-                $nout(self.ode())
+                self.ode().dim()
             }
             fn nparams(&self) -> usize {
                 0
@@ -149,9 +150,9 @@ impl<'a> SparseOde<'a> {
     }
 }
 
-op_of_ode!(Rhs<'_, '_>, SparseOde::dim);
-op_of_ode!(Init<'_, '_>, SparseOde::dim);
-op_of_ode!(SparseOde<'_>, SparseOde::dim);
+op_of_ode!(Rhs<'_, '_>);
+op_of_ode!(Init<'_, '_>);
+op_of_ode!(SparseOde<'_>);
 
 impl NonLinearOp for Rhs<'_, '_> {
     fn call_inplace(&self, x: &V, t: f64, y: &mut V) {

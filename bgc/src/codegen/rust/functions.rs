@@ -442,14 +442,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             || (matches!(name, "jac_x_into" | "jac_u_into") && !plan.mass.is_empty());
         if !corrected && self.splits(m.iter().filter(|e| !e.2.is_zero()).count()) {
             let statements = self.entry_statements(m.iter(), (rows, cols, row_prefix));
-            let out = Out {
-                name: "jac",
-                ty,
-                passed: "jac",
-            };
-            let stem = name.strip_suffix("_into").unwrap_or(name);
-            let prologue = vec!["    jac.fill(0.0);".to_string()];
-            let d = self.parts(stem, &statements, out, self.terms_enabled, prologue);
+            let d = self.jacobian_parts(name, ty, &statements, self.terms_enabled);
             if !(d.uses.t || d.uses.x || d.uses.u) {
                 self.constant_jacobian(name, ty);
             }
@@ -505,21 +498,17 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         }
     }
 
-    /// One assignment `jac[(r, c)] = value;` per entry that is not identically zero, as
-    /// [`Self::matrix_entries`] writes them.
+    /// One assignment `jac[(r, c)] = value;` per entry that is not identically zero, in the order given, under a
+    /// comment naming it ([`entry_label`]).
     pub(super) fn entry_statements<'e>(
         &self,
         entries: impl Iterator<Item = (usize, usize, &'e Expr)>,
-        (rows, cols, row_prefix): (&[String], &[String], &str),
+        names: (&[String], &[String], &str),
     ) -> Vec<Statement<'e>> {
         entries
             .filter(|(_, _, e)| !e.is_zero())
             .map(|(r, c, e)| Statement {
-                label: format!(
-                    "∂({row_prefix}{})/∂{} = ",
-                    rows.get(r).map_or("", String::as_str),
-                    cols.get(c).map_or("", String::as_str)
-                ),
+                label: entry_label(names, r, c),
                 expr: e,
                 head: format!("jac[({r}, {c})] = "),
                 tail: ";".into(),
@@ -527,24 +516,36 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             .collect()
     }
 
-    /// `jac.fill(0.0)` and one assignment per entry `(row, column, value)` that is not identically zero, in the
-    /// order given, under a comment naming it (`∂(d/dt p_mass)/∂q_spring = …`): rows and columns named by
-    /// `names`, the rows with a prefix.
+    /// `jac.fill(0.0)` and the entry statements in one body, as [`Self::entry_statements`] gives them.
     pub(super) fn matrix_entries<'e>(
         &self,
         d: &mut Draft,
         entries: impl Iterator<Item = (usize, usize, &'e Expr)>,
-        (rows, cols, row_prefix): (&[String], &[String], &str),
+        names: (&[String], &[String], &str),
     ) {
         d.lines.push("    jac.fill(0.0);".into());
-        for (r, c, e) in entries.filter(|(_, _, e)| !e.is_zero()) {
-            let lhs = format!(
-                "∂({row_prefix}{})/∂{} = ",
-                rows.get(r).map_or("", String::as_str),
-                cols.get(c).map_or("", String::as_str)
-            );
-            self.statement(d, &lhs, e, &format!("jac[({r}, {c})] = "), ";");
+        for s in self.entry_statements(entries, names) {
+            self.statement(d, &s.label, s.expr, &s.head, &s.tail);
         }
+    }
+
+    /// The body of the Jacobian function `name` (`jac_x_into`, writing a `ty`) as `jac.fill(0.0)` and calls of
+    /// parts of bounded size that write the `statements`.
+    pub(super) fn jacobian_parts(
+        &mut self,
+        name: &str,
+        ty: &'static str,
+        statements: &[Statement],
+        cached: bool,
+    ) -> Draft {
+        let out = Out {
+            name: "jac",
+            ty,
+            passed: "jac",
+        };
+        let stem = name.strip_suffix("_into").unwrap_or(name);
+        let prologue = vec!["    jac.fill(0.0);".to_string()];
+        self.parts(stem, statements, out, cached, prologue)
     }
 
     /// Whether `∂f/∂x` also gets its sparse form: when a `JacX` takes more than
@@ -600,11 +601,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             .iter()
             .enumerate()
             .map(|(k, &(r, c, e))| Statement {
-                label: format!(
-                    "∂({row_prefix}{})/∂{} = ",
-                    rows.get(r).map_or("", String::as_str),
-                    cols.get(c).map_or("", String::as_str)
-                ),
+                label: entry_label((rows, cols, row_prefix), r, c),
                 expr: e,
                 head: format!("values[{k}] = "),
                 tail: ";".into(),
@@ -996,4 +993,18 @@ impl Writer<'_> {
 /// The function that takes the parameter terms for the model function `name`: `rhs_into` → `rhs_with`.
 pub(super) fn with_terms_name(name: &str) -> String {
     format!("{}_with", name.strip_suffix("_into").unwrap_or(name))
+}
+
+/// The comment naming the entry `(r, c)` of a Jacobian (`∂(d/dt p_mass)/∂q_spring = `): rows and columns named by
+/// `names`, the rows with a prefix.
+fn entry_label(
+    (rows, cols, row_prefix): (&[String], &[String], &str),
+    r: usize,
+    c: usize,
+) -> String {
+    format!(
+        "∂({row_prefix}{})/∂{} = ",
+        rows.get(r).map_or("", String::as_str),
+        cols.get(c).map_or("", String::as_str)
+    )
 }

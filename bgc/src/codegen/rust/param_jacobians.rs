@@ -9,7 +9,6 @@
 
 use super::super::format;
 use super::super::mass::MassColumns;
-use super::parts::Out;
 use super::{Arg, Writer, output_names};
 use crate::symbolic::Expr;
 
@@ -90,14 +89,7 @@ pub type OutJacP = SMatrix<f64, N_OUTPUTS, N_PARAMS>;
         let with_mass = solve_mass && !plan.mass.is_empty();
         if !with_mass && shared.is_empty() && self.splits(needed.len()) {
             let statements = self.entry_statements(entries, (rows, cols, row_prefix));
-            let out = Out {
-                name: "jac",
-                ty,
-                passed: "jac",
-            };
-            let stem = name.strip_suffix("_into").unwrap_or(name);
-            let prologue = vec!["    jac.fill(0.0);".to_string()];
-            let d = self.parts(stem, &statements, out, false, prologue);
+            let d = self.jacobian_parts(name, ty, &statements, false);
             self.model_function(name, doc, d, Arg::new("jac", ty, true));
             return;
         }

@@ -32,7 +32,6 @@
 use super::eval::{apply_func, pow_f64};
 use super::expr::{Expr, Node, Symbol};
 use crate::ir::Func;
-use std::collections::BTreeMap;
 use std::ops;
 use std::sync::OnceLock;
 
@@ -62,11 +61,12 @@ impl Expr {
     /// The canonical sum of `terms` (0 when empty).
     pub fn sum(terms: impl IntoIterator<Item = Expr>) -> Expr {
         let mut constant = 0.0;
-        let mut collected: BTreeMap<Expr, f64> = BTreeMap::new();
+        let mut collected: Vec<(Expr, f64)> = Vec::new();
         for term in terms {
             collect_term(&term, &mut constant, &mut collected);
         }
-        if constant.is_nan() || collected.values().any(|c| c.is_nan()) {
+        let collected = merge_like(collected, |sum: &mut f64, c| *sum += c, |c| c);
+        if constant.is_nan() || collected.iter().any(|(_, c)| c.is_nan()) {
             return Expr::constant(f64::NAN);
         }
         let mut out: Vec<Expr> = Vec::with_capacity(collected.len() + 1);
@@ -89,17 +89,22 @@ impl Expr {
     /// The canonical product of `factors` (1 when empty).
     pub fn product(factors: impl IntoIterator<Item = Expr>) -> Expr {
         let mut coeff = 1.0;
-        let mut bases: BTreeMap<Expr, Vec<Expr>> = BTreeMap::new();
+        let mut bases: Vec<(Expr, Expr)> = Vec::new();
         for f in factors {
             collect_factor(&f, &mut coeff, &mut bases);
         }
         if coeff == 0.0 || coeff.is_nan() {
             return Expr::constant(coeff);
         }
+        let bases = merge_like(
+            bases,
+            |exps: &mut Exponents, e| exps.push(e),
+            Exponents::One,
+        );
         let mut out: Vec<Expr> = Vec::with_capacity(bases.len() + 1);
         let mut needs_another_pass = false;
         for (base, exps) in bases {
-            let f = base.pow(&Expr::sum(exps));
+            let f = base.pow(&exps.total());
             // `pow` can yield a constant (`x^0`), a product (`(x*y)^2`) or a power of another base
             // (`((y^1.5)^0.5)^2 = y^1.5`), which must be merged again.
             needs_another_pass |=
@@ -232,7 +237,48 @@ fn call2(func: Func, a: &Expr, b: &Expr) -> Expr {
 }
 
 /// Adds `term` into a sum being collected, keyed by the term without its numeric coefficient.
-fn collect_term(term: &Expr, constant: &mut f64, collected: &mut BTreeMap<Expr, f64>) {
+/// `items` sorted by key with the values of equal keys combined, in the order they came (so that sums of
+/// coefficients are added in the order of the terms, as written).
+fn merge_like<V, A>(
+    mut items: Vec<(Expr, V)>,
+    mut add: impl FnMut(&mut A, V),
+    first: impl Fn(V) -> A,
+) -> Vec<(Expr, A)> {
+    // Stable: equal keys keep their order.
+    items.sort_by(|a, b| a.0.cmp(&b.0));
+    let mut out: Vec<(Expr, A)> = Vec::with_capacity(items.len());
+    for (key, value) in items {
+        match out.last_mut() {
+            Some((last, acc)) if *last == key => add(acc, value),
+            _ => out.push((key, first(value))),
+        }
+    }
+    out
+}
+
+/// The exponents of one base in a product: usually one, which needs no sum.
+enum Exponents {
+    One(Expr),
+    Many(Vec<Expr>),
+}
+
+impl Exponents {
+    fn push(&mut self, e: Expr) {
+        match self {
+            Exponents::One(first) => *self = Exponents::Many(vec![first.clone(), e]),
+            Exponents::Many(es) => es.push(e),
+        }
+    }
+
+    fn total(self) -> Expr {
+        match self {
+            Exponents::One(e) => e,
+            Exponents::Many(es) => Expr::sum(es),
+        }
+    }
+}
+
+fn collect_term(term: &Expr, constant: &mut f64, collected: &mut Vec<(Expr, f64)>) {
     match term.node() {
         Node::Const(c) => *constant += c,
         Node::Add(terms) => {
@@ -242,7 +288,7 @@ fn collect_term(term: &Expr, constant: &mut f64, collected: &mut BTreeMap<Expr, 
         }
         _ => {
             let (coeff, rest) = term.coeff_and_factors();
-            *collected.entry(rest_of(rest)).or_insert(0.0) += coeff;
+            collected.push((rest_of(rest), coeff));
         }
     }
 }
@@ -260,7 +306,7 @@ fn scale_rest(rest: Expr, coeff: f64) -> Expr {
     Expr::from_canonical(Node::Mul(factors))
 }
 
-fn collect_factor(f: &Expr, coeff: &mut f64, bases: &mut BTreeMap<Expr, Vec<Expr>>) {
+fn collect_factor(f: &Expr, coeff: &mut f64, bases: &mut Vec<(Expr, Expr)>) {
     match f.node() {
         Node::Const(c) => *coeff *= c,
         Node::Mul(fs) => {
@@ -268,15 +314,15 @@ fn collect_factor(f: &Expr, coeff: &mut f64, bases: &mut BTreeMap<Expr, Vec<Expr
                 collect_factor(x, coeff, bases);
             }
         }
-        Node::Pow(b, e) => bases.entry(b.clone()).or_default().push(e.clone()),
+        Node::Pow(b, e) => bases.push((b.clone(), e.clone())),
         Node::Add(_) => match split_content(f) {
             Some((content, primitive)) => {
                 *coeff *= content;
-                bases.entry(primitive).or_default().push(Expr::one());
+                bases.push((primitive, Expr::one()));
             }
-            None => bases.entry(f.clone()).or_default().push(Expr::one()),
+            None => bases.push((f.clone(), Expr::one())),
         },
-        _ => bases.entry(f.clone()).or_default().push(Expr::one()),
+        _ => bases.push((f.clone(), Expr::one())),
     }
 }
 
@@ -305,6 +351,20 @@ fn split_content(sum: &Expr) -> Option<(f64, Expr)> {
 }
 
 /// The coefficient-free term made of `factors`.
+impl Expr {
+    /// `-self` for a canonical product: its factors with the coefficient negated. This is what `-self` builds,
+    /// without collecting the factors again (they are already distinct, sorted and not a lone sum).
+    pub(super) fn negated_product(&self) -> Expr {
+        match self.node() {
+            Node::Mul(_) => {
+                let (coeff, rest) = self.coeff_and_factors();
+                scale_rest(rest_of(rest), -coeff)
+            }
+            _ => -self,
+        }
+    }
+}
+
 fn rest_of(factors: &[Expr]) -> Expr {
     match factors {
         [single] => single.clone(),

@@ -13,7 +13,7 @@
 use super::intern::intern;
 use crate::ir::Func;
 use std::fmt;
-use std::hash::{DefaultHasher, Hash, Hasher};
+use std::hash::{Hash, Hasher};
 use std::sync::Arc;
 
 /// What a symbol stands for. The declaration order is the sort order, so in a product parameters come before
@@ -268,43 +268,81 @@ fn normalize_const(c: f64) -> f64 {
 }
 
 fn structural_hash(node: &Node) -> u64 {
-    // `DefaultHasher::new()` uses fixed keys, so hashes are the same in every run.
-    let mut h = DefaultHasher::new();
+    // A fixed mixing function: hashes are the same in every run. Children contribute their cached hashes, so this
+    // is constant work per child.
+    let mut h = Mixer::default();
     match node {
         Node::Const(c) => {
-            0u8.hash(&mut h);
-            c.to_bits().hash(&mut h);
+            h.word(0);
+            h.word(c.to_bits());
         }
         Node::Sym(s) => {
-            1u8.hash(&mut h);
+            h.word(1);
             s.hash(&mut h);
         }
         Node::Add(xs) => {
-            2u8.hash(&mut h);
-            for x in xs {
-                x.0.hash.hash(&mut h);
-            }
+            h.word(2);
+            xs.iter().for_each(|x| h.word(x.0.hash));
         }
         Node::Mul(xs) => {
-            3u8.hash(&mut h);
-            for x in xs {
-                x.0.hash.hash(&mut h);
-            }
+            h.word(3);
+            xs.iter().for_each(|x| h.word(x.0.hash));
         }
         Node::Pow(b, e) => {
-            4u8.hash(&mut h);
-            b.0.hash.hash(&mut h);
-            e.0.hash.hash(&mut h);
+            h.word(4);
+            h.word(b.0.hash);
+            h.word(e.0.hash);
         }
         Node::Call(f, xs) => {
-            5u8.hash(&mut h);
+            h.word(5);
             f.hash(&mut h);
-            for x in xs {
-                x.0.hash.hash(&mut h);
-            }
+            xs.iter().for_each(|x| h.word(x.0.hash));
         }
     }
     h.finish()
+}
+
+/// A multiply-rotate hash over 64-bit words with a final avalanche, so that every bit of the result (the table's
+/// shard is chosen by the top bits, its bucket by the low ones) depends on every input bit.
+#[derive(Default)]
+struct Mixer(u64);
+
+impl Mixer {
+    fn word(&mut self, w: u64) {
+        self.0 = (self.0.rotate_left(26) ^ w).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    }
+}
+
+impl Hasher for Mixer {
+    fn finish(&self) -> u64 {
+        // The finaliser of MurmurHash3.
+        let mut x = self.0;
+        x ^= x >> 33;
+        x = x.wrapping_mul(0xff51_afd7_ed55_8ccd);
+        x ^= x >> 33;
+        x = x.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+        x ^ (x >> 33)
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut w = [0u8; 8];
+            w[..chunk.len()].copy_from_slice(chunk);
+            self.word(u64::from_le_bytes(w));
+        }
+    }
+
+    fn write_u8(&mut self, v: u8) {
+        self.word(u64::from(v));
+    }
+
+    fn write_u64(&mut self, v: u64) {
+        self.word(v);
+    }
+
+    fn write_usize(&mut self, v: usize) {
+        self.word(v as u64);
+    }
 }
 
 impl PartialEq for Expr {

@@ -16,6 +16,7 @@
 
 use super::expr::{Inner, Node};
 use std::collections::HashMap;
+use std::collections::hash_map::Entry;
 use std::hash::{BuildHasherDefault, Hasher};
 use std::sync::{Arc, LazyLock, Mutex, PoisonError, Weak};
 
@@ -66,36 +67,55 @@ struct Shard {
 }
 
 impl Shard {
-    fn find(&self, hash: u64, node: &Node) -> Option<Arc<Inner>> {
-        let matches = |w: &Weak<Inner>| w.upgrade().filter(|a| shallow_eq(&a.node, node));
-        match self.map.get(&hash)? {
-            Bucket::One(w) => matches(w),
-            Bucket::Many(ws) => ws.iter().find_map(matches),
-        }
-    }
-
-    fn insert(&mut self, hash: u64, node: &Arc<Inner>) {
-        let weak = Arc::downgrade(node);
-        match self.map.remove(&hash) {
-            None => {
-                self.map.insert(hash, Bucket::One(weak));
+    /// The live node equal to `node` under `hash` with the candidate handed back (to be dropped by the caller), or
+    /// the candidate made a node and recorded under `hash`: one probe of the map either way.
+    fn find_or_insert(
+        &mut self,
+        hash: u64,
+        node: Node,
+        tree_size: u64,
+    ) -> (Arc<Inner>, Option<Node>) {
+        let matches = |w: &Weak<Inner>| w.upgrade().filter(|a| shallow_eq(&a.node, &node));
+        let fresh = |node| {
+            Arc::new(Inner {
+                node,
+                hash,
+                tree_size,
+            })
+        };
+        let made = match self.map.entry(hash) {
+            Entry::Vacant(slot) => {
+                let made = fresh(node);
+                slot.insert(Bucket::One(Arc::downgrade(&made)));
+                made
             }
-            Some(Bucket::One(old)) if old.strong_count() == 0 => {
-                self.map.insert(hash, Bucket::One(weak));
+            Entry::Occupied(mut slot) => {
+                let bucket = slot.get_mut();
+                let found = match bucket {
+                    Bucket::One(w) => matches(w),
+                    Bucket::Many(ws) => ws.iter().find_map(matches),
+                };
+                if let Some(found) = found {
+                    return (found, Some(node));
+                }
+                let made = fresh(node);
+                let weak = Arc::downgrade(&made);
+                match bucket {
+                    Bucket::One(old) if old.strong_count() == 0 => *old = weak,
+                    Bucket::One(old) => *bucket = Bucket::Many(vec![old.clone(), weak]),
+                    Bucket::Many(ws) => {
+                        ws.retain(|w| w.strong_count() > 0);
+                        ws.push(weak);
+                    }
+                }
+                made
             }
-            Some(Bucket::One(old)) => {
-                self.map.insert(hash, Bucket::Many(vec![old, weak]));
-            }
-            Some(Bucket::Many(mut ws)) => {
-                ws.retain(|w| w.strong_count() > 0);
-                ws.push(weak);
-                self.map.insert(hash, Bucket::Many(ws));
-            }
-        }
+        };
         self.entries += 1;
         if self.entries >= self.sweep_at.max(MIN_SWEEP) {
             self.sweep();
         }
+        (made, None)
     }
 
     /// Drops the entries of dead nodes.
@@ -127,17 +147,10 @@ pub(super) fn intern(node: Node, hash: u64, tree_size: u64) -> Arc<Inner> {
     let shard = &TABLE[(hash >> 60) as usize % SHARDS];
     // A panic cannot leave a shard inconsistent (each update is one map operation), so a poisoned lock is usable.
     let mut guard = shard.lock().unwrap_or_else(PoisonError::into_inner);
-    if let Some(found) = guard.find(hash, &node) {
-        drop(guard);
-        return found;
-    }
-    let fresh = Arc::new(Inner {
-        node,
-        hash,
-        tree_size,
-    });
-    guard.insert(hash, &fresh);
-    fresh
+    let (found, candidate) = guard.find_or_insert(hash, node, tree_size);
+    drop(guard);
+    drop(candidate);
+    found
 }
 
 /// Equality of two nodes whose children are interned: same operation, same leaf, identical children.

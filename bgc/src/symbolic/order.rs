@@ -28,7 +28,12 @@ impl Ord for Expr {
         if self.same_node(other) {
             return Ordering::Equal;
         }
-        let mut steps = vec![Step::Expr(self, other)];
+        // Most comparisons are decided by the first step, which then allocates nothing.
+        let mut steps = Vec::new();
+        let first = Step::Expr(self, other).run(&mut steps);
+        if first.is_ne() {
+            return first;
+        }
         while let Some(step) = steps.pop() {
             let order = step.run(&mut steps);
             if order.is_ne() {

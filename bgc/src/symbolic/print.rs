@@ -36,7 +36,7 @@ pub(super) const ATOM: u8 = 5;
 pub(super) fn negated(e: &Expr) -> Option<Expr> {
     match e.node() {
         Node::Const(c) if *c < 0.0 => Some(Expr::constant(-c)),
-        Node::Mul(_) if e.coeff_and_factors().0 < 0.0 => Some(-e),
+        Node::Mul(_) if e.coeff_and_factors().0 < 0.0 => Some(e.negated_product()),
         _ => None,
     }
 }

@@ -63,8 +63,19 @@ impl Doc {
 
     /// The whole text.
     pub fn into_string(self) -> String {
-        let mut out = String::new();
-        let mut pending: Vec<&Doc> = vec![&self];
+        // The length first, so that the text is written into one allocation of the right size.
+        let mut len = 0;
+        let mut pending: Vec<&Doc> = Vec::with_capacity(16);
+        pending.push(&self);
+        while let Some(d) = pending.pop() {
+            match &d.piece {
+                Piece::Text(s) => len += s.len(),
+                Piece::Cat(parts) => pending.extend(parts.iter()),
+                Piece::Shared(rc) => pending.push(rc),
+            }
+        }
+        let mut out = String::with_capacity(len);
+        pending.push(&self);
         while let Some(d) = pending.pop() {
             match &d.piece {
                 Piece::Text(s) => out.push_str(s),

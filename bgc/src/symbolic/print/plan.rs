@@ -24,8 +24,15 @@ use std::rc::Rc;
 /// Nodes between kept ones on any path, at most.
 pub(super) const SPACING: u32 = 16;
 
+/// Expressions of at most this many nodes as a tree are printed straight through: printing them whole costs no
+/// more than planning, and keeping changes only how the text is built, never the text.
+const SMALL_TREE: usize = SPACING as usize;
+
 /// The nodes to print ahead, in post-order, each with whether it is read more than once.
 pub(super) fn plan(root: &Expr) -> Vec<(&Expr, bool)> {
+    if root.node_count() <= SMALL_TREE {
+        return Vec::new();
+    }
     let dag = Dag::new([root]);
     let n = dag.len();
     let mut parents = vec![0u32; n];

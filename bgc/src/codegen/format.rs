@@ -85,6 +85,10 @@ pub(super) fn comment(
         Wrap::Equation => 4,
     };
     let first_lead = format!("{lead} ");
+    if width(&first_lead) + width(text) <= line_width {
+        // The common case, and what the wrapping below gives for it: one line.
+        return vec![format!("{first_lead}{text}")];
+    }
     let next_lead = format!("{lead} {}", " ".repeat(hanging));
     let mut lines: Vec<String> = Vec::new();
     let mut cur = String::new();

@@ -302,7 +302,33 @@ pub(in crate::codegen) struct Writer<'a> {
     /// Whether the bodies read parameter terms: not when there would be more than `MAX_LETS` of them (a large
     /// model), which `ParamTerms::at` could not bind.
     terms_enabled: bool,
+    /// Printed forms of expressions met before: a large model's Jacobians repeat a few entries thousands of times.
+    printed: RefCell<Printed>,
     pub(in crate::codegen) out: String,
+}
+
+/// Memo of [`Writer::code`] and the text of equation comments, keyed by expression (a node, so lookups are by
+/// identity). Both are pure functions of the expression for one writer. Cleared when full, to bound its memory.
+#[derive(Default)]
+struct Printed {
+    code: HashMap<Expr, RustCode>,
+    text: HashMap<Expr, String>,
+}
+
+impl Printed {
+    const CAPACITY: usize = 4096;
+
+    fn get_or<T: Clone>(map: &mut HashMap<Expr, T>, e: &Expr, make: impl FnOnce() -> T) -> T {
+        if let Some(v) = map.get(e) {
+            return v.clone();
+        }
+        let v = make();
+        if map.len() >= Self::CAPACITY {
+            map.clear();
+        }
+        map.insert(e.clone(), v.clone());
+        v
+    }
 }
 
 impl<'a> Writer<'a> {
@@ -380,6 +406,7 @@ impl<'a> Writer<'a> {
             terms: RefCell::new(terms::ParamTerms::new(derived_symbols)),
             with_terms: Vec::new(),
             terms_enabled: false,
+            printed: RefCell::default(),
             out: String::new(),
         }
     }
@@ -398,7 +425,8 @@ impl<'a> Writer<'a> {
     }
 
     fn code(&self, e: &Expr) -> RustCode {
-        to_rust_code(e, &|s| self.name(s))
+        let mut printed = self.printed.borrow_mut();
+        Printed::get_or(&mut printed.code, e, || to_rust_code(e, &|s| self.name(s)))
     }
 
     /// Wrapped documentation lines `{indent}/// text`; the text is made inert for rustdoc and rustc
@@ -435,7 +463,11 @@ impl<'a> Writer<'a> {
 
     /// The equation `{label}{e}` (`d/dt x = ...`) as comment lines above a statement of a function body.
     fn equation(&self, indent: usize, label: &str, e: &Expr) -> Vec<String> {
-        let text = format!("{label}{}", crate::symbolic::to_text(e));
+        let text = {
+            let mut printed = self.printed.borrow_mut();
+            Printed::get_or(&mut printed.text, e, || crate::symbolic::to_text(e))
+        };
+        let text = format!("{label}{text}");
         format::comment(indent, "//", &text, Wrap::Equation, self.width)
     }
 

@@ -25,9 +25,16 @@ impl<'a> Dag<'a> {
         roots: impl IntoIterator<Item = &'a Expr>,
         descend: impl Fn(&Expr) -> bool,
     ) -> Dag<'a> {
+        let roots: Vec<&'a Expr> = roots.into_iter().collect();
+        // Sized for the expressions as trees (their distinct nodes are at most that), up to a bound: most walks
+        // are of small expressions, and growing a table step by step costs more than walking it.
+        let capacity = roots
+            .iter()
+            .fold(0usize, |n, r| n.saturating_add(r.node_count()))
+            .min(4096);
         let mut dag = Dag {
-            order: Vec::new(),
-            index: HashMap::default(),
+            order: Vec::with_capacity(capacity),
+            index: HashMap::with_capacity_and_hasher(capacity, PassThroughState::default()),
         };
         // Nodes on the stack are marked with `usize::MAX` until they are placed in the order.
         let mut stack: Vec<(&'a Expr, usize)> = Vec::new();

@@ -1,6 +1,7 @@
 //! The generated back-support rhs against a hand-written nalgebra implementation of the paper's Eq. (3)
 //! (`ẋ = A x + B u` with `A`, `B` formed once; see `tests/support/eq3.rs`). The generated rhs works in the energy
-//! states plus the four angles (10 states) and computes the bond-graph equations directly.
+//! states plus the four angles (10 states) and computes the bond-graph equations directly. `memory_floor` does the
+//! loads and stores of `Model::rhs` without its arithmetic.
 
 use bgc_models::back_support as m;
 use bgc_runtime::model::ContinuousModel;
@@ -10,6 +11,36 @@ use std::hint::black_box;
 
 #[path = "../tests/support/eq3.rs"]
 mod eq3;
+
+/// The memory traffic of `Model::rhs` without its arithmetic: the 21 values the back-support rhs reads (6 states,
+/// 2 inputs, 8 parameters and 5 parameter terms) loaded one at a time and its 10 rates stored one at a time, as
+/// the generated code does, with 11 additions in between; volatile accesses keep the compiler from merging or
+/// dropping any of them. The rhs does 25 flops (14 multiplications, 11 additions and subtractions), 1.74 ns at
+/// 4 flops per cycle and 3.6 GHz, but the bench machine (AMD EPYC, Zen 5) completes only about two
+/// floating-point loads or stores per cycle, so these 31 take about 4 ns on their own (docs/runtime.md).
+fn memory_floor(consts: &[f64; 13], x: &m::State, u: &m::Inputs, dx: &mut m::State) {
+    // SAFETY: every pointer comes from a reference to an element of a live array.
+    let read = |v: &f64| unsafe { std::ptr::read_volatile(v) };
+    let [x0, x1, x2, x3, x4, x5] = std::array::from_fn(|i| read(&x[i]));
+    let [u0, u1] = std::array::from_fn(|i| read(&u[i]));
+    let c: [f64; 13] = std::array::from_fn(|i| read(&consts[i]));
+    let rates = [
+        x0 + c[0],
+        x1 + c[1],
+        x2 + c[2],
+        x3 + c[3],
+        x4 + c[4],
+        x5 + c[5],
+        u0 + c[6],
+        u1 + c[7],
+        c[8] + c[9],
+        c[10] + c[11] + c[12],
+    ];
+    for (d, r) in dx.iter_mut().zip(rates) {
+        // SAFETY: as above.
+        unsafe { std::ptr::write_volatile(d, r) };
+    }
+}
 
 fn rhs(c: &mut Criterion) {
     let p = m::Params::default();
@@ -29,6 +60,15 @@ fn rhs(c: &mut Criterion) {
     group.bench_function("model_rhs", |b| {
         b.iter(|| {
             black_box(&model).rhs(0.0, black_box(&x), black_box(&u), &mut dx);
+            black_box(&dx);
+        })
+    });
+    // The loads and stores of `model_rhs` alone: the floor of any rhs that reads and writes its values one at a
+    // time.
+    let consts: [f64; 13] = std::array::from_fn(|i| 1.0 + i as f64);
+    group.bench_function("memory_floor", |b| {
+        b.iter(|| {
+            memory_floor(black_box(&consts), black_box(&x), black_box(&u), &mut dx);
             black_box(&dx);
         })
     });

@@ -1,0 +1,172 @@
+//! The linear plant, its zero-order-hold loop, the Kalman filter and the continuous observer at a size whose
+//! `NX × NX` matrices do not fit a thread's stack: 520 states, so that one such matrix takes
+//! 520² · 8 B = 2.16 MB, more than the 2 MiB of a spawned thread's default stack (`std::thread` and the test
+//! harness). Each test runs on a thread of exactly that size; a stack overflow would abort the test binary.
+//! The models are diagonal or nearly so, so that every result has a hand derivation.
+
+use bgc_runtime::estimation::observer::ContinuousObserver;
+use bgc_runtime::estimation::{KalmanFilter, LinearDiscreteModel, UpdateOutcome};
+use bgc_runtime::matrix::{boxed_identity, zeroed_box};
+use bgc_runtime::sim::{LinearPlant, SampledLoopConfig, simulate_sampled_linear_loop};
+use bgc_runtime::statespace::StateSpace;
+use nalgebra::{DMatrix, SVector, Vector1};
+
+const N: usize = 520;
+
+/// Runs `test` on a thread with a 2 MiB stack and passes a failed assertion on with its message.
+fn on_a_2_mib_thread(test: impl FnOnce() + Send + 'static) {
+    // `spawn` without `stack_size` takes `RUST_MIN_STACK` if set; the size is given so that the test does not
+    // depend on the environment: 2 MiB, the default.
+    let thread = std::thread::Builder::new().stack_size(2 << 20).spawn(test);
+    if let Err(panic) = thread.expect("a thread").join() {
+        std::panic::resume_unwind(panic);
+    }
+}
+
+/// `e_k` as a column of `rows` entries.
+fn unit_column(rows: usize, k: usize) -> DMatrix<f64> {
+    DMatrix::from_fn(rows, 1, |i, _| if i == k { 1.0 } else { 0.0 })
+}
+
+/// `N` decoupled first-order lags `ẋᵢ = −λ xᵢ`, the input on the first, the first measured, under a constant
+/// input of 1 from `x = (0, 1, 1, …)`. By hand, with `φ = e^{−λT}` and `γ = (1 − φ)/λ`: `x₀[k] = γ (1 − φᵏ)/(1 − φ)`
+/// and `xᵢ[k] = φᵏ` for `i > 0`; the measurement is `x₀`.
+#[test]
+fn a_linear_plant_of_520_states_runs_its_sampled_loop_on_a_2_mib_thread() {
+    on_a_2_mib_thread(|| {
+        let (lambda, t, samples) = (2.0, 0.05, 4);
+        let ss = StateSpace::new(
+            DMatrix::identity(N, N) * -lambda,
+            unit_column(N, 0),
+            unit_column(N, 0).transpose(),
+            DMatrix::zeros(1, 1),
+        )
+        .expect("a state-space model");
+        let plant = LinearPlant::<N, 1, 1>::from_state_space(&ss).expect("the plant's sizes");
+        let x0 = SVector::<f64, N>::from_fn(|i, _| if i == 0 { 0.0 } else { 1.0 });
+        let cfg = SampledLoopConfig::new(t, samples, x0);
+        let mut constant = |_k: usize, _t: f64, _y: &Vector1<f64>| Vector1::new(1.0);
+        let traj = simulate_sampled_linear_loop(&plant, &mut constant, &cfg).expect("a run");
+        let (phi, gamma) = ((-lambda * t).exp(), (1.0 - (-lambda * t).exp()) / lambda);
+        for k in 0..=samples {
+            let driven = gamma * (1.0 - phi.powi(k as i32)) / (1.0 - phi);
+            let x = &traj.states[k];
+            assert!((x[0] - driven).abs() < 1e-13, "x₀[{k}] = {}", x[0]);
+            assert!((traj.measurements[k][0] - driven).abs() < 1e-13, "y[{k}]");
+            let decayed = phi.powi(k as i32);
+            let worst = (1..N).map(|i| (x[i] - decayed).abs()).fold(0.0, f64::max);
+            assert!(
+                worst < 1e-13,
+                "largest error of the free states at {k}: {worst:e}"
+            );
+        }
+        // The plant as a model: its Jacobian is A, written into a matrix on the heap.
+        let mut jac = zeroed_box::<N, N>();
+        bgc_runtime::model::ContinuousModel::jac_x(&plant, 0.0, &x0, &Vector1::new(0.0), &mut jac);
+        assert_eq!(
+            (jac[(0, 0)], jac[(N - 1, N - 1)], jac[(0, 1)]),
+            (-lambda, -lambda, 0.0)
+        );
+    });
+}
+
+/// A Kalman filter of `N` random walks `x[k+1] = α x[k] + B u` with `Q = diag(0, q, q, …)` (singular, so no
+/// certificate holds and every step runs the definiteness test in the filter's work matrix), the state
+/// `m = N/2` measured with variance `r`, from `P₀ = p₀ I`. By hand, after one step:
+/// `P⁻ = diag(α² p₀ + qᵢ)`; `S = P⁻ₘₘ + r`, `K = (P⁻ₘₘ / S) eₘ`, `Pₘₘ = P⁻ₘₘ r / S`, the other entries of `P⁻`
+/// unchanged; `x⁻ = α x + B u` and `xₘ = x⁻ₘ + K (y − x⁻ₘ)`.
+#[test]
+fn a_kalman_filter_of_520_states_steps_on_a_2_mib_thread() {
+    on_a_2_mib_thread(|| {
+        let (alpha, q, r, p0, u, y) = (0.9, 0.01, 0.04, 2.0, 0.5, 1.5);
+        let m = N / 2;
+        let ss = StateSpace::new_discrete(
+            DMatrix::identity(N, N) * alpha,
+            unit_column(N, 0),
+            unit_column(N, m).transpose(),
+            DMatrix::zeros(1, 1),
+            0.1,
+        )
+        .expect("a state-space model");
+        let model = LinearDiscreteModel::<N, 1, 1>::boxed_from_state_space(&ss).expect("sizes");
+        let mut q_matrix = boxed_identity::<N>(q);
+        q_matrix[(0, 0)] = 0.0;
+        let x0 = SVector::<f64, N>::from_fn(|i, _| 0.001 * i as f64);
+        let r_matrix = Vector1::new(r);
+        let mut kf =
+            KalmanFilter::from_refs(&model, &q_matrix, &r_matrix, &x0, &boxed_identity(p0))
+                .expect("a filter");
+        // A clone, made on the heap too.
+        let mut twin = kf.clone();
+        kf.predict(&Vector1::new(u)).expect("a prediction");
+        let outcome = kf
+            .update(&Vector1::new(y), &Vector1::new(u))
+            .expect("an update");
+        assert!(matches!(
+            outcome,
+            UpdateOutcome::Accepted { repair: None, .. }
+        ));
+
+        let predicted = |i: usize| alpha * alpha * p0 + if i == 0 { 0.0 } else { q };
+        let s = predicted(m) + r;
+        let (p, x) = (kf.covariance(), kf.state());
+        assert!((kf.innovation_covariance()[(0, 0)] - s).abs() < 1e-14);
+        assert!((kf.gain()[(m, 0)] - predicted(m) / s).abs() < 1e-15);
+        for i in 0..N {
+            let expected = if i == m {
+                predicted(m) * r / s
+            } else {
+                predicted(i)
+            };
+            assert!(
+                (p[(i, i)] - expected).abs() < 1e-14,
+                "P[{i}, {i}] = {}",
+                p[(i, i)]
+            );
+            let prior = alpha * x0[i] + if i == 0 { u } else { 0.0 };
+            let corrected = if i == m {
+                prior + predicted(m) / s * (y - prior)
+            } else {
+                prior
+            };
+            assert!((x[i] - corrected).abs() < 1e-14, "x[{i}] = {}", x[i]);
+        }
+        let off_diagonal =
+            (0..N).flat_map(|j| (0..N).filter(move |&i| i != j).map(move |i| (i, j)));
+        assert!(off_diagonal.clone().all(|(i, j)| p[(i, j)] == 0.0));
+
+        // The clone kept the initial estimate, and `set_state_from` takes a covariance held on the heap.
+        assert_eq!((twin.covariance()[(m, m)], twin.state()[1]), (p0, x0[1]));
+        twin.set_state_from(&x0, &boxed_identity(2.0 * p0))
+            .expect("a new estimate");
+        assert_eq!(twin.covariance()[(m, m)], 2.0 * p0);
+    });
+}
+
+/// The observer `x̂' = A x̂ + B u + L (y − C x̂)` of `N` lags `ẋᵢ = −xᵢ` with the first state measured and
+/// `L = 3 e₀`: by hand `x̂'₀ = −x̂₀ + u + 3 (y − x̂₀)`, `x̂'ᵢ = −x̂ᵢ`, and `A − L C` is `−I` with `−4` at `(0, 0)`.
+#[test]
+fn a_continuous_observer_of_520_states_runs_on_a_2_mib_thread() {
+    on_a_2_mib_thread(|| {
+        let a = boxed_identity::<N>(-1.0);
+        let mut b = zeroed_box::<N, 1>();
+        b[0] = 1.0;
+        let mut c = zeroed_box::<1, N>();
+        c[0] = 1.0;
+        let mut l = zeroed_box::<N, 1>();
+        l[0] = 3.0;
+        let observer =
+            ContinuousObserver::from_refs(&a, &b, &c, &zeroed_box(), &l).expect("finite");
+        let x_hat = SVector::<f64, N>::from_fn(|i, _| 1.0 + i as f64);
+        let (u, y) = (Vector1::new(0.5), Vector1::new(2.0));
+        let dx = observer.rhs(&x_hat, &u, &y);
+        assert!((dx[0] - (-1.0 + 0.5 + 3.0 * (2.0 - 1.0))).abs() < 1e-15);
+        assert!((1..N).all(|i| dx[i] == -x_hat[i]));
+        let error_dynamics = observer.error_dynamics();
+        assert_eq!(
+            (error_dynamics[(0, 0)], error_dynamics[(N - 1, N - 1)]),
+            (-4.0, -1.0)
+        );
+        assert_eq!(error_dynamics.sum(), -4.0 - (N - 1) as f64);
+    });
+}

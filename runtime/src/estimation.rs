@@ -1,4 +1,6 @@
-//! State and parameter estimation on fixed-size, stack-allocated vectors and matrices.
+//! State and parameter estimation on fixed-size vectors and matrices: the Kalman filter and the observer keep
+//! their `NX × NX` matrices on the heap (any size on any thread), the unscented filters on the stack (see
+//! `docs/runtime.md`, section 2, for the sizes that fit).
 //!
 //! - [`kalman`]: the discrete linear Kalman filter (time-varying and fixed/steady-state gain, Joseph form),
 //!   gain conversions and a steady-state gain by Riccati iteration;

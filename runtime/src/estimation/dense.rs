@@ -276,11 +276,22 @@ pub fn cholesky_solve<const N: usize, const C: usize>(
 }
 
 /// Solves `A X = B` by Gaussian elimination with partial pivoting; `None` when `A` is numerically singular.
+/// The elimination works on a copy of `A` in a [`with_square_scratch`] matrix (on the heap for a large `N`).
 pub fn solve_general<const N: usize, const C: usize>(
     a: &SMatrix<f64, N, N>,
     b: &SMatrix<f64, N, C>,
 ) -> Option<SMatrix<f64, N, C>> {
-    let mut m = *a;
+    with_square_scratch(|m: &mut SMatrix<f64, N, N>| {
+        m.copy_from(a);
+        eliminate(m, b)
+    })
+}
+
+/// [`solve_general`] overwriting `m` (`A`) with its eliminated form.
+fn eliminate<const N: usize, const C: usize>(
+    m: &mut SMatrix<f64, N, N>,
+    b: &SMatrix<f64, N, C>,
+) -> Option<SMatrix<f64, N, C>> {
     let mut x = *b;
     let scale = m.amax();
     if !(scale > 0.0 && scale.is_finite()) {

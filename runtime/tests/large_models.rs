@@ -1,11 +1,17 @@
 //! The linear plant, its zero-order-hold loop, the Kalman filter and the continuous observer at a size whose
 //! `NX × NX` matrices do not fit a thread's stack: 520 states, so that one such matrix takes
 //! 520² · 8 B = 2.16 MB, more than the 2 MiB of a spawned thread's default stack (`std::thread` and the test
-//! harness). Each test runs on a thread of exactly that size; a stack overflow would abort the test binary.
-//! The models are diagonal or nearly so, so that every result has a hand derivation.
+//! harness); the UKF and the dual UKF at 362 states, whose `362 × 725` sigma-point matrix takes 2.10 MB, more
+//! than 2 MiB too (and whose step costs `O(NX³)` in the test build's light optimisation). Each test runs on a
+//! thread of exactly that size; a stack overflow would abort the test binary. The models are diagonal or nearly
+//! so, so that every result has a hand derivation.
 
+use bgc_runtime::estimation::dual_ukf::DualUkf;
 use bgc_runtime::estimation::observer::ContinuousObserver;
-use bgc_runtime::estimation::{KalmanFilter, LinearDiscreteModel, UpdateOutcome};
+use bgc_runtime::estimation::ukf_augmented::AugmentedUkf;
+use bgc_runtime::estimation::{
+    KalmanFilter, LinearDiscreteModel, SigmaPoints, UnscentedKalmanFilter, UpdateOutcome,
+};
 use bgc_runtime::matrix::{boxed_identity, zeroed_box};
 use bgc_runtime::sim::{LinearPlant, SampledLoopConfig, simulate_sampled_linear_loop};
 use bgc_runtime::statespace::StateSpace;
@@ -168,5 +174,162 @@ fn a_continuous_observer_of_520_states_runs_on_a_2_mib_thread() {
             (-4.0, -1.0)
         );
         assert_eq!(error_dynamics.sum(), -4.0 - (N - 1) as f64);
+    });
+}
+
+/// States of the unscented filters' tests, and their sigma points (`2 NU_STATES + 1`).
+const NU_STATES: usize = 362;
+const NU_POINTS: usize = 725;
+
+/// The UKF of `NU_STATES` scaled random walks `x[k+1] = α x[k]` with `Q = q I`, the state `m` measured with
+/// variance `r`, from `P₀ = p₀ I`, with `α = 1`, `κ = 0` sigma points (`W₀⁽ᵐ⁾ = 0`). For a linear model the
+/// unscented transform is exact, so the hand derivation of the Kalman filter's test holds to rounding:
+/// `P⁻ = (α² p₀ + q) I`, `S = P⁻ₘₘ + r`, `Pₘₘ = P⁻ₘₘ r / S`, `xₘ = α x₀ₘ + (P⁻ₘₘ / S) (y − α x₀ₘ)`.
+#[test]
+fn a_ukf_of_362_states_steps_on_a_2_mib_thread() {
+    on_a_2_mib_thread(|| {
+        let (alpha, q, r, p0, y) = (0.9, 0.01, 0.04, 2.0, 1.5);
+        let m = NU_STATES / 2;
+        let x0 = SVector::<f64, NU_STATES>::from_fn(|i, _| 0.001 * i as f64);
+        let points = SigmaPoints::new(1.0, 2.0, 0.0).expect("weights");
+        let mut ukf = UnscentedKalmanFilter::<NU_STATES, 1, 1, NU_POINTS>::from_refs(
+            points,
+            &boxed_identity(q),
+            &Vector1::new(r),
+            &x0,
+            &boxed_identity(p0),
+        )
+        .expect("a filter");
+        let u = Vector1::new(0.0);
+        ukf.predict(&u, |x, _u| x * alpha).expect("a prediction");
+        let outcome = ukf
+            .update(&Vector1::new(y), &u, |x, _u| Vector1::new(x[m]))
+            .expect("an update");
+        assert!(matches!(outcome, UpdateOutcome::Accepted { .. }));
+        let predicted = alpha * alpha * p0 + q;
+        let s = predicted + r;
+        let (p, x) = (ukf.covariance(), ukf.state());
+        for i in 0..NU_STATES {
+            let expected = if i == m { predicted * r / s } else { predicted };
+            assert!(
+                (p[(i, i)] - expected).abs() < 1e-12,
+                "P[{i}, {i}] = {}",
+                p[(i, i)]
+            );
+            let prior = alpha * x0[i];
+            let corrected = if i == m {
+                prior + predicted / s * (y - prior)
+            } else {
+                prior
+            };
+            assert!((x[i] - corrected).abs() < 1e-12, "x[{i}] = {}", x[i]);
+        }
+        let largest_off_diagonal = (0..NU_STATES)
+            .flat_map(|j| (0..NU_STATES).filter(move |&i| i != j).map(move |i| (i, j)))
+            .map(|(i, j)| p[(i, j)].abs())
+            .fold(0.0, f64::max);
+        assert!(
+            largest_off_diagonal < 1e-12,
+            "largest off-diagonal entry {largest_off_diagonal:e}"
+        );
+    });
+}
+
+/// A dual UKF of the same walks with the factor `w` as its one parameter, `x[k+1] = w x[k]`, started at
+/// `w = α`: its state filter's step is the UKF's step at `α`, so after one step its state estimate is that of
+/// a plain UKF run alongside (the same arithmetic, hence equal to the last bit).
+#[test]
+fn a_dual_ukf_of_362_states_steps_on_a_2_mib_thread() {
+    on_a_2_mib_thread(|| {
+        let (alpha, q, r, p0, y) = (0.9, 0.01, 0.04, 2.0, 1.5);
+        let m = NU_STATES / 2;
+        let x0 = SVector::<f64, NU_STATES>::from_fn(|i, _| 0.001 * i as f64);
+        let points = SigmaPoints::new(1.0, 2.0, 0.0).expect("weights");
+        let filter = || {
+            UnscentedKalmanFilter::<NU_STATES, 1, 1, NU_POINTS>::from_refs(
+                points,
+                &boxed_identity(q),
+                &Vector1::new(r),
+                &x0,
+                &boxed_identity(p0),
+            )
+            .expect("a filter")
+        };
+        let mut plain = filter();
+        let param_points = SigmaPoints::<1, 3>::new(1.0, 2.0, 0.0).expect("weights");
+        let (w0, pw0) = (Vector1::new(alpha), Vector1::new(0.01));
+        let mut dual = DualUkf::new(filter(), param_points, w0, pw0, 1.0).expect("a dual UKF");
+        let u = Vector1::new(0.0);
+        let measure = |x: &SVector<f64, NU_STATES>| Vector1::new(x[m]);
+        dual.step_with(
+            &u,
+            &Vector1::new(y),
+            |x, _u, w| x * w[0],
+            |x, _u, _w| measure(x),
+        )
+        .expect("a step");
+        plain.predict(&u, |x, _u| x * alpha).expect("a prediction");
+        plain
+            .update(&Vector1::new(y), &u, |x, _u| measure(x))
+            .expect("an update");
+        assert_eq!(dual.state(), plain.state());
+        assert!(dual.parameters()[0].is_finite());
+    });
+}
+
+/// The augmented UKF of the same walks with the process noise `v` (variance `q`) entering the first state and
+/// the measurement noise `n` (variance `r`) added to `x_m`: `NA = 362 + 1 + 1` augmented states and 729 points.
+/// By hand, `P⁻ = α² p₀ I + q e₀e₀ᵀ`, and the update is the Kalman filter's: `Pₘₘ = P⁻ₘₘ r / (P⁻ₘₘ + r)`.
+#[test]
+fn an_augmented_ukf_of_362_states_steps_on_a_2_mib_thread() {
+    on_a_2_mib_thread(|| {
+        let (alpha, q, r, p0, y) = (0.9, 0.01, 0.04, 2.0, 1.5);
+        let m = NU_STATES / 2;
+        let x0 = SVector::<f64, NU_STATES>::from_fn(|i, _| 0.001 * i as f64);
+        let points = SigmaPoints::new(1.0, 2.0, 0.0).expect("weights");
+        let mut ukf = AugmentedUkf::<NU_STATES, 1, 1, 1, 1, 364, 729>::from_refs(
+            points,
+            &Vector1::new(q),
+            &Vector1::new(r),
+            &x0,
+            &boxed_identity(p0),
+        )
+        .expect("a filter");
+        let u = Vector1::new(0.0);
+        let propagate = |x: &SVector<f64, NU_STATES>, _u: &Vector1<f64>, v: &Vector1<f64>| {
+            let mut next = x * alpha;
+            next[0] += v[0];
+            next
+        };
+        ukf.predict(&u, propagate).expect("a prediction");
+        let measure = |x: &SVector<f64, NU_STATES>, _u: &Vector1<f64>, n: &Vector1<f64>| {
+            Vector1::new(x[m] + n[0])
+        };
+        let outcome = ukf
+            .update(&Vector1::new(y), &u, measure)
+            .expect("an update");
+        assert!(matches!(outcome, UpdateOutcome::Accepted { .. }));
+        let predicted = |i: usize| alpha * alpha * p0 + if i == 0 { q } else { 0.0 };
+        let s = predicted(m) + r;
+        let (p, x) = (ukf.covariance(), ukf.state());
+        for i in 0..NU_STATES {
+            let expected = if i == m {
+                predicted(m) * r / s
+            } else {
+                predicted(i)
+            };
+            assert!(
+                (p[(i, i)] - expected).abs() < 1e-12,
+                "P[{i}, {i}] = {}",
+                p[(i, i)]
+            );
+            let prior = alpha * x0[i];
+            let corrected = if i == m {
+                prior + predicted(m) / s * (y - prior)
+            } else {
+                prior
+            };
+            assert!((x[i] - corrected).abs() < 1e-12, "x[{i}] = {}", x[i]);
+        }
     });
 }

@@ -8,6 +8,7 @@
 
 use bgc_runtime::estimation::dual_ukf::DualUkf;
 use bgc_runtime::estimation::observer::ContinuousObserver;
+use bgc_runtime::estimation::srukf::SquareRootUkf;
 use bgc_runtime::estimation::ukf_augmented::AugmentedUkf;
 use bgc_runtime::estimation::{
     KalmanFilter, LinearDiscreteModel, SigmaPoints, UnscentedKalmanFilter, UpdateOutcome,
@@ -188,7 +189,7 @@ const NU_POINTS: usize = 725;
 #[test]
 fn a_ukf_of_362_states_steps_on_a_2_mib_thread() {
     on_a_2_mib_thread(|| {
-        let (alpha, q, r, p0, y) = (0.9, 0.01, 0.04, 2.0, 1.5);
+        let (alpha, q, r, p0, y) = WALK;
         let m = NU_STATES / 2;
         let x0 = SVector::<f64, NU_STATES>::from_fn(|i, _| 0.001 * i as f64);
         let points = SigmaPoints::new(1.0, 2.0, 0.0).expect("weights");
@@ -206,33 +207,73 @@ fn a_ukf_of_362_states_steps_on_a_2_mib_thread() {
             .update(&Vector1::new(y), &u, |x, _u| Vector1::new(x[m]))
             .expect("an update");
         assert!(matches!(outcome, UpdateOutcome::Accepted { .. }));
-        let predicted = alpha * alpha * p0 + q;
-        let s = predicted + r;
-        let (p, x) = (ukf.covariance(), ukf.state());
-        for i in 0..NU_STATES {
-            let expected = if i == m { predicted * r / s } else { predicted };
-            assert!(
-                (p[(i, i)] - expected).abs() < 1e-12,
-                "P[{i}, {i}] = {}",
-                p[(i, i)]
-            );
-            let prior = alpha * x0[i];
-            let corrected = if i == m {
-                prior + predicted / s * (y - prior)
-            } else {
-                prior
-            };
-            assert!((x[i] - corrected).abs() < 1e-12, "x[{i}] = {}", x[i]);
-        }
-        let largest_off_diagonal = (0..NU_STATES)
-            .flat_map(|j| (0..NU_STATES).filter(move |&i| i != j).map(move |i| (i, j)))
-            .map(|(i, j)| p[(i, j)].abs())
-            .fold(0.0, f64::max);
-        assert!(
-            largest_off_diagonal < 1e-12,
-            "largest off-diagonal entry {largest_off_diagonal:e}"
-        );
+        assert_walk_step(ukf.covariance(), ukf.state(), &x0);
     });
+}
+
+/// The square-root UKF of the UKF's test, against the same hand derivation.
+#[test]
+fn a_square_root_ukf_of_362_states_steps_on_a_2_mib_thread() {
+    on_a_2_mib_thread(|| {
+        let (alpha, q, r, p0, y) = WALK;
+        let m = NU_STATES / 2;
+        let x0 = SVector::<f64, NU_STATES>::from_fn(|i, _| 0.001 * i as f64);
+        let points = SigmaPoints::new(1.0, 2.0, 0.0).expect("weights");
+        let mut ukf = SquareRootUkf::<NU_STATES, 1, 1, NU_POINTS>::from_refs(
+            points,
+            &boxed_identity(q),
+            &Vector1::new(r),
+            &x0,
+            &boxed_identity(p0),
+        )
+        .expect("a filter");
+        let u = Vector1::new(0.0);
+        ukf.predict(&u, |x, _u| x * alpha).expect("a prediction");
+        let outcome = ukf
+            .update(&Vector1::new(y), &u, |x, _u| Vector1::new(x[m]))
+            .expect("an update");
+        assert!(matches!(outcome, UpdateOutcome::Accepted { .. }));
+        assert_walk_step(&ukf.covariance(), ukf.state(), &x0);
+    });
+}
+
+/// `(α, q, r, p₀, y)` of the unscented filters' tests.
+const WALK: (f64, f64, f64, f64, f64) = (0.9, 0.01, 0.04, 2.0, 1.5);
+
+/// The hand derivation of one step of the UKF's test: `P = diag(α² p₀ + q)` but `Pₘₘ = P⁻ₘₘ r / S`, and
+/// `x = α x₀` but `xₘ = α x₀ₘ + (P⁻ₘₘ / S) (y − α x₀ₘ)`, to rounding.
+fn assert_walk_step(
+    p: &nalgebra::SMatrix<f64, NU_STATES, NU_STATES>,
+    x: &SVector<f64, NU_STATES>,
+    x0: &SVector<f64, NU_STATES>,
+) {
+    let (alpha, q, r, p0, y) = WALK;
+    let m = NU_STATES / 2;
+    let predicted = alpha * alpha * p0 + q;
+    let s = predicted + r;
+    for i in 0..NU_STATES {
+        let expected = if i == m { predicted * r / s } else { predicted };
+        assert!(
+            (p[(i, i)] - expected).abs() < 1e-12,
+            "P[{i}, {i}] = {}",
+            p[(i, i)]
+        );
+        let prior = alpha * x0[i];
+        let corrected = if i == m {
+            prior + predicted / s * (y - prior)
+        } else {
+            prior
+        };
+        assert!((x[i] - corrected).abs() < 1e-12, "x[{i}] = {}", x[i]);
+    }
+    let largest_off_diagonal = (0..NU_STATES)
+        .flat_map(|j| (0..NU_STATES).filter(move |&i| i != j).map(move |i| (i, j)))
+        .map(|(i, j)| p[(i, j)].abs())
+        .fold(0.0, f64::max);
+    assert!(
+        largest_off_diagonal < 1e-12,
+        "largest off-diagonal entry {largest_off_diagonal:e}"
+    );
 }
 
 /// A dual UKF of the same walks with the factor `w` as its one parameter, `x[k+1] = w x[k]`, started at
@@ -241,7 +282,7 @@ fn a_ukf_of_362_states_steps_on_a_2_mib_thread() {
 #[test]
 fn a_dual_ukf_of_362_states_steps_on_a_2_mib_thread() {
     on_a_2_mib_thread(|| {
-        let (alpha, q, r, p0, y) = (0.9, 0.01, 0.04, 2.0, 1.5);
+        let (alpha, q, r, p0, y) = WALK;
         let m = NU_STATES / 2;
         let x0 = SVector::<f64, NU_STATES>::from_fn(|i, _| 0.001 * i as f64);
         let points = SigmaPoints::new(1.0, 2.0, 0.0).expect("weights");
@@ -283,7 +324,7 @@ fn a_dual_ukf_of_362_states_steps_on_a_2_mib_thread() {
 #[test]
 fn an_augmented_ukf_of_362_states_steps_on_a_2_mib_thread() {
     on_a_2_mib_thread(|| {
-        let (alpha, q, r, p0, y) = (0.9, 0.01, 0.04, 2.0, 1.5);
+        let (alpha, q, r, p0, y) = WALK;
         let m = NU_STATES / 2;
         let x0 = SVector::<f64, NU_STATES>::from_fn(|i, _| 0.001 * i as f64);
         let points = SigmaPoints::new(1.0, 2.0, 0.0).expect("weights");

@@ -5,7 +5,7 @@
 //!
 //! - [`cholesky_lower`]: `P = L Lᵀ` with `L` lower triangular and a positive diagonal, or `None` when `P` is not
 //!   numerically positive definite;
-//! - [`cholesky_psd`]: the same for a positive *semi*-definite matrix (zero pivots allowed), used for noise
+//! - [`cholesky_psd_into`]: the same for a positive *semi*-definite matrix (zero pivots allowed), used for noise
 //!   covariances that may be singular (a noise-free channel);
 //! - [`solve_lower`]/[`solve_upper_transposed`]: triangular solves with a lower factor;
 //! - [`positive_definite_in`]: the definiteness test of a covariance by an `LDLᵀ` sweep;
@@ -169,16 +169,16 @@ pub fn cholesky_above_floor<const N: usize>(
         .then_some(l)
 }
 
-/// Lower factor `L` with `L Lᵀ = P` of a symmetric positive *semi*-definite matrix. A pivot below
-/// `tol · max(1, max diag)` is treated as zero (its column is set to zero); a clearly negative pivot or a
-/// non-finite entry gives `None`.
+/// [`cholesky_psd_into`] returning the factor.
+#[cfg(test)]
 pub fn cholesky_psd<const N: usize>(p: &SMatrix<f64, N, N>) -> Option<SMatrix<f64, N, N>> {
     let mut l = SMatrix::<f64, N, N>::zeros();
     cholesky_psd_into(p, &mut l).then_some(l)
 }
 
-/// [`cholesky_psd`] written into `l`, which must be zero on entry; `false` when `p` is not positive
-/// semi-definite or not finite.
+/// Lower factor `L` with `L Lᵀ = P` of a symmetric positive *semi*-definite matrix, written into `l`, which
+/// must be zero on entry. A pivot below `tol · max(1, max diag)` is treated as zero (its column is left zero);
+/// a clearly negative pivot or a non-finite entry gives `false`.
 pub fn cholesky_psd_into<const N: usize>(
     p: &SMatrix<f64, N, N>,
     l: &mut SMatrix<f64, N, N>,

@@ -2,7 +2,7 @@
 //! [`super::dual_ukf`]) share, generic over the sizes of state, measurement and point set.
 //!
 //! - input checks: a non-finite input `u` is an error, a non-finite measurement `y` is a rejected update;
-//! - [`evaluate_points`]: a model function at every sigma point, with the first non-finite output reported as
+//! - [`evaluate_points_into`] (and [`evaluate_points`]): a model function at every sigma point, with the first non-finite output reported as
 //!   [`EstimationError::NonFiniteModelOutput`];
 //! - [`predicted_moments_into`]: `x̂⁻ = mean(χ*)`, `P⁻ = Σ W⁽ᶜ⁾ (χ*ᵢ − x̂⁻)(χ*ᵢ − x̂⁻)ᵀ (+ Q)`, repaired;
 //! - [`innovation_moments`]: `ŷ = mean(Y)`, `S = Σ W⁽ᶜ⁾ (Yᵢ − ŷ)(Yᵢ − ŷ)ᵀ (+ R)`,
@@ -11,8 +11,7 @@
 //!   small parameter filter): NIS and gate, `K = P_xy S⁻¹`, `x̂ += K e`, `P −= K S Kᵀ`, repaired;
 //! - [`FilterSettings`]: what the filters are configured with (sigma points, mean and residual functions, fault
 //!   policy), with the predict moments and the whole correction of a covariance-form filter as methods, and
-//!   [`settings_methods`], the public methods that replace those settings;
-//! - [`sigma_images`]: the input check, the sigma points and their images under a model function.
+//!   [`settings_methods`], the public methods that replace those settings.
 //!
 //! None of them allocates or panics, and each leaves the caller's estimate alone unless the whole step
 //! succeeded. The `_into`/`_in` forms write their `N × NS` and `N × N` results into matrices the caller holds
@@ -91,20 +90,6 @@ pub(crate) fn evaluate_points_into<const N: usize, const NS: usize>(
     }
 }
 
-/// The sigma points `χ` (from `draw`, called once `u` has passed [`check_input`]) and their images
-/// `g(χᵢ, u)`, evaluated as in [`evaluate_points`] under the name `function`.
-pub(crate) fn sigma_images<const N: usize, const M: usize, const NU: usize, const NS: usize>(
-    function: &'static str,
-    u: &SVector<f64, NU>,
-    draw: impl FnOnce() -> Result<SMatrix<f64, N, NS>, EstimationError>,
-    mut g: impl FnMut(&SVector<f64, N>, &SVector<f64, NU>) -> SVector<f64, M>,
-) -> Result<(SMatrix<f64, N, NS>, SMatrix<f64, M, NS>), EstimationError> {
-    check_input(u)?;
-    let chi = draw()?;
-    let images = evaluate_points(function, |i| g(&chi.column(i).into_owned(), u))?;
-    Ok((chi, images))
-}
-
 /// `Err` when the state mean function gave a non-finite mean.
 pub(crate) fn check_state_mean<const N: usize>(x: &SVector<f64, N>) -> Result<(), EstimationError> {
     match first_non_finite(x) {
@@ -168,11 +153,22 @@ pub(crate) fn check_precision<const NP: usize, const N: usize, const NS: usize>(
     quantity: &'static str,
     filter: &'static str,
 ) -> Result<(), EstimationError> {
+    check_precision_of_diagonal(floor, &cov.diagonal(), points, quantity, filter)
+}
+
+/// [`check_precision`] given the diagonal of the covariance only.
+pub(crate) fn check_precision_of_diagonal<const NP: usize, const N: usize, const NS: usize>(
+    floor: &SVector<f64, N>,
+    diagonal: &SVector<f64, N>,
+    points: &SigmaPoints<NP, NS>,
+    quantity: &'static str,
+    filter: &'static str,
+) -> Result<(), EstimationError> {
     for index in 0..N {
         if floor[index] == 0.0 {
             continue;
         }
-        let relative_error = floor[index] / cov[(index, index)].abs();
+        let relative_error = floor[index] / diagonal[index].abs();
         if relative_error > PRECISION_LIMIT || relative_error.is_nan() {
             return Err(EstimationError::PrecisionLoss {
                 filter,

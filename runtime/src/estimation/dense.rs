@@ -20,8 +20,8 @@
 //! states), so the factorisations a large filter needs write into matrices the caller holds
 //! ([`cholesky_lower_into`], [`cholesky_psd_into`], [`positive_definite_in`], [`symmetric_eigen_in_place`]);
 //! the functions that return a matrix are those applied to the small matrices of a step (innovation
-//! covariances, the UKFs' covariances). [`with_square_scratch`] lends an `N × N` work matrix: on the stack when
-//! it is small, on the heap otherwise.
+//! covariances, the dual UKF's parameter covariance). [`with_square_scratch`] lends an `N × N` work matrix: on
+//! the stack when it is small, on the heap otherwise.
 
 use nalgebra::{SMatrix, SVector};
 

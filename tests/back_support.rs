@@ -137,7 +137,7 @@ fn eq3_by_hand(p: &Params) -> Plant {
         0.0, 0.0,
         0.0, -p.d_eh,
     ]);
-    Plant { a, b, c, d }
+    Plant::new(a, b, c, d)
 }
 
 /// `got` equals `want` entrywise to `rel` times the largest |entry| of `want`.

@@ -38,12 +38,7 @@ fn plant() -> LinearPlant<NX, 1, 2> {
         0.0, 1.0, 0.0, 0.0, 0.0, 0.0,
         0.0, 0.0, ks, 0.0, -ks, 0.0,
     ]);
-    LinearPlant {
-        a,
-        b,
-        c,
-        d: SMatrix::zeros(),
-    }
+    LinearPlant::new(a, b, c, SMatrix::zeros())
 }
 
 /// The ODE path sees the plant only through the model trait, as it sees a generated model.
@@ -82,8 +77,8 @@ struct Observer {
 impl Observer {
     fn design(p: &LinearPlant<NX, 1, 2>) -> Observer {
         let mut big = DMatrix::<f64>::zeros(NX + 1, NX + 1);
-        big.view_mut((0, 0), (NX, NX)).copy_from(&(p.a * T));
-        big.view_mut((0, NX), (NX, 1)).copy_from(&(p.b * T));
+        big.view_mut((0, 0), (NX, NX)).copy_from(&(*p.a * T));
+        big.view_mut((0, NX), (NX, 1)).copy_from(&(*p.b * T));
         let e = expm(&big).expect("the plant discretises");
         let ad = DMatrix::from_fn(NX, NX, |i, j| e[(i, j)]);
         let bd = DMatrix::from_fn(NX, 1, |i, _| e[(i, NX)]);
@@ -95,7 +90,7 @@ impl Observer {
         Observer {
             ad: SMatrix::from_fn(|i, j| ad[(i, j)]),
             bd: SMatrix::from_fn(|i, _| bd[(i, 0)]),
-            c: p.c,
+            c: *p.c,
             m: SMatrix::from_fn(|i, j| kf.filter_gain[(i, j)]),
             k: SMatrix::from_fn(|_, j| lqr.k[(0, j)]),
             x_hat: SVector::zeros(),

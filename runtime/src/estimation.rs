@@ -1,4 +1,6 @@
-//! State and parameter estimation on fixed-size, stack-allocated vectors and matrices.
+//! State and parameter estimation on fixed-size vectors and matrices. The filters and the observer keep their
+//! `NX × NX` (and sigma-point) matrices and the work space of a step on the heap, allocated when they are built,
+//! so that a filter of any size runs on any thread and a step allocates nothing.
 //!
 //! - [`kalman`]: the discrete linear Kalman filter (time-varying and fixed/steady-state gain, Joseph form),
 //!   gain conversions and a steady-state gain by Riccati iteration;

@@ -5,10 +5,17 @@
 //! [`StateSpace`] that `lqr`, `lqi`, `lqe` and `c2d_zoh` take. Gains and covariances come back as `DMatrix`;
 //! [`fixed`] copies one into the `SMatrix` a `KalmanFilter` or a control loop needs, checking its shape, and
 //! [`dynamic`] goes the other way (weights written as fixed-size literals, for instance).
+//!
+//! # Large models
+//!
+//! An `R × C` `SMatrix` takes `8 R C` bytes wherever it is declared: an `NX × NX` one exceeds a spawned thread's
+//! 2 MiB stack at 512 states. [`zeroed_box`], [`boxed_copy`], [`boxed_fixed`] and [`boxed_identity`] build one
+//! on the heap without building it on the stack first (`Box::new(SMatrix::zeros())` does), for the
+//! constructors of filters, observers and plants that take their matrices by reference.
 
 use crate::linalg::MatrixError;
 use crate::statespace::{StateSpace, StateSpaceError};
-use nalgebra::{DMatrix, SMatrix};
+use nalgebra::{DMatrix, SMatrix, SVector};
 
 /// `(A, B, C, D)` of `ẋ = A x + B u`, `y = C x + D u` in fixed sizes, as generated models' `state_space` and
 /// [`crate::linearize::jacobians_at`] give them.
@@ -39,6 +46,57 @@ pub fn fixed<const R: usize, const C: usize>(
         });
     }
     Ok(SMatrix::from_fn(|i, j| m[(i, j)]))
+}
+
+/// An `R × C` matrix of zeros on the heap, never on the stack (`bytemuck::zeroed_box`).
+pub fn zeroed_box<const R: usize, const C: usize>() -> Box<SMatrix<f64, R, C>> {
+    bytemuck::zeroed_box()
+}
+
+/// A copy of `m` on the heap, written there entry by entry.
+pub fn boxed_copy<const R: usize, const C: usize>(
+    m: &SMatrix<f64, R, C>,
+) -> Box<SMatrix<f64, R, C>> {
+    let mut out = zeroed_box::<R, C>();
+    out.copy_from(m);
+    out
+}
+
+/// `s I` on the heap.
+pub fn boxed_identity<const N: usize>(s: f64) -> Box<SMatrix<f64, N, N>> {
+    let mut out = zeroed_box::<N, N>();
+    out.fill_diagonal(s);
+    out
+}
+
+/// [`fixed`] on the heap: the `R × C` matrix with the entries of `m`, for a size that does not fit the stack.
+pub fn boxed_fixed<const R: usize, const C: usize>(
+    name: &'static str,
+    m: &DMatrix<f64>,
+) -> Result<Box<SMatrix<f64, R, C>>, MatrixError> {
+    if m.nrows() != R || m.ncols() != C {
+        return Err(MatrixError::Shape {
+            name,
+            rows: m.nrows(),
+            cols: m.ncols(),
+            expected_rows: R,
+            expected_cols: C,
+        });
+    }
+    let mut out = zeroed_box::<R, C>();
+    out.copy_from(m);
+    Ok(out)
+}
+
+/// `M₁ v₁ + M₂ v₂` with the matrices read where they are: `model.a * x`, a matrix value, may copy the matrix
+/// to the stack first (an unoptimised build does), where a reference times a vector does not.
+pub(crate) fn product_sum<const R: usize, const C1: usize, const C2: usize>(
+    m1: &SMatrix<f64, R, C1>,
+    v1: &SVector<f64, C1>,
+    m2: &SMatrix<f64, R, C2>,
+    v2: &SVector<f64, C2>,
+) -> SVector<f64, R> {
+    m1 * v1 + m2 * v2
 }
 
 /// The continuous-time [`StateSpace`] `ẋ = A x + B u`, `y = C x + D u` of fixed-size matrices, as a generated

@@ -16,6 +16,7 @@ mod estimation_health;
 mod estimation_reference;
 mod estimation_robustness;
 mod fit_identifiability;
+mod large_models;
 mod linalg_care;
 mod linalg_dare;
 mod linalg_design;

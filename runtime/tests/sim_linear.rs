@@ -15,12 +15,12 @@ use nalgebra::{Matrix1, SMatrix, SVector, Vector1, Vector2};
 const T: f64 = 0.1;
 
 fn first_order(a: f64, b: f64) -> LinearPlant<1, 1, 1> {
-    LinearPlant {
-        a: Matrix1::new(-a),
-        b: Matrix1::new(b),
-        c: Matrix1::new(1.0),
-        d: Matrix1::new(0.0),
-    }
+    LinearPlant::new(
+        Matrix1::new(-a),
+        Matrix1::new(b),
+        Matrix1::new(1.0),
+        Matrix1::new(0.0),
+    )
 }
 
 /// ẋ = −a x + b u under zero-order hold: x[k+1] = φ x[k] + γ u[k], φ = e^{−aT}, γ = b (1 − φ) / a (by hand);
@@ -82,12 +82,12 @@ fn linear_loop_matches_the_ode_path() {
         0.0, 0.0, 0.0, 1.0,
         1.0, 0.1, -1.0, -0.1,
     ]);
-    let plant = LinearPlant {
+    let plant = LinearPlant::new(
         a,
-        b: SMatrix::<f64, 4, 1>::from_column_slice(&[0.0, 0.0, 0.0, 1.0]),
-        c: SMatrix::<f64, 2, 4>::from_row_slice(&[1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]),
-        d: SMatrix::zeros(),
-    };
+        SMatrix::<f64, 4, 1>::from_column_slice(&[0.0, 0.0, 0.0, 1.0]),
+        SMatrix::<f64, 2, 4>::from_row_slice(&[1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0]),
+        SMatrix::zeros(),
+    );
     let mut cfg = SampledLoopConfig::new(0.05, 200, SVector::<f64, 4>::new(1.0, 0.0, -0.5, 0.0));
     cfg.measurement_noise_std = Vector2::new(0.01, 0.02);
     cfg.process_noise_std = SVector::<f64, 4>::new(0.0, 0.5, 0.0, 0.5);

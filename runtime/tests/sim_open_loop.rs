@@ -144,7 +144,9 @@ fn error_time(e: &SimError) -> f64 {
         | SimError::NonFiniteOutput { time, .. }
         | SimError::NonFiniteInput { time, .. }
         | SimError::TooManySteps { time, .. } => *time,
-        SimError::BadSetting { .. } | SimError::Discretisation { .. } => f64::NAN,
+        SimError::BadSetting { .. }
+        | SimError::Discretisation { .. }
+        | SimError::PlantShape { .. } => f64::NAN,
     }
 }
 

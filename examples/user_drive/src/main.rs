@@ -99,7 +99,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let filter = KalmanFilter::with_fixed_gain(plant, qd, rd, filter_gain, SVector::zeros(), p0)?;
 
     // 4. The sampled-data loop on the linear plant (its exact zero-order-hold step), with noisy measurements.
-    let drive_plant = LinearPlant { a, b, c, d };
+    let drive_plant = LinearPlant::new(a, b, c, d);
     let mut controller = PositionController {
         filter,
         kx,

@@ -38,6 +38,9 @@ pub fn accelerometer_angle(acc_x: f64, acc_y: f64, acc_z: f64) -> f64 {
 #[derive(Clone, Debug)]
 pub struct AngleKalmanFilter {
     kf: KalmanFilter<2, 1, 1>,
+    /// The filter a step works on, a copy of `kf` made by `clone_from` (which allocates nothing), swapped with
+    /// `kf` when the step succeeds.
+    next: KalmanFilter<2, 1, 1>,
 }
 
 impl AngleKalmanFilter {
@@ -67,7 +70,10 @@ impl AngleKalmanFilter {
         };
         let q = Matrix2::new(q_angle, 0.0, 0.0, q_bias);
         let kf = KalmanFilter::new(model, q, Matrix1::new(r), Vector2::new(angle0, bias0), p0)?;
-        Ok(AngleKalmanFilter { kf })
+        Ok(AngleKalmanFilter {
+            next: kf.clone(),
+            kf,
+        })
     }
 
     /// One sample: predict with the gyro rate, correct with the accelerometer angle. A non-finite gyro rate,
@@ -79,10 +85,11 @@ impl AngleKalmanFilter {
         accel_angle: f64,
     ) -> Result<UpdateOutcome, EstimationError> {
         let u = Vector1::new(gyro_rate);
-        let mut next = self.kf.clone();
+        let next = &mut self.next;
+        next.clone_from(&self.kf);
         next.predict(&u)?;
         let outcome = next.update(&Vector1::new(accel_angle), &u)?;
-        self.kf = next;
+        std::mem::swap(&mut self.kf, &mut self.next);
         Ok(outcome)
     }
 

@@ -5,16 +5,46 @@
 //!
 //! - [`cholesky_lower`]: `P = L Lᵀ` with `L` lower triangular and a positive diagonal, or `None` when `P` is not
 //!   numerically positive definite;
-//! - [`cholesky_psd`]: the same for a positive *semi*-definite matrix (zero pivots allowed), used for noise
+//! - [`cholesky_psd_into`]: the same for a positive *semi*-definite matrix (zero pivots allowed), used for noise
 //!   covariances that may be singular (a noise-free channel);
 //! - [`solve_lower`]/[`solve_upper_transposed`]: triangular solves with a lower factor;
-//! - [`symmetric_eigen`]: cyclic Jacobi eigen-decomposition of a symmetric matrix (used to repair covariances);
+//! - [`positive_definite_in`]: the definiteness test of a covariance by an `LDLᵀ` sweep;
+//! - [`symmetric_eigen_in_place`]: cyclic Jacobi eigen-decomposition of a symmetric matrix (used to repair
+//!   covariances);
 //! - [`givens_absorb`]/[`hyperbolic_downdate`]: rank-one update and downdate of a Cholesky factor, the
 //!   building blocks of the square-root UKF's "QR" step.
 //!
 //! Loop indices are bounded by the const sizes, so indexing cannot go out of range.
+//!
+//! An `N × N` matrix takes `8 N²` bytes wherever it is declared (more than a spawned thread's 2 MiB stack at 512
+//! states), so the factorisations a large filter needs write into matrices the caller holds
+//! ([`cholesky_lower_into`], [`cholesky_psd_into`], [`positive_definite_in`], [`symmetric_eigen_in_place`]);
+//! the functions that return a matrix are those applied to the small matrices of a step (innovation
+//! covariances, the dual UKF's parameter covariance). [`with_square_scratch`] lends an `N × N` work matrix: on
+//! the stack when it is small, on the heap otherwise.
 
 use nalgebra::{SMatrix, SVector};
+
+/// The largest work matrix (in bytes) that [`with_square_scratch`] puts on the stack: 64 KiB, `N ≤ 90`.
+const STACK_SCRATCH_BYTES: usize = 64 << 10;
+
+/// Calls `f` with an `N × N` matrix of zeros to work in: on the stack up to 64 KiB (no allocation), on the heap
+/// above (allocated zeroed, never built on the stack).
+pub fn with_square_scratch<const N: usize, T>(f: impl FnOnce(&mut SMatrix<f64, N, N>) -> T) -> T {
+    if N * N * size_of::<f64>() <= STACK_SCRATCH_BYTES {
+        on_stack(f)
+    } else {
+        f(&mut bytemuck::zeroed_box())
+    }
+}
+
+/// The stack branch of [`with_square_scratch`], in a frame of its own: a large `N` would otherwise reserve the
+/// matrix in the caller's frame even though this branch never runs for it.
+#[inline(never)]
+fn on_stack<const N: usize, T>(f: impl FnOnce(&mut SMatrix<f64, N, N>) -> T) -> T {
+    let mut scratch = SMatrix::<f64, N, N>::zeros();
+    f(&mut scratch)
+}
 
 /// Symmetrises `m` in place: `m ← (m + mᵀ)/2`.
 pub fn symmetrise<const N: usize>(m: &mut SMatrix<f64, N, N>) {
@@ -53,13 +83,22 @@ pub fn first_non_finite<const N: usize>(v: &SVector<f64, N>) -> Option<usize> {
 /// when a pivot is not positive or not finite.
 pub fn cholesky_lower<const N: usize>(p: &SMatrix<f64, N, N>) -> Option<SMatrix<f64, N, N>> {
     let mut l = SMatrix::<f64, N, N>::zeros();
+    cholesky_lower_into(p, &mut l).then_some(l)
+}
+
+/// [`cholesky_lower`] written into `l` (whose upper triangle must be zero, or is left as it was); `false`, with
+/// `l` partly written, when a pivot is not positive or not finite.
+pub fn cholesky_lower_into<const N: usize>(
+    p: &SMatrix<f64, N, N>,
+    l: &mut SMatrix<f64, N, N>,
+) -> bool {
     for j in 0..N {
         let mut d = p[(j, j)];
         for k in 0..j {
             d -= l[(j, k)] * l[(j, k)];
         }
         if !(d > 0.0 && d.is_finite()) {
-            return None;
+            return false;
         }
         let ljj = d.sqrt();
         l[(j, j)] = ljj;
@@ -71,16 +110,27 @@ pub fn cholesky_lower<const N: usize>(p: &SMatrix<f64, N, N>) -> Option<SMatrix<
             l[(i, j)] = s / ljj;
         }
     }
-    Some(l)
+    true
+}
+
+/// [`positive_definite_in`] with a work matrix on the stack.
+#[cfg(test)]
+pub fn positive_definite<const N: usize>(p: &SMatrix<f64, N, N>) -> bool {
+    positive_definite_in(p, &mut [[0.0_f64; N]; N])
 }
 
 /// Whether the symmetric `p` (only the lower triangle is read) is numerically positive definite: the test of
 /// [`cholesky_lower`] (every pivot positive and finite) by an `LDLᵀ` sweep, which needs one division per column and
-/// no square root; the filters check their covariance with it after every step.
-pub fn positive_definite<const N: usize>(p: &SMatrix<f64, N, N>) -> bool {
+/// no square root; the filters check their covariance with it after every step. `ld` is its work matrix (any
+/// contents; overwritten), held by the caller so that a large `N` needs no `N × N` value on the stack.
+#[inline]
+pub fn positive_definite_in<const N: usize>(
+    p: &SMatrix<f64, N, N>,
+    ld: &mut [[f64; N]; N],
+) -> bool {
     // `P = L D Lᵀ` with unit lower `L`, kept by rows as `ld[i][k] = l_ik d_k` so that every sum below is a dot
-    // product of two contiguous row prefixes: one multiply-add per term.
-    let mut ld = [[0.0_f64; N]; N];
+    // product of two contiguous row prefixes: one multiply-add per term. Only the prefixes before the diagonal
+    // are read, and each is written before it is read.
     // `w[k] = l_jk` (`= ld[j][k] / d_k`) for the current column `j`.
     let mut w = [0.0_f64; N];
     let mut inv = [0.0_f64; N];
@@ -119,23 +169,32 @@ pub fn cholesky_above_floor<const N: usize>(
         .then_some(l)
 }
 
-/// Lower factor `L` with `L Lᵀ = P` of a symmetric positive *semi*-definite matrix. A pivot below
-/// `tol · max(1, max diag)` is treated as zero (its column is set to zero); a clearly negative pivot or a
-/// non-finite entry gives `None`.
+/// [`cholesky_psd_into`] returning the factor.
+#[cfg(test)]
 pub fn cholesky_psd<const N: usize>(p: &SMatrix<f64, N, N>) -> Option<SMatrix<f64, N, N>> {
+    let mut l = SMatrix::<f64, N, N>::zeros();
+    cholesky_psd_into(p, &mut l).then_some(l)
+}
+
+/// Lower factor `L` with `L Lᵀ = P` of a symmetric positive *semi*-definite matrix, written into `l`, which
+/// must be zero on entry. A pivot below `tol · max(1, max diag)` is treated as zero (its column is left zero);
+/// a clearly negative pivot or a non-finite entry gives `false`.
+pub fn cholesky_psd_into<const N: usize>(
+    p: &SMatrix<f64, N, N>,
+    l: &mut SMatrix<f64, N, N>,
+) -> bool {
     if !all_finite(p) {
-        return None;
+        return false;
     }
     let scale = (0..N).map(|i| p[(i, i)].abs()).fold(1.0_f64, f64::max);
     let tol = 1e-12 * scale;
-    let mut l = SMatrix::<f64, N, N>::zeros();
     for j in 0..N {
         let mut d = p[(j, j)];
         for k in 0..j {
             d -= l[(j, k)] * l[(j, k)];
         }
         if d < -tol {
-            return None;
+            return false;
         }
         if d <= tol {
             // A zero pivot: the rest of this column must vanish too for P to be semi-definite.
@@ -145,7 +204,7 @@ pub fn cholesky_psd<const N: usize>(p: &SMatrix<f64, N, N>) -> Option<SMatrix<f6
                     s -= l[(i, k)] * l[(j, k)];
                 }
                 if s.abs() > tol.sqrt() * scale.sqrt() {
-                    return None;
+                    return false;
                 }
             }
             continue;
@@ -160,7 +219,7 @@ pub fn cholesky_psd<const N: usize>(p: &SMatrix<f64, N, N>) -> Option<SMatrix<f6
             l[(i, j)] = s / ljj;
         }
     }
-    Some(l)
+    true
 }
 
 /// Solves `L X = B` for `X` with `L` lower triangular; `None` if a diagonal entry is zero or the result is not
@@ -217,11 +276,22 @@ pub fn cholesky_solve<const N: usize, const C: usize>(
 }
 
 /// Solves `A X = B` by Gaussian elimination with partial pivoting; `None` when `A` is numerically singular.
+/// The elimination works on a copy of `A` in a [`with_square_scratch`] matrix (on the heap for a large `N`).
 pub fn solve_general<const N: usize, const C: usize>(
     a: &SMatrix<f64, N, N>,
     b: &SMatrix<f64, N, C>,
 ) -> Option<SMatrix<f64, N, C>> {
-    let mut m = *a;
+    with_square_scratch(|m: &mut SMatrix<f64, N, N>| {
+        m.copy_from(a);
+        eliminate(m, b)
+    })
+}
+
+/// [`solve_general`] overwriting `m` (`A`) with its eliminated form.
+fn eliminate<const N: usize, const C: usize>(
+    m: &mut SMatrix<f64, N, N>,
+    b: &SMatrix<f64, N, C>,
+) -> Option<SMatrix<f64, N, C>> {
     let mut x = *b;
     let scale = m.amax();
     if !(scale > 0.0 && scale.is_finite()) {
@@ -261,21 +331,33 @@ pub fn solve_general<const N: usize, const C: usize>(
     all_finite(&x).then_some(x)
 }
 
-/// Eigen-decomposition `M = V diag(λ) Vᵀ` of a symmetric matrix by the cyclic Jacobi method. Returns the
-/// eigenvalues and the eigenvectors (columns), or `None` if an entry is not finite or the sweeps do not
-/// converge.
+/// [`symmetric_eigen_in_place`] on a copy of `m`, returning the eigenvalues and the eigenvectors.
+#[cfg(test)]
 pub fn symmetric_eigen<const N: usize>(
     m: &SMatrix<f64, N, N>,
 ) -> Option<(SVector<f64, N>, SMatrix<f64, N, N>)> {
-    if !all_finite(m) {
+    let mut a = *m;
+    let mut v = SMatrix::<f64, N, N>::zeros();
+    let values = symmetric_eigen_in_place(&mut a, &mut v)?;
+    Some((values, v))
+}
+
+/// Eigen-decomposition `M = V diag(λ) Vᵀ` of a symmetric matrix by the cyclic Jacobi method, in matrices the
+/// caller holds: `a` (`M`, symmetrised first) is rotated towards its diagonal of eigenvalues and `v` (any
+/// contents) receives the eigenvectors (columns). Returns the eigenvalues, or `None` if an entry is not finite
+/// or the sweeps do not converge.
+pub fn symmetric_eigen_in_place<const N: usize>(
+    a: &mut SMatrix<f64, N, N>,
+    v: &mut SMatrix<f64, N, N>,
+) -> Option<SVector<f64, N>> {
+    if !all_finite(a) {
         return None;
     }
-    let mut a = *m;
-    symmetrise(&mut a);
-    let mut v = SMatrix::<f64, N, N>::identity();
+    symmetrise(a);
+    v.fill_with_identity();
     let norm = a.norm();
     if norm == 0.0 {
-        return Some((SVector::zeros(), v));
+        return Some(SVector::zeros());
     }
     for _sweep in 0..100 {
         let mut off = 0.0;
@@ -285,11 +367,7 @@ pub fn symmetric_eigen<const N: usize>(
             }
         }
         if off.sqrt() <= 1e-15 * norm {
-            let mut vals = SVector::<f64, N>::zeros();
-            for i in 0..N {
-                vals[i] = a[(i, i)];
-            }
-            return Some((vals, v));
+            return Some(SVector::from_fn(|i, _| a[(i, i)]));
         }
         for p in 0..N {
             for q in (p + 1)..N {

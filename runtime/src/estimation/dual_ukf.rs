@@ -281,6 +281,9 @@ pub struct DualUkf<
     const NSP: usize,
 > {
     state: UnscentedKalmanFilter<NX, NU, NY, NSX>,
+    /// A copy of `state` taken at the start of a step (by `clone_from`, which allocates nothing), restored
+    /// when the step fails.
+    backup: UnscentedKalmanFilter<NX, NU, NY, NSX>,
     param_points: SigmaPoints<NP, NSP>,
     w: SVector<f64, NP>,
     pw: SMatrix<f64, NP, NP>,
@@ -330,6 +333,7 @@ impl<
             });
         }
         Ok(DualUkf {
+            backup: state.clone(),
             state,
             param_points,
             w: w0,
@@ -377,7 +381,7 @@ impl<
         u: &SVector<f64, NU>,
         y: &SVector<f64, NY>,
     ) -> Result<DualOutcome, EstimationError> {
-        let result = self.step_inner(model, u, y);
+        let result = self.restored_on_error(|filter| filter.step_inner(model, u, y));
         match (result, model.take_error()) {
             (_, Some(e)) => Err(e),
             (r, None) => r,
@@ -406,14 +410,13 @@ impl<
         y: &SVector<f64, NY>,
     ) -> Result<DualOutcome, EstimationError> {
         check_input(u)?;
-        let mut st = self.state.clone();
+        let st = &mut self.state;
         let x_prev = *st.state();
         let w_prior = self.w;
         let state_prediction_repair = st.predict(u, |x, u| model.propagate(x, u, &w_prior))?;
 
         if let Some(rejected) = rejected_measurement(y) {
             model.commit(&self.w)?;
-            self.state = st;
             return Ok(DualOutcome {
                 state_prediction_repair,
                 state: rejected,
@@ -449,7 +452,6 @@ impl<
         )?;
 
         model.commit(&w)?;
-        self.state = st;
         self.w = w;
         self.pw = pw;
         self.param_innovation = e;
@@ -472,6 +474,23 @@ impl<
         u: &SVector<f64, NU>,
         y: &SVector<f64, NY>,
         observation: Option<&ParameterObservation<ND>>,
+        f: F,
+        h: H,
+        output: Y,
+    ) -> Result<SeparateOutcome<ND>, EstimationError>
+    where
+        F: FnMut(&SVector<f64, NX>, &SVector<f64, NU>, &SVector<f64, NP>) -> SVector<f64, NX>,
+        H: FnMut(&SVector<f64, NX>, &SVector<f64, NU>, &SVector<f64, NP>) -> SVector<f64, NY>,
+        Y: FnMut(&SVector<f64, NX>, &SVector<f64, NU>, &SVector<f64, NP>) -> SVector<f64, ND>,
+    {
+        self.restored_on_error(|filter| filter.step_separate_inner(u, y, observation, f, h, output))
+    }
+
+    fn step_separate_inner<const ND: usize, F, H, Y>(
+        &mut self,
+        u: &SVector<f64, NU>,
+        y: &SVector<f64, NY>,
+        observation: Option<&ParameterObservation<ND>>,
         mut f: F,
         mut h: H,
         mut output: Y,
@@ -486,7 +505,7 @@ impl<
             check_positive_semidefinite("P_e", &obs.noise)?;
         }
         let w_prior = self.w;
-        let mut st = self.state.clone();
+        let st = &mut self.state;
         let state_prediction_repair = st.predict(u, |x, u| f(x, u, &w_prior))?;
         let state = st.update(y, u, |x, u| h(x, u, &w_prior))?;
 
@@ -515,7 +534,6 @@ impl<
                 }
             },
         };
-        self.state = st;
         self.w = w;
         self.pw = pw;
         Ok(SeparateOutcome {
@@ -524,6 +542,20 @@ impl<
             parameters,
             parameter_innovation,
         })
+    }
+
+    /// Runs `step` on the filter and restores the state filter as it was when `step` fails (the parameters
+    /// and the model are committed only at a step's end).
+    fn restored_on_error<T>(
+        &mut self,
+        step: impl FnOnce(&mut Self) -> Result<T, EstimationError>,
+    ) -> Result<T, EstimationError> {
+        self.backup.clone_from(&self.state);
+        let result = step(self);
+        if result.is_err() {
+            self.state.clone_from(&self.backup);
+        }
+        result
     }
 
     /// The parameter filter's step on an observation `d` (`what` names the observation function in errors): forgetting (Eq. 27, `P_w / λ`, repaired), sigma points

@@ -17,7 +17,10 @@
 //!
 //! Nothing here panics.
 
-use super::dense::{all_finite, cholesky_lower, positive_definite, symmetric_eigen, symmetrise};
+use super::dense::{
+    all_finite, cholesky_lower_into, cholesky_psd_into, positive_definite_in,
+    symmetric_eigen_in_place, symmetrise, with_square_scratch,
+};
 use crate::model::ParamError;
 use nalgebra::{SMatrix, SVector};
 
@@ -206,20 +209,41 @@ pub(crate) fn repair_covariance<const N: usize>(
     floor: f64,
     filter: &'static str,
 ) -> Result<Option<CovarianceRepair>, EstimationError> {
+    repair_covariance_in(p, floor, filter, &mut SMatrix::zeros())
+}
+
+/// [`repair_covariance`] working in `work` (any contents; overwritten): no `N × N` value on the stack, for a
+/// filter that keeps its work matrix on the heap.
+pub(crate) fn repair_covariance_in<const N: usize>(
+    p: &mut SMatrix<f64, N, N>,
+    floor: f64,
+    filter: &'static str,
+    work: &mut SMatrix<f64, N, N>,
+) -> Result<Option<CovarianceRepair>, EstimationError> {
     if !all_finite(p) {
         return Err(EstimationError::NonFiniteCovariance { filter });
     }
     symmetrise(p);
-    if positive_definite(p) {
+    if positive_definite_in(p, &mut work.data.0) {
         return Ok(None);
     }
-    let (vals, vecs) = symmetric_eigen(p).ok_or(EstimationError::NonFiniteCovariance { filter })?;
+    // `p` becomes the rotated (nearly diagonal) matrix and `work` the eigenvectors `V`.
+    let vals =
+        symmetric_eigen_in_place(p, work).ok_or(EstimationError::NonFiniteCovariance { filter })?;
     let min_eigenvalue = vals.iter().copied().fold(f64::INFINITY, f64::min);
-    let mut d = SMatrix::<f64, N, N>::zeros();
-    for i in 0..N {
-        d[(i, i)] = vals[i].max(floor);
+    // `P = V diag(max(λ, floor)) Vᵀ`, column `j` as the sum of the columns of `V` weighted by `λₖ V[j, k]`.
+    let v = &work.data.0;
+    let out = &mut p.data.0;
+    for j in 0..N {
+        let mut col = [0.0_f64; N];
+        for k in 0..N {
+            let s = vals[k].max(floor) * v[k][j];
+            for (c, vik) in col.iter_mut().zip(&v[k]) {
+                *c += vik * s;
+            }
+        }
+        out[j] = col;
     }
-    *p = vecs * d * vecs.transpose();
     symmetrise(p);
     Ok(Some(CovarianceRepair {
         min_eigenvalue,
@@ -256,7 +280,8 @@ pub(crate) fn check_positive_definite<const N: usize>(
         name,
         kind: "definite",
     };
-    if !is_symmetric(m) || cholesky_lower(m).is_none() {
+    // The factor is written into a work matrix: on the heap for a large `N` (see `dense`).
+    if !is_symmetric(m) || !with_square_scratch(|l| cholesky_lower_into(m, l)) {
         return Err(not_pd);
     }
     Ok(())
@@ -268,7 +293,7 @@ pub(crate) fn check_positive_semidefinite<const N: usize>(
     m: &SMatrix<f64, N, N>,
 ) -> Result<(), EstimationError> {
     check_finite(name, m)?;
-    if !is_symmetric(m) || super::dense::cholesky_psd(m).is_none() {
+    if !is_symmetric(m) || !with_square_scratch(|l| cholesky_psd_into(m, l)) {
         return Err(EstimationError::NotPositiveDefinite {
             name,
             kind: "semi-definite",

@@ -50,6 +50,16 @@
 //!
 //! Faults follow [`super::fault`]: non-finite or gated measurements are rejected, a singular `S` is an error,
 //! the covariance is kept exactly symmetric and repaired if it loses definiteness.
+//!
+//! # Large models
+//!
+//! The filter keeps its `NX × NX` matrices (`A`, `Aᵀ`, `Q`, `P`, the next `P` and a work matrix) on the heap,
+//! allocated once by the constructor, and a step declares no `NX × NX` value: a filter of any size runs on any
+//! thread (an `NX × NX` matrix exceeds a spawned thread's 2 MiB stack at 512 states), and a step of a small
+//! one still allocates nothing. [`KalmanFilter::new`] takes its matrices by value, on the caller's stack;
+//! [`KalmanFilter::from_refs`] borrows them, so that a large model's matrices can stay where they are built
+//! ([`LinearDiscreteModel::boxed_from_state_space`], [`crate::matrix::boxed_fixed`]). [`steady_state_gain`]
+//! works on stack values: for a large model, `crate::design::dlqe` solves the same DARE on `DMatrix`.
 
 mod definite;
 mod products;
@@ -58,8 +68,9 @@ use super::dense::{all_finite, cholesky_lower, cholesky_solve, first_non_finite,
 use super::fault::{
     CovarianceRepair, EstimationError, FaultPolicy, UpdateOutcome, check_additive_noise,
     check_estimate, check_finite, check_positive_definite, check_positive_semidefinite,
-    repair_covariance,
+    repair_covariance_in,
 };
+use crate::matrix::{boxed_copy, product_sum, zeroed_box};
 use crate::statespace::StateSpace;
 use definite::{DefinitePrediction, DefiniteUpdate, InnovationFloor, UpdateNorms};
 use nalgebra::{DMatrix, SMatrix, SVector};
@@ -94,6 +105,20 @@ impl<const NX: usize, const NU: usize, const NY: usize> LinearDiscreteModel<NX, 
         Ok(m)
     }
 
+    /// [`Self::from_state_space`] on the heap, for a model whose matrices do not fit the stack.
+    pub fn boxed_from_state_space(ss: &StateSpace) -> Result<Box<Self>, EstimationError> {
+        if ss.dt().is_none() {
+            return Err(EstimationError::NotDiscrete);
+        }
+        let mut m: Box<Self> = bytemuck::zeroed_box();
+        copy_dynamic("A", ss.a(), &mut m.a)?;
+        copy_dynamic("B", ss.b(), &mut m.b)?;
+        copy_dynamic("C", ss.c(), &mut m.c)?;
+        copy_dynamic("D", ss.d(), &mut m.d)?;
+        m.validate()?;
+        Ok(m)
+    }
+
     /// Checks that every matrix is finite.
     pub fn validate(&self) -> Result<(), EstimationError> {
         check_finite("A", &self.a)?;
@@ -101,6 +126,12 @@ impl<const NX: usize, const NU: usize, const NY: usize> LinearDiscreteModel<NX, 
         check_finite("C", &self.c)?;
         check_finite("D", &self.d)
     }
+}
+
+// SAFETY: four `SMatrix<f64, _, _>` (arrays of `f64`), for which all-zero bytes are a valid value (`0.0`).
+unsafe impl<const NX: usize, const NU: usize, const NY: usize> bytemuck::Zeroable
+    for LinearDiscreteModel<NX, NU, NY>
+{
 }
 
 /// How the gain is obtained.
@@ -113,14 +144,23 @@ pub enum GainMode<const NX: usize, const NY: usize> {
 }
 
 /// A discrete Kalman filter with `NX` states, `NU` inputs and `NY` measurements.
-#[derive(Clone, Debug)]
+///
+/// `clone` allocates the filter's matrices anew; `clone_from` copies into those of an existing filter and
+/// allocates nothing (for a step that must leave the filter unchanged when it fails).
+#[derive(Debug)]
 pub struct KalmanFilter<const NX: usize, const NU: usize, const NY: usize> {
-    model: LinearDiscreteModel<NX, NU, NY>,
-    q: SMatrix<f64, NX, NX>,
+    model: Box<LinearDiscreteModel<NX, NU, NY>>,
+    q: Box<SMatrix<f64, NX, NX>>,
     r: SMatrix<f64, NY, NY>,
     x: SVector<f64, NX>,
     /// Exactly symmetric: symmetrised when given, and every step computes one triangle and mirrors it.
-    p: SMatrix<f64, NX, NX>,
+    p: Box<SMatrix<f64, NX, NX>>,
+    /// The covariance a step computes, swapped with `p` when the step succeeds (so that a failed step leaves
+    /// `p` as it was).
+    next_p: Box<SMatrix<f64, NX, NX>>,
+    /// Work space of a step: `P Aᵀ` of the prediction, the factor of the definiteness test, the eigenvectors
+    /// of a repair.
+    work: Box<SMatrix<f64, NX, NX>>,
     gain_mode: GainMode<NX, NY>,
     gain: SMatrix<f64, NX, NY>,
     innovation: SVector<f64, NY>,
@@ -132,14 +172,31 @@ pub struct KalmanFilter<const NX: usize, const NU: usize, const NY: usize> {
 }
 
 /// What a step needs that depends only on the model and the noise covariances, computed once.
-#[derive(Clone, Copy, Debug)]
+#[derive(Debug)]
 struct ModelTerms<const NX: usize, const NY: usize> {
     /// `Aᵀ` and `Cᵀ`: the products read their columns (the rows of `A` and `C`) contiguously.
-    at: SMatrix<f64, NX, NX>,
+    at: Box<SMatrix<f64, NX, NX>>,
     ct: SMatrix<f64, NX, NY>,
     definite_prediction: DefinitePrediction,
     definite_update: DefiniteUpdate,
     innovation_floor: InnovationFloor<NY>,
+}
+
+impl<const NX: usize, const NY: usize> Clone for ModelTerms<NX, NY> {
+    fn clone(&self) -> Self {
+        ModelTerms {
+            at: boxed_copy(&self.at),
+            ..*self
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.at.copy_from(&source.at);
+        self.ct = source.ct;
+        self.definite_prediction = source.definite_prediction;
+        self.definite_update = source.definite_update;
+        self.innovation_floor = source.innovation_floor;
+    }
 }
 
 impl<const NX: usize, const NY: usize> ModelTerms<NX, NY> {
@@ -148,8 +205,10 @@ impl<const NX: usize, const NY: usize> ModelTerms<NX, NY> {
         q: &SMatrix<f64, NX, NX>,
         r: &SMatrix<f64, NY, NY>,
     ) -> Self {
+        let mut at = zeroed_box::<NX, NX>();
+        at.tr_copy_from(&model.a);
         ModelTerms {
-            at: model.a.transpose(),
+            at,
             ct: model.c.transpose(),
             definite_prediction: DefinitePrediction::of(&model.a, q),
             definite_update: DefiniteUpdate::of(&model.c, r),
@@ -158,10 +217,63 @@ impl<const NX: usize, const NY: usize> ModelTerms<NX, NY> {
     }
 }
 
+impl<const NX: usize, const NU: usize, const NY: usize> Clone for KalmanFilter<NX, NU, NY> {
+    fn clone(&self) -> Self {
+        KalmanFilter {
+            model: boxed_model(&self.model),
+            q: boxed_copy(&self.q),
+            p: boxed_copy(&self.p),
+            // Work space: its contents are never read before a step writes them.
+            next_p: zeroed_box(),
+            work: zeroed_box(),
+            fixed: self.fixed.clone(),
+            ..*self
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        copy_model(&mut self.model, &source.model);
+        self.q.copy_from(&source.q);
+        self.r = source.r;
+        self.x = source.x;
+        self.p.copy_from(&source.p);
+        self.gain_mode = source.gain_mode;
+        self.gain = source.gain;
+        self.innovation = source.innovation;
+        self.innovation_cov = source.innovation_cov;
+        self.policy = source.policy;
+        self.fixed.clone_from(&source.fixed);
+        self.eigenvalue_floor = source.eigenvalue_floor;
+    }
+}
+
+/// A copy of `model` on the heap, written there matrix by matrix.
+fn boxed_model<const NX: usize, const NU: usize, const NY: usize>(
+    model: &LinearDiscreteModel<NX, NU, NY>,
+) -> Box<LinearDiscreteModel<NX, NU, NY>> {
+    let mut out: Box<LinearDiscreteModel<NX, NU, NY>> = bytemuck::zeroed_box();
+    copy_model(&mut out, model);
+    out
+}
+
+/// Copies the matrices of `source` into `out` (by reference: `*out = *source` may pass through the stack).
+fn copy_model<const NX: usize, const NU: usize, const NY: usize>(
+    out: &mut LinearDiscreteModel<NX, NU, NY>,
+    source: &LinearDiscreteModel<NX, NU, NY>,
+) {
+    out.a.copy_from(&source.a);
+    out.b.copy_from(&source.b);
+    out.c.copy_from(&source.c);
+    out.d.copy_from(&source.d);
+}
+
 impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY> {
     /// A time-varying filter. `q` and `r` must be symmetric positive semi-definite (a noise-free sensor is
     /// allowed; an innovation covariance that ends up singular is then reported by `update`), `p0` positive
     /// definite (and symmetric to rounding; it is kept symmetrised).
+    ///
+    /// The matrices are taken by value, on the caller's stack; for a model of several hundred states use
+    /// [`Self::from_refs`] (see the module docs).
     pub fn new(
         model: LinearDiscreteModel<NX, NU, NY>,
         q: SMatrix<f64, NX, NX>,
@@ -169,23 +281,37 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         x0: SVector<f64, NX>,
         p0: SMatrix<f64, NX, NX>,
     ) -> Result<Self, EstimationError> {
+        Self::from_refs(&model, &q, &r, &x0, &p0)
+    }
+
+    /// [`Self::new`] from borrowed matrices, which the filter copies to the heap: for a model whose matrices
+    /// do not fit the stack, built in a `Box` (see the module docs).
+    pub fn from_refs(
+        model: &LinearDiscreteModel<NX, NU, NY>,
+        q: &SMatrix<f64, NX, NX>,
+        r: &SMatrix<f64, NY, NY>,
+        x0: &SVector<f64, NX>,
+        p0: &SMatrix<f64, NX, NX>,
+    ) -> Result<Self, EstimationError> {
         model.validate()?;
-        check_additive_noise(&q, &r)?;
-        check_estimate(("x0", "P0"), &x0, &p0)?;
-        let mut p = p0;
+        check_additive_noise(q, r)?;
+        check_estimate(("x0", "P0"), x0, p0)?;
+        let mut p = boxed_copy(p0);
         symmetrise(&mut p);
         Ok(KalmanFilter {
-            model,
-            q,
-            r,
-            x: x0,
+            model: boxed_model(model),
+            q: boxed_copy(q),
+            r: *r,
+            x: *x0,
             p,
+            next_p: zeroed_box(),
+            work: zeroed_box(),
             gain_mode: GainMode::TimeVarying,
             gain: SMatrix::zeros(),
             innovation: SVector::zeros(),
-            innovation_cov: r,
+            innovation_cov: *r,
             policy: FaultPolicy::default(),
-            fixed: ModelTerms::of(&model, &q, &r),
+            fixed: ModelTerms::of(model, q, r),
             eigenvalue_floor: 0.0,
         })
     }
@@ -199,11 +325,18 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         x0: SVector<f64, NX>,
         p0: SMatrix<f64, NX, NX>,
     ) -> Result<Self, EstimationError> {
-        check_finite("K", &k)?;
         let mut f = Self::new(model, q, r, x0, p0)?;
-        f.gain_mode = GainMode::Fixed(k);
-        f.gain = k;
+        f.set_fixed_gain(k)?;
         Ok(f)
+    }
+
+    /// Makes the filter a steady-state one with the fixed innovation gain `k` from now on (the form of
+    /// [`Self::with_fixed_gain`] for a filter built by [`Self::from_refs`]).
+    pub fn set_fixed_gain(&mut self, k: SMatrix<f64, NX, NY>) -> Result<(), EstimationError> {
+        check_finite("K", &k)?;
+        self.gain_mode = GainMode::Fixed(k);
+        self.gain = k;
+        Ok(())
     }
 
     /// Replaces the fault policy (NIS gate, eigenvalue floor).
@@ -219,9 +352,18 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         x: SVector<f64, NX>,
         p: SMatrix<f64, NX, NX>,
     ) -> Result<(), EstimationError> {
-        check_estimate(("x", "P"), &x, &p)?;
-        self.x = x;
-        self.p = p;
+        self.set_state_from(&x, &p)
+    }
+
+    /// [`Self::set_state`] from borrowed values, copied into the filter (for a `P` held on the heap).
+    pub fn set_state_from(
+        &mut self,
+        x: &SVector<f64, NX>,
+        p: &SMatrix<f64, NX, NX>,
+    ) -> Result<(), EstimationError> {
+        check_estimate(("x", "P"), x, p)?;
+        self.x = *x;
+        self.p.copy_from(p);
         symmetrise(&mut self.p);
         self.eigenvalue_floor = 0.0;
         Ok(())
@@ -235,16 +377,16 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         if let Some(index) = first_non_finite(u) {
             return Err(EstimationError::NonFiniteInput { index });
         }
-        let m = &self.model;
-        let x = m.a * self.x + m.b * u;
+        let m = &*self.model;
+        let x = product_sum(&m.a, &self.x, &m.b, u);
         if first_non_finite(&x).is_some() {
             return Err(EstimationError::Overflow {
                 filter: FILTER,
                 quantity: "predicted state",
             });
         }
-        let mut p = SMatrix::zeros();
-        congruence_plus(&m.a, &self.fixed.at, &self.p, &self.q, &mut p);
+        let p = &mut *self.next_p;
+        congruence_plus(&m.a, &self.fixed.at, &self.p, &self.q, p, &mut self.work);
         // A certificate also bounds every entry of `p` far below overflow; without one, `repair_covariance`
         // checks that they are finite.
         let certified = self
@@ -253,10 +395,10 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
             .eigenvalue_floor(self.p.trace());
         let repair = match certified {
             Some(_) => None,
-            None => repair_covariance(&mut p, self.policy.eigen_floor, FILTER)?,
+            None => repair_covariance_in(p, self.policy.eigen_floor, FILTER, &mut self.work)?,
         };
         self.x = x;
-        self.p = p;
+        std::mem::swap(&mut self.p, &mut self.next_p);
         self.eigenvalue_floor = certified.unwrap_or(0.0);
         Ok(repair)
     }
@@ -275,8 +417,8 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         if let Some(index) = first_non_finite(u) {
             return Err(EstimationError::NonFiniteInput { index });
         }
-        let m = &self.model;
-        let e = y - m.c * self.x - m.d * u;
+        let m = &*self.model;
+        let e = y - product_sum(&m.c, &self.x, &m.d, u);
         // P Cᵀ = (C P)ᵀ serves the innovation covariance, the gain and the Joseph form.
         let pct = covariance_times_ct(&self.p, &self.fixed.ct);
         let s = innovation_covariance(&pct, &self.fixed.ct, &self.r);
@@ -318,8 +460,8 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         if first_non_finite(&x).is_some() {
             return Err(overflow("corrected state"));
         }
-        let mut p = SMatrix::zeros();
-        let w = joseph(&self.p, &k, &pct, &s, &mut p);
+        let p = &mut *self.next_p;
+        let w = joseph(&self.p, &k, &pct, &s, p);
         let certified = self.eigenvalue_floor > 0.0
             && self.fixed.definite_update.holds(
                 self.eigenvalue_floor,
@@ -334,10 +476,10 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         let repair = if certified {
             None
         } else {
-            repair_covariance(&mut p, self.policy.eigen_floor, FILTER)?
+            repair_covariance_in(p, self.policy.eigen_floor, FILTER, &mut self.work)?
         };
         self.x = x;
-        self.p = p;
+        std::mem::swap(&mut self.p, &mut self.next_p);
         self.gain = k;
         self.eigenvalue_floor = 0.0;
         Ok(UpdateOutcome::Accepted { nis, repair })
@@ -372,6 +514,25 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
     pub fn model(&self) -> &LinearDiscreteModel<NX, NU, NY> {
         &self.model
     }
+}
+
+/// Copies `m` into `out`, checking its shape (an error naming `name` otherwise).
+fn copy_dynamic<const R: usize, const C: usize>(
+    name: &'static str,
+    m: &DMatrix<f64>,
+    out: &mut SMatrix<f64, R, C>,
+) -> Result<(), EstimationError> {
+    if m.nrows() != R || m.ncols() != C {
+        return Err(EstimationError::Shape {
+            name,
+            rows: m.nrows(),
+            cols: m.ncols(),
+            expected_rows: R,
+            expected_cols: C,
+        });
+    }
+    out.copy_from(m);
+    Ok(())
 }
 
 /// Copies a dynamically sized matrix (e.g. a gain from [`crate::design`]) into a fixed-size one, checking

@@ -4,22 +4,28 @@
 //! paper 004, or pole placement). [`ContinuousObserver::rhs`] is the right-hand side a simulator integrates
 //! together with the plant; the estimation error `e = x − x̂` obeys `e' = (A − L C) e`, whose matrix
 //! [`ContinuousObserver::error_dynamics`] returns.
+//!
+//! The observer keeps its matrices on the heap and its right-hand side declares vectors only, so an observer
+//! of any size runs on any thread (an `NX × NX` matrix exceeds a spawned thread's 2 MiB stack at 512 states);
+//! [`ContinuousObserver::from_refs`] builds one from matrices held on the heap.
 
 use super::fault::{EstimationError, check_finite};
+use crate::matrix::{boxed_copy, product_sum};
 use nalgebra::{SMatrix, SVector};
 
 /// A continuous-time observer with `NX` states, `NU` inputs and `NY` measurements.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ContinuousObserver<const NX: usize, const NU: usize, const NY: usize> {
-    a: SMatrix<f64, NX, NX>,
-    b: SMatrix<f64, NX, NU>,
-    c: SMatrix<f64, NY, NX>,
-    d: SMatrix<f64, NY, NU>,
-    l: SMatrix<f64, NX, NY>,
+    a: Box<SMatrix<f64, NX, NX>>,
+    b: Box<SMatrix<f64, NX, NU>>,
+    c: Box<SMatrix<f64, NY, NX>>,
+    d: Box<SMatrix<f64, NY, NU>>,
+    l: Box<SMatrix<f64, NX, NY>>,
 }
 
 impl<const NX: usize, const NU: usize, const NY: usize> ContinuousObserver<NX, NU, NY> {
-    /// An observer for `ẋ = A x + B u`, `y = C x + D u` with gain `l`; all entries must be finite.
+    /// An observer for `ẋ = A x + B u`, `y = C x + D u` with gain `l`; all entries must be finite. The matrices
+    /// are taken by value, on the caller's stack; [`Self::from_refs`] borrows them.
     pub fn new(
         a: SMatrix<f64, NX, NX>,
         b: SMatrix<f64, NX, NU>,
@@ -27,12 +33,30 @@ impl<const NX: usize, const NU: usize, const NY: usize> ContinuousObserver<NX, N
         d: SMatrix<f64, NY, NU>,
         l: SMatrix<f64, NX, NY>,
     ) -> Result<Self, EstimationError> {
-        check_finite("A", &a)?;
-        check_finite("B", &b)?;
-        check_finite("C", &c)?;
-        check_finite("D", &d)?;
-        check_finite("L", &l)?;
-        Ok(ContinuousObserver { a, b, c, d, l })
+        Self::from_refs(&a, &b, &c, &d, &l)
+    }
+
+    /// [`Self::new`] from borrowed matrices, which the observer copies to the heap (for a model whose
+    /// matrices do not fit the stack).
+    pub fn from_refs(
+        a: &SMatrix<f64, NX, NX>,
+        b: &SMatrix<f64, NX, NU>,
+        c: &SMatrix<f64, NY, NX>,
+        d: &SMatrix<f64, NY, NU>,
+        l: &SMatrix<f64, NX, NY>,
+    ) -> Result<Self, EstimationError> {
+        check_finite("A", a)?;
+        check_finite("B", b)?;
+        check_finite("C", c)?;
+        check_finite("D", d)?;
+        check_finite("L", l)?;
+        Ok(ContinuousObserver {
+            a: boxed_copy(a),
+            b: boxed_copy(b),
+            c: boxed_copy(c),
+            d: boxed_copy(d),
+            l: boxed_copy(l),
+        })
     }
 
     /// `x̂' = A x̂ + B u + L (y − C x̂ − D u)`. Non-finite inputs give a non-finite derivative, which the
@@ -43,7 +67,9 @@ impl<const NX: usize, const NU: usize, const NY: usize> ContinuousObserver<NX, N
         u: &SVector<f64, NU>,
         y: &SVector<f64, NY>,
     ) -> SVector<f64, NX> {
-        self.a * x_hat + self.b * u + self.l * (y - self.output(x_hat, u))
+        let innovation = y - self.output(x_hat, u);
+        let l = &*self.l;
+        product_sum(&self.a, x_hat, &self.b, u) + l * innovation
     }
 
     /// Writes [`Self::rhs`] into `dx` (the form of [`crate::model::ContinuousModel::rhs`]).
@@ -59,12 +85,14 @@ impl<const NX: usize, const NU: usize, const NY: usize> ContinuousObserver<NX, N
 
     /// The estimated output `C x̂ + D u`.
     pub fn output(&self, x_hat: &SVector<f64, NX>, u: &SVector<f64, NU>) -> SVector<f64, NY> {
-        self.c * x_hat + self.d * u
+        product_sum(&self.c, x_hat, &self.d, u)
     }
 
-    /// `A − L C`, the matrix of the error dynamics `e' = (A − L C) e`.
-    pub fn error_dynamics(&self) -> SMatrix<f64, NX, NX> {
-        self.a - self.l * self.c
+    /// `A − L C`, the matrix of the error dynamics `e' = (A − L C) e`, on the heap.
+    pub fn error_dynamics(&self) -> Box<SMatrix<f64, NX, NX>> {
+        let mut out = boxed_copy(&self.a);
+        out.gemm(-1.0, &self.l, &self.c, 1.0);
+        out
     }
 
     /// The gain `L`.

@@ -26,7 +26,7 @@
 //! assert!((points.mean_weights().sum() - 1.0).abs() < 1e-15);
 //! ```
 
-use super::dense::cholesky_lower;
+use super::dense::{cholesky_lower, cholesky_lower_into};
 use super::fault::EstimationError;
 use nalgebra::{SMatrix, SVector};
 
@@ -163,21 +163,52 @@ impl<const N: usize, const NS: usize> SigmaPoints<N, NS> {
         Ok(self.generate_from_factor(x, &s))
     }
 
+    /// [`Self::generate`] written into `chi`, with the Cholesky factor of `p` in `factor` (any contents;
+    /// overwritten): no `N × N` or `N × NS` value on the stack, for a filter that keeps them on the heap.
+    pub(crate) fn generate_into(
+        &self,
+        x: &SVector<f64, N>,
+        p: &SMatrix<f64, N, N>,
+        factor: &mut SMatrix<f64, N, N>,
+        chi: &mut SMatrix<f64, N, NS>,
+    ) -> Result<(), EstimationError> {
+        // The factorisation writes the lower triangle only; the points read whole columns.
+        factor.fill(0.0);
+        if !cholesky_lower_into(p, factor) {
+            return Err(EstimationError::NotPositiveDefinite {
+                name: "covariance for the sigma points",
+                kind: "definite",
+            });
+        }
+        self.generate_from_factor_into(x, factor, chi);
+        Ok(())
+    }
+
     /// The sigma points from a square-root factor `s` with `s sᵀ = P`.
     pub fn generate_from_factor(
         &self,
         x: &SVector<f64, N>,
         s: &SMatrix<f64, N, N>,
     ) -> SMatrix<f64, N, NS> {
-        let g = self.gamma();
         let mut chi = SMatrix::<f64, N, NS>::zeros();
+        self.generate_from_factor_into(x, s, &mut chi);
+        chi
+    }
+
+    /// [`Self::generate_from_factor`] written into `chi`.
+    pub(crate) fn generate_from_factor_into(
+        &self,
+        x: &SVector<f64, N>,
+        s: &SMatrix<f64, N, N>,
+        chi: &mut SMatrix<f64, N, NS>,
+    ) {
+        let g = self.gamma();
         chi.set_column(0, x);
         for i in 0..N {
             let d = s.column(i) * g;
             chi.set_column(1 + i, &(x + d));
             chi.set_column(1 + N + i, &(x - d));
         }
-        chi
     }
 }
 
@@ -190,13 +221,32 @@ pub(crate) fn unscented_transform<const N: usize, const NS: usize>(
     mean: MeanFn<N, NS>,
     residual: ResidualFn<N>,
 ) -> (SVector<f64, N>, SMatrix<f64, N, N>) {
-    let m = mean(points, wm);
     let mut cov = SMatrix::<f64, N, N>::zeros();
+    let m = unscented_transform_into(points, wm, wc, mean, residual, &mut cov);
+    (m, cov)
+}
+
+/// [`unscented_transform`] with the covariance written into `cov` (any contents; overwritten) and the mean
+/// returned: each term `(rₐ r_b) W⁽ᶜ⁾ᵢ` added in place, without the `N × N` products `rᵢ rᵢᵀ`.
+pub(crate) fn unscented_transform_into<const N: usize, const NS: usize>(
+    points: &SMatrix<f64, N, NS>,
+    wm: &SVector<f64, NS>,
+    wc: &SVector<f64, NS>,
+    mean: MeanFn<N, NS>,
+    residual: ResidualFn<N>,
+    cov: &mut SMatrix<f64, N, N>,
+) -> SVector<f64, N> {
+    let m = mean(points, wm);
+    cov.fill(0.0);
     for i in 0..NS {
         let r = residual(&points.column(i).into_owned(), &m);
-        cov += r * r.transpose() * wc[i];
+        for b in 0..N {
+            for a in 0..N {
+                cov[(a, b)] += r[a] * r[b] * wc[i];
+            }
+        }
     }
-    (m, cov)
+    m
 }
 
 /// The estimated rounding error of each diagonal entry of `Σ W⁽ᶜ⁾ rᵢ rᵢᵀ`, `rᵢ = residual(pointsᵢ, mean)`.

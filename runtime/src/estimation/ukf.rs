@@ -22,6 +22,14 @@
 //!
 //! Every step works on copies and commits at the end: a step that returns an error leaves the filter
 //! unchanged. Steps do not allocate.
+//!
+//! # Large models
+//!
+//! The filter keeps `P`, `Q` and the work space of a step (the sigma points and their images, the next
+//! covariance, a work matrix for the Cholesky factor and the covariance repair) on the heap, allocated once by
+//! the constructor, and a step declares no `NX × NX` or `NX × (2 NX + 1)` value: a filter of any size runs on any
+//! thread. [`UnscentedKalmanFilter::new`] takes its matrices by value, on the caller's stack;
+//! [`UnscentedKalmanFilter::from_refs`] borrows them. `clone_from` copies without allocating.
 
 use super::fault::{
     CovarianceRepair, EstimationError, FaultPolicy, UpdateOutcome, check_additive_noise,
@@ -29,26 +37,73 @@ use super::fault::{
 };
 use super::sigma::{ResidualFn, SigmaPoints};
 use super::unscented::{
-    FilterSettings, model_measurement, model_process, rejected_measurement, settings_methods,
-    sigma_images,
+    FilterSettings, check_input, evaluate_points_into, model_measurement, model_process,
+    rejected_measurement, settings_methods,
 };
+use crate::matrix::boxed_copy;
 use crate::model::DiscreteModel;
 use nalgebra::{SMatrix, SVector};
 
 const FILTER: &str = "UKF";
 
 /// An additive-noise UKF with `NX` states, `NU` inputs, `NY` measurements and `NS = 2 NX + 1` sigma points.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct UnscentedKalmanFilter<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
 {
     settings: FilterSettings<NX, NX, NY, NS>,
     x: SVector<f64, NX>,
-    p: SMatrix<f64, NX, NX>,
-    q: SMatrix<f64, NX, NX>,
+    p: Box<SMatrix<f64, NX, NX>>,
+    q: Box<SMatrix<f64, NX, NX>>,
     r: SMatrix<f64, NY, NY>,
     innovation: SVector<f64, NY>,
     innovation_cov: SMatrix<f64, NY, NY>,
     gain: SMatrix<f64, NX, NY>,
+    work: Box<StepWork<NX, NY, NS>>,
+}
+
+/// The matrices a step writes before it commits; their contents between steps mean nothing.
+#[derive(Debug)]
+struct StepWork<const NX: usize, const NY: usize, const NS: usize> {
+    /// The sigma points.
+    chi: SMatrix<f64, NX, NS>,
+    /// Their images under the process function.
+    propagated: SMatrix<f64, NX, NS>,
+    /// Their images under the measurement function.
+    measured: SMatrix<f64, NY, NS>,
+    /// The covariance being computed.
+    next_p: SMatrix<f64, NX, NX>,
+    /// The Cholesky factor of the sigma points, then the covariance repair's work matrix.
+    factor: SMatrix<f64, NX, NX>,
+}
+
+// SAFETY: `SMatrix<f64, _, _>` fields only (arrays of `f64`), for which all-zero bytes are `0.0`.
+unsafe impl<const NX: usize, const NY: usize, const NS: usize> bytemuck::Zeroable
+    for StepWork<NX, NY, NS>
+{
+}
+
+impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize> Clone
+    for UnscentedKalmanFilter<NX, NU, NY, NS>
+{
+    fn clone(&self) -> Self {
+        UnscentedKalmanFilter {
+            p: boxed_copy(&self.p),
+            q: boxed_copy(&self.q),
+            work: bytemuck::zeroed_box(),
+            ..*self
+        }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.settings = source.settings;
+        self.x = source.x;
+        self.p.copy_from(&source.p);
+        self.q.copy_from(&source.q);
+        self.r = source.r;
+        self.innovation = source.innovation;
+        self.innovation_cov = source.innovation_cov;
+        self.gain = source.gain;
+    }
 }
 
 impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
@@ -56,7 +111,8 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
 {
     /// A UKF with sigma points `points`, process noise `q` (positive semi-definite), measurement noise `r`
     /// (positive semi-definite; a singular innovation covariance is reported by `update`) and initial
-    /// estimate `(x0, p0)` (`p0` positive definite).
+    /// estimate `(x0, p0)` (`p0` positive definite). The matrices are taken by value, on the caller's stack;
+    /// [`Self::from_refs`] borrows them.
     pub fn new(
         points: SigmaPoints<NX, NS>,
         q: SMatrix<f64, NX, NX>,
@@ -64,17 +120,30 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         x0: SVector<f64, NX>,
         p0: SMatrix<f64, NX, NX>,
     ) -> Result<Self, EstimationError> {
-        check_additive_noise(&q, &r)?;
-        check_estimate(("x0", "P0"), &x0, &p0)?;
+        Self::from_refs(points, &q, &r, &x0, &p0)
+    }
+
+    /// [`Self::new`] from borrowed matrices, which the filter copies to the heap (for a model whose matrices
+    /// do not fit the stack; see the module docs).
+    pub fn from_refs(
+        points: SigmaPoints<NX, NS>,
+        q: &SMatrix<f64, NX, NX>,
+        r: &SMatrix<f64, NY, NY>,
+        x0: &SVector<f64, NX>,
+        p0: &SMatrix<f64, NX, NX>,
+    ) -> Result<Self, EstimationError> {
+        check_additive_noise(q, r)?;
+        check_estimate(("x0", "P0"), x0, p0)?;
         Ok(UnscentedKalmanFilter {
             settings: FilterSettings::new(points, FILTER),
-            x: x0,
-            p: p0,
-            q,
-            r,
+            x: *x0,
+            p: boxed_copy(p0),
+            q: boxed_copy(q),
+            r: *r,
             innovation: SVector::zeros(),
-            innovation_cov: r,
+            innovation_cov: *r,
             gain: SMatrix::zeros(),
+            work: bytemuck::zeroed_box(),
         })
     }
 
@@ -87,7 +156,7 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         r: SMatrix<f64, NY, NY>,
     ) -> Result<(), EstimationError> {
         check_additive_noise(&q, &r)?;
-        self.q = q;
+        self.q.copy_from(&q);
         self.r = r;
         Ok(())
     }
@@ -98,9 +167,18 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         x: SVector<f64, NX>,
         p: SMatrix<f64, NX, NX>,
     ) -> Result<(), EstimationError> {
-        check_estimate(("x", "P"), &x, &p)?;
-        self.x = x;
-        self.p = p;
+        self.set_state_from(&x, &p)
+    }
+
+    /// [`Self::set_state`] from borrowed values, copied into the filter (for a `P` held on the heap).
+    pub fn set_state_from(
+        &mut self,
+        x: &SVector<f64, NX>,
+        p: &SMatrix<f64, NX, NX>,
+    ) -> Result<(), EstimationError> {
+        check_estimate(("x", "P"), x, p)?;
+        self.x = *x;
+        self.p.copy_from(p);
         Ok(())
     }
 
@@ -113,11 +191,20 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
     where
         F: FnMut(&SVector<f64, NX>, &SVector<f64, NU>) -> SVector<f64, NX>,
     {
-        let draw = || self.settings.points.generate(&self.x, &self.p);
-        let (_, prop) = sigma_images("process function", u, draw, f)?;
-        let (x, p, repair) = self.settings.predicted(&prop, Some(&self.q))?;
+        let mut f = f;
+        check_input(u)?;
+        let w = &mut *self.work;
+        let points = &self.settings.points;
+        points.generate_into(&self.x, &self.p, &mut w.factor, &mut w.chi)?;
+        let chi = &w.chi;
+        let propagate = |i: usize| f(&chi.column(i).into_owned(), u);
+        evaluate_points_into("process function", propagate, &mut w.propagated)?;
+        let out = (&mut w.next_p, &mut w.factor);
+        let (x, repair) = self
+            .settings
+            .predicted_into(&w.propagated, Some(&self.q), out)?;
         self.x = x;
-        self.p = p;
+        self.p.copy_from(&w.next_p);
         Ok(repair)
     }
 
@@ -134,11 +221,23 @@ impl<const NX: usize, const NU: usize, const NY: usize, const NS: usize>
         if let Some(rejected) = rejected_measurement(y) {
             return Ok(rejected);
         }
-        let draw = || self.settings.points.generate(&self.x, &self.p);
-        let (chi, ys) = sigma_images("measurement function", u, draw, h)?;
-        let correction =
-            self.settings
-                .correct(&mut self.x, &mut self.p, &chi, &ys, y, Some(&self.r))?;
+        let mut h = h;
+        check_input(u)?;
+        let w = &mut *self.work;
+        let points = &self.settings.points;
+        points.generate_into(&self.x, &self.p, &mut w.factor, &mut w.chi)?;
+        let chi = &w.chi;
+        let measure = |i: usize| h(&chi.column(i).into_owned(), u);
+        evaluate_points_into("measurement function", measure, &mut w.measured)?;
+        let points_and_y = (&w.chi, &w.measured, y);
+        let scratch = (&mut w.next_p, &mut w.factor);
+        let correction = self.settings.correct_in(
+            &mut self.x,
+            &mut self.p,
+            points_and_y,
+            Some(&self.r),
+            scratch,
+        )?;
         self.innovation = correction.innovation;
         self.innovation_cov = correction.innovation_cov;
         if let Some(k) = correction.gain {

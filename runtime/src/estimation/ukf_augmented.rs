@@ -20,14 +20,18 @@ use super::fault::{
 };
 use super::sigma::SigmaPoints;
 use super::unscented::{
-    FilterSettings, check_input, evaluate_points, rejected_measurement, settings_methods,
+    FilterSettings, check_input, evaluate_points_into, rejected_measurement, settings_methods,
 };
+use crate::matrix::boxed_copy;
 use nalgebra::{SMatrix, SVector};
 
 const FILTER: &str = "augmented UKF";
 
 /// A UKF with non-additive process noise (`NV` entries) and measurement noise (`NN` entries).
-#[derive(Clone, Debug)]
+///
+/// `P`, the propagated points and the work space of a step are kept on the heap, allocated by the constructor,
+/// and a step declares no matrix of `NX²`, `NA²` or `NA NS` entries: a filter of any size runs on any thread.
+#[derive(Debug)]
 pub struct AugmentedUkf<
     const NX: usize,
     const NU: usize,
@@ -39,16 +43,61 @@ pub struct AugmentedUkf<
 > {
     settings: FilterSettings<NA, NX, NY, NS>,
     x: SVector<f64, NX>,
-    p: SMatrix<f64, NX, NX>,
+    p: Box<SMatrix<f64, NX, NX>>,
     q: SMatrix<f64, NV, NV>,
     r: SMatrix<f64, NN, NN>,
     /// Propagated state parts of the last predict's points.
-    propagated: SMatrix<f64, NX, NS>,
+    propagated: Box<SMatrix<f64, NX, NS>>,
     /// Measurement-noise parts of the last predict's points.
     meas_noise: SMatrix<f64, NN, NS>,
     fresh: bool,
     innovation: SVector<f64, NY>,
     innovation_cov: SMatrix<f64, NY, NY>,
+    work: Box<AugmentedWork<NX, NY, NA, NS>>,
+}
+
+/// The matrices a step writes before it commits; their contents between steps mean nothing.
+#[derive(Debug)]
+struct AugmentedWork<const NX: usize, const NY: usize, const NA: usize, const NS: usize> {
+    /// The augmented covariance `diag(P, Q, R)`.
+    pa: SMatrix<f64, NA, NA>,
+    /// Its Cholesky factor.
+    factor: SMatrix<f64, NA, NA>,
+    /// The augmented sigma points.
+    chi: SMatrix<f64, NA, NS>,
+    /// The state parts of the points a step propagates or measures.
+    states: SMatrix<f64, NX, NS>,
+    /// The points' measurements.
+    measured: SMatrix<f64, NY, NS>,
+    /// The covariance being computed, and the covariance repair's work matrix.
+    next_p: SMatrix<f64, NX, NX>,
+    repair: SMatrix<f64, NX, NX>,
+}
+
+// SAFETY: `SMatrix<f64, _, _>` fields only (arrays of `f64`), for which all-zero bytes are `0.0`.
+unsafe impl<const NX: usize, const NY: usize, const NA: usize, const NS: usize> bytemuck::Zeroable
+    for AugmentedWork<NX, NY, NA, NS>
+{
+}
+
+impl<
+    const NX: usize,
+    const NU: usize,
+    const NY: usize,
+    const NV: usize,
+    const NN: usize,
+    const NA: usize,
+    const NS: usize,
+> Clone for AugmentedUkf<NX, NU, NY, NV, NN, NA, NS>
+{
+    fn clone(&self) -> Self {
+        AugmentedUkf {
+            p: boxed_copy(&self.p),
+            propagated: boxed_copy(&self.propagated),
+            work: bytemuck::zeroed_box(),
+            ..*self
+        }
+    }
 }
 
 impl<
@@ -64,7 +113,8 @@ impl<
     const SIZE_CHECK: () = assert!(NA == NX + NV + NN, "NA must equal NX + NV + NN");
 
     /// `q` and `r` must be positive definite (a noise entry with zero variance should be left out of the
-    /// model instead), `p0` positive definite.
+    /// model instead), `p0` positive definite. The matrices are taken by value, on the caller's stack;
+    /// [`Self::from_refs`] borrows them.
     pub fn new(
         points: SigmaPoints<NA, NS>,
         q: SMatrix<f64, NV, NV>,
@@ -72,36 +122,52 @@ impl<
         x0: SVector<f64, NX>,
         p0: SMatrix<f64, NX, NX>,
     ) -> Result<Self, EstimationError> {
+        Self::from_refs(points, &q, &r, &x0, &p0)
+    }
+
+    /// [`Self::new`] from borrowed matrices, copied into the filter (`P₀` of a large model held on the heap).
+    pub fn from_refs(
+        points: SigmaPoints<NA, NS>,
+        q: &SMatrix<f64, NV, NV>,
+        r: &SMatrix<f64, NN, NN>,
+        x0: &SVector<f64, NX>,
+        p0: &SMatrix<f64, NX, NX>,
+    ) -> Result<Self, EstimationError> {
         #[allow(clippy::let_unit_value)]
         let () = Self::SIZE_CHECK;
-        check_positive_definite("Q", &q)?;
-        check_positive_definite("R", &r)?;
-        check_estimate(("x0", "P0"), &x0, &p0)?;
+        check_positive_definite("Q", q)?;
+        check_positive_definite("R", r)?;
+        check_estimate(("x0", "P0"), x0, p0)?;
         Ok(AugmentedUkf {
             settings: FilterSettings::new(points, FILTER),
-            x: x0,
-            p: p0,
-            q,
-            r,
-            propagated: SMatrix::zeros(),
+            x: *x0,
+            p: boxed_copy(p0),
+            q: *q,
+            r: *r,
+            propagated: bytemuck::zeroed_box(),
             meas_noise: SMatrix::zeros(),
             fresh: false,
             innovation: SVector::zeros(),
             innovation_cov: SMatrix::zeros(),
+            work: bytemuck::zeroed_box(),
         })
     }
 
     settings_methods!();
 
-    fn augmented_points(&self) -> Result<SMatrix<f64, NA, NS>, EstimationError> {
+    /// The sigma points of `(x, P)` augmented with the noise, written into `work.chi`.
+    fn augmented_points(&mut self) -> Result<(), EstimationError> {
         let mut xa = SVector::<f64, NA>::zeros();
         xa.fixed_rows_mut::<NX>(0).copy_from(&self.x);
-        let mut pa = SMatrix::<f64, NA, NA>::zeros();
-        pa.fixed_view_mut::<NX, NX>(0, 0).copy_from(&self.p);
-        pa.fixed_view_mut::<NV, NV>(NX, NX).copy_from(&self.q);
-        pa.fixed_view_mut::<NN, NN>(NX + NV, NX + NV)
+        let w = &mut *self.work;
+        w.pa.fill(0.0);
+        w.pa.fixed_view_mut::<NX, NX>(0, 0).copy_from(&*self.p);
+        w.pa.fixed_view_mut::<NV, NV>(NX, NX).copy_from(&self.q);
+        w.pa.fixed_view_mut::<NN, NN>(NX + NV, NX + NV)
             .copy_from(&self.r);
-        self.settings.points.generate(&xa, &pa)
+        self.settings
+            .points
+            .generate_into(&xa, &w.pa, &mut w.factor, &mut w.chi)
     }
 
     /// The time update through `f(x, u, v)`.
@@ -114,19 +180,22 @@ impl<
         F: FnMut(&SVector<f64, NX>, &SVector<f64, NU>, &SVector<f64, NV>) -> SVector<f64, NX>,
     {
         check_input(u)?;
-        let chi = self.augmented_points()?;
-        let prop = evaluate_points("process function", |i| {
+        self.augmented_points()?;
+        let w = &mut *self.work;
+        let chi = &w.chi;
+        let propagate = |i: usize| {
             let c = chi.column(i);
             let xs: SVector<f64, NX> = c.fixed_rows::<NX>(0).into_owned();
             let vs: SVector<f64, NV> = c.fixed_rows::<NV>(NX).into_owned();
             f(&xs, u, &vs)
-        })?;
-        let noise: SMatrix<f64, NN, NS> = chi.fixed_rows::<NN>(NX + NV).into_owned();
-        let (x, p, repair) = self.settings.predicted(&prop, None)?;
+        };
+        evaluate_points_into("process function", propagate, &mut w.states)?;
+        let out = (&mut w.next_p, &mut w.repair);
+        let (x, repair) = self.settings.predicted_into(&w.states, None, out)?;
         self.x = x;
-        self.p = p;
-        self.propagated = prop;
-        self.meas_noise = noise;
+        self.p.copy_from(&w.next_p);
+        self.propagated.copy_from(&w.states);
+        self.meas_noise = w.chi.fixed_rows::<NN>(NX + NV).into_owned();
         self.fresh = true;
         Ok(repair)
     }
@@ -146,23 +215,32 @@ impl<
             return Ok(rejected);
         }
         check_input(u)?;
-        let (xs, ns) = if self.fresh {
-            (self.propagated, self.meas_noise)
+        // The points' state and noise parts: those of the last prediction, or drawn anew into the work space.
+        let ns = if self.fresh {
+            self.work.states.copy_from(&*self.propagated);
+            self.meas_noise
         } else {
-            let chi = self.augmented_points()?;
-            (
-                chi.fixed_rows::<NX>(0).into_owned(),
-                chi.fixed_rows::<NN>(NX + NV).into_owned(),
-            )
+            self.augmented_points()?;
+            let w = &mut *self.work;
+            w.states.copy_from(&w.chi.fixed_rows::<NX>(0));
+            w.chi.fixed_rows::<NN>(NX + NV).into_owned()
         };
-        let ys = evaluate_points("measurement function", |i| {
+        let w = &mut *self.work;
+        let xs = &w.states;
+        let measure = |i: usize| {
             let xi: SVector<f64, NX> = xs.column(i).into_owned();
             let ni: SVector<f64, NN> = ns.column(i).into_owned();
             h(&xi, u, &ni)
-        })?;
-        let correction = self
-            .settings
-            .correct(&mut self.x, &mut self.p, &xs, &ys, y, None)?;
+        };
+        evaluate_points_into("measurement function", measure, &mut w.measured)?;
+        let scratch = (&mut w.next_p, &mut w.repair);
+        let correction = self.settings.correct_in(
+            &mut self.x,
+            &mut self.p,
+            (&w.states, &w.measured, y),
+            None,
+            scratch,
+        )?;
         self.innovation = correction.innovation;
         self.innovation_cov = correction.innovation_cov;
         self.fresh = false;

@@ -2,27 +2,30 @@
 //! [`super::dual_ukf`]) share, generic over the sizes of state, measurement and point set.
 //!
 //! - input checks: a non-finite input `u` is an error, a non-finite measurement `y` is a rejected update;
-//! - [`evaluate_points`]: a model function at every sigma point, with the first non-finite output reported as
+//! - [`evaluate_points_into`] (and [`evaluate_points`]): a model function at every sigma point, with the first non-finite output reported as
 //!   [`EstimationError::NonFiniteModelOutput`];
-//! - [`predicted_moments`]: `x̂⁻ = mean(χ*)`, `P⁻ = Σ W⁽ᶜ⁾ (χ*ᵢ − x̂⁻)(χ*ᵢ − x̂⁻)ᵀ (+ Q)`, repaired;
+//! - [`predicted_moments_into`]: `x̂⁻ = mean(χ*)`, `P⁻ = Σ W⁽ᶜ⁾ (χ*ᵢ − x̂⁻)(χ*ᵢ − x̂⁻)ᵀ (+ Q)`, repaired;
 //! - [`innovation_moments`]: `ŷ = mean(Y)`, `S = Σ W⁽ᶜ⁾ (Yᵢ − ŷ)(Yᵢ − ŷ)ᵀ (+ R)`,
 //!   `P_xy = Σ W⁽ᶜ⁾ (χᵢ − x̂)(Yᵢ − ŷ)ᵀ`;
-//! - [`kalman_correct`]: NIS and gate, `K = P_xy S⁻¹`, `x̂ += K e`, `P −= K S Kᵀ`, repaired;
+//! - [`kalman_correct_in`] (and [`kalman_correct`], with its work matrices on the stack, for the dual UKF's
+//!   small parameter filter): NIS and gate, `K = P_xy S⁻¹`, `x̂ += K e`, `P −= K S Kᵀ`, repaired;
 //! - [`FilterSettings`]: what the filters are configured with (sigma points, mean and residual functions, fault
 //!   policy), with the predict moments and the whole correction of a covariance-form filter as methods, and
-//!   [`settings_methods`], the public methods that replace those settings;
-//! - [`sigma_images`]: the input check, the sigma points and their images under a model function.
+//!   [`settings_methods`], the public methods that replace those settings.
 //!
-//! None of them allocates or panics; each returns its results by value so that the caller commits only when
-//! the whole step succeeded.
+//! None of them allocates or panics, and each leaves the caller's estimate alone unless the whole step
+//! succeeded. The `_into`/`_in` forms write their `N × NS` and `N × N` results into matrices the caller holds
+//! (the filters' work spaces on the heap), so that a step of a large filter has none on the stack; the forms
+//! that return matrices by value serve the square-root UKF and the dual UKF's parameter filter.
 
 use super::dense::{cholesky_above_floor, cholesky_solve, first_non_finite, symmetrise};
 use super::fault::{
-    CovarianceRepair, EstimationError, FaultPolicy, RejectReason, UpdateOutcome, repair_covariance,
+    CovarianceRepair, EstimationError, FaultPolicy, RejectReason, UpdateOutcome,
+    repair_covariance_in,
 };
 use super::sigma::{
     MeanFn, ResidualFn, SigmaPoints, cross_covariance, first_bad_column, rounding_floor, subtract,
-    unscented_transform, weighted_mean,
+    unscented_transform, unscented_transform_into, weighted_mean,
 };
 use crate::model::DiscreteModel;
 use nalgebra::{SMatrix, SVector};
@@ -62,33 +65,29 @@ pub(crate) fn rejected_measurement<const NY: usize>(y: &SVector<f64, NY>) -> Opt
 /// The columns `eval(0) … eval(NS − 1)`; a non-finite column is an error naming `function` and the point.
 pub(crate) fn evaluate_points<const N: usize, const NS: usize>(
     function: &'static str,
-    mut eval: impl FnMut(usize) -> SVector<f64, N>,
+    eval: impl FnMut(usize) -> SVector<f64, N>,
 ) -> Result<SMatrix<f64, N, NS>, EstimationError> {
     let mut out = SMatrix::<f64, N, NS>::zeros();
+    evaluate_points_into(function, eval, &mut out)?;
+    Ok(out)
+}
+
+/// [`evaluate_points`] written into `out`.
+pub(crate) fn evaluate_points_into<const N: usize, const NS: usize>(
+    function: &'static str,
+    mut eval: impl FnMut(usize) -> SVector<f64, N>,
+    out: &mut SMatrix<f64, N, NS>,
+) -> Result<(), EstimationError> {
     for i in 0..NS {
         out.set_column(i, &eval(i));
     }
-    match first_bad_column(&out) {
+    match first_bad_column(out) {
         Some(sigma_point) => Err(EstimationError::NonFiniteModelOutput {
             function,
             sigma_point,
         }),
-        None => Ok(out),
+        None => Ok(()),
     }
-}
-
-/// The sigma points `χ` (from `draw`, called once `u` has passed [`check_input`]) and their images
-/// `g(χᵢ, u)`, evaluated as in [`evaluate_points`] under the name `function`.
-pub(crate) fn sigma_images<const N: usize, const M: usize, const NU: usize, const NS: usize>(
-    function: &'static str,
-    u: &SVector<f64, NU>,
-    draw: impl FnOnce() -> Result<SMatrix<f64, N, NS>, EstimationError>,
-    mut g: impl FnMut(&SVector<f64, N>, &SVector<f64, NU>) -> SVector<f64, M>,
-) -> Result<(SMatrix<f64, N, NS>, SMatrix<f64, M, NS>), EstimationError> {
-    check_input(u)?;
-    let chi = draw()?;
-    let images = evaluate_points(function, |i| g(&chi.column(i).into_owned(), u))?;
-    Ok((chi, images))
 }
 
 /// `Err` when the state mean function gave a non-finite mean.
@@ -102,33 +101,29 @@ pub(crate) fn check_state_mean<const N: usize>(x: &SVector<f64, N>) -> Result<()
     }
 }
 
-/// A predicted mean, its covariance and the repair the covariance needed.
-pub(crate) type Prediction<const NX: usize> = (
-    SVector<f64, NX>,
-    SMatrix<f64, NX, NX>,
-    Option<CovarianceRepair>,
-);
-
 /// The predicted mean and covariance of the propagated points `prop` (weights of `points`), plus the additive
 /// process noise `q` if any; the covariance is repaired under `policy` (the repair is returned) before the mean
-/// is checked.
-pub(crate) fn predicted_moments<const NP: usize, const NX: usize, const NS: usize>(
+/// is checked. The covariance is written into `out.0`, and `out.1` is the repair's work matrix (contents of
+/// both overwritten); returns the mean and the repair.
+pub(crate) fn predicted_moments_into<const NP: usize, const NX: usize, const NS: usize>(
     prop: &SMatrix<f64, NX, NS>,
     points: &SigmaPoints<NP, NS>,
     fns: &SpaceFns<NX, NS>,
     q: Option<&SMatrix<f64, NX, NX>>,
     policy: &FaultPolicy,
     filter: &'static str,
-) -> Result<Prediction<NX>, EstimationError> {
-    let (x, mut p) = unscented_transform(
+    (p, work): (&mut SMatrix<f64, NX, NX>, &mut SMatrix<f64, NX, NX>),
+) -> Result<(SVector<f64, NX>, Option<CovarianceRepair>), EstimationError> {
+    let x = unscented_transform_into(
         prop,
         points.mean_weights(),
         points.covariance_weights(),
         fns.mean,
         fns.residual,
+        p,
     );
     if let Some(q) = q {
-        p += q;
+        *p += q;
     }
     check_state_mean(&x)?;
     let floor = rounding_floor(
@@ -138,9 +133,9 @@ pub(crate) fn predicted_moments<const NP: usize, const NX: usize, const NS: usiz
         points.covariance_weights(),
         fns.residual,
     );
-    check_precision(&floor, &p, points, "predicted covariance", filter)?;
-    let repair = repair_covariance(&mut p, policy.eigen_floor, filter)?;
-    Ok((x, p, repair))
+    check_precision(&floor, p, points, "predicted covariance", filter)?;
+    let repair = repair_covariance_in(p, policy.eigen_floor, filter, work)?;
+    Ok((x, repair))
 }
 
 /// Four significant digits: a covariance entry whose estimated rounding error exceeds this fraction of the
@@ -158,11 +153,22 @@ pub(crate) fn check_precision<const NP: usize, const N: usize, const NS: usize>(
     quantity: &'static str,
     filter: &'static str,
 ) -> Result<(), EstimationError> {
+    check_precision_of_diagonal(floor, &cov.diagonal(), points, quantity, filter)
+}
+
+/// [`check_precision`] given the diagonal of the covariance only.
+pub(crate) fn check_precision_of_diagonal<const NP: usize, const N: usize, const NS: usize>(
+    floor: &SVector<f64, N>,
+    diagonal: &SVector<f64, N>,
+    points: &SigmaPoints<NP, NS>,
+    quantity: &'static str,
+    filter: &'static str,
+) -> Result<(), EstimationError> {
     for index in 0..N {
         if floor[index] == 0.0 {
             continue;
         }
-        let relative_error = floor[index] / cov[(index, index)].abs();
+        let relative_error = floor[index] / diagonal[index].abs();
         if relative_error > PRECISION_LIMIT || relative_error.is_nan() {
             return Err(EstimationError::PrecisionLoss {
                 filter,
@@ -236,6 +242,25 @@ pub(crate) fn kalman_correct<const NP: usize, const N: usize, const M: usize, co
     policy: &FaultPolicy,
     filter: &'static str,
 ) -> Result<(UpdateOutcome, Option<SMatrix<f64, N, M>>), EstimationError> {
+    let scratch = (&mut SMatrix::zeros(), &mut SMatrix::zeros());
+    kalman_correct_in(x, p, innovation, pxy, (points, policy, filter), scratch)
+}
+
+/// [`kalman_correct`] computing the new covariance in `scratch.0` (copied into `p` on acceptance) with
+/// `scratch.1` as the repair's work matrix (contents of both overwritten).
+pub(crate) fn kalman_correct_in<
+    const NP: usize,
+    const N: usize,
+    const M: usize,
+    const NS: usize,
+>(
+    x: &mut SVector<f64, N>,
+    p: &mut SMatrix<f64, N, N>,
+    innovation: Innovation<'_, M>,
+    pxy: &SMatrix<f64, N, M>,
+    (points, policy, filter): (&SigmaPoints<NP, NS>, &FaultPolicy, &'static str),
+    (new_p, work): (&mut SMatrix<f64, N, N>, &mut SMatrix<f64, N, N>),
+) -> Result<(UpdateOutcome, Option<SMatrix<f64, N, M>>), EstimationError> {
     let Innovation { e, s, floor } = innovation;
     let singular = EstimationError::SingularInnovation { filter };
     let ls = cholesky_above_floor(s, floor).ok_or(singular.clone())?;
@@ -255,16 +280,26 @@ pub(crate) fn kalman_correct<const NP: usize, const N: usize, const M: usize, co
         .ok_or(singular)?
         .transpose();
     let new_x = *x + k * e;
-    let mut new_p = *p - k * s * k.transpose();
+    // `P − (K S) Kᵀ`, entry by entry, each sum over the measurements in order (as the product would form it).
+    let ks = k * s;
+    for j in 0..N {
+        for i in 0..N {
+            let mut kskt = 0.0;
+            for a in 0..M {
+                kskt += ks[(i, a)] * k[(j, a)];
+            }
+            new_p[(i, j)] = p[(i, j)] - kskt;
+        }
+    }
     if first_non_finite(&new_x).is_some() {
         return Err(EstimationError::Overflow {
             filter,
             quantity: "corrected state",
         });
     }
-    let repair = repair_covariance(&mut new_p, policy.eigen_floor, filter)?;
+    let repair = repair_covariance_in(new_p, policy.eigen_floor, filter, work)?;
     *x = new_x;
-    *p = new_p;
+    p.copy_from(new_p);
     Ok((UpdateOutcome::Accepted { nis, repair }, Some(k)))
 }
 
@@ -326,33 +361,32 @@ impl<const NP: usize, const NX: usize, const NY: usize, const NS: usize>
         }
     }
 
-    /// [`predicted_moments`] of the propagated points `prop` with these settings.
-    pub fn predicted(
+    /// [`predicted_moments_into`] of the propagated points `prop` with these settings.
+    pub fn predicted_into(
         &self,
         prop: &SMatrix<f64, NX, NS>,
         q: Option<&SMatrix<f64, NX, NX>>,
-    ) -> Result<Prediction<NX>, EstimationError> {
-        predicted_moments(
-            prop,
-            &self.points,
-            &self.x_fns,
-            q,
-            &self.policy,
-            self.filter,
-        )
+        out: (&mut SMatrix<f64, NX, NX>, &mut SMatrix<f64, NX, NX>),
+    ) -> Result<(SVector<f64, NX>, Option<CovarianceRepair>), EstimationError> {
+        let (points, fns, policy) = (&self.points, &self.x_fns, &self.policy);
+        predicted_moments_into(prop, points, fns, q, policy, self.filter, out)
     }
 
     /// The measurement correction of a covariance-form filter at the estimate `(x, p)`: [`innovation_moments`]
     /// of the points `chi` and their measurements `ys` (plus `r` if the noise is additive), `S` symmetrised,
-    /// `e = residual(y, ŷ)`, then [`kalman_correct`], which changes `x` and `p` only on acceptance.
-    pub fn correct(
+    /// `e = residual(y, ŷ)`, then [`kalman_correct_in`] with the new covariance and the repair's work matrix
+    /// in `scratch`, which changes `x` and `p` only on acceptance.
+    pub fn correct_in(
         &self,
         x: &mut SVector<f64, NX>,
         p: &mut SMatrix<f64, NX, NX>,
-        chi: &SMatrix<f64, NX, NS>,
-        ys: &SMatrix<f64, NY, NS>,
-        y: &SVector<f64, NY>,
+        (chi, ys, y): (
+            &SMatrix<f64, NX, NS>,
+            &SMatrix<f64, NY, NS>,
+            &SVector<f64, NY>,
+        ),
         r: Option<&SMatrix<f64, NY, NY>>,
+        scratch: (&mut SMatrix<f64, NX, NX>, &mut SMatrix<f64, NX, NX>),
     ) -> Result<Correction<NX, NY>, EstimationError> {
         let (y_hat, mut s, pxy, floor) = innovation_moments(
             chi,
@@ -370,15 +404,8 @@ impl<const NP: usize, const NX: usize, const NY: usize, const NS: usize>
             s: &s,
             floor: &floor,
         };
-        let (outcome, gain) = kalman_correct(
-            x,
-            p,
-            innovation,
-            &pxy,
-            &self.points,
-            &self.policy,
-            self.filter,
-        )?;
+        let settings = (&self.points, &self.policy, self.filter);
+        let (outcome, gain) = kalman_correct_in(x, p, innovation, &pxy, settings, scratch)?;
         Ok(Correction {
             outcome,
             gain,

@@ -39,4 +39,7 @@ pub enum SimError {
     /// The exact discretisation of a linear plant failed (its matrix exponential overflowed).
     #[error("the zero-order-hold discretisation of the linear plant failed: {message}")]
     Discretisation { message: String },
+    /// A linear plant built from a state-space model whose matrices do not have the plant's sizes.
+    #[error("the linear plant does not match the state-space model: {message}")]
+    PlantShape { message: String },
 }

@@ -7,27 +7,86 @@
 //! (Van Loan's block exponential, as [`crate::linalg::c2d_zoh`] with the disturbance as an extra input). One
 //! matrix exponential per run replaces an ODE solve per sample, and the step is exact up to rounding instead
 //! of up to the solver's tolerance.
+//!
+//! The plant's matrices and the step's `A_d`, `B_d`, `E_d` are kept on the heap, and a step writes into
+//! vectors only: a plant of any size runs on any thread (an `NX × NX` matrix exceeds a spawned thread's 2 MiB
+//! stack at 512 states).
 
 use nalgebra::{DMatrix, SMatrix, SVector};
 
 use super::error::SimError;
 use crate::linalg::expm;
+use crate::linearize::BoxedJacobians;
+use crate::matrix::{boxed_copy, boxed_fixed, product_sum, zeroed_box};
 use crate::model::ContinuousModel;
+use crate::statespace::StateSpace;
 
-/// A linear time-invariant plant `ẋ = A x + B u`, `y = C x + D u`.
+/// A linear time-invariant plant `ẋ = A x + B u`, `y = C x + D u`, its matrices on the heap.
+///
+/// [`LinearPlant::new`] takes the matrices by value (a small plant); [`LinearPlant::from_state_space`] and
+/// [`LinearPlant::from_jacobians`] build a plant of any size without a matrix on the stack.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LinearPlant<const NX: usize, const NU: usize, const NY: usize> {
-    pub a: SMatrix<f64, NX, NX>,
-    pub b: SMatrix<f64, NX, NU>,
-    pub c: SMatrix<f64, NY, NX>,
-    pub d: SMatrix<f64, NY, NU>,
+    pub a: Box<SMatrix<f64, NX, NX>>,
+    pub b: Box<SMatrix<f64, NX, NU>>,
+    pub c: Box<SMatrix<f64, NY, NX>>,
+    pub d: Box<SMatrix<f64, NY, NU>>,
+}
+
+impl<const NX: usize, const NU: usize, const NY: usize> LinearPlant<NX, NU, NY> {
+    /// The plant of the given matrices (each moved to the heap; for a plant whose matrices fit the stack).
+    pub fn new(
+        a: SMatrix<f64, NX, NX>,
+        b: SMatrix<f64, NX, NU>,
+        c: SMatrix<f64, NY, NX>,
+        d: SMatrix<f64, NY, NU>,
+    ) -> Self {
+        LinearPlant {
+            a: boxed_copy(&a),
+            b: boxed_copy(&b),
+            c: boxed_copy(&c),
+            d: boxed_copy(&d),
+        }
+    }
+
+    /// The plant of a continuous-time [`StateSpace`] (a linearisation, a design model), copied to the heap
+    /// entry by entry; an error naming the matrix whose shape is not `NX`, `NU`, `NY`'s, or when `ss` is
+    /// discrete.
+    pub fn from_state_space(ss: &StateSpace) -> Result<Self, SimError> {
+        if let Some(dt) = ss.dt() {
+            return Err(SimError::BadSetting {
+                name: "linear plant sample time",
+                value: dt,
+                reason: "a linear plant is continuous-time; discretisation is the loop's",
+            });
+        }
+        let shape = |e: crate::linalg::MatrixError| SimError::PlantShape {
+            message: e.to_string(),
+        };
+        Ok(LinearPlant {
+            a: boxed_fixed("A", ss.a()).map_err(shape)?,
+            b: boxed_fixed("B", ss.b()).map_err(shape)?,
+            c: boxed_fixed("C", ss.c()).map_err(shape)?,
+            d: boxed_fixed("D", ss.d()).map_err(shape)?,
+        })
+    }
+
+    /// The plant of a linearisation's Jacobians ([`crate::linearize::boxed_jacobians_at`]), without a copy.
+    pub fn from_jacobians(j: BoxedJacobians<NX, NU, NY>) -> Self {
+        LinearPlant {
+            a: j.a,
+            b: j.b,
+            c: j.c,
+            d: j.d,
+        }
+    }
 }
 
 impl<const NX: usize, const NU: usize, const NY: usize> ContinuousModel<NX, NU, NY>
     for LinearPlant<NX, NU, NY>
 {
     fn rhs(&self, _t: f64, x: &SVector<f64, NX>, u: &SVector<f64, NU>, dx: &mut SVector<f64, NX>) {
-        *dx = self.a * x + self.b * u;
+        *dx = product_sum(&self.a, x, &self.b, u);
     }
 
     fn outputs(
@@ -37,7 +96,7 @@ impl<const NX: usize, const NU: usize, const NY: usize> ContinuousModel<NX, NU, 
         u: &SVector<f64, NU>,
         y: &mut SVector<f64, NY>,
     ) {
-        *y = self.c * x + self.d * u;
+        *y = product_sum(&self.c, x, &self.d, u);
     }
 
     fn jac_x(
@@ -47,7 +106,7 @@ impl<const NX: usize, const NU: usize, const NY: usize> ContinuousModel<NX, NU, 
         _u: &SVector<f64, NU>,
         jac: &mut SMatrix<f64, NX, NX>,
     ) {
-        *jac = self.a;
+        jac.copy_from(&self.a);
     }
 
     fn jac_u(
@@ -57,7 +116,7 @@ impl<const NX: usize, const NU: usize, const NY: usize> ContinuousModel<NX, NU, 
         _u: &SVector<f64, NU>,
         jac: &mut SMatrix<f64, NX, NU>,
     ) {
-        *jac = self.b;
+        jac.copy_from(&self.b);
     }
 
     fn output_jac_x(
@@ -67,7 +126,7 @@ impl<const NX: usize, const NU: usize, const NY: usize> ContinuousModel<NX, NU, 
         _u: &SVector<f64, NU>,
         jac: &mut SMatrix<f64, NY, NX>,
     ) {
-        *jac = self.c;
+        jac.copy_from(&self.c);
     }
 
     fn output_jac_u(
@@ -77,15 +136,15 @@ impl<const NX: usize, const NU: usize, const NY: usize> ContinuousModel<NX, NU, 
         _u: &SVector<f64, NU>,
         jac: &mut SMatrix<f64, NY, NU>,
     ) {
-        *jac = self.d;
+        jac.copy_from(&self.d);
     }
 }
 
 /// The exact one-sample step of a [`LinearPlant`] under zero-order hold (see the module docs).
 pub(crate) struct ZohStep<const NX: usize, const NU: usize> {
-    ad: SMatrix<f64, NX, NX>,
-    bd: SMatrix<f64, NX, NU>,
-    ed: SMatrix<f64, NX, NX>,
+    ad: Box<SMatrix<f64, NX, NX>>,
+    bd: Box<SMatrix<f64, NX, NU>>,
+    ed: Box<SMatrix<f64, NX, NX>>,
 }
 
 impl<const NX: usize, const NU: usize> ZohStep<NX, NU> {
@@ -114,11 +173,16 @@ impl<const NX: usize, const NU: usize> ZohStep<NX, NU> {
         let e = expm(&big).map_err(|e| SimError::Discretisation {
             message: e.to_string(),
         })?;
-        Ok(ZohStep {
-            ad: SMatrix::from_fn(|i, j| e[(i, j)]),
-            bd: SMatrix::from_fn(|i, j| e[(i, NX + j)]),
-            ed: SMatrix::from_fn(|i, j| e[(i, NX + NU + j)]),
-        })
+        let block = |column: usize| e.view((0, column), (NX, NX));
+        let mut step = ZohStep {
+            ad: zeroed_box::<NX, NX>(),
+            bd: zeroed_box::<NX, NU>(),
+            ed: zeroed_box::<NX, NX>(),
+        };
+        step.ad.copy_from(&block(0));
+        step.bd.copy_from(&e.view((0, NX), (NX, NU)));
+        step.ed.copy_from(&block(NX + NU));
+        Ok(step)
     }
 
     /// `A_d x + B_d u + E_d w`.
@@ -128,6 +192,7 @@ impl<const NX: usize, const NU: usize> ZohStep<NX, NU> {
         u: &SVector<f64, NU>,
         w: &SVector<f64, NX>,
     ) -> SVector<f64, NX> {
-        self.ad * x + self.bd * u + self.ed * w
+        let (ad, bd, ed) = (&*self.ad, &*self.bd, &*self.ed);
+        ad * x + bd * u + ed * w
     }
 }

@@ -1,14 +1,14 @@
 //! Certificates that make the `O(n³)` definiteness test of a Kalman step's covariance unnecessary.
 //!
 //! The filter keeps its covariance symmetric positive definite: after each step it factorises the result
-//! (`dense::positive_definite`) and repairs it if that fails. When the noise covariances bound the smallest
+//! (`dense::positive_definite_in`) and repairs it if that fails. When the noise covariances bound the smallest
 //! eigenvalue of the exact result away from zero by more than the rounding error of the computed one, the
 //! computed result is positive definite by Weyl's inequality (`|λᵢ(X + E) − λᵢ(X)| ≤ ‖E‖₂` for symmetric `X`,
 //! `E`) and the test is skipped; the bounds below cost `O(n m)` per step. Each asks the same margin the test
 //! would: the eigenvalue bound must exceed twice the rounding bound. Norms are Frobenius norms (`‖·‖₂ ≤ ‖·‖_F`,
 //! submultiplicative), and `‖P‖_F ≤ tr P` for a positive-definite `P`.
 
-use super::super::dense::symmetric_eigen;
+use super::super::dense::{symmetric_eigen_in_place, with_square_scratch};
 use nalgebra::{SMatrix, SVector};
 
 /// A magnitude whose sums of a few terms, rounded up, stay far below `f64::MAX`: a certificate whose bound on the
@@ -21,10 +21,14 @@ fn gamma(k: usize) -> f64 {
 }
 
 /// The smallest eigenvalue of a symmetric matrix less its own rounding error (`n ε ‖M‖_F`), or `−∞` when
-/// the eigenvalues cannot be computed; not positive for a singular matrix.
+/// the eigenvalues cannot be computed; not positive for a singular matrix. The decomposition works in two
+/// scratch matrices (on the heap for a large `N`).
 fn smallest_eigenvalue<const N: usize>(m: &SMatrix<f64, N, N>) -> f64 {
-    symmetric_eigen(m).map_or(f64::NEG_INFINITY, |(values, _)| values.min())
-        - N as f64 * f64::EPSILON * m.norm()
+    let smallest = with_square_scratch(|a: &mut SMatrix<f64, N, N>| {
+        a.copy_from(m);
+        with_square_scratch(|v| symmetric_eigen_in_place(a, v))
+    });
+    smallest.map_or(f64::NEG_INFINITY, |values| values.min()) - N as f64 * f64::EPSILON * m.norm()
 }
 
 /// The time update `P⁻ = A P Aᵀ + Q`: `A P Aᵀ ⪰ 0`, so `λ_min(A P Aᵀ + Q) ≥ λ_min(Q)`, and the rounding error
@@ -197,7 +201,7 @@ mod tests {
         InnovationFactor, covariance_times_ct, innovation_covariance, joseph,
     };
     use super::*;
-    use crate::estimation::dense::{cholesky_lower, positive_definite};
+    use crate::estimation::dense::{cholesky_lower, positive_definite, symmetric_eigen};
 
     /// Uniform numbers in `[−1, 1)` from a fixed seed (xorshift64*), so that every run sees the same cases.
     struct Numbers(u64);

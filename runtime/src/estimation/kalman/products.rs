@@ -10,7 +10,8 @@
 
 use nalgebra::{ArrayStorage, SMatrix, SVector};
 
-/// `A P Aᵀ + Q` for symmetric `P` and `Q`, from `A` and `Aᵀ` (kept with the filter): `T = P Aᵀ`, then
+/// `A P Aᵀ + Q` for symmetric `P` and `Q`, from `A` and `Aᵀ` (kept with the filter): `T = P Aᵀ` (written into
+/// `t`, the filter's work matrix: an `NX × NX` local would not fit the stack of a large filter), then
 /// `A T + Q`, its upper triangle mirrored (`4 NX³` flops).
 pub(super) fn congruence_plus<const NX: usize>(
     a: &SMatrix<f64, NX, NX>,
@@ -18,10 +19,11 @@ pub(super) fn congruence_plus<const NX: usize>(
     p: &SMatrix<f64, NX, NX>,
     q: &SMatrix<f64, NX, NX>,
     out: &mut SMatrix<f64, NX, NX>,
+    t: &mut SMatrix<f64, NX, NX>,
 ) {
     let (a, at, p) = (&a.data.0, &at.data.0, &p.data.0);
+    let t = &mut t.data.0;
     // Column i of T = P Aᵀ is P times column i of Aᵀ (row i of A).
-    let mut t = [[0.0_f64; NX]; NX];
     for i in 0..NX {
         let mut col = [0.0_f64; NX];
         for k in 0..NX {

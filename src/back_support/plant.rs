@@ -167,8 +167,8 @@ pub fn rigid_rotation(p: &Params) -> SVector<f64, NX> {
 pub fn design_model(plant: &Plant, p: &Params) -> Result<DesignModel, BackSupportError> {
     let v = rigid_rotation(p);
     let scale = plant.a.abs().max() * v.abs().max();
-    let av = (&*plant.a * v).abs().max();
-    let cv = (&*plant.c * v).abs().max() / plant.c.abs().max().max(f64::MIN_POSITIVE);
+    let av = (*plant.a * v).abs().max();
+    let cv = (*plant.c * v).abs().max() / plant.c.abs().max().max(f64::MIN_POSITIVE);
     if av > RIGID_ROTATION_TOLERANCE * scale || cv > RIGID_ROTATION_TOLERANCE * v.abs().max() {
         return Err(BackSupportError::NotRigidInvariant {
             residual: (av / scale).max(cv),

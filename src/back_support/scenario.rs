@@ -261,7 +261,7 @@ pub fn run(
     let human_torque: Vec<f64> = traj.states[..n]
         .iter()
         .zip(&traj.inputs)
-        .map(|(x, u)| (&*plant.c * x + &*plant.d * u)[output::HUMAN_TORQUE])
+        .map(|(x, u)| (*plant.c * x + *plant.d * u)[output::HUMAN_TORQUE])
         .collect();
     let human_torque_estimate: Vec<f64> = controller
         .estimates

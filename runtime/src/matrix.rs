@@ -36,6 +36,15 @@ pub fn fixed<const R: usize, const C: usize>(
     name: &'static str,
     m: &DMatrix<f64>,
 ) -> Result<SMatrix<f64, R, C>, MatrixError> {
+    check_shape::<R, C>(name, m)?;
+    Ok(SMatrix::from_fn(|i, j| m[(i, j)]))
+}
+
+/// An error naming `name` unless `m` is `R × C`.
+fn check_shape<const R: usize, const C: usize>(
+    name: &'static str,
+    m: &DMatrix<f64>,
+) -> Result<(), MatrixError> {
     if m.nrows() != R || m.ncols() != C {
         return Err(MatrixError::Shape {
             name,
@@ -45,7 +54,7 @@ pub fn fixed<const R: usize, const C: usize>(
             expected_cols: C,
         });
     }
-    Ok(SMatrix::from_fn(|i, j| m[(i, j)]))
+    Ok(())
 }
 
 /// An `R × C` matrix of zeros on the heap, never on the stack (`bytemuck::zeroed_box`).
@@ -74,15 +83,7 @@ pub fn boxed_fixed<const R: usize, const C: usize>(
     name: &'static str,
     m: &DMatrix<f64>,
 ) -> Result<Box<SMatrix<f64, R, C>>, MatrixError> {
-    if m.nrows() != R || m.ncols() != C {
-        return Err(MatrixError::Shape {
-            name,
-            rows: m.nrows(),
-            cols: m.ncols(),
-            expected_rows: R,
-            expected_cols: C,
-        });
-    }
+    check_shape::<R, C>(name, m)?;
     let mut out = zeroed_box::<R, C>();
     out.copy_from(m);
     Ok(out)

@@ -12,53 +12,15 @@
 //! Run with `cargo bench -p bgc --bench equations_scaling`. The same generators, at small sizes, are checked against
 //! hand-derived values in `tests/equations_scaling.rs`.
 
-#[path = "support/chain.rs"]
-mod chain;
+#[path = "support/families.rs"]
+mod families;
 
 use bgc::causality::analyse;
 use bgc::lower::{MemoryLoader, lower};
 use bgc::span::SourceMap;
-use chain::benchmark_chain;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use families::{benchmark_chain, ladder, mtf_chain, output_chain};
 use std::hint::black_box;
-
-fn ladder(rungs: usize) -> String {
-    let mut s = String::from(
-        "model ladder {\n    domain electrical;\n    input u [V];\n    param r = 1 [Ohm];\n    param c = 1e-3 [F];\n    Se src = u;\n    C cap = c;\n",
-    );
-    let mut chain = String::from("src");
-    for k in 1..=rungs {
-        s += &format!("    1 s{k};\n    R rs{k} = r;\n    0 n{k};\n    R rp{k} = {k}*r;\n");
-        s += &format!("    bond s{k} -> rs{k};\n    bond n{k} -> rp{k};\n");
-        chain += &format!(" -> s{k} -> n{k}");
-    }
-    s += &format!("    bond {chain} -> cap;\n    output i1 [A] = f(rs1);\n}}\n");
-    s
-}
-
-fn output_chain(levels: usize) -> String {
-    let mut s = String::from(
-        "model outchain {\n    domain translational;\n    param m = 1 [kg];\n    param k = 1 [N/m];\n    param q0 = 1 [m];\n    1 j;\n    I mass = m;\n    C spring = 1/k;\n    bond j -> mass;\n    bond j -> spring;\n    output y1 [1] = sin(q(spring)*q(spring)/(q0*q0)) + cos(q(spring)/q0);\n",
-    );
-    for i in 2..=levels {
-        let p = i - 1;
-        s += &format!("    output y{i} [1] = sin(y{p}*y{p}) + cos(y{p});\n");
-    }
-    s + "}\n"
-}
-
-fn mtf_chain(n: usize) -> String {
-    let mut s = String::from(
-        "model mtfchain {\n    domain rotational;\n    param J = 1 [kg m^2];\n    param b = 0.1 [N m s/rad];\n    input tau [N m];\n    var theta [rad] = int(f(j0));\n    Se drive = tau;\n    1 j0;\n    I i0 = J;\n    R r0 = b;\n    bond drive -> j0;\n    bond j0 -> i0;\n    bond j0 -> r0;\n",
-    );
-    for k in 1..=n {
-        let p = k - 1;
-        s += &format!(
-            "    1 j{k};\n    I i{k} = J;\n    MTF g{k} = 1 + 0.1*cos(theta);\n    bond j{p} -> g{k} -> j{k};\n    bond j{k} -> i{k};\n"
-        );
-    }
-    s + "}\n"
-}
 
 /// Lowers, assigns causality and derives; returns the number of states so that nothing is optimised away.
 fn derive(text: &str) -> usize {

@@ -4,8 +4,8 @@
 //!
 //! Run with `cargo bench -p bgc --bench simulate_scaling`.
 
-#[path = "support/chain.rs"]
-mod chain;
+#[path = "support/families.rs"]
+mod families;
 
 use bgc::causality::analyse;
 use bgc::lower::{MemoryLoader, lower};
@@ -13,8 +13,8 @@ use bgc::simulate::System;
 use bgc::simulate::input::Signal;
 use bgc::simulate::integrate::{Method, RunOptions, run};
 use bgc::span::SourceMap;
-use chain::benchmark_chain;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use families::benchmark_chain;
 use std::hint::black_box;
 
 /// The compiled system of the chain of `n` masses, driven by `u = sin(3t)`.

@@ -5,34 +5,9 @@
 
 use crate::codegen_support::rustc::build_and_run;
 use crate::codegen_support::{generate_text, scratch};
+use crate::equations_support::families::benchmark_chain;
 use crate::loops_globalised::LIBM_STD;
 use bgc::codegen::rust::Options;
-
-/// A chain of `n` masses `m` with dampers `b` to ground, joined by springs `1/k`, the first held to a wall by a
-/// spring `1/k` and driven by the force `u`: `2n` states `q_wall, p_mass1, q_spring1, ..., p_mass<n>`, every
-/// element sharing one of the three parameters.
-fn shared_chain(n: usize) -> String {
-    let mut s = String::from(
-        "model chain {\n    domain translational;\n    param m = 1 [kg];\n    param b = 0.5 [N s/m];\n    \
-         param k = 1 [N/m];\n    input u [N];\n    Se drive = u;\n    C wall = 1/k;\n    bond drive -> v1;\n    \
-         bond v1 -> wall;\n",
-    );
-    for i in 1..=n {
-        s.push_str(&format!(
-            "    1 v{i};\n    I mass{i} = m;\n    R damp{i} = b;\n    bond v{i} -> mass{i};\n    \
-             bond v{i} -> damp{i};\n"
-        ));
-        if i < n {
-            let j = i + 1;
-            s.push_str(&format!(
-                "    0 x{i};\n    C spring{i} = 1/k;\n    bond v{i} -> x{i};\n    bond x{i} -> v{j};\n    \
-                 bond x{i} -> spring{i};\n"
-            ));
-        }
-    }
-    s.push_str("}\n");
-    s
-}
 
 const MASSES: usize = 300;
 const STATES: usize = 2 * MASSES;
@@ -134,7 +109,7 @@ fn hand_rates(x: &[f64]) -> Vec<f64> {
 fn a_large_chain_runs_on_a_default_thread_stack_with_the_hand_derived_rates() {
     let code = generate_text(
         "chain.bg",
-        &shared_chain(MASSES),
+        &benchmark_chain(MASSES),
         Options { runtime: false },
     );
     assert!(code.contains(&format!("pub const N_STATES: usize = {STATES};")));
@@ -212,7 +187,7 @@ fn a_large_chain_runs_on_a_default_thread_stack_with_the_hand_derived_rates() {
 
 #[test]
 fn validate_checks_each_distinct_value_once_and_names_its_first_element() {
-    let code = generate_text("chain.bg", &shared_chain(40), Options { runtime: false });
+    let code = generate_text("chain.bg", &benchmark_chain(40), Options { runtime: false });
     let start = code.find("pub fn validate").unwrap_or_default();
     let end = code[start..]
         .find("\n    }\n")
@@ -228,7 +203,7 @@ fn validate_checks_each_distinct_value_once_and_names_its_first_element() {
         assert!(validate.contains(comment), "{comment}\n{validate}");
     }
     // A value alone keeps its element's message.
-    let one = generate_text("chain.bg", &shared_chain(1), Options { runtime: false });
+    let one = generate_text("chain.bg", &benchmark_chain(1), Options { runtime: false });
     assert!(
         one.contains("reason: \"the inertia of `mass1` (m) must be positive and finite\","),
         "{one}"

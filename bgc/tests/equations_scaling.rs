@@ -11,6 +11,8 @@ use bgc::lower::{MemoryLoader, lower};
 use bgc::simulate::System;
 use bgc::span::SourceMap;
 
+use crate::equations_support::families::{ladder, mtf_chain, output_chain};
+
 /// Lowers, analyses and derives one model from source text; any error fails the test.
 pub fn equations(text: &str) -> Equations {
     let mut sources = SourceMap::new();
@@ -24,53 +26,6 @@ pub fn equations(text: &str) -> Equations {
     let errors: Vec<&Diagnostic> = diags.iter().filter(|d| d.is_error()).collect();
     assert!(errors.is_empty(), "{errors:?}");
     eqs
-}
-
-/// `Se u -> 1 s1 (R r) -> 0 n1 (R 1·r) -> 1 s2 (R r) -> 0 n2 (R 2·r) -> … -> C c`: every rung's resistors form an
-/// algebraic loop with the next rung's.
-pub fn ladder(rungs: usize) -> String {
-    let mut s = String::from(
-        "model ladder {\n    domain electrical;\n    input u [V];\n    param r = 1 [Ohm];\n    param c = 1e-3 [F];\n    Se src = u;\n    C cap = c;\n",
-    );
-    let mut chain = String::from("src");
-    for k in 1..=rungs {
-        s += &format!("    1 s{k};\n    R rs{k} = r;\n    0 n{k};\n    R rp{k} = {k}*r;\n");
-        s += &format!("    bond s{k} -> rs{k};\n    bond n{k} -> rp{k};\n");
-        chain += &format!(" -> s{k} -> n{k}");
-    }
-    s += &format!("    bond {chain} -> cap;\n    output i1 [A] = f(rs1);\n}}\n");
-    s
-}
-
-/// A mass on a spring with outputs `y_1 = sin((q/q0)²) + cos(q/q0)`, `y_i = sin(y_{i-1}·y_{i-1}) + cos(y_{i-1})`.
-pub fn output_chain(levels: usize) -> String {
-    let mut s = String::from(
-        "model outchain {\n    domain translational;\n    param m = 1 [kg];\n    param k = 1 [N/m];\n    param q0 = 1 [m];\n    1 j;\n    I mass = m;\n    C spring = 1/k;\n    bond j -> mass;\n    bond j -> spring;\n    output y1 [1] = sin(q(spring)*q(spring)/(q0*q0)) + cos(q(spring)/q0);\n",
-    );
-    for i in 2..=levels {
-        s += &format!(
-            "    output y{i} [1] = sin(y{}*y{}) + cos(y{});\n",
-            i - 1,
-            i - 1,
-            i - 1
-        );
-    }
-    s + "}\n"
-}
-
-/// `Se tau -> 1 j0 {I J, R b} -> MTF g1 -> 1 j1 {I J} -> … -> MTF gN -> 1 jN {I J}`, every modulus
-/// `1 + 0.1 cos(theta)` with `theta = ∫ f(j0)`.
-pub fn mtf_chain(n: usize) -> String {
-    let mut s = String::from(
-        "model mtfchain {\n    domain rotational;\n    param J = 1 [kg m^2];\n    param b = 0.1 [N m s/rad];\n    input tau [N m];\n    var theta [rad] = int(f(j0));\n    Se drive = tau;\n    1 j0;\n    I i0 = J;\n    R r0 = b;\n    bond drive -> j0;\n    bond j0 -> i0;\n    bond j0 -> r0;\n",
-    );
-    for k in 1..=n {
-        s += &format!(
-            "    1 j{k};\n    I i{k} = J;\n    MTF g{k} = 1 + 0.1*cos(theta);\n    bond j{} -> g{k} -> j{k};\n    bond j{k} -> i{k};\n",
-            k - 1
-        );
-    }
-    s + "}\n"
 }
 
 fn state(eqs: &Equations, name: &str) -> usize {

@@ -365,7 +365,7 @@ fn a_parameter_index_out_of_range_is_an_error() {
 /// earlier output as one shared node; its `∂y/∂p` agree with differences of the outputs.
 #[test]
 fn outputs_through_earlier_outputs_are_differentiated_as_shared_nodes() {
-    let eqs = equations_of_text(&crate::equations_scaling::output_chain(24));
+    let eqs = equations_of_text(&crate::equations_support::families::output_chain(24));
     let given = vec![None; eqs.params.len()];
     let free = [index(&eqs, "q0"), index(&eqs, "k")];
     let point: (&[f64], &[f64], f64) = (&[0.3, 0.7], &[], 0.0);

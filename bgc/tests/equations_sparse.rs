@@ -11,36 +11,16 @@ use bgc::span::SourceMap;
 use bgc::symbolic::{Expr, Symbol};
 
 use crate::equations_scaling::equations;
+use crate::equations_support::families::{chain_with, output_chain_with};
 
-/// A mass on a spring with outputs `y_1 = sin((q/q0)²) + cos(q/q0)`, `y_i = sin(y_{i-1}²) + cos(y_{i-1})`.
+/// The output chain with `q0 = 2`.
 fn output_chain(levels: usize) -> String {
-    let mut s = String::from(
-        "model outchain {\n    domain translational;\n    param m = 1 [kg];\n    param k = 1 [N/m];\n    param q0 = 2 [m];\n    1 j;\n    I mass = m;\n    C spring = 1/k;\n    bond j -> mass;\n    bond j -> spring;\n    output y1 [1] = sin(q(spring)*q(spring)/(q0*q0)) + cos(q(spring)/q0);\n",
-    );
-    for i in 2..=levels {
-        let p = i - 1;
-        s += &format!("    output y{i} [1] = sin(y{p}*y{p}) + cos(y{p});\n");
-    }
-    s + "}\n"
+    output_chain_with(levels, 2.0)
 }
 
-/// A chain of `n` masses with dampers, joined by springs, driven by a force `u`.
+/// The benchmark chain with masses of 1.5 kg and springs of 3 N/m, driven by a force `u`.
 pub fn chain(n: usize) -> String {
-    let mut s = String::from(
-        "model chain {\n    domain translational;\n    param m = 1.5 [kg];\n    param b = 0.5 [N s/m];\n    param k = 3 [N/m];\n    input u [N];\n    Se drive = u;\n    C wall = 1/k;\n    bond drive -> v1;\n    bond v1 -> wall;\n",
-    );
-    for i in 1..=n {
-        s += &format!(
-            "    1 v{i};\n    I mass{i} = m;\n    R damp{i} = b;\n    bond v{i} -> mass{i};\n    bond v{i} -> damp{i};\n"
-        );
-        if i < n {
-            let j = i + 1;
-            s += &format!(
-                "    0 x{i};\n    C spring{i} = 1/k;\n    bond v{i} -> x{i};\n    bond x{i} -> v{j};\n    bond x{i} -> spring{i};\n"
-            );
-        }
-    }
-    s + "}\n"
+    chain_with(n, 1.5, 3.0)
 }
 
 /// The outputs of the chain by hand: `y_1 = sin((q/q0)²) + cos(q/q0)`, then `y_i = sin(y²) + cos(y)`.

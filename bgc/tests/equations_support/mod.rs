@@ -4,6 +4,9 @@
 // Index loops read like the textbook elimination they implement.
 #![allow(clippy::needless_range_loop)]
 
+#[path = "../../benches/support/families.rs"]
+pub mod families;
+
 use bgc::ir::{
     Bond, Domain, Expr, Input, Model, Node, Output, Param, Relation, SpanTable, Target, Var,
 };

@@ -944,15 +944,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
                     d.lines.push(format!("    {total}"));
                 }
             }
-            self.function(Function {
-                doc: doc.to_string(),
-                name: name.to_string(),
-                args: Self::model_args(d.uses),
-                ret: " -> f64".into(),
-                body: Self::body_text(&d.lines),
-                locals: d.locals,
-                inline: false,
-            });
+            self.scalar_function(name, doc, d);
         }
     }
 }
@@ -978,6 +970,11 @@ impl Writer<'_> {
         let prologue = vec!["    let mut total = 0.0;".to_string()];
         let mut d = self.parts(name, &statements, out, false, prologue);
         d.lines.push("    total".into());
+        self.scalar_function(name, doc, d);
+    }
+
+    /// The model function `name(p, t, x, u) -> f64` whose body `d` ends in its value.
+    fn scalar_function(&mut self, name: &str, doc: &str, d: Draft) {
         self.function(Function {
             doc: doc.to_string(),
             name: name.to_string(),

@@ -1,0 +1,80 @@
+//! The model families whose cost the equations-core issue bounds, as `.bg` text: one copy, shared by the benches
+//! (`#[path]`) and by the tests (`tests/equations_support`), which check the same families at small sizes against
+//! hand-derived values.
+// Each includer uses some of the families.
+#![allow(dead_code)]
+
+/// The benchmark chain of the equations-core issue: `Se` drives mass 1; each 1-junction has `I` (m = 1) and `R`
+/// (b = 0.5); a `C` to the wall at the first; a 0-junction and a `C` between neighbours; `2N` states.
+pub fn benchmark_chain(n: usize) -> String {
+    chain_with(n, 1.0, 1.0)
+}
+
+/// The benchmark chain with masses `m` and springs `1/k` (the dampers keep `b = 0.5`): `2n` states `q_wall,
+/// p_mass1, q_spring1, ..., p_mass<n>`.
+pub fn chain_with(n: usize, m: f64, k: f64) -> String {
+    let mut s = format!(
+        "model chain {{\n    domain translational;\n    param m = {m} [kg];\n    param b = 0.5 [N s/m];\n    param k = {k} [N/m];\n    input u [N];\n    Se drive = u;\n    C wall = 1/k;\n    bond drive -> v1;\n    bond v1 -> wall;\n",
+    );
+    for i in 1..=n {
+        s += &format!(
+            "    1 v{i};\n    I mass{i} = m;\n    R damp{i} = b;\n    bond v{i} -> mass{i};\n    bond v{i} -> damp{i};\n"
+        );
+        if i < n {
+            let j = i + 1;
+            s += &format!(
+                "    0 x{i};\n    C spring{i} = 1/k;\n    bond v{i} -> x{i};\n    bond x{i} -> v{j};\n    bond x{i} -> spring{i};\n"
+            );
+        }
+    }
+    s + "}\n"
+}
+
+/// `Se u -> 1 s1 (R r) -> 0 n1 (R 1·r) -> 1 s2 (R r) -> 0 n2 (R 2·r) -> … -> C c`: every rung's resistors form an
+/// algebraic loop with the next rung's.
+pub fn ladder(rungs: usize) -> String {
+    let mut s = String::from(
+        "model ladder {\n    domain electrical;\n    input u [V];\n    param r = 1 [Ohm];\n    param c = 1e-3 [F];\n    Se src = u;\n    C cap = c;\n",
+    );
+    let mut chain = String::from("src");
+    for k in 1..=rungs {
+        s += &format!("    1 s{k};\n    R rs{k} = r;\n    0 n{k};\n    R rp{k} = {k}*r;\n");
+        s += &format!("    bond s{k} -> rs{k};\n    bond n{k} -> rp{k};\n");
+        chain += &format!(" -> s{k} -> n{k}");
+    }
+    s += &format!("    bond {chain} -> cap;\n    output i1 [A] = f(rs1);\n}}\n");
+    s
+}
+
+/// A mass on a spring with outputs `y_1 = sin((q/q0)²) + cos(q/q0)`, `y_i = sin(y_{i-1}·y_{i-1}) + cos(y_{i-1})`,
+/// `q0 = 1`.
+pub fn output_chain(levels: usize) -> String {
+    output_chain_with(levels, 1.0)
+}
+
+/// [`output_chain`] with the length scale `q0`.
+pub fn output_chain_with(levels: usize, q0: f64) -> String {
+    let mut s = format!(
+        "model outchain {{\n    domain translational;\n    param m = 1 [kg];\n    param k = 1 [N/m];\n    param q0 = {q0} [m];\n    1 j;\n    I mass = m;\n    C spring = 1/k;\n    bond j -> mass;\n    bond j -> spring;\n    output y1 [1] = sin(q(spring)*q(spring)/(q0*q0)) + cos(q(spring)/q0);\n",
+    );
+    for i in 2..=levels {
+        let p = i - 1;
+        s += &format!("    output y{i} [1] = sin(y{p}*y{p}) + cos(y{p});\n");
+    }
+    s + "}\n"
+}
+
+/// `Se tau -> 1 j0 {I J, R b} -> MTF g1 -> 1 j1 {I J} -> … -> MTF gN -> 1 jN {I J}`, every modulus
+/// `1 + 0.1 cos(theta)` with `theta = ∫ f(j0)`.
+pub fn mtf_chain(n: usize) -> String {
+    let mut s = String::from(
+        "model mtfchain {\n    domain rotational;\n    param J = 1 [kg m^2];\n    param b = 0.1 [N m s/rad];\n    input tau [N m];\n    var theta [rad] = int(f(j0));\n    Se drive = tau;\n    1 j0;\n    I i0 = J;\n    R r0 = b;\n    bond drive -> j0;\n    bond j0 -> i0;\n    bond j0 -> r0;\n",
+    );
+    for k in 1..=n {
+        let p = k - 1;
+        s += &format!(
+            "    1 j{k};\n    I i{k} = J;\n    MTF g{k} = 1 + 0.1*cos(theta);\n    bond j{p} -> g{k} -> j{k};\n    bond j{k} -> i{k};\n"
+        );
+    }
+    s + "}\n"
+}

@@ -440,33 +440,26 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         let corrected = !correction.is_empty()
             || !shared.is_empty()
             || (matches!(name, "jac_x_into" | "jac_u_into") && !plan.mass.is_empty());
-        if !corrected && self.splits(m.iter().filter(|e| !e.2.is_zero()).count()) {
+        let d = if !corrected && self.splits(m.iter().filter(|e| !e.2.is_zero()).count()) {
             let statements = self.entry_statements(m.iter(), (rows, cols, row_prefix));
-            let d = self.jacobian_parts(name, ty, &statements, self.terms_enabled);
-            if !(d.uses.t || d.uses.x || d.uses.u) {
-                self.constant_jacobian(name, ty);
+            self.jacobian_parts(name, ty, &statements, self.terms_enabled)
+        } else {
+            nonzero.extend(shared.iter().map(|(_, v)| v));
+            let mut d = self.draft_cached(&nonzero);
+            self.solve_tears(&mut d, &nonzero);
+            self.shared_statements(&mut d, shared);
+            self.matrix_entries(&mut d, m.iter(), (rows, cols, row_prefix));
+            self.loop_correction(&mut d, g_z, r_v, size);
+            match name {
+                "jac_x_into" => self.mass_solve_in_jacobian(&mut d, MassColumns::States),
+                // Without inputs `∂f/∂u` has no columns to solve for (and an empty loop fails `clippy`).
+                "jac_u_into" if !self.plan.inputs.is_empty() => {
+                    self.mass_solve_in_jacobian(&mut d, MassColumns::Inputs)
+                }
+                _ => {}
             }
-            let sparse = name == "jac_x_into" && self.wants_sparse_jac_x();
-            self.model_function(name, doc, d, Arg::new("jac", ty, true));
-            if sparse {
-                self.sparse_jac_x(m, rows, cols, row_prefix);
-            }
-            return;
-        }
-        nonzero.extend(shared.iter().map(|(_, v)| v));
-        let mut d = self.draft_cached(&nonzero);
-        self.solve_tears(&mut d, &nonzero);
-        self.shared_statements(&mut d, shared);
-        self.matrix_entries(&mut d, m.iter(), (rows, cols, row_prefix));
-        self.loop_correction(&mut d, g_z, r_v, size);
-        match name {
-            "jac_x_into" => self.mass_solve_in_jacobian(&mut d, MassColumns::States),
-            // Without inputs `∂f/∂u` has no columns to solve for (and an empty loop fails `clippy`).
-            "jac_u_into" if !self.plan.inputs.is_empty() => {
-                self.mass_solve_in_jacobian(&mut d, MassColumns::Inputs)
-            }
-            _ => {}
-        }
+            d
+        };
         if !(d.uses.t || d.uses.x || d.uses.u) {
             self.constant_jacobian(name, ty);
         }

@@ -9,15 +9,17 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::SVector;
 use std::hint::black_box;
 
+#[path = "../../runtime/benches/support/clock.rs"]
+mod clock;
 #[path = "../tests/support/eq3.rs"]
 mod eq3;
 
 /// The memory traffic of `Model::rhs` without its arithmetic: the 21 values the back-support rhs reads (6 states,
 /// 2 inputs, 8 parameters and 5 parameter terms) loaded one at a time and its 10 rates stored one at a time, as
 /// the generated code does, with 11 additions in between; volatile accesses keep the compiler from merging or
-/// dropping any of them. The rhs does 25 flops (14 multiplications, 11 additions and subtractions), 1.74 ns at
-/// 4 flops per cycle and 3.6 GHz, but the bench machine (AMD EPYC, Zen 5) completes only about two
-/// floating-point loads or stores per cycle, so these 31 take about 4 ns on their own (docs/runtime.md).
+/// dropping any of them. The rhs does 25 flops (14 multiplications, 11 additions and subtractions), 6.25 cycles
+/// at 4 flops per cycle; these 31 loads and stores take 14–15 cycles on their own on the machines measured
+/// (docs/runtime.md). `clock_3000_cycles` converts cycles to nanoseconds on the machine that runs the bench.
 fn memory_floor(consts: &[f64; 13], x: &m::State, u: &m::Inputs, dx: &mut m::State) {
     // SAFETY: every pointer comes from a reference to an element of a live array.
     let read = |v: &f64| unsafe { std::ptr::read_volatile(v) };
@@ -99,5 +101,5 @@ fn rhs(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, rhs);
+criterion_group!(benches, clock::clock, rhs);
 criterion_main!(benches);

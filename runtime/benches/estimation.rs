@@ -9,6 +9,9 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::{SMatrix, SVector};
 use std::hint::black_box;
 
+#[path = "support/clock.rs"]
+mod clock;
+
 /// Three damped pendulums (a 3-joint leg without coupling), masses `w`, semi-implicit Euler at 100 Hz.
 fn leg(x: &SVector<f64, 6>, u: &SVector<f64, 3>, w: &SVector<f64, 3>) -> SVector<f64, 6> {
     let dt = 0.01;
@@ -32,7 +35,8 @@ fn joints(x: &SVector<f64, 6>) -> SVector<f64, 3> {
 /// `m = 2`, `p = 1`, is 1,029 + 392 + 140 + 147 + 98 + 18 = 1,824, about 1,850 with the factor and solves of
 /// the 2 × 2 `S`; the step executes about 2,500 (whole columns of the symmetric products, the certificates
 /// that replace the definiteness test of `P`). At 4 flops per cycle (two multiplies and two adds per cycle,
-/// scalar) and 3.6 GHz the bound of 1,850 flops is 128 ns, and 1.5 times it 193 ns; with two-wide vectors
+/// scalar) the bound of 1,850 flops is 462 cycles, and 1.5 times it 694 cycles; `clock_3000_cycles` in the same
+/// bench converts cycles to nanoseconds on the machine that runs it (`support/clock.rs`). With two-wide vectors
 /// (SSE2, the default target) the hardware's peak is twice that.
 fn kalman_step(c: &mut Criterion) {
     let mut a = SMatrix::<f64, 7, 7>::identity();
@@ -117,5 +121,5 @@ fn dual_ukf_step(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, kalman_step, ukf_step, dual_ukf_step);
+criterion_group!(benches, clock::clock, kalman_step, ukf_step, dual_ukf_step);
 criterion_main!(benches);

@@ -103,19 +103,24 @@ impl Expr {
         );
         let mut out: Vec<Expr> = Vec::with_capacity(bases.len() + 1);
         let mut needs_another_pass = false;
+        // Factors that are their bases (exponent 1) keep the order of the bases, which is sorted already.
+        let mut reordered = false;
         for (base, exps) in bases {
             let f = base.pow(&exps.total());
             // `pow` can yield a constant (`x^0`), a product (`(x*y)^2`) or a power of another base
             // (`((y^1.5)^0.5)^2 = y^1.5`), which must be merged again.
             needs_another_pass |=
                 matches!(f.node(), Node::Const(_) | Node::Mul(_)) || f.base_exp().0 != &base;
+            reordered |= !f.same_node(&base);
             out.push(f);
         }
         if needs_another_pass {
             out.push(Expr::constant(coeff));
             return Expr::product(out);
         }
-        out.sort();
+        if reordered {
+            out.sort();
+        }
         if coeff != 1.0 {
             if let [single] = out.as_slice()
                 && let Node::Add(terms) = single.node()

@@ -28,7 +28,10 @@ impl Ord for Expr {
         if self.same_node(other) {
             return Ordering::Equal;
         }
-        // Most comparisons are decided by the first step, which then allocates nothing.
+        // Most comparisons are decided by the bases of the first factors, which needs no work list.
+        if let Some(order) = by_first_bases(self, other) {
+            return order;
+        }
         let mut steps = Vec::new();
         let first = Step::Expr(self, other).run(&mut steps);
         if first.is_ne() {
@@ -41,6 +44,31 @@ impl Ord for Expr {
             }
         }
         Ordering::Equal
+    }
+}
+
+/// The order of two expressions when the bases of their first factors decide it: constants against anything else,
+/// or first bases of different kinds or different symbols (the first step of the full comparison, which compares
+/// factors before their number and coefficients). `None` when the full comparison must go on.
+fn by_first_bases(x: &Expr, y: &Expr) -> Option<Ordering> {
+    match (x.node(), y.node()) {
+        (Node::Const(a), Node::Const(b)) => return Some(a.total_cmp(b)),
+        (Node::Const(_), _) => return Some(Ordering::Less),
+        (_, Node::Const(_)) => return Some(Ordering::Greater),
+        _ => {}
+    }
+    let (bx, _) = x.coeff_and_factors().1.first()?.base_exp();
+    let (by, _) = y.coeff_and_factors().1.first()?.base_exp();
+    if bx.same_node(by) {
+        return None;
+    }
+    let by_rank = rank(bx).cmp(&rank(by));
+    if by_rank.is_ne() {
+        return Some(by_rank);
+    }
+    match (bx.node(), by.node()) {
+        (Node::Sym(a), Node::Sym(b)) => Some(a.cmp(b)).filter(|o| o.is_ne()),
+        _ => None,
     }
 }
 

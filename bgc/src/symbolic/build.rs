@@ -61,24 +61,34 @@ impl Expr {
     /// The canonical sum of `terms` (0 when empty).
     pub fn sum(terms: impl IntoIterator<Item = Expr>) -> Expr {
         let mut constant = 0.0;
-        let mut collected: Vec<(Expr, f64)> = Vec::new();
+        let mut collected: Vec<(Expr, (f64, Expr))> = Vec::new();
         for term in terms {
             collect_term(&term, &mut constant, &mut collected);
         }
-        let collected = merge_like(collected, |sum: &mut f64, c| *sum += c, |c| c);
-        if constant.is_nan() || collected.iter().any(|(_, c)| c.is_nan()) {
+        // A term that met no like term is kept as it came (it is `coeff * rest` already).
+        let collected = merge_like(
+            collected,
+            |(sum, alone): &mut (f64, Option<Expr>), (c, _)| {
+                *sum += c;
+                *alone = None;
+            },
+            |(c, term)| (c, Some(term)),
+        );
+        if constant.is_nan() || collected.iter().any(|(_, (c, _))| c.is_nan()) {
             return Expr::constant(f64::NAN);
         }
         let mut out: Vec<Expr> = Vec::with_capacity(collected.len() + 1);
         if constant != 0.0 {
             out.push(Expr::constant(constant));
         }
-        for (rest, coeff) in collected {
+        for (rest, (coeff, alone)) in collected {
             if coeff != 0.0 {
-                out.push(scale_rest(rest, coeff));
+                out.push(alone.unwrap_or_else(|| scale_rest(rest, coeff)));
             }
         }
-        out.sort();
+        // Sorted already: the constant comes first, and terms compare by their coefficient-free factors before
+        // their coefficients, so the order of the distinct `rest`s is the order of the terms.
+        debug_assert!(out.is_sorted());
         match out.len() {
             0 => Expr::zero(),
             1 => out.pop().unwrap_or_else(Expr::zero),
@@ -283,7 +293,7 @@ impl Exponents {
     }
 }
 
-fn collect_term(term: &Expr, constant: &mut f64, collected: &mut Vec<(Expr, f64)>) {
+fn collect_term(term: &Expr, constant: &mut f64, collected: &mut Vec<(Expr, (f64, Expr))>) {
     match term.node() {
         Node::Const(c) => *constant += c,
         Node::Add(terms) => {
@@ -293,7 +303,7 @@ fn collect_term(term: &Expr, constant: &mut f64, collected: &mut Vec<(Expr, f64)
         }
         _ => {
             let (coeff, rest) = term.coeff_and_factors();
-            collected.push((rest_of(rest), coeff));
+            collected.push((rest_of(rest), (coeff, term.clone())));
         }
     }
 }

@@ -31,6 +31,7 @@
 
 use super::eval::{apply_func, pow_f64};
 use super::expr::{Expr, Node, Symbol};
+use super::order::cmp_factors;
 use crate::ir::Func;
 use std::ops;
 use std::sync::OnceLock;
@@ -61,33 +62,44 @@ impl Expr {
     /// The canonical sum of `terms` (0 when empty).
     pub fn sum(terms: impl IntoIterator<Item = Expr>) -> Expr {
         let mut constant = 0.0;
-        let mut collected: Vec<(Expr, (f64, Expr))> = Vec::new();
+        let mut collected: Vec<(f64, Expr)> = Vec::new();
         for term in terms {
             collect_term(&term, &mut constant, &mut collected);
         }
-        // A term that met no like term is kept as it came (it is `coeff * rest` already).
-        let collected = merge_like(
-            collected,
-            |(sum, alone): &mut (f64, Option<Expr>), (c, _)| {
-                *sum += c;
-                *alone = None;
-            },
-            |(c, term)| (c, Some(term)),
-        );
-        if constant.is_nan() || collected.iter().any(|(_, (c, _))| c.is_nan()) {
+        // Like terms (equal factors) made adjacent; stable, so their coefficients add in the order they came.
+        collected.sort_by(|(_, a), (_, b)| {
+            cmp_factors(a.coeff_and_factors().1, b.coeff_and_factors().1)
+        });
+        // Per distinct term: the sum of its coefficients, and the term itself while it met no like term (it is
+        // `coeff * rest` already, so it needs no building).
+        let mut merged: Vec<(f64, Expr, bool)> = Vec::with_capacity(collected.len());
+        for (c, term) in collected {
+            match merged.last_mut() {
+                Some((sum, last, alone)) if same_factors(last, &term) => {
+                    *sum += c;
+                    *alone = false;
+                }
+                _ => merged.push((c, term, true)),
+            }
+        }
+        if constant.is_nan() || merged.iter().any(|(c, _, _)| c.is_nan()) {
             return Expr::constant(f64::NAN);
         }
-        let mut out: Vec<Expr> = Vec::with_capacity(collected.len() + 1);
+        let mut out: Vec<Expr> = Vec::with_capacity(merged.len() + 1);
         if constant != 0.0 {
             out.push(Expr::constant(constant));
         }
-        for (rest, (coeff, alone)) in collected {
-            if coeff != 0.0 {
-                out.push(alone.unwrap_or_else(|| scale_rest(rest, coeff)));
+        for (coeff, term, alone) in merged {
+            if coeff == 0.0 {
+                continue;
             }
+            out.push(match alone {
+                true => term,
+                false => scale_rest(rest_of(term.coeff_and_factors().1), coeff),
+            });
         }
         // Sorted already: the constant comes first, and terms compare by their coefficient-free factors before
-        // their coefficients, so the order of the distinct `rest`s is the order of the terms.
+        // their coefficients, so the order of the distinct factor lists is the order of the terms.
         debug_assert!(out.is_sorted());
         match out.len() {
             0 => Expr::zero(),
@@ -293,7 +305,7 @@ impl Exponents {
     }
 }
 
-fn collect_term(term: &Expr, constant: &mut f64, collected: &mut Vec<(Expr, (f64, Expr))>) {
+fn collect_term(term: &Expr, constant: &mut f64, collected: &mut Vec<(f64, Expr)>) {
     match term.node() {
         Node::Const(c) => *constant += c,
         Node::Add(terms) => {
@@ -301,11 +313,14 @@ fn collect_term(term: &Expr, constant: &mut f64, collected: &mut Vec<(Expr, (f64
                 collect_term(t, constant, collected);
             }
         }
-        _ => {
-            let (coeff, rest) = term.coeff_and_factors();
-            collected.push((rest_of(rest), (coeff, term.clone())));
-        }
+        _ => collected.push((term.coeff_and_factors().0, term.clone())),
     }
+}
+
+/// True when two terms have the same coefficient-free factors (interned, so the same nodes).
+fn same_factors(a: &Expr, b: &Expr) -> bool {
+    let (fa, fb) = (a.coeff_and_factors().1, b.coeff_and_factors().1);
+    fa.len() == fb.len() && fa.iter().zip(fb).all(|(f, g)| f.same_node(g))
 }
 
 /// `coeff * rest` where `rest` is a canonical coefficient-free term (a non-sum, possibly a product).

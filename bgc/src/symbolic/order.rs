@@ -59,6 +59,11 @@ fn by_first_bases(x: &Expr, y: &Expr) -> Option<Ordering> {
     }
     let (bx, _) = x.coeff_and_factors().1.first()?.base_exp();
     let (by, _) = y.coeff_and_factors().1.first()?.base_exp();
+    by_bases(bx, by)
+}
+
+/// The order of two bases when their kinds or (for symbols) their symbols decide it.
+fn by_bases(bx: &Expr, by: &Expr) -> Option<Ordering> {
     if bx.same_node(by) {
         return None;
     }
@@ -125,13 +130,40 @@ fn compare_exprs<'a>(x: &'a Expr, y: &'a Expr, steps: &mut Vec<Step<'a>>) -> Ord
             let (ca, fa) = x.coeff_and_factors();
             let (cb, fb) = y.coeff_and_factors();
             steps.push(Step::Decided(ca.total_cmp(&cb)));
-            steps.push(Step::Decided(fa.len().cmp(&fb.len())));
-            for (f, g) in fa.iter().zip(fb).rev() {
-                steps.push(Step::Factor(f, g));
-            }
+            push_factor_lists(fa, fb, steps);
             Ordering::Equal
         }
     }
+}
+
+/// Factor lists compared factor by factor, then the shorter first.
+fn push_factor_lists<'a>(fa: &'a [Expr], fb: &'a [Expr], steps: &mut Vec<Step<'a>>) {
+    steps.push(Step::Decided(fa.len().cmp(&fb.len())));
+    for (f, g) in fa.iter().zip(fb).rev() {
+        steps.push(Step::Factor(f, g));
+    }
+}
+
+/// The order of two coefficient-free terms given by their factors (`coeff_and_factors().1`): the order of the
+/// products of those factors, without building them.
+pub(super) fn cmp_factors(fa: &[Expr], fb: &[Expr]) -> Ordering {
+    if fa.len() == fb.len() && fa.iter().zip(fb).all(|(f, g)| f.same_node(g)) {
+        return Ordering::Equal;
+    }
+    if let (Some(f), Some(g)) = (fa.first(), fb.first())
+        && let Some(order) = by_bases(f.base_exp().0, g.base_exp().0)
+    {
+        return order;
+    }
+    let mut steps = Vec::new();
+    push_factor_lists(fa, fb, &mut steps);
+    while let Some(step) = steps.pop() {
+        let order = step.run(&mut steps);
+        if order.is_ne() {
+            return order;
+        }
+    }
+    Ordering::Equal
 }
 
 fn compare_bases<'a>(x: &'a Expr, y: &'a Expr, steps: &mut Vec<Step<'a>>) -> Ordering {

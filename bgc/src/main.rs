@@ -5,6 +5,10 @@
 
 mod cli;
 
+/// See `mimalloc` in Cargo.toml: the command allocates and frees many small values.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 use std::process::ExitCode;
 
 fn main() -> ExitCode {

@@ -1,6 +1,7 @@
 //! Printed text as a tree of pieces (a rope), so that putting a printed part inside a larger one costs a constant,
 //! not the length of the part: printing a deep expression stays linear in the length of the text.
 
+use std::borrow::Cow;
 use std::rc::Rc;
 
 /// Text under construction. Dropping and flattening walk it with a work list, so depth is no concern.
@@ -11,14 +12,15 @@ pub(in crate::symbolic) struct Doc {
 }
 
 enum Piece {
-    Text(String),
+    /// Owned text, or a literal (a sign, a parenthesis, an operator) that needs no allocation.
+    Text(Cow<'static, str>),
     Cat(Vec<Doc>),
     /// The printed form of a subexpression used in several places, printed once.
     Shared(Rc<Doc>),
 }
 
 impl Doc {
-    pub fn text(s: impl Into<String>) -> Doc {
+    pub fn text(s: impl Into<Cow<'static, str>>) -> Doc {
         let s = s.into();
         Doc {
             first: s.chars().next(),
@@ -45,12 +47,12 @@ impl Doc {
     }
 
     /// `(self)` with the given parentheses.
-    pub fn wrap(self, open: &str, close: &str) -> Doc {
+    pub fn wrap(self, open: impl Into<Cow<'static, str>>, close: &'static str) -> Doc {
         Doc::cat(vec![Doc::text(open), self, Doc::text(close)])
     }
 
     /// The parts joined by `sep`.
-    pub fn join(parts: Vec<Doc>, sep: &str) -> Doc {
+    pub fn join(parts: Vec<Doc>, sep: &'static str) -> Doc {
         let mut out = Vec::with_capacity(2 * parts.len());
         for (i, p) in parts.into_iter().enumerate() {
             if i > 0 {
@@ -62,7 +64,10 @@ impl Doc {
     }
 
     /// The whole text.
-    pub fn into_string(self) -> String {
+    pub fn into_string(mut self) -> String {
+        if let Piece::Text(s) = &mut self.piece {
+            return std::mem::take(s).into_owned();
+        }
         // The length first, so that the text is written into one allocation of the right size.
         let mut len = 0;
         let mut pending: Vec<&Doc> = Vec::with_capacity(16);
@@ -89,23 +94,30 @@ impl Doc {
 
 impl Drop for Doc {
     fn drop(&mut self) {
+        // Text needs no work list (most pieces are text, and so is every piece the loop below empties).
+        if matches!(self.piece, Piece::Text(_)) {
+            return;
+        }
         let mut pending: Vec<Piece> = vec![std::mem::replace(
             &mut self.piece,
-            Piece::Text(String::new()),
+            Piece::Text(Cow::Borrowed("")),
         )];
         while let Some(piece) = pending.pop() {
             match piece {
                 Piece::Text(_) => {}
                 Piece::Cat(parts) => {
                     for mut p in parts {
-                        pending.push(std::mem::replace(&mut p.piece, Piece::Text(String::new())));
+                        pending.push(std::mem::replace(
+                            &mut p.piece,
+                            Piece::Text(Cow::Borrowed("")),
+                        ));
                     }
                 }
                 Piece::Shared(rc) => {
                     if let Ok(mut doc) = Rc::try_unwrap(rc) {
                         pending.push(std::mem::replace(
                             &mut doc.piece,
-                            Piece::Text(String::new()),
+                            Piece::Text(Cow::Borrowed("")),
                         ));
                     }
                 }

@@ -228,6 +228,6 @@ impl Layout for LatexPrinter<'_> {
             Func::Sinh => "\\sinh",
             Func::Cosh => "\\cosh",
         };
-        inner.wrap(&format!("{name}\\left("), "\\right)")
+        inner.wrap(format!("{name}\\left("), "\\right)")
     }
 }

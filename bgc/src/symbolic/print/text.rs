@@ -89,6 +89,6 @@ impl Layout for TextPrinter<'_> {
 
     fn call(&self, f: Func, args: &[Expr]) -> Doc {
         let args: Vec<Doc> = args.iter().map(|a| self.print(a).0).collect();
-        Doc::join(args, ", ").wrap(&format!("{}(", f.name()), ")")
+        Doc::join(args, ", ").wrap(format!("{}(", f.name()), ")")
     }
 }

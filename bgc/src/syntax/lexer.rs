@@ -246,6 +246,10 @@ impl<'a> Lexer<'a> {
         let mut rest = text.strip_prefix('\u{feff}').unwrap_or(text);
         while !rest.is_empty() {
             let start = text.len() - rest.len();
+            if let Some(r) = self.common(start, rest) {
+                rest = r;
+                continue;
+            }
             if let Ok((r, ws)) = whitespace(rest) {
                 self.flush_junk();
                 self.note_whitespace(start, ws);
@@ -299,6 +303,54 @@ impl<'a> Lexer<'a> {
             value: 0.0,
             unterminated: false,
         });
+    }
+
+    /// The common tokens, recognised from their first byte without trying each parser in turn: whitespace, ASCII
+    /// names, numbers and the punctuation that begins nothing else. Returns the rest of the text, or `None` to leave
+    /// the text to the general parsers (comments, `/`, `.`, `-`, strings, names with `µ`, invalid characters).
+    fn common(&mut self, start: usize, rest: &'a str) -> Option<&'a str> {
+        let bytes = rest.as_bytes();
+        let first = *bytes.first()?;
+        let run = |from: usize, pred: fn(u8) -> bool| {
+            from + bytes
+                .get(from..)
+                .unwrap_or(&[])
+                .iter()
+                .take_while(|&&b| pred(b))
+                .count()
+        };
+        match first {
+            b' ' | b'\t' | b'\r' | b'\n' | 0x0c => {
+                let len = run(0, |b| matches!(b, b' ' | b'\t' | b'\r' | b'\n' | 0x0c));
+                let (ws, r) = rest.split_at_checked(len)?;
+                self.flush_junk();
+                self.note_whitespace(start, ws);
+                Some(r)
+            }
+            b'a'..=b'z' | b'A'..=b'Z' | b'_' => {
+                let len = run(1, |b| b.is_ascii_alphanumeric() || b == b'_');
+                // A non-ASCII character may continue the name (`µ`): the general parser decides.
+                if bytes.get(len).is_some_and(|b| !b.is_ascii()) {
+                    return None;
+                }
+                self.flush_junk();
+                self.push(Tok::Ident, start, start + len, 0.0);
+                rest.get(len..)
+            }
+            b'0'..=b'9' => {
+                let (r, n) = number(rest).ok()?;
+                self.flush_junk();
+                Some(self.number(start, n, r))
+            }
+            b'{' | b'}' | b'(' | b')' | b'[' | b']' | b';' | b',' | b'=' | b':' | b'+' | b'*'
+            | b'^' | b'!' => {
+                let (r, kind) = punct(rest).ok()?;
+                self.flush_junk();
+                self.push(kind, start, start + 1, 0.0);
+                Some(r)
+            }
+            _ => None,
+        }
     }
 
     /// Records blank lines: a newline followed by only whitespace and another newline.

@@ -52,8 +52,40 @@ pub const KEYWORDS: &[&str] = &[
 /// line.
 const CLAUSE_KEYWORDS: &[&str] = &["hint", "stroke"];
 
+/// Whether `s` is one of [`KEYWORDS`]. Every name the parser reads is checked, so this is a `match` (which compiles
+/// to a switch on length and bytes) rather than a scan of the list.
 pub fn is_keyword(s: &str) -> bool {
-    KEYWORDS.contains(&s)
+    matches!(
+        s,
+        "model"
+            | "component"
+            | "param"
+            | "input"
+            | "output"
+            | "var"
+            | "bond"
+            | "port"
+            | "import"
+            | "domain"
+            | "coords"
+            | "allow"
+            | "hint"
+            | "stroke"
+            | "Se"
+            | "Sf"
+            | "MSe"
+            | "MSf"
+            | "C"
+            | "I"
+            | "R"
+            | "TF"
+            | "GY"
+            | "MTF"
+            | "MGY"
+            | "CF"
+            | "RF"
+            | "IF"
+    )
 }
 
 /// A diagnostic has been recorded; the caller recovers.
@@ -212,8 +244,11 @@ impl<'a> Parser<'a> {
     }
 
     pub(super) fn is_statement_keyword(&self, t: Token) -> bool {
+        if t.kind != Tok::Ident {
+            return false;
+        }
         let text = self.tok_text(t);
-        t.kind == Tok::Ident && is_keyword(text) && !CLAUSE_KEYWORDS.contains(&text)
+        is_keyword(text) && !CLAUSE_KEYWORDS.contains(&text)
     }
 
     // ----- diagnostics -----
@@ -285,10 +320,16 @@ impl<'a> Parser<'a> {
     /// Reads a name being declared or referred to. A keyword or a name with non-ASCII letters is reported but
     /// accepted, so that the rest of the statement is still checked.
     pub(super) fn expect_name(&mut self, what: &str) -> PResult<Ident> {
+        self.expect_name_for(|| what.to_string())
+    }
+
+    /// [`Parser::expect_name`] with the description of what is expected built only when it is missing: a name is
+    /// read for every element, and the description would otherwise be formatted each time.
+    pub(super) fn expect_name_for(&mut self, what: impl FnOnce() -> String) -> PResult<Ident> {
         let t = self.peek();
         if t.kind != Tok::Ident {
             return Err(self.expected(
-                what,
+                &what(),
                 "a name is a letter or `_` followed by letters, digits and `_`",
             ));
         }

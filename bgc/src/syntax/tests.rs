@@ -537,3 +537,16 @@ fn a_bad_model_name_is_one_error_and_the_body_is_read() {
     assert_eq!(diags.len(), 1, "{diags:#?}");
     assert_eq!(body_of(&file).len(), 1);
 }
+
+#[test]
+fn is_keyword_matches_the_keyword_list() {
+    use super::parser::{KEYWORDS, is_keyword};
+    for k in KEYWORDS {
+        assert!(is_keyword(k), "{k}");
+    }
+    for w in [
+        "", "models", "Model", "c", "i", "TF1", "0", "1", "x", "bonds", "hin",
+    ] {
+        assert!(!is_keyword(w), "{w}");
+    }
+}

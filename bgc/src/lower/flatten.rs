@@ -189,7 +189,13 @@ impl<'a> Builder<'a> {
 
     pub fn qualified(&self, sid: usize, name: &str) -> String {
         match self.scopes.get(sid) {
-            Some(s) => format!("{}{}", s.prefix, name),
+            Some(s) => {
+                // Called for every declaration: joined by hand, without the formatting machinery.
+                let mut q = String::with_capacity(s.prefix.len() + name.len());
+                q.push_str(&s.prefix);
+                q.push_str(name);
+                q
+            }
             None => name.to_string(),
         }
     }

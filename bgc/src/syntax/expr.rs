@@ -138,7 +138,7 @@ impl<'a> Parser<'a> {
             Tok::Number => {
                 self.bump();
                 Ok(Expr {
-                    kind: ExprKind::Number(t.value),
+                    kind: ExprKind::Number(self.number_value(t)),
                     span: self.tok_span(t),
                 })
             }

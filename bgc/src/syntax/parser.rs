@@ -98,7 +98,9 @@ pub struct Parser<'a> {
     pub(super) file: FileId,
     pub(super) text: &'a str,
     pub(super) toks: Vec<Token>,
-    pub(super) strings: Vec<String>,
+    numbers: Vec<(u32, f64)>,
+    strings: Vec<(u32, String)>,
+    unterminated: Vec<u32>,
     pub(super) pos: usize,
     pub(super) diags: Vec<Diagnostic>,
     pub(super) depth: usize,
@@ -124,7 +126,9 @@ pub fn parse_file(file: FileId, text: &str) -> (ast::File, Vec<Diagnostic>) {
         file,
         text,
         toks: lexed.tokens,
+        numbers: lexed.numbers,
         strings: lexed.strings,
+        unterminated: lexed.unterminated,
         pos: 0,
         diags: lexed.diagnostics,
         depth: 0,
@@ -165,8 +169,6 @@ impl<'a> Parser<'a> {
                 kind: Tok::Eof,
                 start: self.text.len() as u32,
                 end: self.text.len() as u32,
-                value: 0.0,
-                unterminated: false,
             })
     }
 
@@ -187,6 +189,32 @@ impl<'a> Parser<'a> {
             Some(self.bump())
         } else {
             None
+        }
+    }
+
+    /// The value of a number token (0 for a malformed one, already reported).
+    pub(super) fn number_value(&self, t: Token) -> f64 {
+        match self
+            .numbers
+            .binary_search_by_key(&t.start, |&(start, _)| start)
+        {
+            Ok(i) => self.numbers.get(i).map_or(0.0, |&(_, v)| v),
+            Err(_) => 0.0,
+        }
+    }
+
+    /// The unescaped text of a string token.
+    pub(super) fn string_value(&self, t: Token) -> String {
+        match self
+            .strings
+            .binary_search_by_key(&t.start, |(start, _)| *start)
+        {
+            Ok(i) => self
+                .strings
+                .get(i)
+                .map(|(_, s)| s.clone())
+                .unwrap_or_default(),
+            Err(_) => String::new(),
         }
     }
 
@@ -260,7 +288,7 @@ impl<'a> Parser<'a> {
             Tok::Ident if is_keyword(text) => format!("keyword `{text}`"),
             Tok::Ident => format!("`{}`", shorten(text)),
             Tok::Number => format!("number `{}`", shorten(text)),
-            Tok::Str(_) => "a string".to_string(),
+            Tok::Str => "a string".to_string(),
             other => other.describe().to_string(),
         }
     }
@@ -291,8 +319,10 @@ impl<'a> Parser<'a> {
             return Ok(());
         }
         let t = self.peek();
-        let after_unterminated =
-            self.pos > 0 && self.toks.get(self.pos - 1).is_some_and(|p| p.unterminated);
+        let after_unterminated = self.pos > 0
+            && self.toks.get(self.pos - 1).is_some_and(|p| {
+                p.kind == Tok::Str && self.unterminated.binary_search(&p.start).is_ok()
+            });
         if after_unterminated && (self.starts_line(t) || matches!(t.kind, Tok::RBrace | Tok::Eof)) {
             // The unterminated string swallowed the rest of its line, `;` included; it is reported already.
             return Ok(());

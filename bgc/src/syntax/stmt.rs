@@ -209,9 +209,9 @@ impl<'a> Parser<'a> {
     /// An optional description string.
     pub(super) fn description(&mut self) -> Option<String> {
         match self.peek().kind {
-            Tok::Str(i) => {
-                self.bump();
-                Some(self.strings.get(i as usize).cloned().unwrap_or_default())
+            Tok::Str => {
+                let t = self.bump();
+                Some(self.string_value(t))
             }
             _ => None,
         }

@@ -41,7 +41,7 @@ pub(crate) struct Builder<'a> {
     pub decls: &'a HashMap<String, &'a ModelDecl>,
     pub diags: Vec<Diagnostic>,
     pub model: ir::Model,
-    pub scopes: Vec<Scope>,
+    pub scopes: Vec<Scope<'a>>,
     pub nodes: Vec<NodeInfo<'a>>,
     pub bonds: Vec<BondInfo>,
     pub params: Vec<ParamInfo>,

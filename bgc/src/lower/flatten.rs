@@ -201,7 +201,7 @@ impl<'a> Builder<'a> {
     }
 
     /// Declares a name in a scope; false (with BG0202 reported) when it is already taken.
-    pub(super) fn declare(&mut self, sid: usize, name: &Ident, entity: Entity) -> bool {
+    pub(super) fn declare(&mut self, sid: usize, name: &'a Ident, entity: Entity) -> bool {
         if let Some(scope) = self.scopes.get_mut(sid)
             && let Err(d) = scope.declare(&name.name, name.span, entity)
         {

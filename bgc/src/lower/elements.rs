@@ -33,6 +33,10 @@ impl Builder<'_> {
         let decl = info.decl;
         let scope = info.scope;
         let kind = decl.kind;
+        if kind.is_junction() && matches!(decl.body, ElementBody::None) {
+            // Most of a large model; nothing to check, and no need for a copy of the name.
+            return Some(Relation::Junction);
+        }
         let name = self.model.graph[n].name.clone();
         match (&decl.body, kind) {
             (ElementBody::None, k) if k.is_junction() => Some(Relation::Junction),

@@ -81,9 +81,10 @@ impl Builder<'_> {
         all.sort_unstable();
         let (incoming, outgoing, all) = (&*incoming, &*outgoing, &*all);
         let kind = self.model.graph[n].kind;
-        let name = self.model.graph[n].name.clone();
         let decl_span = self.node_name_span(n);
+        // The node's name is copied (out of the graph that the checks change) only for a message.
         if all.is_empty() {
+            let name = self.model.graph[n].name.clone();
             self.diags.push(
                 Diagnostic::error("BG0306", format!("`{name}` is not connected"))
                     .with_primary(decl_span, format!("this {} has no bond", kind_name(kind)))
@@ -94,6 +95,7 @@ impl Builder<'_> {
         match kind {
             k if k.is_junction() => {
                 if all.len() < 2 {
+                    let name = self.model.graph[n].name.clone();
                     self.diags.push(
                             Diagnostic::error("BG0305", format!("junction `{name}` has only one bond"))
                                 .with_primary(decl_span, "a junction joins at least two bonds")
@@ -104,6 +106,7 @@ impl Builder<'_> {
             }
             k if k.is_two_port() => {
                 if incoming.len() != 1 || outgoing.len() != 1 {
+                    let name = self.model.graph[n].name.clone();
                     let mut d = Diagnostic::error(
                         "BG0304",
                         format!(
@@ -130,9 +133,13 @@ impl Builder<'_> {
                     self.model.graph[*e].from_port = 1;
                 }
             }
-            k if k.is_field() => self.field_ports(n, &name, incoming, outgoing, decl_span),
+            k if k.is_field() => {
+                let name = self.model.graph[n].name.clone();
+                self.field_ports(n, &name, incoming, outgoing, decl_span);
+            }
             _ => {
                 if all.len() > 1 {
+                    let name = self.model.graph[n].name.clone();
                     let mut d = Diagnostic::error(
                         "BG0301",
                         format!("`{name}` is a 1-port but has {} bonds", all.len()),
@@ -144,7 +151,7 @@ impl Builder<'_> {
                         "bond `{name}` to a junction and bond the other elements to that junction"
                     )));
                 }
-                self.power_direction(kind, &name, incoming, outgoing);
+                self.power_direction(n, kind, incoming, outgoing);
             }
         }
     }
@@ -211,8 +218,8 @@ impl Builder<'_> {
     /// which way the bond is drawn and which way is usual, and the help writes the bond turned round.
     fn power_direction(
         &mut self,
+        n: NodeIndex,
         kind: ElementKind,
-        name: &str,
         incoming: &[EdgeIndex],
         outgoing: &[EdgeIndex],
     ) {
@@ -227,6 +234,7 @@ impl Builder<'_> {
         let Some((from, to)) = self.model.graph.edge_endpoints(e) else {
             return;
         };
+        let name = self.model.graph[n].name.clone();
         let from = self.model.graph[from].name.clone();
         let to = self.model.graph[to].name.clone();
         let kw = match kind {

@@ -49,8 +49,8 @@ impl Parser<'_> {
     }
 
     /// One node or a comma-separated fan-out.
-    fn node_group(&mut self) -> PResult<Vec<NodeRef>> {
-        let mut group = vec![self.node_ref()?];
+    fn node_group(&mut self) -> PResult<ShortList<NodeRef>> {
+        let mut group = ShortList::one(self.node_ref()?);
         while self.eat(Tok::Comma).is_some() {
             group.push(self.node_ref()?);
         }

@@ -217,7 +217,7 @@ fn instances() {
 fn bonds() {
     match one("bond motor -> j1 -> gear -> rotor, fric;") {
         Stmt::Bond(b) => {
-            let sizes: Vec<usize> = b.chain.iter().map(Vec::len).collect();
+            let sizes: Vec<usize> = b.chain.iter().map(|g| g.len()).collect();
             assert_eq!(sizes, vec![1, 1, 1, 2]);
         }
         other => panic!("{other:?}"),

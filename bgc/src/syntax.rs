@@ -21,6 +21,7 @@ mod format;
 mod items;
 mod lexer;
 mod parser;
+mod short_list;
 mod stmt;
 mod suggest;
 

@@ -44,8 +44,10 @@ fn build(model: &Model, engine: &Engine) -> Signals {
             Role::Zero | Role::One => {
                 let zero = engine.roles[n as usize] == Role::Zero;
                 // The strong bond of a 0-junction is the one it does not set, of a 1-junction the one it sets.
-                let strong: Vec<u32> = bonds.iter().copied().filter(|&b| sets(b) != zero).collect();
-                let [k] = strong[..] else { continue };
+                let mut strong = bonds.iter().copied().filter(|&b| sets(b) != zero);
+                let (Some(k), None) = (strong.next(), strong.next()) else {
+                    continue;
+                };
                 for &b in bonds.iter().filter(|&&b| b != k) {
                     if zero {
                         edges.push((effort(k), effort(b), n));

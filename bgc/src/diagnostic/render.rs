@@ -16,6 +16,10 @@ pub const MAX_SHOWN: usize = 100;
 /// `color` adds ANSI colours (for terminals). Only the first [`MAX_SHOWN`] are rendered, and a label on a line longer
 /// than 240 bytes shows a window of the line around it.
 pub fn to_text(sources: &SourceMap, diags: &[Diagnostic], color: bool) -> String {
+    if diags.is_empty() {
+        // Nothing to show: no need for a copy of every file.
+        return String::new();
+    }
     let mut files = SimpleFiles::new();
     let mut count = 0;
     for (_, f) in sources.files() {

@@ -10,7 +10,9 @@ use crate::syntax::ast::{BondStmt, Ident, NodeRef};
 
 impl<'a> Builder<'a> {
     pub(super) fn bond_stmt(&mut self, sid: usize, b: &'a BondStmt) {
-        let mut created = Vec::new();
+        // The label and the hint apply only when the statement made exactly one bond: count, keep the first.
+        let mut created = 0usize;
+        let mut first = None;
         for pair in b.chain.windows(2) {
             let [tails, heads] = pair else { continue };
             for tail in tails {
@@ -49,11 +51,14 @@ impl<'a> Builder<'a> {
                         to,
                         domain: None,
                     });
-                    created.push((e, from, to));
+                    created += 1;
+                    first = first.or(Some((e, from, to)));
                 }
             }
         }
-        if let [(e, from, to)] = created[..] {
+        if created == 1
+            && let Some((e, from, to)) = first
+        {
             if let Some(label) = &b.label {
                 let _ = self.declare(sid, label, Entity::Bond(e));
             }

@@ -4,7 +4,7 @@ use super::scope::{End, Scope};
 use crate::diagnostic::Diagnostic;
 use crate::ir::{self, Domain, OutputId, VarId};
 use crate::span::Span;
-use crate::syntax::ast::{CoordsDecl, ElementDecl, ModelDecl, OutputDecl, VarDecl};
+use crate::syntax::ast::{CoordsDecl, ElementDecl, ModelDecl, OutputDecl, Stmt, VarDecl};
 use petgraph::graph::{DiGraph, EdgeIndex, NodeIndex};
 use std::collections::HashMap;
 
@@ -41,7 +41,7 @@ pub(crate) struct Builder<'a> {
     pub decls: &'a HashMap<String, &'a ModelDecl>,
     pub diags: Vec<Diagnostic>,
     pub model: ir::Model,
-    pub scopes: Vec<Scope>,
+    pub scopes: Vec<Scope<'a>>,
     pub nodes: Vec<NodeInfo<'a>>,
     pub bonds: Vec<BondInfo>,
     pub params: Vec<ParamInfo>,
@@ -71,13 +71,16 @@ pub(crate) struct Builder<'a> {
 
 impl<'a> Builder<'a> {
     pub fn new(decls: &'a HashMap<String, &'a ModelDecl>, decl: &'a ModelDecl) -> Self {
+        // The model's own elements and bonds (instances add to them): tables of the right size from the start
+        // rather than ones that reallocate and copy their way up to hundreds of thousands of entries.
+        let (nodes, bonds) = own_size(decl);
         Builder {
             decls,
             diags: Vec::new(),
             model: ir::Model {
                 name: decl.name.name.clone(),
                 doc: decl.doc.clone(),
-                graph: DiGraph::new(),
+                graph: DiGraph::with_capacity(nodes, bonds),
                 params: Vec::new(),
                 inputs: Vec::new(),
                 outputs: Vec::new(),
@@ -85,12 +88,17 @@ impl<'a> Builder<'a> {
                 coords: None,
                 spans: ir::SpanTable {
                     model: decl.span,
+                    nodes: Vec::with_capacity(nodes),
+                    node_names: Vec::with_capacity(nodes),
+                    node_relations: Vec::with_capacity(nodes),
+                    node_instances: Vec::with_capacity(nodes),
+                    bonds: Vec::with_capacity(bonds),
                     ..Default::default()
                 },
             },
             scopes: Vec::new(),
-            nodes: Vec::new(),
-            bonds: Vec::new(),
+            nodes: Vec::with_capacity(nodes),
+            bonds: Vec::with_capacity(bonds),
             params: Vec::new(),
             field_bonds: HashMap::new(),
             pending_outputs: Vec::new(),
@@ -152,4 +160,24 @@ impl<'a> Builder<'a> {
             .copied()
             .unwrap_or_default()
     }
+}
+
+/// The number of elements a model declares itself and the number of bonds its bond statements make (a fan-out or
+/// chain makes one per pair of neighbouring nodes).
+fn own_size(decl: &ModelDecl) -> (usize, usize) {
+    let (mut nodes, mut bonds) = (0usize, 0usize);
+    for stmt in &decl.body {
+        match stmt {
+            Stmt::Element(_) => nodes += 1,
+            Stmt::Bond(b) => {
+                for pair in b.chain.windows(2) {
+                    if let [tails, heads] = pair {
+                        bonds = bonds.saturating_add(tails.len().saturating_mul(heads.len()));
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    (nodes, bonds)
 }

@@ -37,20 +37,20 @@ impl Builder<'_> {
     pub fn infer_domains(&mut self) {
         let nb = self.model.graph.edge_count();
         let mut parent: Vec<usize> = (0..nb).collect();
+        // One buffer for every node's bonds, rather than a fresh vector per node.
+        let mut edges: Vec<usize> = Vec::new();
         for n in self.model.graph.node_indices() {
             if !self.model.graph[n].kind.is_junction() {
                 continue;
             }
-            let edges: Vec<usize> = self.model.graph.edges(n).map(|e| e.id().index()).collect();
-            let edges: Vec<usize> = edges
-                .into_iter()
-                .chain(
-                    self.model
-                        .graph
-                        .edges_directed(n, petgraph::Direction::Incoming)
-                        .map(|e| e.id().index()),
-                )
-                .collect();
+            edges.clear();
+            edges.extend(self.model.graph.edges(n).map(|e| e.id().index()));
+            edges.extend(
+                self.model
+                    .graph
+                    .edges_directed(n, petgraph::Direction::Incoming)
+                    .map(|e| e.id().index()),
+            );
             if let Some((&first, rest)) = edges.split_first() {
                 for &e in rest {
                     let (a, b) = (find(&mut parent, first), find(&mut parent, e));
@@ -61,6 +61,7 @@ impl Builder<'_> {
         let mut explicit: Vec<Vec<Constraint>> = vec![Vec::new(); nb];
         let mut defaults: Vec<Vec<Constraint>> = vec![Vec::new(); nb];
         let mut weak: Vec<Vec<Constraint>> = vec![Vec::new(); nb];
+        let mut node_edges: Vec<EdgeIndex> = Vec::new();
         for n in self.model.graph.node_indices() {
             let Some(info) = self.node_info(n) else {
                 continue;
@@ -70,18 +71,19 @@ impl Builder<'_> {
             let default = self.scopes.get(info.scope).and_then(|s| s.default_domain);
             // A TF, GY or field may join domains: its scope's default only decides when nothing else does.
             let weak_default = kind.is_two_port() || kind.is_field();
-            let edges: Vec<EdgeIndex> = self
-                .model
-                .graph
-                .edges_directed(n, petgraph::Direction::Outgoing)
-                .chain(
-                    self.model
-                        .graph
-                        .edges_directed(n, petgraph::Direction::Incoming),
-                )
-                .map(|e| e.id())
-                .collect();
-            for e in edges {
+            node_edges.clear();
+            node_edges.extend(
+                self.model
+                    .graph
+                    .edges_directed(n, petgraph::Direction::Outgoing)
+                    .chain(
+                        self.model
+                            .graph
+                            .edges_directed(n, petgraph::Direction::Incoming),
+                    )
+                    .map(|e| e.id()),
+            );
+            for &e in &node_edges {
                 let g = find(&mut parent, e.index());
                 if let Some((domain, span)) = written {
                     explicit[g].push(Constraint {

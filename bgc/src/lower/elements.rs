@@ -33,6 +33,10 @@ impl Builder<'_> {
         let decl = info.decl;
         let scope = info.scope;
         let kind = decl.kind;
+        if kind.is_junction() && matches!(decl.body, ElementBody::None) {
+            // Most of a large model; nothing to check, and no need for a copy of the name.
+            return Some(Relation::Junction);
+        }
         let name = self.model.graph[n].name.clone();
         match (&decl.body, kind) {
             (ElementBody::None, k) if k.is_junction() => Some(Relation::Junction),
@@ -83,8 +87,16 @@ impl Builder<'_> {
                     } else {
                         (u.flow, u.flow_text, "a flow")
                     };
-                    let expected = format!("{text} ({what} in the {} domain)", d.name());
-                    if self.expect_unit(q, want, v.span, &expected, &name) {
+                    // The expectation is spelled out only for the message.
+                    if !q.fits(want)
+                        && self.expect_unit(
+                            q,
+                            want,
+                            v.span,
+                            &format!("{text} ({what} in the {} domain)", d.name()),
+                            &name,
+                        )
+                    {
                         self.explain_units(&expr);
                         self.suggest_domain(Place::OnePort(kind), &name, q.dim(), (d, d));
                     }
@@ -107,8 +119,16 @@ impl Builder<'_> {
                         K::I => "an inertia",
                         _ => "a resistance",
                     };
-                    let expected = format!("{text} ({what} in the {} domain)", d.name());
-                    if self.expect_unit(q, want, v.span, &expected, &name) {
+                    // The expectation is spelled out only for the message.
+                    if !q.fits(want)
+                        && self.expect_unit(
+                            q,
+                            want,
+                            v.span,
+                            &format!("{text} ({what} in the {} domain)", d.name()),
+                            &name,
+                        )
+                    {
                         self.explain_units(&expr);
                         self.suggest_domain(Place::OnePort(kind), &name, q.dim(), (d, d));
                     }
@@ -141,7 +161,9 @@ impl Builder<'_> {
                             "a gyrator modulus: input effort over output flow",
                         )
                     };
-                    if let Some(want) = num.checked_div(uo.flow) {
+                    if let Some(want) = num.checked_div(uo.flow)
+                        && !q.fits(want)
+                    {
                         let text = format!("{want} ({what}, {} to {})", din.name(), dout.name());
                         if self.expect_unit(q, want, v.span, &text, &name) {
                             self.explain_units(&expr);

@@ -189,13 +189,19 @@ impl<'a> Builder<'a> {
 
     pub fn qualified(&self, sid: usize, name: &str) -> String {
         match self.scopes.get(sid) {
-            Some(s) => format!("{}{}", s.prefix, name),
+            Some(s) => {
+                // Called for every declaration: joined by hand, without the formatting machinery.
+                let mut q = String::with_capacity(s.prefix.len() + name.len());
+                q.push_str(&s.prefix);
+                q.push_str(name);
+                q
+            }
             None => name.to_string(),
         }
     }
 
     /// Declares a name in a scope; false (with BG0202 reported) when it is already taken.
-    pub(super) fn declare(&mut self, sid: usize, name: &Ident, entity: Entity) -> bool {
+    pub(super) fn declare(&mut self, sid: usize, name: &'a Ident, entity: Entity) -> bool {
         if let Some(scope) = self.scopes.get_mut(sid)
             && let Err(d) = scope.declare(&name.name, name.span, entity)
         {

@@ -164,18 +164,18 @@ impl Builder<'_> {
         let r = match &arg.kind {
             ExprKind::Node(r) => r.clone(),
             ExprKind::Name(n) => NodeRef {
-                path: vec![ast::Ident {
+                path: ast::ShortList::one(ast::Ident {
                     name: n.clone(),
                     span: arg.span,
-                }],
+                }),
                 port: None,
                 span: arg.span,
             },
             ExprKind::Indexed(n, i) => NodeRef {
-                path: vec![ast::Ident {
+                path: ast::ShortList::one(ast::Ident {
                     name: n.clone(),
                     span: arg.span,
-                }],
+                }),
                 port: Some((*i, arg.span)),
                 span: arg.span,
             },

@@ -10,6 +10,10 @@ use petgraph::graph::{EdgeIndex, NodeIndex};
 use std::collections::HashMap;
 use std::collections::hash_map::Entry;
 
+/// The name tables of scopes hash with foldhash: several times faster than the standard SipHash on the short names
+/// of a model, and seeded per process, so that the names of a file cannot be chosen to collide.
+pub(crate) type NameMap<K, V> = HashMap<K, V, foldhash::fast::RandomState>;
+
 /// What a name in a scope stands for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Entity {
@@ -46,13 +50,13 @@ pub(crate) struct End {
 }
 
 #[derive(Clone, Debug, Default)]
-pub(crate) struct Scope {
+pub(crate) struct Scope<'a> {
     /// `""` for the model, `"sensor."` for instance `sensor`, `"arm.sensor."` nested.
     pub prefix: String,
     /// Each name's entity, declaration span and rank in declaration order (so that suggestions do not depend on
-    /// hashing order without keeping a second copy of every name).
-    pub names: HashMap<String, (Entity, Span, u32)>,
-    pub ports: HashMap<String, (End, Span)>,
+    /// hashing order). The names are borrowed from the syntax tree, which outlives lowering.
+    pub names: NameMap<&'a str, (Entity, Span, u32)>,
+    pub ports: NameMap<String, (End, Span)>,
     pub port_order: Vec<String>,
     pub default_domain: Option<(Domain, Span)>,
     /// The component's name and its declaration's name span (None for a model).
@@ -68,11 +72,11 @@ pub(crate) struct Scope {
     pub connected: bool,
 }
 
-impl Scope {
+impl<'a> Scope<'a> {
     /// Declares a name, or returns the duplicate-name diagnostic (BG0202).
-    pub fn declare(&mut self, name: &str, span: Span, entity: Entity) -> Result<(), Diagnostic> {
+    pub fn declare(&mut self, name: &'a str, span: Span, entity: Entity) -> Result<(), Diagnostic> {
         let rank = self.names.len() as u32;
-        match self.names.entry(name.to_string()) {
+        match self.names.entry(name) {
             Entry::Occupied(first) => Err(duplicate(name, span, first.get().1)),
             Entry::Vacant(slot) => {
                 slot.insert((entity, span, rank));
@@ -91,7 +95,7 @@ impl Scope {
             .names
             .iter()
             .filter(|(_, (e, _, _))| filter(*e))
-            .map(|(n, (_, _, rank))| (*rank, n.as_str()))
+            .map(|(n, (_, _, rank))| (*rank, *n))
             .collect();
         candidates.sort_unstable_by_key(|(rank, _)| *rank);
         closest(name, candidates.into_iter().map(|(_, n)| n))

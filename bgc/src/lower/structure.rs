@@ -18,6 +18,15 @@ use petgraph::Direction;
 use petgraph::graph::{EdgeIndex, NodeIndex};
 use petgraph::visit::EdgeRef;
 
+/// The bonds of one node, reused from node to node.
+#[derive(Default)]
+struct NodeBonds {
+    incoming: Vec<EdgeIndex>,
+    outgoing: Vec<EdgeIndex>,
+    /// Both, in bond order.
+    all: Vec<EdgeIndex>,
+}
+
 impl Builder<'_> {
     pub fn check_structure(&mut self) {
         // An instance none of whose ports is bonded is reported once, not through each of its nodes.
@@ -39,40 +48,43 @@ impl Builder<'_> {
                 loose.push(scope.prefix.clone());
             }
         }
-        let nodes: Vec<NodeIndex> = self.model.graph.node_indices().collect();
-        for n in nodes {
+        // One set of bond lists for all nodes, rather than three fresh vectors per node.
+        let mut bonds = NodeBonds::default();
+        for i in 0..self.model.graph.node_count() {
+            let n = NodeIndex::new(i);
             // Ports are still numbered, but the counts of these nodes follow from errors already reported.
             let quiet = loose
                 .iter()
                 .any(|p| self.model.graph[n].name.starts_with(p.as_str()))
                 || self.suspect_nodes.contains(&n);
             let reported = self.diags.len();
-            self.check_node(n);
+            self.check_node(n, &mut bonds);
             if quiet {
                 self.diags.truncate(reported);
             }
         }
     }
 
-    fn check_node(&mut self, n: NodeIndex) {
-        let incoming: Vec<EdgeIndex> = self
-            .model
-            .graph
-            .edges_directed(n, Direction::Incoming)
-            .map(|e| e.id())
-            .collect();
-        let outgoing: Vec<EdgeIndex> = self
-            .model
-            .graph
-            .edges_directed(n, Direction::Outgoing)
-            .map(|e| e.id())
-            .collect();
-        let kind = self.model.graph[n].kind;
-        let name = self.model.graph[n].name.clone();
-        let decl_span = self.node_name_span(n);
-        let mut all: Vec<EdgeIndex> = incoming.iter().chain(outgoing.iter()).copied().collect();
+    fn check_node(&mut self, n: NodeIndex, bonds: &mut NodeBonds) {
+        let NodeBonds {
+            incoming,
+            outgoing,
+            all,
+        } = bonds;
+        let graph = &self.model.graph;
+        incoming.clear();
+        incoming.extend(graph.edges_directed(n, Direction::Incoming).map(|e| e.id()));
+        outgoing.clear();
+        outgoing.extend(graph.edges_directed(n, Direction::Outgoing).map(|e| e.id()));
+        all.clear();
+        all.extend(incoming.iter().chain(outgoing.iter()).copied());
         all.sort_unstable();
+        let (incoming, outgoing, all) = (&*incoming, &*outgoing, &*all);
+        let kind = self.model.graph[n].kind;
+        let decl_span = self.node_name_span(n);
+        // The node's name is copied (out of the graph that the checks change) only for a message.
         if all.is_empty() {
+            let name = self.model.graph[n].name.clone();
             self.diags.push(
                 Diagnostic::error("BG0306", format!("`{name}` is not connected"))
                     .with_primary(decl_span, format!("this {} has no bond", kind_name(kind)))
@@ -83,6 +95,7 @@ impl Builder<'_> {
         match kind {
             k if k.is_junction() => {
                 if all.len() < 2 {
+                    let name = self.model.graph[n].name.clone();
                     self.diags.push(
                             Diagnostic::error("BG0305", format!("junction `{name}` has only one bond"))
                                 .with_primary(decl_span, "a junction joins at least two bonds")
@@ -93,6 +106,7 @@ impl Builder<'_> {
             }
             k if k.is_two_port() => {
                 if incoming.len() != 1 || outgoing.len() != 1 {
+                    let name = self.model.graph[n].name.clone();
                     let mut d = Diagnostic::error(
                         "BG0304",
                         format!(
@@ -105,23 +119,27 @@ impl Builder<'_> {
                         decl_span,
                         format!("a {} has an input and an output port", k.keyword()),
                     );
-                    for e in &all {
+                    for e in all {
                         d = d.with_secondary(self.bond_span(*e), "a bond of it");
                     }
                     self.diags.push(d.with_help(
                             "the bond pointing into it is its input (port 0), the bond pointing out of it its output (port 1)",
                         ));
                 }
-                for e in &incoming {
+                for e in incoming {
                     self.model.graph[*e].to_port = 0;
                 }
-                for e in &outgoing {
+                for e in outgoing {
                     self.model.graph[*e].from_port = 1;
                 }
             }
-            k if k.is_field() => self.field_ports(n, &name, &incoming, &outgoing, decl_span),
+            k if k.is_field() => {
+                let name = self.model.graph[n].name.clone();
+                self.field_ports(n, &name, incoming, outgoing, decl_span);
+            }
             _ => {
                 if all.len() > 1 {
+                    let name = self.model.graph[n].name.clone();
                     let mut d = Diagnostic::error(
                         "BG0301",
                         format!("`{name}` is a 1-port but has {} bonds", all.len()),
@@ -133,7 +151,7 @@ impl Builder<'_> {
                         "bond `{name}` to a junction and bond the other elements to that junction"
                     )));
                 }
-                self.power_direction(kind, &name, &incoming, &outgoing);
+                self.power_direction(n, kind, incoming, outgoing);
             }
         }
     }
@@ -200,8 +218,8 @@ impl Builder<'_> {
     /// which way the bond is drawn and which way is usual, and the help writes the bond turned round.
     fn power_direction(
         &mut self,
+        n: NodeIndex,
         kind: ElementKind,
-        name: &str,
         incoming: &[EdgeIndex],
         outgoing: &[EdgeIndex],
     ) {
@@ -216,6 +234,7 @@ impl Builder<'_> {
         let Some((from, to)) = self.model.graph.edge_endpoints(e) else {
             return;
         };
+        let name = self.model.graph[n].name.clone();
         let from = self.model.graph[from].name.clone();
         let to = self.model.graph[to].name.clone();
         let kw = match kind {

@@ -6,6 +6,8 @@
 use crate::span::Span;
 use serde::Serialize;
 
+pub use super::short_list::ShortList;
+
 /// A name as written, with its place.
 #[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize)]
 pub struct Ident {
@@ -313,7 +315,7 @@ pub struct PortDecl {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct NodeRef {
     /// `inst.port` has two parts; deeper nesting is allowed (`a.b.c`).
-    pub path: Vec<Ident>,
+    pub path: ShortList<Ident>,
     /// `field[i]`, 1-based as written.
     pub port: Option<(u32, Span)>,
     pub span: Span,
@@ -324,7 +326,7 @@ pub struct NodeRef {
 pub struct BondStmt {
     pub label: Option<Ident>,
     /// The chain: each entry is joined to the next by an arrow. All but the last have exactly one node.
-    pub chain: Vec<Vec<NodeRef>>,
+    pub chain: Vec<ShortList<NodeRef>>,
     pub hint: Option<CausalHint>,
     pub span: Span,
 }

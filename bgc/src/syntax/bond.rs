@@ -14,7 +14,9 @@ impl Parser<'_> {
             label = Some(self.expect_name("the bond's name")?);
             self.bump();
         }
-        let mut chain = vec![self.node_group()?];
+        // Most bonds are `a -> b`: room for two groups saves a reallocation per bond.
+        let mut chain = Vec::with_capacity(2);
+        chain.push(self.node_group()?);
         if !self.at(Tok::Arrow) {
             return Err(self.expected(
                 "`->`",
@@ -47,8 +49,8 @@ impl Parser<'_> {
     }
 
     /// One node or a comma-separated fan-out.
-    fn node_group(&mut self) -> PResult<Vec<NodeRef>> {
-        let mut group = vec![self.node_ref()?];
+    fn node_group(&mut self) -> PResult<ShortList<NodeRef>> {
+        let mut group = ShortList::one(self.node_ref()?);
         while self.eat(Tok::Comma).is_some() {
             group.push(self.node_ref()?);
         }

@@ -138,7 +138,7 @@ impl<'a> Parser<'a> {
             Tok::Number => {
                 self.bump();
                 Ok(Expr {
-                    kind: ExprKind::Number(t.value),
+                    kind: ExprKind::Number(self.number_value(t)),
                     span: self.tok_span(t),
                 })
             }
@@ -205,10 +205,10 @@ impl<'a> Parser<'a> {
             };
             if let Some((name, port)) = node {
                 arg.kind = ExprKind::Node(NodeRef {
-                    path: vec![Ident {
+                    path: ShortList::one(Ident {
                         name,
                         span: arg.span,
-                    }],
+                    }),
                     port,
                     span: arg.span,
                 });
@@ -249,8 +249,9 @@ impl<'a> Parser<'a> {
                  port (`leg[2]`)",
             ));
         }
-        let mut path =
-            vec![self.expect_name("a node (an element, a junction, `inst.port` or `field[i]`)")?];
+        let mut path = ShortList::one(
+            self.expect_name("a node (an element, a junction, `inst.port` or `field[i]`)")?,
+        );
         while self.eat(Tok::Dot).is_some() {
             path.push(self.expect_name("a port name after `.`")?);
         }

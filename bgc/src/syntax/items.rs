@@ -80,9 +80,9 @@ impl Parser<'_> {
         let result = (|| {
             let t = self.peek();
             let path = match t.kind {
-                Tok::Str(i) => {
-                    self.bump();
-                    self.strings.get(i as usize).cloned().unwrap_or_default()
+                Tok::Str => {
+                    let t = self.bump();
+                    self.string_value(t)
                 }
                 _ => {
                     return Err(self.expected(

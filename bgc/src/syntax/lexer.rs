@@ -14,14 +14,14 @@ use nom::character::complete::{char, digit0, digit1, one_of};
 use nom::combinator::{opt, recognize};
 use nom::{IResult, Parser};
 
-/// The class of a token. Literal values live beside the tokens (see [`Lexed`]).
+/// The class of a token. Literal values live beside the tokens (see [`Lexed`]), so that a token is three words.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Tok {
     Ident,
-    /// A number literal; its value is in [`Token::value`].
+    /// A number literal; its value is in [`Lexed::numbers`].
     Number,
-    /// A string literal; its unescaped text is `Lexed::strings[index]`.
-    Str(u32),
+    /// A string literal; its unescaped text is in [`Lexed::strings`].
+    Str,
     LBrace,
     RBrace,
     LParen,
@@ -49,7 +49,7 @@ impl Tok {
         match self {
             Tok::Ident => "a name",
             Tok::Number => "a number",
-            Tok::Str(_) => "a string",
+            Tok::Str => "a string",
             Tok::LBrace => "`{`",
             Tok::RBrace => "`}`",
             Tok::LParen => "`(`",
@@ -73,15 +73,12 @@ impl Tok {
     }
 }
 
+/// A token: its class and its bytes. A large file has millions of them, so a token carries nothing else.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Token {
     pub kind: Tok,
     pub start: u32,
     pub end: u32,
-    /// The value of a number token (0 for other tokens and for malformed numbers, which are already reported).
-    pub value: f64,
-    /// A string literal without its closing quote (already reported); it ran to the end of its line.
-    pub unterminated: bool,
 }
 
 /// A `//` or `///` comment.
@@ -102,7 +99,13 @@ pub struct RawComment {
 pub struct Lexed {
     /// The tokens, always ending with one [`Tok::Eof`].
     pub tokens: Vec<Token>,
-    pub strings: Vec<String>,
+    /// The value of each number token, by the token's start, in order (0 for a malformed number, which is already
+    /// reported).
+    pub numbers: Vec<(u32, f64)>,
+    /// The unescaped text of each string token, by the token's start, in order.
+    pub strings: Vec<(u32, String)>,
+    /// The starts of the string tokens without a closing quote (already reported; each ran to the end of its line).
+    pub unterminated: Vec<u32>,
     pub comments: Vec<RawComment>,
     /// Byte offsets of the starts of blank lines, so the formatter can keep paragraphs apart.
     pub blank_lines: Vec<u32>,
@@ -187,8 +190,9 @@ struct Lexer<'a> {
 /// Splits `text` into tokens. See the module documentation.
 pub fn lex(file: FileId, text: &str) -> Lexed {
     let mut out = Lexed::default();
-    // About one token per six bytes in typical models; reserving avoids repeated growth of a large vector.
-    out.tokens.reserve(text.len() / 6 + 1);
+    // From one token per six bytes in commented models to one per three in generated ones; reserving avoids
+    // repeated growth of a large vector (pages reserved but never written cost nothing).
+    out.tokens.reserve(text.len() / 3 + 1);
     let mut lx = Lexer {
         file,
         text,
@@ -205,18 +209,30 @@ impl<'a> Lexer<'a> {
         Span::new(self.file, start, end)
     }
 
-    fn push(&mut self, kind: Tok, start: usize, end: usize, value: f64) {
+    fn push(&mut self, kind: Tok, start: usize, end: usize) {
         self.out.tokens.push(Token {
             kind,
             start: start as u32,
             end: end as u32,
-            value,
-            unterminated: false,
         });
         self.at_line_start = false;
     }
 
+    fn push_number(&mut self, start: usize, end: usize, value: f64) {
+        self.out.numbers.push((start as u32, value));
+        self.push(Tok::Number, start, end);
+    }
+
+    /// Reports the pending run of invalid characters, if any (before each token, so always inlined: the check is
+    /// a compare, the call it would otherwise be costs more).
+    #[inline(always)]
     fn flush_junk(&mut self) {
+        if self.junk.is_some() {
+            self.report_junk();
+        }
+    }
+
+    fn report_junk(&mut self) {
         if let Some((start, end)) = self.junk.take() {
             let shown: String = self
                 .text
@@ -246,6 +262,10 @@ impl<'a> Lexer<'a> {
         let mut rest = text.strip_prefix('\u{feff}').unwrap_or(text);
         while !rest.is_empty() {
             let start = text.len() - rest.len();
+            if let Some(r) = self.common(start, rest) {
+                rest = r;
+                continue;
+            }
             if let Ok((r, ws)) = whitespace(rest) {
                 self.flush_junk();
                 self.note_whitespace(start, ws);
@@ -260,7 +280,7 @@ impl<'a> Lexer<'a> {
             }
             if let Ok((r, _)) = ident(rest) {
                 self.flush_junk();
-                self.push(Tok::Ident, start, text.len() - r.len(), 0.0);
+                self.push(Tok::Ident, start, text.len() - r.len());
                 rest = r;
                 continue;
             }
@@ -276,7 +296,7 @@ impl<'a> Lexer<'a> {
             }
             if let Ok((r, kind)) = punct(rest) {
                 self.flush_junk();
-                self.push(kind, start, text.len() - r.len(), 0.0);
+                self.push(kind, start, text.len() - r.len());
                 rest = r;
                 continue;
             }
@@ -296,9 +316,76 @@ impl<'a> Lexer<'a> {
             kind: Tok::Eof,
             start: end as u32,
             end: end as u32,
-            value: 0.0,
-            unterminated: false,
         });
+    }
+
+    /// The common tokens, recognised from their first byte without trying each parser in turn: whitespace, ASCII
+    /// names, numbers and the punctuation that begins nothing else. Returns the rest of the text, or `None` to leave
+    /// the text to the general parsers (comments, `/`, `.`, `-`, strings, names with `µ`, invalid characters).
+    fn common(&mut self, start: usize, rest: &'a str) -> Option<&'a str> {
+        let bytes = rest.as_bytes();
+        let first = *bytes.first()?;
+        let run = |from: usize, pred: fn(u8) -> bool| {
+            from + bytes
+                .get(from..)
+                .unwrap_or(&[])
+                .iter()
+                .take_while(|&&b| pred(b))
+                .count()
+        };
+        match first {
+            b' ' | b'\t' | b'\r' | b'\n' | 0x0c => {
+                let len = run(0, |b| matches!(b, b' ' | b'\t' | b'\r' | b'\n' | 0x0c));
+                let (ws, r) = rest.split_at_checked(len)?;
+                self.flush_junk();
+                self.note_whitespace(start, ws);
+                Some(r)
+            }
+            b'a'..=b'z' | b'A'..=b'Z' | b'_' => {
+                let len = run(1, |b| b.is_ascii_alphanumeric() || b == b'_');
+                // A non-ASCII character may continue the name (`µ`): the general parser decides.
+                if bytes.get(len).is_some_and(|b| !b.is_ascii()) {
+                    return None;
+                }
+                self.flush_junk();
+                self.push(Tok::Ident, start, start + len);
+                rest.get(len..)
+            }
+            b'0'..=b'9' => {
+                let (r, n) = number(rest).ok()?;
+                self.flush_junk();
+                Some(self.number(start, n, r))
+            }
+            b'{' | b'}' | b'(' | b')' | b'[' | b']' | b';' | b',' | b'=' | b':' | b'+' | b'*'
+            | b'^' | b'!' => {
+                let kind = match first {
+                    b'{' => Tok::LBrace,
+                    b'}' => Tok::RBrace,
+                    b'(' => Tok::LParen,
+                    b')' => Tok::RParen,
+                    b'[' => Tok::LBracket,
+                    b']' => Tok::RBracket,
+                    b';' => Tok::Semi,
+                    b',' => Tok::Comma,
+                    b'=' => Tok::Eq,
+                    b':' => Tok::Colon,
+                    b'+' => Tok::Plus,
+                    b'*' => Tok::Star,
+                    b'^' => Tok::Caret,
+                    _ => Tok::Bang,
+                };
+                self.flush_junk();
+                self.push(kind, start, start + 1);
+                rest.get(1..)
+            }
+            // `->` is most of the `-` in bond statements.
+            b'-' if bytes.get(1) == Some(&b'>') => {
+                self.flush_junk();
+                self.push(Tok::Arrow, start, start + 2);
+                rest.get(2..)
+            }
+            _ => None,
+        }
     }
 
     /// Records blank lines: a newline followed by only whitespace and another newline.
@@ -360,18 +447,18 @@ impl<'a> Lexer<'a> {
                     .with_primary(span, "not a valid number")
                     .with_help(help),
             );
-            self.push(Tok::Number, start, end, 0.0);
+            self.push_number(start, end, 0.0);
             return rest;
         }
         match n.parse::<f64>() {
-            Ok(v) if v.is_finite() => self.push(Tok::Number, start, end, v),
+            Ok(v) if v.is_finite() => self.push_number(start, end, v),
             _ => {
                 self.out.diagnostics.push(
                     Diagnostic::error("BG0103", format!("number `{literal}` is not finite"))
                         .with_primary(span, "too large to be represented as a 64-bit float")
                         .with_help("numbers must be finite; the largest is about 1.8e308"),
                 );
-                self.push(Tok::Number, start, end, 0.0);
+                self.push_number(start, end, 0.0);
             }
         }
         rest
@@ -410,11 +497,10 @@ impl<'a> Lexer<'a> {
                 c => value.push(c),
             }
         }
-        let index = self.out.strings.len() as u32;
-        self.out.strings.push(value);
+        self.out.strings.push((start as u32, value));
         match end {
             Some(len) => {
-                self.push(Tok::Str(index), start, start + len, 0.0);
+                self.push(Tok::Str, start, start + len);
                 rest.get(len..).unwrap_or("")
             }
             None => {
@@ -424,10 +510,8 @@ impl<'a> Lexer<'a> {
                         .with_primary(self.span(start, start + len), "this string has no closing `\"`")
                         .with_help("close the string with `\"` on the same line; write a quote inside it as `\\\"`"),
                 );
-                self.push(Tok::Str(index), start, start + len, 0.0);
-                if let Some(t) = self.out.tokens.last_mut() {
-                    t.unterminated = true;
-                }
+                self.push(Tok::Str, start, start + len);
+                self.out.unterminated.push(start as u32);
                 rest.get(len..).unwrap_or("")
             }
         }

@@ -52,8 +52,40 @@ pub const KEYWORDS: &[&str] = &[
 /// line.
 const CLAUSE_KEYWORDS: &[&str] = &["hint", "stroke"];
 
+/// Whether `s` is one of [`KEYWORDS`]. Every name the parser reads is checked, so this is a `match` (which compiles
+/// to a switch on length and bytes) rather than a scan of the list.
 pub fn is_keyword(s: &str) -> bool {
-    KEYWORDS.contains(&s)
+    matches!(
+        s,
+        "model"
+            | "component"
+            | "param"
+            | "input"
+            | "output"
+            | "var"
+            | "bond"
+            | "port"
+            | "import"
+            | "domain"
+            | "coords"
+            | "allow"
+            | "hint"
+            | "stroke"
+            | "Se"
+            | "Sf"
+            | "MSe"
+            | "MSf"
+            | "C"
+            | "I"
+            | "R"
+            | "TF"
+            | "GY"
+            | "MTF"
+            | "MGY"
+            | "CF"
+            | "RF"
+            | "IF"
+    )
 }
 
 /// A diagnostic has been recorded; the caller recovers.
@@ -66,7 +98,9 @@ pub struct Parser<'a> {
     pub(super) file: FileId,
     pub(super) text: &'a str,
     pub(super) toks: Vec<Token>,
-    pub(super) strings: Vec<String>,
+    numbers: Vec<(u32, f64)>,
+    strings: Vec<(u32, String)>,
+    unterminated: Vec<u32>,
     pub(super) pos: usize,
     pub(super) diags: Vec<Diagnostic>,
     pub(super) depth: usize,
@@ -92,7 +126,9 @@ pub fn parse_file(file: FileId, text: &str) -> (ast::File, Vec<Diagnostic>) {
         file,
         text,
         toks: lexed.tokens,
+        numbers: lexed.numbers,
         strings: lexed.strings,
+        unterminated: lexed.unterminated,
         pos: 0,
         diags: lexed.diagnostics,
         depth: 0,
@@ -133,8 +169,6 @@ impl<'a> Parser<'a> {
                 kind: Tok::Eof,
                 start: self.text.len() as u32,
                 end: self.text.len() as u32,
-                value: 0.0,
-                unterminated: false,
             })
     }
 
@@ -155,6 +189,32 @@ impl<'a> Parser<'a> {
             Some(self.bump())
         } else {
             None
+        }
+    }
+
+    /// The value of a number token (0 for a malformed one, already reported).
+    pub(super) fn number_value(&self, t: Token) -> f64 {
+        match self
+            .numbers
+            .binary_search_by_key(&t.start, |&(start, _)| start)
+        {
+            Ok(i) => self.numbers.get(i).map_or(0.0, |&(_, v)| v),
+            Err(_) => 0.0,
+        }
+    }
+
+    /// The unescaped text of a string token.
+    pub(super) fn string_value(&self, t: Token) -> String {
+        match self
+            .strings
+            .binary_search_by_key(&t.start, |(start, _)| *start)
+        {
+            Ok(i) => self
+                .strings
+                .get(i)
+                .map(|(_, s)| s.clone())
+                .unwrap_or_default(),
+            Err(_) => String::new(),
         }
     }
 
@@ -212,8 +272,11 @@ impl<'a> Parser<'a> {
     }
 
     pub(super) fn is_statement_keyword(&self, t: Token) -> bool {
+        if t.kind != Tok::Ident {
+            return false;
+        }
         let text = self.tok_text(t);
-        t.kind == Tok::Ident && is_keyword(text) && !CLAUSE_KEYWORDS.contains(&text)
+        is_keyword(text) && !CLAUSE_KEYWORDS.contains(&text)
     }
 
     // ----- diagnostics -----
@@ -225,7 +288,7 @@ impl<'a> Parser<'a> {
             Tok::Ident if is_keyword(text) => format!("keyword `{text}`"),
             Tok::Ident => format!("`{}`", shorten(text)),
             Tok::Number => format!("number `{}`", shorten(text)),
-            Tok::Str(_) => "a string".to_string(),
+            Tok::Str => "a string".to_string(),
             other => other.describe().to_string(),
         }
     }
@@ -256,8 +319,10 @@ impl<'a> Parser<'a> {
             return Ok(());
         }
         let t = self.peek();
-        let after_unterminated =
-            self.pos > 0 && self.toks.get(self.pos - 1).is_some_and(|p| p.unterminated);
+        let after_unterminated = self.pos > 0
+            && self.toks.get(self.pos - 1).is_some_and(|p| {
+                p.kind == Tok::Str && self.unterminated.binary_search(&p.start).is_ok()
+            });
         if after_unterminated && (self.starts_line(t) || matches!(t.kind, Tok::RBrace | Tok::Eof)) {
             // The unterminated string swallowed the rest of its line, `;` included; it is reported already.
             return Ok(());
@@ -285,10 +350,16 @@ impl<'a> Parser<'a> {
     /// Reads a name being declared or referred to. A keyword or a name with non-ASCII letters is reported but
     /// accepted, so that the rest of the statement is still checked.
     pub(super) fn expect_name(&mut self, what: &str) -> PResult<Ident> {
+        self.expect_name_for(|| what.to_string())
+    }
+
+    /// [`Parser::expect_name`] with the description of what is expected built only when it is missing: a name is
+    /// read for every element, and the description would otherwise be formatted each time.
+    pub(super) fn expect_name_for(&mut self, what: impl FnOnce() -> String) -> PResult<Ident> {
         let t = self.peek();
         if t.kind != Tok::Ident {
             return Err(self.expected(
-                what,
+                &what(),
                 "a name is a letter or `_` followed by letters, digits and `_`",
             ));
         }

@@ -51,7 +51,9 @@ impl<'a> Parser<'a> {
         }
         let docs = match word {
             "domain" | "coords" | "bond" | "port" | "allow" => {
-                self.reject_docs(docs, &format!("a `{word}` statement"));
+                if !docs.is_empty() {
+                    self.reject_docs(docs, &format!("a `{word}` statement"));
+                }
                 Vec::new()
             }
             _ => docs,
@@ -207,9 +209,9 @@ impl<'a> Parser<'a> {
     /// An optional description string.
     pub(super) fn description(&mut self) -> Option<String> {
         match self.peek().kind {
-            Tok::Str(i) => {
-                self.bump();
-                Some(self.strings.get(i as usize).cloned().unwrap_or_default())
+            Tok::Str => {
+                let t = self.bump();
+                Some(self.string_value(t))
             }
             _ => None,
         }
@@ -219,7 +221,8 @@ impl<'a> Parser<'a> {
     fn element(&mut self, docs: Docs, kind: ElementKind) -> PResult<ElementDecl> {
         let kw = self.bump();
         let kind_span = self.tok_span(kw);
-        let name = self.expect_name(&format!("the name of the `{}` element", kind.keyword()))?;
+        let name =
+            self.expect_name_for(|| format!("the name of the `{}` element", kind.keyword()))?;
         let mut ports = None;
         if let Some(open) = self.eat(Tok::LParen) {
             let n = self.positive_int("the number of ports")?;

@@ -217,7 +217,7 @@ fn instances() {
 fn bonds() {
     match one("bond motor -> j1 -> gear -> rotor, fric;") {
         Stmt::Bond(b) => {
-            let sizes: Vec<usize> = b.chain.iter().map(Vec::len).collect();
+            let sizes: Vec<usize> = b.chain.iter().map(|g| g.len()).collect();
             assert_eq!(sizes, vec![1, 1, 1, 2]);
         }
         other => panic!("{other:?}"),
@@ -536,4 +536,17 @@ fn a_bad_model_name_is_one_error_and_the_body_is_read() {
     let (file, diags) = parse(FileId(0), "model 3 { param a = 1 [1]; }");
     assert_eq!(diags.len(), 1, "{diags:#?}");
     assert_eq!(body_of(&file).len(), 1);
+}
+
+#[test]
+fn is_keyword_matches_the_keyword_list() {
+    use super::parser::{KEYWORDS, is_keyword};
+    for k in KEYWORDS {
+        assert!(is_keyword(k), "{k}");
+    }
+    for w in [
+        "", "models", "Model", "c", "i", "TF1", "0", "1", "x", "bonds", "hin",
+    ] {
+        assert!(!is_keyword(w), "{w}");
+    }
 }

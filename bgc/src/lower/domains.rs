@@ -72,17 +72,7 @@ impl Builder<'_> {
             // A TF, GY or field may join domains: its scope's default only decides when nothing else does.
             let weak_default = kind.is_two_port() || kind.is_field();
             node_edges.clear();
-            node_edges.extend(
-                self.model
-                    .graph
-                    .edges_directed(n, petgraph::Direction::Outgoing)
-                    .chain(
-                        self.model
-                            .graph
-                            .edges_directed(n, petgraph::Direction::Incoming),
-                    )
-                    .map(|e| e.id()),
-            );
+            node_edges.extend(bonds_at(&self.model.graph, n));
             for &e in &node_edges {
                 let g = find(&mut parent, e.index());
                 if let Some((domain, span)) = written {
@@ -145,16 +135,8 @@ impl Builder<'_> {
             }
         }
         for n in self.model.graph.node_indices() {
-            let d = self
-                .model
-                .graph
-                .edges_directed(n, petgraph::Direction::Outgoing)
-                .chain(
-                    self.model
-                        .graph
-                        .edges_directed(n, petgraph::Direction::Incoming),
-                )
-                .find_map(|e| self.bonds.get(e.id().index()).and_then(|b| b.domain));
+            let d = bonds_at(&self.model.graph, n)
+                .find_map(|e| self.bonds.get(e.index()).and_then(|b| b.domain));
             if let Some(info) = self.nodes.get_mut(n.index()) {
                 info.domain = d;
             }
@@ -189,4 +171,15 @@ impl Builder<'_> {
         );
         Some(first.domain)
     }
+}
+
+/// The bonds at node `n`: those leaving it, then those arriving.
+fn bonds_at(
+    graph: &petgraph::graph::DiGraph<crate::ir::Node, crate::ir::Bond>,
+    n: NodeIndex,
+) -> impl Iterator<Item = EdgeIndex> + '_ {
+    graph
+        .edges_directed(n, petgraph::Direction::Outgoing)
+        .chain(graph.edges_directed(n, petgraph::Direction::Incoming))
+        .map(|e| e.id())
 }

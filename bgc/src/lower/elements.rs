@@ -87,19 +87,7 @@ impl Builder<'_> {
                     } else {
                         (u.flow, u.flow_text, "a flow")
                     };
-                    // The expectation is spelled out only for the message.
-                    if !q.fits(want)
-                        && self.expect_unit(
-                            q,
-                            want,
-                            v.span,
-                            &format!("{text} ({what} in the {} domain)", d.name()),
-                            &name,
-                        )
-                    {
-                        self.explain_units(&expr);
-                        self.suggest_domain(Place::OnePort(kind), &name, q.dim(), (d, d));
-                    }
+                    self.one_port_unit(kind, &name, (&expr, q, v.span), (want, text, what), d);
                 }
                 Some(Relation::Source(expr))
             }
@@ -119,19 +107,7 @@ impl Builder<'_> {
                         K::I => "an inertia",
                         _ => "a resistance",
                     };
-                    // The expectation is spelled out only for the message.
-                    if !q.fits(want)
-                        && self.expect_unit(
-                            q,
-                            want,
-                            v.span,
-                            &format!("{text} ({what} in the {} domain)", d.name()),
-                            &name,
-                        )
-                    {
-                        self.explain_units(&expr);
-                        self.suggest_domain(Place::OnePort(kind), &name, q.dim(), (d, d));
-                    }
+                    self.one_port_unit(kind, &name, (&expr, q, v.span), (want, text, what), d);
                 }
                 self.check_value(kind, &name, &expr, v.span);
                 Some(Relation::Linear(expr))
@@ -220,6 +196,33 @@ impl Builder<'_> {
     }
 
     /// BG0303 when a value's dimension is not the one its place needs.
+    /// Checks the unit `q` of a one-port element's value (`value`: the expression, its unit, its span) against
+    /// `expected` (the unit, its text, what the value is) in domain `d`, and explains a mismatch.
+    fn one_port_unit(
+        &mut self,
+        kind: K,
+        name: &str,
+        value: (&ir::Expr, Q, Span),
+        expected: (Dim, &str, &str),
+        d: Domain,
+    ) {
+        let (expr, q, span) = value;
+        let (want, text, what) = expected;
+        // The expectation is spelled out only for the message.
+        if !q.fits(want)
+            && self.expect_unit(
+                q,
+                want,
+                span,
+                &format!("{text} ({what} in the {} domain)", d.name()),
+                name,
+            )
+        {
+            self.explain_units(expr);
+            self.suggest_domain(Place::OnePort(kind), name, q.dim(), (d, d));
+        }
+    }
+
     pub fn expect_unit(&mut self, q: Q, want: Dim, span: Span, expected: &str, name: &str) -> bool {
         if q.fits(want) {
             return false;

@@ -137,11 +137,9 @@ impl Builder<'_> {
                             "a gyrator modulus: input effort over output flow",
                         )
                     };
-                    if let Some(want) = num.checked_div(uo.flow)
-                        && !q.fits(want)
-                    {
-                        let text = format!("{want} ({what}, {} to {})", din.name(), dout.name());
-                        if self.expect_unit(q, want, v.span, &text, &name) {
+                    if let Some(want) = num.checked_div(uo.flow) {
+                        let text = || format!("{want} ({what}, {} to {})", din.name(), dout.name());
+                        if self.expect_unit(q, want, v.span, text, &name) {
                             self.explain_units(&expr);
                             self.suggest_domain(Place::TwoPort(kind), &name, q.dim(), (din, dout));
                         }
@@ -195,7 +193,6 @@ impl Builder<'_> {
         );
     }
 
-    /// BG0303 when a value's dimension is not the one its place needs.
     /// Checks the unit `q` of a one-port element's value (`value`: the expression, its unit, its span) against
     /// `expected` (the unit, its text, what the value is) in domain `d`, and explains a mismatch.
     fn one_port_unit(
@@ -208,25 +205,32 @@ impl Builder<'_> {
     ) {
         let (expr, q, span) = value;
         let (want, text, what) = expected;
-        // The expectation is spelled out only for the message.
-        if !q.fits(want)
-            && self.expect_unit(
-                q,
-                want,
-                span,
-                &format!("{text} ({what} in the {} domain)", d.name()),
-                name,
-            )
-        {
+        if self.expect_unit(
+            q,
+            want,
+            span,
+            || format!("{text} ({what} in the {} domain)", d.name()),
+            name,
+        ) {
             self.explain_units(expr);
             self.suggest_domain(Place::OnePort(kind), name, q.dim(), (d, d));
         }
     }
 
-    pub fn expect_unit(&mut self, q: Q, want: Dim, span: Span, expected: &str, name: &str) -> bool {
+    /// BG0303 when a value's dimension is not the one its place needs; `expected` spells the expectation out and
+    /// is called only then (values that fit, nearly all, format nothing).
+    pub fn expect_unit(
+        &mut self,
+        q: Q,
+        want: Dim,
+        span: Span,
+        expected: impl FnOnce() -> String,
+        name: &str,
+    ) -> bool {
         if q.fits(want) {
             return false;
         }
+        let expected = expected();
         self.diags.push(
             Diagnostic::error(
                 "BG0303",
@@ -372,11 +376,13 @@ impl Builder<'_> {
                     q,
                     want,
                     law.rhs.span,
-                    &format!(
-                        "{text} (the unit of `{}` in the {} domain)",
-                        var_letter(var),
-                        d.name()
-                    ),
+                    || {
+                        format!(
+                            "{text} (the unit of `{}` in the {} domain)",
+                            var_letter(var),
+                            d.name()
+                        )
+                    },
                     name,
                 );
             }
@@ -495,11 +501,13 @@ impl Builder<'_> {
                         q,
                         want,
                         law.rhs.span,
-                        &format!(
-                            "{want} (momentum of port {} over flow of port {})",
-                            i + 1,
-                            j + 1
-                        ),
+                        || {
+                            format!(
+                                "{want} (momentum of port {} over flow of port {})",
+                                i + 1,
+                                j + 1
+                            )
+                        },
                         name,
                     );
                 }
@@ -519,12 +527,14 @@ impl Builder<'_> {
                         q,
                         want,
                         law.rhs.span,
-                        &format!(
-                            "{text} (the unit of `{}[{}]` in the {} domain)",
-                            var_letter(var),
-                            port + 1,
-                            d.name()
-                        ),
+                        || {
+                            format!(
+                                "{text} (the unit of `{}[{}]` in the {} domain)",
+                                var_letter(var),
+                                port + 1,
+                                d.name()
+                            )
+                        },
                         name,
                     );
                 }

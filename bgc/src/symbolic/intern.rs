@@ -155,15 +155,14 @@ pub(super) fn intern(node: Node, hash: u64, tree_size: u64) -> Arc<Inner> {
 
 /// Equality of two nodes whose children are interned: same operation, same leaf, identical children.
 fn shallow_eq(a: &Node, b: &Node) -> bool {
-    let same = |xs: &[super::Expr], ys: &[super::Expr]| {
-        xs.len() == ys.len() && xs.iter().zip(ys).all(|(x, y)| x.same_node(y))
-    };
     match (a, b) {
         (Node::Const(x), Node::Const(y)) => x.to_bits() == y.to_bits(),
         (Node::Sym(x), Node::Sym(y)) => x == y,
-        (Node::Add(xs), Node::Add(ys)) | (Node::Mul(xs), Node::Mul(ys)) => same(xs, ys),
+        (Node::Add(xs), Node::Add(ys)) | (Node::Mul(xs), Node::Mul(ys)) => {
+            super::Expr::same_nodes(xs, ys)
+        }
         (Node::Pow(b1, e1), Node::Pow(b2, e2)) => b1.same_node(b2) && e1.same_node(e2),
-        (Node::Call(f, xs), Node::Call(g, ys)) => f == g && same(xs, ys),
+        (Node::Call(f, xs), Node::Call(g, ys)) => f == g && super::Expr::same_nodes(xs, ys),
         _ => false,
     }
 }

@@ -155,26 +155,35 @@ fn punct(i: &str) -> IResult<&str, Tok> {
         return Ok((rest, Tok::Arrow));
     }
     let (rest, c) = one_of("{}()[];,=:.+-*/^!").parse(i)?;
-    let kind = match c {
-        '{' => Tok::LBrace,
-        '}' => Tok::RBrace,
-        '(' => Tok::LParen,
-        ')' => Tok::RParen,
-        '[' => Tok::LBracket,
-        ']' => Tok::RBracket,
-        ';' => Tok::Semi,
-        ',' => Tok::Comma,
-        '=' => Tok::Eq,
-        ':' => Tok::Colon,
-        '.' => Tok::Dot,
-        '+' => Tok::Plus,
-        '-' => Tok::Minus,
-        '*' => Tok::Star,
-        '/' => Tok::Slash,
-        '^' => Tok::Caret,
-        _ => Tok::Bang,
-    };
+    let kind = u8::try_from(c)
+        .ok()
+        .and_then(one_char_punct)
+        .unwrap_or(Tok::Bang);
     Ok((rest, kind))
+}
+
+/// The token of a one-character punctuation mark (`None` for any other byte).
+fn one_char_punct(c: u8) -> Option<Tok> {
+    Some(match c {
+        b'{' => Tok::LBrace,
+        b'}' => Tok::RBrace,
+        b'(' => Tok::LParen,
+        b')' => Tok::RParen,
+        b'[' => Tok::LBracket,
+        b']' => Tok::RBracket,
+        b';' => Tok::Semi,
+        b',' => Tok::Comma,
+        b'=' => Tok::Eq,
+        b':' => Tok::Colon,
+        b'.' => Tok::Dot,
+        b'+' => Tok::Plus,
+        b'-' => Tok::Minus,
+        b'*' => Tok::Star,
+        b'/' => Tok::Slash,
+        b'^' => Tok::Caret,
+        b'!' => Tok::Bang,
+        _ => return None,
+    })
 }
 
 struct Lexer<'a> {
@@ -356,35 +365,20 @@ impl<'a> Lexer<'a> {
                 self.flush_junk();
                 Some(self.number(start, n, r))
             }
-            b'{' | b'}' | b'(' | b')' | b'[' | b']' | b';' | b',' | b'=' | b':' | b'+' | b'*'
-            | b'^' | b'!' => {
-                let kind = match first {
-                    b'{' => Tok::LBrace,
-                    b'}' => Tok::RBrace,
-                    b'(' => Tok::LParen,
-                    b')' => Tok::RParen,
-                    b'[' => Tok::LBracket,
-                    b']' => Tok::RBracket,
-                    b';' => Tok::Semi,
-                    b',' => Tok::Comma,
-                    b'=' => Tok::Eq,
-                    b':' => Tok::Colon,
-                    b'+' => Tok::Plus,
-                    b'*' => Tok::Star,
-                    b'^' => Tok::Caret,
-                    _ => Tok::Bang,
-                };
-                self.flush_junk();
-                self.push(kind, start, start + 1);
-                rest.get(1..)
-            }
             // `->` is most of the `-` in bond statements.
             b'-' if bytes.get(1) == Some(&b'>') => {
                 self.flush_junk();
                 self.push(Tok::Arrow, start, start + 2);
                 rest.get(2..)
             }
-            _ => None,
+            // `.`, `-` and `/` may begin a number or a comment: left to the general parsers.
+            b'.' | b'-' | b'/' => None,
+            _ => {
+                let kind = one_char_punct(first)?;
+                self.flush_junk();
+                self.push(kind, start, start + 1);
+                rest.get(1..)
+            }
         }
     }
 

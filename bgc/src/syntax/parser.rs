@@ -15,8 +15,22 @@ use crate::span::{FileId, Span};
 /// The deepest nesting of expressions (parentheses, unary minus, powers, call arguments) the parser accepts.
 pub const MAX_DEPTH: usize = 200;
 
-/// Words that cannot be used as names.
-pub const KEYWORDS: &[&str] = &[
+/// The keywords, written once: [`KEYWORDS`] lists them, and [`is_keyword`] is a `match` over the same words (it
+/// compiles to a switch on length and bytes; every name the parser reads is checked, so a scan of the list would
+/// cost more).
+macro_rules! keywords {
+    ($($word:literal),* $(,)?) => {
+        /// Words that cannot be used as names.
+        pub const KEYWORDS: &[&str] = &[$($word),*];
+
+        /// Whether `s` is one of [`KEYWORDS`].
+        pub fn is_keyword(s: &str) -> bool {
+            matches!(s, $($word)|*)
+        }
+    };
+}
+
+keywords! {
     "model",
     "component",
     "param",
@@ -45,48 +59,12 @@ pub const KEYWORDS: &[&str] = &[
     "CF",
     "RF",
     "IF",
-];
+}
 
 /// The keywords that never begin a statement: `stroke` (a bond's causality hint, inside the bond statement) and the
 /// reserved `hint`. Every other keyword begins a statement or an item, and recovery stops before one that starts a
 /// line.
 const CLAUSE_KEYWORDS: &[&str] = &["hint", "stroke"];
-
-/// Whether `s` is one of [`KEYWORDS`]. Every name the parser reads is checked, so this is a `match` (which compiles
-/// to a switch on length and bytes) rather than a scan of the list.
-pub fn is_keyword(s: &str) -> bool {
-    matches!(
-        s,
-        "model"
-            | "component"
-            | "param"
-            | "input"
-            | "output"
-            | "var"
-            | "bond"
-            | "port"
-            | "import"
-            | "domain"
-            | "coords"
-            | "allow"
-            | "hint"
-            | "stroke"
-            | "Se"
-            | "Sf"
-            | "MSe"
-            | "MSf"
-            | "C"
-            | "I"
-            | "R"
-            | "TF"
-            | "GY"
-            | "MTF"
-            | "MGY"
-            | "CF"
-            | "RF"
-            | "IF"
-    )
-}
 
 /// A diagnostic has been recorded; the caller recovers.
 #[derive(Debug)]

@@ -54,13 +54,11 @@ impl<'l, T> IntoIterator for &'l ShortList<T> {
 impl<T> FromIterator<T> for ShortList<T> {
     fn from_iter<I: IntoIterator<Item = T>>(iter: I) -> Self {
         let mut items: Vec<T> = iter.into_iter().collect();
-        match (items.pop(), items.is_empty()) {
-            (Some(only), true) => ShortList::One(only),
-            (Some(last), false) => {
-                items.push(last);
-                ShortList::Many(items)
-            }
-            (None, _) => ShortList::Many(items),
+        match items.len() {
+            1 => items
+                .pop()
+                .map_or(ShortList::Many(Vec::new()), ShortList::One),
+            _ => ShortList::Many(items),
         }
     }
 }

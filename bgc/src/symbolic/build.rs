@@ -93,9 +93,10 @@ impl Expr {
             if coeff == 0.0 {
                 continue;
             }
-            out.push(match alone {
-                true => term,
-                false => scale_rest(rest_of(term.coeff_and_factors().1), coeff),
+            out.push(if alone {
+                term
+            } else {
+                scale_rest(rest_of(term.coeff_and_factors().1), coeff)
             });
         }
         // Sorted already: the constant comes first, and terms compare by their coefficient-free factors before
@@ -118,11 +119,7 @@ impl Expr {
         if coeff == 0.0 || coeff.is_nan() {
             return Expr::constant(coeff);
         }
-        let bases = merge_like(
-            bases,
-            |exps: &mut Exponents, e| exps.push(e),
-            Exponents::One,
-        );
+        let bases = merge_bases(bases);
         let mut out: Vec<Expr> = Vec::with_capacity(bases.len() + 1);
         let mut needs_another_pass = false;
         // Factors that are their bases (exponent 1) keep the order of the bases, which is sorted already.
@@ -263,21 +260,16 @@ fn call2(func: Func, a: &Expr, b: &Expr) -> Expr {
     Expr::from_canonical(Node::Call(func, vec![a.clone(), b.clone()]))
 }
 
-/// Adds `term` into a sum being collected, keyed by the term without its numeric coefficient.
-/// `items` sorted by key with the values of equal keys combined, in the order they came (so that sums of
-/// coefficients are added in the order of the terms, as written).
-fn merge_like<V, A>(
-    mut items: Vec<(Expr, V)>,
-    mut add: impl FnMut(&mut A, V),
-    first: impl Fn(V) -> A,
-) -> Vec<(Expr, A)> {
-    // Stable: equal keys keep their order.
-    items.sort_by(|a, b| a.0.cmp(&b.0));
-    let mut out: Vec<(Expr, A)> = Vec::with_capacity(items.len());
-    for (key, value) in items {
+/// The factors of a product grouped by base: sorted by base, the exponents of equal bases kept in the order they
+/// came (so that their sum is added in the order of the factors, as written).
+fn merge_bases(mut bases: Vec<(Expr, Expr)>) -> Vec<(Expr, Exponents)> {
+    // Stable: equal bases keep their order.
+    bases.sort_by(|a, b| a.0.cmp(&b.0));
+    let mut out: Vec<(Expr, Exponents)> = Vec::with_capacity(bases.len());
+    for (base, exponent) in bases {
         match out.last_mut() {
-            Some((last, acc)) if *last == key => add(acc, value),
-            _ => out.push((key, first(value))),
+            Some((last, exps)) if *last == base => exps.push(exponent),
+            _ => out.push((base, Exponents::One(exponent))),
         }
     }
     out
@@ -305,6 +297,8 @@ impl Exponents {
     }
 }
 
+/// Adds `term` (each of its terms, for a sum) to a sum being collected: a constant to `constant`, any other term
+/// with its numeric coefficient.
 fn collect_term(term: &Expr, constant: &mut f64, collected: &mut Vec<(f64, Expr)>) {
     match term.node() {
         Node::Const(c) => *constant += c,
@@ -319,8 +313,7 @@ fn collect_term(term: &Expr, constant: &mut f64, collected: &mut Vec<(f64, Expr)
 
 /// True when two terms have the same coefficient-free factors (interned, so the same nodes).
 fn same_factors(a: &Expr, b: &Expr) -> bool {
-    let (fa, fb) = (a.coeff_and_factors().1, b.coeff_and_factors().1);
-    fa.len() == fb.len() && fa.iter().zip(fb).all(|(f, g)| f.same_node(g))
+    Expr::same_nodes(a.coeff_and_factors().1, b.coeff_and_factors().1)
 }
 
 /// `coeff * rest` where `rest` is a canonical coefficient-free term (a non-sum, possibly a product).

@@ -177,6 +177,12 @@ impl Expr {
         Arc::ptr_eq(&self.0, &other.0)
     }
 
+    /// Two lists of the same nodes, in the same order.
+    #[inline]
+    pub(super) fn same_nodes(xs: &[Expr], ys: &[Expr]) -> bool {
+        xs.len() == ys.len() && xs.iter().zip(ys).all(|(x, y)| x.same_node(y))
+    }
+
     /// The node's address: an identity that lasts as long as the node.
     pub(super) fn address(&self) -> usize {
         Arc::as_ptr(&self.0) as usize

@@ -32,19 +32,24 @@ impl Ord for Expr {
         if let Some(order) = by_first_bases(self, other) {
             return order;
         }
+        // The first step runs before anything is pushed: no allocation when it decides.
         let mut steps = Vec::new();
-        let first = Step::Expr(self, other).run(&mut steps);
-        if first.is_ne() {
-            return first;
+        match Step::Expr(self, other).run(&mut steps) {
+            Ordering::Equal => run(steps),
+            decided => decided,
         }
-        while let Some(step) = steps.pop() {
-            let order = step.run(&mut steps);
-            if order.is_ne() {
-                return order;
-            }
-        }
-        Ordering::Equal
     }
+}
+
+/// Runs the steps of a comparison until one decides it.
+fn run(mut steps: Vec<Step<'_>>) -> Ordering {
+    while let Some(step) = steps.pop() {
+        let order = step.run(&mut steps);
+        if order.is_ne() {
+            return order;
+        }
+    }
+    Ordering::Equal
 }
 
 /// The order of two expressions when the bases of their first factors decide it: constants against anything else,
@@ -147,7 +152,7 @@ fn push_factor_lists<'a>(fa: &'a [Expr], fb: &'a [Expr], steps: &mut Vec<Step<'a
 /// The order of two coefficient-free terms given by their factors (`coeff_and_factors().1`): the order of the
 /// products of those factors, without building them.
 pub(super) fn cmp_factors(fa: &[Expr], fb: &[Expr]) -> Ordering {
-    if fa.len() == fb.len() && fa.iter().zip(fb).all(|(f, g)| f.same_node(g)) {
+    if Expr::same_nodes(fa, fb) {
         return Ordering::Equal;
     }
     if let (Some(f), Some(g)) = (fa.first(), fb.first())
@@ -157,13 +162,7 @@ pub(super) fn cmp_factors(fa: &[Expr], fb: &[Expr]) -> Ordering {
     }
     let mut steps = Vec::new();
     push_factor_lists(fa, fb, &mut steps);
-    while let Some(step) = steps.pop() {
-        let order = step.run(&mut steps);
-        if order.is_ne() {
-            return order;
-        }
-    }
-    Ordering::Equal
+    run(steps)
 }
 
 fn compare_bases<'a>(x: &'a Expr, y: &'a Expr, steps: &mut Vec<Step<'a>>) -> Ordering {

@@ -98,30 +98,24 @@ impl Drop for Doc {
         if matches!(self.piece, Piece::Text(_)) {
             return;
         }
-        let mut pending: Vec<Piece> = vec![std::mem::replace(
-            &mut self.piece,
-            Piece::Text(Cow::Borrowed("")),
-        )];
+        let mut pending: Vec<Piece> = vec![self.take_piece()];
         while let Some(piece) = pending.pop() {
             match piece {
                 Piece::Text(_) => {}
-                Piece::Cat(parts) => {
-                    for mut p in parts {
-                        pending.push(std::mem::replace(
-                            &mut p.piece,
-                            Piece::Text(Cow::Borrowed("")),
-                        ));
-                    }
-                }
+                Piece::Cat(parts) => pending.extend(parts.into_iter().map(|mut p| p.take_piece())),
                 Piece::Shared(rc) => {
                     if let Ok(mut doc) = Rc::try_unwrap(rc) {
-                        pending.push(std::mem::replace(
-                            &mut doc.piece,
-                            Piece::Text(Cow::Borrowed("")),
-                        ));
+                        pending.push(doc.take_piece());
                     }
                 }
             }
         }
+    }
+}
+
+impl Doc {
+    /// The piece, leaving empty text in its place (which drops without a work list).
+    fn take_piece(&mut self) -> Piece {
+        std::mem::replace(&mut self.piece, Piece::Text(Cow::Borrowed("")))
     }
 }

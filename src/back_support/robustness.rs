@@ -33,7 +33,7 @@
 use nalgebra::DMatrix;
 
 use bgc_runtime::analysis::{
-    StabilityMargins, dc_gain, logspace, loop_at_plant_input, peak_gain, siso_response,
+    Resolvent, StabilityMargins, dc_gain, logspace, loop_at_plant_input, peak_gain,
     stability_margins,
 };
 use bgc_runtime::statespace::StateSpace;
@@ -188,9 +188,10 @@ fn ratio_crossing(
     den: &StateSpace,
     level_db: f64,
 ) -> Result<Option<f64>, BackSupportError> {
+    let (num, den) = (Resolvent::new(num), Resolvent::new(den));
     let f = |hz: f64| -> Result<f64, BackSupportError> {
         let w = 2.0 * std::f64::consts::PI * hz;
-        let ratio = siso_response(num, w)?.norm() / siso_response(den, w)?.norm();
+        let ratio = num.siso(w)?.norm() / den.siso(w)?.norm();
         Ok(20.0 * ratio.log10() - level_db)
     };
     let grid = logspace(SCAN_LOW_HZ, SCAN_HIGH_HZ, SCAN_POINTS)?;

@@ -1,21 +1,22 @@
 //! Frequency response of a state-space model.
 //!
 //! For a continuous model the response at `ω` is `G(jω) = C (jωI − A)⁻¹ B + D`; for a discrete model with
-//! sample time `T` it is `G(e^{jωT}) = C (e^{jωT} I − A)⁻¹ B + D`, defined for `0 ≤ ω ≤ π/T`. Each point is
-//! computed by a complex LU factorisation of the resolvent with partial pivoting, and the residual of the
-//! solve is checked so that a frequency sitting on (or numerically on) a pole is reported rather than
-//! returned as a meaningless number.
+//! sample time `T` it is `G(e^{jωT}) = C (e^{jωT} I − A)⁻¹ B + D`, defined for `0 ≤ ω ≤ π/T`. The points are
+//! evaluated by a [`Resolvent`] (one Hessenberg reduction of `A`, then a solve per point), and the residual
+//! of each solve is checked so that a frequency sitting on (or numerically on) a pole is reported rather
+//! than returned as a meaningless number.
 
 use nalgebra::{Complex, DMatrix};
 
 use super::error::AnalysisError;
+pub use super::resolvent::Resolvent;
 use crate::statespace::StateSpace;
 
 /// A complex number in double precision.
 pub type C64 = Complex<f64>;
 
 /// Relative residual above which a resolvent solve is refused.
-const RESIDUAL_LIMIT: f64 = 1e-8;
+pub(super) const RESIDUAL_LIMIT: f64 = 1e-8;
 
 /// The most points [`logspace`] builds (80 MB of frequencies), so that a mistyped length is an error rather
 /// than an allocation failure that aborts the process.
@@ -23,13 +24,18 @@ pub const MAX_GRID_POINTS: usize = 10_000_000;
 
 /// The point of the complex plane at which frequency `omega` (rad/s) is evaluated: `jω`, or `e^{jωT}`.
 pub fn evaluation_point(sys: &StateSpace, omega: f64) -> Result<C64, AnalysisError> {
+    point_of(sys.dt(), omega)
+}
+
+/// [`evaluation_point`] for a model of sample time `dt` (`None`: continuous).
+pub(super) fn point_of(dt: Option<f64>, omega: f64) -> Result<C64, AnalysisError> {
     if !omega.is_finite() || omega < 0.0 {
         return Err(AnalysisError::BadFrequency {
             omega,
             reason: "frequencies must be finite and non-negative",
         });
     }
-    match sys.dt() {
+    match dt {
         None => Ok(C64::new(0.0, omega)),
         Some(dt) => {
             let nyquist = std::f64::consts::PI / dt;
@@ -43,43 +49,7 @@ pub fn evaluation_point(sys: &StateSpace, omega: f64) -> Result<C64, AnalysisErr
 
 /// `C (pI − A)⁻¹ B + D` at a point `p` of the complex plane; `omega` only names the point in errors.
 pub fn transfer_at(sys: &StateSpace, p: C64, omega: f64) -> Result<DMatrix<C64>, AnalysisError> {
-    let n = sys.n_states();
-    let d = sys.d().map(|v| C64::new(v, 0.0));
-    if n == 0 {
-        return Ok(d);
-    }
-    let mut resolvent = sys.a().map(|v| C64::new(-v, 0.0));
-    for i in 0..n {
-        resolvent[(i, i)] += p;
-    }
-    let b = sys.b().map(|v| C64::new(v, 0.0));
-    let x = resolvent
-        .clone()
-        .lu()
-        .solve(&b)
-        .ok_or(AnalysisError::PoleOnContour { omega })?;
-    if x.iter().any(|v| !(v.re.is_finite() && v.im.is_finite())) {
-        return Err(AnalysisError::PoleOnContour { omega });
-    }
-    let residual = (&resolvent * &x - &b).norm();
-    let scale = resolvent.norm() * x.norm() + b.norm();
-    if !(residual.is_finite() && scale.is_finite()) {
-        // The entries are finite but their products are not: no residual, and no response, can be trusted.
-        return Err(AnalysisError::Overflow { omega });
-    }
-    let relative = if scale > 0.0 { residual / scale } else { 0.0 };
-    if relative > RESIDUAL_LIMIT {
-        return Err(AnalysisError::IllConditioned {
-            omega,
-            residual: relative,
-        });
-    }
-    let c = sys.c().map(|v| C64::new(v, 0.0));
-    let g = c * x + d;
-    if g.iter().any(|v| !(v.re.is_finite() && v.im.is_finite())) {
-        return Err(AnalysisError::Overflow { omega });
-    }
-    Ok(g)
+    Resolvent::new(sys).transfer_at(p, omega)
 }
 
 /// The frequency response matrix (outputs × inputs) at each frequency of `omegas` (rad/s).
@@ -87,17 +57,14 @@ pub fn frequency_response(
     sys: &StateSpace,
     omegas: &[f64],
 ) -> Result<Vec<DMatrix<C64>>, AnalysisError> {
-    omegas
-        .iter()
-        .map(|&w| transfer_at(sys, evaluation_point(sys, w)?, w))
-        .collect()
+    let resolvent = Resolvent::new(sys);
+    omegas.iter().map(|&w| resolvent.response(w)).collect()
 }
 
 /// The response of a SISO model at one frequency.
 pub fn siso_response(sys: &StateSpace, omega: f64) -> Result<C64, AnalysisError> {
     check_siso(sys, "siso_response")?;
-    let g = transfer_at(sys, evaluation_point(sys, omega)?, omega)?;
-    Ok(g[(0, 0)])
+    Resolvent::new(sys).siso(omega)
 }
 
 /// The steady-state gain `G(0)` (continuous) or `G(1)` (discrete).

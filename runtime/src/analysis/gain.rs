@@ -1,13 +1,13 @@
 //! Gain-based figures of a SISO model: the bandwidth relative to the DC gain, the first crossing of an
 //! absolute level, and the peak gain.
 //!
-//! All three scan the grid of [`search_grid`] (dense logarithmic, pole frequencies inserted) and refine by
+//! All three scan the grid of [`search_grid`](super::margins::search_grid) (dense logarithmic, pole frequencies inserted) and refine by
 //! Brent's method (crossings) or golden-section search (the peak). Frequencies are in rad/s; divide by `2π`
 //! for Hz (the back-support paper quotes its disturbance-rejection bandwidth, 52 Hz, in Hz).
 
 use super::error::AnalysisError;
-use super::freqresp::{check_siso, dc_gain, siso_response};
-use super::margins::search_grid;
+use super::freqresp::{Resolvent, check_siso, dc_gain};
+use super::margins::grid_of;
 use super::scalar_search::{brent_root, golden_min};
 use crate::statespace::StateSpace;
 
@@ -18,6 +18,7 @@ use crate::statespace::StateSpace;
 /// definition ("the first frequency in which the gain descends to below −3 dB of its DC value").
 pub fn bandwidth(sys: &StateSpace, drop_db: f64) -> Result<Option<f64>, AnalysisError> {
     check_siso(sys, "bandwidth")?;
+    let resolvent = Resolvent::new(sys);
     if !(drop_db.is_finite() && drop_db < 0.0) {
         return Err(AnalysisError::BadParameter {
             name: "drop_db",
@@ -30,9 +31,9 @@ pub fn bandwidth(sys: &StateSpace, drop_db: f64) -> Result<Option<f64>, Analysis
         return Err(AnalysisError::ZeroDcGain);
     }
     let level = |w: f64| -> Result<f64, AnalysisError> {
-        Ok(20.0 * (siso_response(sys, w)?.norm() / g0).log10() - drop_db)
+        Ok(20.0 * (resolvent.siso(w)?.norm() / g0).log10() - drop_db)
     };
-    let grid = search_grid(sys)?;
+    let grid = grid_of(sys, &resolvent)?;
     let (mut w_prev, mut f_prev) = (0.0, -drop_db);
     for &w in &grid {
         let f = match level(w) {
@@ -69,6 +70,7 @@ pub fn first_level_crossing(
     level_db: f64,
 ) -> Result<Option<LevelCrossing>, AnalysisError> {
     check_siso(sys, "first_level_crossing")?;
+    let resolvent = Resolvent::new(sys);
     if !level_db.is_finite() {
         return Err(AnalysisError::BadParameter {
             name: "level_db",
@@ -77,10 +79,10 @@ pub fn first_level_crossing(
         });
     }
     let level = |w: f64| -> Result<f64, AnalysisError> {
-        Ok(20.0 * siso_response(sys, w)?.norm().log10() - level_db)
+        Ok(20.0 * resolvent.siso(w)?.norm().log10() - level_db)
     };
     let mut prev: Option<(f64, f64)> = None;
-    for &w in &search_grid(sys)? {
+    for &w in &grid_of(sys, &resolvent)? {
         let f = match level(w) {
             Ok(f) if f.is_finite() => f,
             Ok(_) | Err(AnalysisError::PoleOnContour { .. }) => {
@@ -107,10 +109,11 @@ pub fn first_level_crossing(
 /// `(gain, frequency)`.
 pub fn peak_gain(sys: &StateSpace) -> Result<(f64, f64), AnalysisError> {
     check_siso(sys, "peak_gain")?;
-    let grid = search_grid(sys)?;
+    let resolvent = Resolvent::new(sys);
+    let grid = grid_of(sys, &resolvent)?;
     let gains: Vec<f64> = grid
         .iter()
-        .map(|&w| match siso_response(sys, w) {
+        .map(|&w| match resolvent.siso(w) {
             Ok(g) => Ok(g.norm()),
             Err(AnalysisError::PoleOnContour { .. }) => Ok(f64::INFINITY),
             Err(e) => Err(e),
@@ -125,7 +128,7 @@ pub fn peak_gain(sys: &StateSpace) -> Result<(f64, f64), AnalysisError> {
     let mut best = (g_max, grid[i]);
     if i > 0 && i + 1 < grid.len() {
         let (w, neg) = golden_min(
-            |w| Ok::<f64, AnalysisError>(-siso_response(sys, w)?.norm()),
+            |w| Ok::<f64, AnalysisError>(-resolvent.siso(w)?.norm()),
             grid[i - 1],
             grid[i + 1],
         )?;

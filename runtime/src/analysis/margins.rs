@@ -31,7 +31,7 @@
 //! the delay itself.
 
 use super::error::AnalysisError;
-use super::freqresp::{C64, check_siso, dc_gain, siso_response, transfer_at};
+use super::freqresp::{C64, Resolvent, check_siso, dc_gain};
 use super::scalar_search::{brent_root, golden_min};
 use crate::statespace::StateSpace;
 
@@ -69,14 +69,16 @@ pub struct StabilityMargins {
 /// The stability margins of the SISO loop transfer `loop_tf` (negative feedback convention).
 pub fn stability_margins(loop_tf: &StateSpace) -> Result<StabilityMargins, AnalysisError> {
     check_siso(loop_tf, "stability_margins")?;
-    let grid = search_grid(loop_tf)?;
+    let resolvent = Resolvent::new(loop_tf);
+    let response = |w| resolvent.siso(w);
+    let grid = grid_of(loop_tf, &resolvent)?;
     let samples: Vec<Option<C64>> = grid
         .iter()
-        .map(|&w| sample(loop_tf, w))
+        .map(|&w| sample(&resolvent, w))
         .collect::<Result<_, _>>()?;
     if samples.iter().all(Option::is_none) {
         // Not one point of the grid could be evaluated: report why instead of a loop without crossings.
-        siso_response(loop_tf, grid[0])?;
+        response(grid[0])?;
     }
 
     let mut phase_crossings = Vec::new();
@@ -96,13 +98,13 @@ pub fn stability_margins(loop_tf: &StateSpace) -> Result<StabilityMargins, Analy
         let (g_lo, g_hi) = (l_lo.norm().ln(), l_hi.norm().ln());
         if g_lo.is_finite() && g_hi.is_finite() && ((g_lo > 0.0) != (g_hi > 0.0)) {
             let w = brent_root(
-                |w| Ok::<f64, AnalysisError>(siso_response(loop_tf, w)?.norm().ln()),
+                |w| Ok::<f64, AnalysisError>(response(w)?.norm().ln()),
                 w_lo,
                 w_hi,
                 g_lo,
                 g_hi,
             )?;
-            let l = siso_response(loop_tf, w)?;
+            let l = response(w)?;
             let pm = l.arg().to_degrees().rem_euclid(360.0) - 180.0;
             gain_crossings.push((w, pm));
         }
@@ -111,13 +113,13 @@ pub fn stability_margins(loop_tf: &StateSpace) -> Result<StabilityMargins, Analy
         let (a_lo, a_hi) = ((-l_lo).arg(), (-l_hi).arg());
         if (a_lo > 0.0) != (a_hi > 0.0) && (l_lo.re <= 0.0 || l_hi.re <= 0.0) {
             let w = brent_root(
-                |w| Ok::<f64, AnalysisError>((-siso_response(loop_tf, w)?).arg()),
+                |w| Ok::<f64, AnalysisError>((-response(w)?).arg()),
                 w_lo,
                 w_hi,
                 a_lo,
                 a_hi,
             )?;
-            let l = siso_response(loop_tf, w)?;
+            let l = response(w)?;
             // A jump of arg(−L) from π to −π (the positive real axis) also changes sign; keep true crossings.
             if l.re < 0.0 && l.im.abs() <= 1e-6 * l.norm() {
                 phase_crossings.push((w, 1.0 / l.norm()));
@@ -140,7 +142,7 @@ pub fn stability_margins(loop_tf: &StateSpace) -> Result<StabilityMargins, Analy
         .map(|&(w, pm)| pm.rem_euclid(360.0).to_radians() / w)
         .fold(f64::INFINITY, f64::min);
     let (stability_margin, stability_margin_frequency) =
-        nearest_approach(loop_tf, &grid, &samples)?;
+        nearest_approach(&resolvent, &grid, &samples)?;
 
     Ok(StabilityMargins {
         gain_margin: best_gm.map_or(f64::INFINITY, |c| c.1),
@@ -167,8 +169,8 @@ pub fn stability_margins(loop_tf: &StateSpace) -> Result<StabilityMargins, Analy
 
 /// The loop response at `w`, or `None` on (or, for an overflowing response, next to) a pole of the loop
 /// (such points break brackets).
-fn sample(sys: &StateSpace, w: f64) -> Result<Option<C64>, AnalysisError> {
-    match siso_response(sys, w) {
+fn sample(resolvent: &Resolvent, w: f64) -> Result<Option<C64>, AnalysisError> {
+    match resolvent.siso(w) {
         Ok(l) => Ok(Some(l)),
         Err(AnalysisError::PoleOnContour { .. })
         | Err(AnalysisError::IllConditioned { .. })
@@ -179,7 +181,7 @@ fn sample(sys: &StateSpace, w: f64) -> Result<Option<C64>, AnalysisError> {
 
 /// Smallest `|1 + L|` on the grid, refined around each local minimum.
 fn nearest_approach(
-    sys: &StateSpace,
+    resolvent: &Resolvent,
     grid: &[f64],
     samples: &[Option<C64>],
 ) -> Result<(f64, Option<f64>), AnalysisError> {
@@ -198,7 +200,7 @@ fn nearest_approach(
         let hi = grid.get(i + 1).copied().unwrap_or(grid[i]);
         let (w, d) = if hi > lo {
             golden_min(
-                |w| Ok::<f64, AnalysisError>((siso_response(sys, w)? + 1.0).norm()),
+                |w| Ok::<f64, AnalysisError>((resolvent.siso(w)? + 1.0).norm()),
                 lo,
                 hi,
             )?
@@ -214,6 +216,11 @@ fn nearest_approach(
 
 /// The frequency grid on which crossings are searched (see the module documentation).
 pub fn search_grid(sys: &StateSpace) -> Result<Vec<f64>, AnalysisError> {
+    grid_of(sys, &Resolvent::new(sys))
+}
+
+/// [`search_grid`] with the model's responses from `resolvent`.
+pub(super) fn grid_of(sys: &StateSpace, resolvent: &Resolvent) -> Result<Vec<f64>, AnalysisError> {
     let corners = pole_frequencies(sys);
     let (slow, fast) = corners
         .iter()
@@ -233,7 +240,7 @@ pub fn search_grid(sys: &StateSpace) -> Result<Vec<f64>, AnalysisError> {
         None => {
             // Widen until the loop gain has fallen well below 1 (or stopped falling: a biproper loop).
             for _ in 0..6 {
-                match siso_or_first(sys, high) {
+                match largest_gain(resolvent, high) {
                     Some(g) if g > 0.5 => high *= 100.0,
                     _ => break,
                 }
@@ -251,9 +258,10 @@ pub fn search_grid(sys: &StateSpace) -> Result<Vec<f64>, AnalysisError> {
 }
 
 /// The largest gain of the model at `w`, if it can be evaluated.
-fn siso_or_first(sys: &StateSpace, w: f64) -> Option<f64> {
+fn largest_gain(resolvent: &Resolvent, w: f64) -> Option<f64> {
     let p = C64::new(0.0, w);
-    transfer_at(sys, p, w)
+    resolvent
+        .transfer_at(p, w)
         .ok()
         .map(|g| g.iter().map(|v| v.norm()).fold(0.0, f64::max))
 }

@@ -90,11 +90,13 @@ where
         let compiler = eqs
             .param_jacobian_at(&given, x.as_slice(), u.as_slice(), t, &free)
             .unwrap_or_else(|e| panic!("{path}: {e}"));
+        let all: Vec<usize> = (0..free.len()).collect();
+        let (mut fp, mut hp) = (vec![0.0; NX * all.len()], vec![0.0; NY * all.len()]);
+        assert!(model.jac_p_columns(t, &x, &u, &all, &mut fp));
+        assert!(model.output_jac_p_columns(t, &x, &u, &all, &mut hp));
         for (c, name) in model.param_names().iter().enumerate() {
-            let (mut fc, mut hc) = (SVector::<f64, NX>::zeros(), SVector::<f64, NY>::zeros());
-            assert!(model.jac_p(t, &x, &u, c, &mut fc));
-            assert!(model.output_jac_p(t, &x, &u, c, &mut hc));
-            let got: Vec<f64> = fc.iter().chain(hc.iter()).copied().collect();
+            let (fc, hc) = (&fp[c * NX..(c + 1) * NX], &hp[c * NY..(c + 1) * NY]);
+            let got: Vec<f64> = fc.iter().chain(hc).copied().collect();
             let (want, rounding) = differences(&model, (t, &x, &u), c);
             let symbolic: Vec<f64> = compiler
                 .fp
@@ -114,9 +116,17 @@ where
                 );
             }
         }
-        // No column beyond the parameters.
-        let mut col = SVector::<f64, NX>::zeros();
-        assert!(!model.jac_p(t, &x, &u, free.len(), &mut col));
+        // A subset in any order: the same columns.
+        let some: Vec<usize> = all.iter().rev().step_by(2).copied().collect();
+        let mut part = vec![0.0; NX * some.len()];
+        assert!(model.jac_p_columns(t, &x, &u, &some, &mut part));
+        for (c, &k) in some.iter().enumerate() {
+            assert_eq!(part[c * NX..(c + 1) * NX], fp[k * NX..(k + 1) * NX]);
+        }
+        // No column beyond the parameters, and no columns into a buffer of the wrong length.
+        let mut col = vec![0.0; NX];
+        assert!(!model.jac_p_columns(t, &x, &u, &[free.len()], &mut col));
+        assert!(!model.output_jac_p_columns(t, &x, &u, &[0], &mut vec![0.0; NY + 1]));
     }
 }
 

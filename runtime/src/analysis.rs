@@ -13,11 +13,13 @@ pub mod freqresp;
 pub mod gain;
 pub mod interconnect;
 pub mod margins;
+mod resolvent;
 mod scalar_search;
 
 pub use error::AnalysisError;
 pub use freqresp::{
-    Bode, C64, bode, dc_gain, frequency_response, logspace, siso_response, unwrap_degrees,
+    Bode, C64, Resolvent, bode, dc_gain, frequency_response, logspace, siso_response,
+    unwrap_degrees,
 };
 pub use gain::{LevelCrossing, bandwidth, first_level_crossing, peak_gain};
 pub use interconnect::{

@@ -20,25 +20,31 @@ mod adapter;
 #[cfg(feature = "ode")]
 pub use adapter::Generated;
 
-/// The derivatives of the rates and outputs with respect to one parameter.
+/// The derivatives of the rates and outputs with respect to chosen parameters.
+///
+/// Both methods take the parameter indices of all the columns wanted at once: a generated model evaluates its
+/// whole parameter Jacobian in one pass (the entries share subexpressions), so a fit with several free
+/// parameters pays for one evaluation per rate, not one per parameter.
 pub trait ParamJacobians<const NX: usize, const NU: usize, const NY: usize> {
-    /// Writes `∂f/∂p_index` into `col`; false for an index out of range.
-    fn jac_p(
+    /// Writes `∂f/∂p_k` for each `k` of `indices` into `columns`, one column of `NX` values after another
+    /// (column-major, as an `NX × indices.len()` matrix); false, with `columns` left unspecified, for an index
+    /// out of range or `columns.len() != NX * indices.len()`.
+    fn jac_p_columns(
         &self,
         t: f64,
         x: &SVector<f64, NX>,
         u: &SVector<f64, NU>,
-        index: usize,
-        col: &mut SVector<f64, NX>,
+        indices: &[usize],
+        columns: &mut [f64],
     ) -> bool;
 
-    /// Writes `∂h/∂p_index` into `col`; false for an index out of range.
-    fn output_jac_p(
+    /// Writes `∂h/∂p_k` for each `k` of `indices` into `columns` likewise (`NY` values per column).
+    fn output_jac_p_columns(
         &self,
         t: f64,
         x: &SVector<f64, NX>,
         u: &SVector<f64, NU>,
-        index: usize,
-        col: &mut SVector<f64, NY>,
+        indices: &[usize],
+        columns: &mut [f64],
     ) -> bool;
 }

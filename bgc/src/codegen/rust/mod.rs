@@ -26,8 +26,8 @@
 //!   `solve_loops(p, t, x, u) -> Result<Tears, LoopError>` (damped Newton's method per block, see
 //!   `codegen::loops`); the functions above solve the loops first and give NaN where `solve_loops` fails;
 //! - `Model` (the parameters, validated) and, with [`Options::runtime`], its implementations of
-//!   `bgc_runtime::model::ContinuousModel`, `Parametric` and `bgc_runtime::fit::generated::ParamJacobians` (a column of
-//!   `jac_p_into` or `output_jac_p_into` by index, for `Generated::exact`).
+//!   `bgc_runtime::model::ContinuousModel`, `Parametric` and `bgc_runtime::fit::generated::ParamJacobians` (the columns
+//!   of given parameter indices from `jac_p_into` or `output_jac_p_into`, for `Generated::exact`).
 //!
 //! Bodies of more than `parts::MAX_PART_STATEMENTS` independent statements are split into private parts (see
 //! `parts`), and `validate` checks each distinct (element value, rule) once.

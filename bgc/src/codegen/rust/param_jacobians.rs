@@ -5,7 +5,7 @@
 //! derived parameter moves with those it is defined from, see [`crate::equations::ParamChain`]). As in `jac_x_into`,
 //! a model with nonlinear algebraic loops adds `∂g/∂z dz/dp` with `dz/dp = −(∂r/∂z)⁻¹ ∂r/∂p`, and the mass-matrix
 //! rows of an I-field are solved from `M ∂ḟ/∂p = ∂F/∂p − (∂M/∂p) ḟ`. With the runtime, `Model` implements
-//! `bgc_runtime::fit::generated::ParamJacobians` (one column by index) from them, for `Generated::exact`.
+//! `bgc_runtime::fit::generated::ParamJacobians` (the columns of given indices) from them, for `Generated::exact`.
 
 use super::super::format;
 use super::super::mass::MassColumns;
@@ -106,22 +106,27 @@ pub type OutJacP = SMatrix<f64, N_OUTPUTS, N_PARAMS>;
         self.model_function(name, doc, d, Arg::new("jac", ty, true));
     }
 
-    /// The runtime's `ParamJacobians` for `Model`: each column copied from the full matrix (none without free
-    /// parameters).
+    /// The runtime's `ParamJacobians` for `Model`: the requested columns copied from the full matrix,
+    /// evaluated once per call (no column exists without free parameters).
     pub(super) fn param_jacobians_impl(&mut self) {
         let empty = self.free.is_empty();
         let arg = |name: &str, ty: &str| {
-            let underscore = if empty { "_" } else { "" };
+            let underscore = if empty && name != "indices" { "_" } else { "" };
             format!("{underscore}{name}: {ty}")
         };
         let mut text = String::from(
             "\nimpl bgc_runtime::fit::generated::ParamJacobians<N_STATES, N_INPUTS, N_OUTPUTS> for Model {\n",
         );
         let methods = [
-            ("jac_p", "jac_p_into", "JacP", "State"),
-            ("output_jac_p", "output_jac_p_into", "OutJacP", "Outputs"),
+            ("jac_p_columns", "jac_p_into", "JacP", "N_STATES"),
+            (
+                "output_jac_p_columns",
+                "output_jac_p_into",
+                "OutJacP",
+                "N_OUTPUTS",
+            ),
         ];
-        for (k, (method, function, ty, column)) in methods.into_iter().enumerate() {
+        for (k, (method, function, ty, rows)) in methods.into_iter().enumerate() {
             if k > 0 {
                 text.push('\n');
             }
@@ -130,8 +135,8 @@ pub type OutJacP = SMatrix<f64, N_OUTPUTS, N_PARAMS>;
                 arg("t", "f64"),
                 arg("x", "&State"),
                 arg("u", "&Inputs"),
-                arg("index", "usize"),
-                arg("col", &format!("&mut {column}")),
+                arg("indices", "&[usize]"),
+                arg("columns", "&mut [f64]"),
             ];
             let head = format!("fn {method}");
             text.push_str(&format::signature(
@@ -139,15 +144,19 @@ pub type OutJacP = SMatrix<f64, N_OUTPUTS, N_PARAMS>;
             ));
             text.push('\n');
             if empty {
-                text.push_str("        false\n");
+                text.push_str("        indices.is_empty()\n");
             } else {
                 text.push_str(&format!(
-                    "        if index >= N_PARAMS {{
+                    "        let valid = |&k: &usize| k < N_PARAMS;
+        if columns.len() != {rows} * indices.len() || !indices.iter().all(valid) {{
             return false;
         }}
         let mut jac = {ty}::zeros();
         {function}(&self.params, t, x, u, &mut jac);
-        col.copy_from(&jac.column(index));
+        for (c, &k) in indices.iter().enumerate() {{
+            let column = &jac.as_slice()[k * {rows}..(k + 1) * {rows}];
+            columns[c * {rows}..(c + 1) * {rows}].copy_from_slice(column);
+        }}
         true
 "
                 ));

@@ -6,15 +6,14 @@ use super::ParamJacobians;
 use crate::fit::sensitivity::FitModel;
 use crate::model::{ContinuousModel, Parametric};
 
-type RateColumn<M, const NX: usize, const NU: usize> =
-    fn(&M, f64, &SVector<f64, NX>, &SVector<f64, NU>, usize, &mut SVector<f64, NX>) -> bool;
-type OutputColumn<M, const NX: usize, const NU: usize, const NY: usize> =
-    fn(&M, f64, &SVector<f64, NX>, &SVector<f64, NU>, usize, &mut SVector<f64, NY>) -> bool;
+/// A [`ParamJacobians`] method: the columns of the given parameter indices, column-major.
+type Columns<M, const NX: usize, const NU: usize> =
+    fn(&M, f64, &SVector<f64, NX>, &SVector<f64, NU>, &[usize], &mut [f64]) -> bool;
 
 /// A fixed-size model adapted to [`FitModel`].
 pub struct Generated<M, const NX: usize, const NU: usize, const NY: usize> {
     model: M,
-    exact: Option<(RateColumn<M, NX, NU>, OutputColumn<M, NX, NU, NY>)>,
+    exact: Option<(Columns<M, NX, NU>, Columns<M, NX, NU>)>,
     linear: bool,
 }
 
@@ -38,7 +37,7 @@ where
     {
         Generated {
             model,
-            exact: Some((M::jac_p, M::output_jac_p)),
+            exact: Some((M::jac_p_columns, M::output_jac_p_columns)),
             linear: false,
         }
     }
@@ -90,32 +89,31 @@ where
     }
 }
 
-impl<M, const NX: usize, const NU: usize, const NY: usize> Generated<M, NX, NU, NY> {
-    /// The matrix whose columns are `column(k)` for the free parameters `k`.
-    fn param_columns<const R: usize>(
-        &self,
-        free: &[usize],
-        column: impl Fn(usize) -> Result<SVector<f64, R>, String>,
-    ) -> Result<DMatrix<f64>, String> {
-        let mut m = DMatrix::zeros(R, free.len());
-        for (c, &k) in free.iter().enumerate() {
-            m.column_mut(c).copy_from(&column(k)?);
+/// The `rows × free.len()` matrix of the parameter columns of `free`: from the model's exact columns when it
+/// has them (`false` means an index that is no parameter), else column by column from `difference`.
+fn param_columns(
+    rows: usize,
+    free: &[usize],
+    exact: Option<impl FnOnce(&mut [f64]) -> bool>,
+    difference: impl Fn(usize) -> Result<DMatrix<f64>, String>,
+) -> Result<DMatrix<f64>, String> {
+    let mut m = DMatrix::zeros(rows, free.len());
+    if free.is_empty() {
+        return Ok(m);
+    }
+    match exact {
+        Some(fill) => {
+            if !fill(m.as_mut_slice()) {
+                return Err(format!("no parameter among {free:?}"));
+            }
         }
-        Ok(m)
+        None => {
+            for (c, &k) in free.iter().enumerate() {
+                m.column_mut(c).copy_from(&difference(k)?);
+            }
+        }
     }
-}
-
-/// A column filled by a [`ParamJacobians`] method, which answers `false` for an index that is no parameter.
-fn exact_column<const R: usize>(
-    fill: impl FnOnce(&mut SVector<f64, R>) -> bool,
-    k: usize,
-) -> Result<SVector<f64, R>, String> {
-    let mut col = SVector::zeros();
-    if fill(&mut col) {
-        Ok(col)
-    } else {
-        Err(format!("no parameter {k}"))
-    }
+    Ok(m)
 }
 
 fn fixed<const N: usize>(v: &[f64]) -> SVector<f64, N> {
@@ -177,9 +175,15 @@ where
         // On the heap, written there: an `NX × NX` matrix takes 8 MB at 1,000 states.
         let mut a: Box<SMatrix<f64, NX, NX>> = bytemuck::zeroed_box();
         self.model.jac_x(t, &x, &u, &mut a);
-        let fp = self.param_columns(free, |k| match self.exact {
-            Some((jac_p, _)) => exact_column(|col| jac_p(&self.model, t, &x, &u, k, col), k),
-            None => Ok(self.difference(t, &x, &u, k)?.0),
+        let exact = self
+            .exact
+            .map(|(columns, _)| move |out: &mut [f64]| columns(&self.model, t, &x, &u, free, out));
+        let fp = param_columns(NX, free, exact, |k| {
+            Ok(DMatrix::from_column_slice(
+                NX,
+                1,
+                self.difference(t, &x, &u, k)?.0.as_slice(),
+            ))
         })?;
         Ok((DMatrix::from_column_slice(NX, NX, a.as_slice()), fp))
     }
@@ -194,11 +198,15 @@ where
         let (x, u) = (fixed::<NX>(x), fixed::<NU>(u));
         let mut c_mat: Box<SMatrix<f64, NY, NX>> = bytemuck::zeroed_box();
         self.model.output_jac_x(t, &x, &u, &mut c_mat);
-        let hp = self.param_columns(free, |k| match self.exact {
-            Some((_, output_jac_p)) => {
-                exact_column(|col| output_jac_p(&self.model, t, &x, &u, k, col), k)
-            }
-            None => Ok(self.difference(t, &x, &u, k)?.1),
+        let exact = self
+            .exact
+            .map(|(_, columns)| move |out: &mut [f64]| columns(&self.model, t, &x, &u, free, out));
+        let hp = param_columns(NY, free, exact, |k| {
+            Ok(DMatrix::from_column_slice(
+                NY,
+                1,
+                self.difference(t, &x, &u, k)?.1.as_slice(),
+            ))
         })?;
         Ok((DMatrix::from_column_slice(NY, NX, c_mat.as_slice()), hp))
     }

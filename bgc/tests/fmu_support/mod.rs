@@ -5,7 +5,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Mutex, OnceLock};
+use std::sync::{Mutex, Once, OnceLock};
 
 pub fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -45,27 +45,7 @@ pub fn python() -> &'static Path {
                 .is_ok_and(|o| o.status.success())
         };
         if !ready(&python) {
-            let made = run(Command::new("python3").args(["-m", "venv"]).arg(&venv));
-            assert!(
-                made.status.success(),
-                "python3 -m venv {} failed:\n{}",
-                venv.display(),
-                text(&made.stderr)
-            );
-            let pip = run(Command::new(&python).args([
-                "-m",
-                "pip",
-                "install",
-                "--quiet",
-                "fmpy",
-                "libcosimpy",
-            ]));
-            assert!(
-                pip.status.success(),
-                "pip install fmpy libcosimpy failed:\n{}{}",
-                text(&pip.stdout),
-                text(&pip.stderr)
-            );
+            make_venv(&venv, &python);
             assert!(
                 ready(&python),
                 "fmpy or libcosimpy does not import after pip install"
@@ -75,8 +55,65 @@ pub fn python() -> &'static Path {
     })
 }
 
+/// Starts making the virtual environment in the background (once), so that it overlaps the FMUs' builds.
+fn prepare_python() {
+    static STARTED: Once = Once::new();
+    STARTED.call_once(|| {
+        std::thread::spawn(|| {
+            // A failure here is reported by the test that calls `python()` next, which tries again.
+            let _ = std::panic::catch_unwind(python);
+        });
+    });
+}
+
+/// A virtual environment at `venv` with FMPy and libcosimpy. The host's pip installs into an environment made
+/// without a pip of its own when it can (`pip --python`, pip 22.3 and later), which saves bootstrapping a second
+/// pip; otherwise the environment's own pip does.
+fn make_venv(venv: &Path, python: &Path) {
+    let install = [
+        "install",
+        "--quiet",
+        "--no-compile",
+        "--disable-pip-version-check",
+    ];
+    let packages = ["fmpy", "libcosimpy"];
+    let bare = run(Command::new("python3")
+        .args(["-m", "venv", "--clear", "--without-pip"])
+        .arg(venv));
+    if bare.status.success() {
+        let host = run(Command::new("python3")
+            .args(["-m", "pip", "--python"])
+            .arg(python)
+            .args(install)
+            .args(packages));
+        if host.status.success() {
+            return;
+        }
+    }
+    let made = run(Command::new("python3")
+        .args(["-m", "venv", "--clear"])
+        .arg(venv));
+    assert!(
+        made.status.success(),
+        "python3 -m venv {} failed:\n{}",
+        venv.display(),
+        text(&made.stderr)
+    );
+    let pip = run(Command::new(python)
+        .args(["-m", "pip"])
+        .args(install)
+        .args(packages));
+    assert!(
+        pip.status.success(),
+        "pip install fmpy libcosimpy failed:\n{}{}",
+        text(&pip.stdout),
+        text(&pip.stderr)
+    );
+}
+
 /// The FMU of `model` (a path relative to the workspace) for FMI `version`, built once per test run.
 pub fn fmu(model: &str, version: u8) -> PathBuf {
+    prepare_python();
     static BUILT: Mutex<Option<HashMap<(String, u8), PathBuf>>> = Mutex::new(None);
     let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
     let map = built.get_or_insert_with(HashMap::new);
@@ -239,6 +276,7 @@ fn driver() -> PathBuf {
 
 /// FMPy's simulation of the FMU (`ModelExchange` or `CoSimulation`).
 pub fn fmpy_simulate(fmu: &Path, kind: &str, s: &Scenario, rtol: f64) -> Table {
+    let scenario = scenario_file(s);
     let o = run(Command::new(python())
         .arg(driver())
         .arg("simulate")
@@ -249,19 +287,24 @@ pub fn fmpy_simulate(fmu: &Path, kind: &str, s: &Scenario, rtol: f64) -> Table {
             &s.dt.to_string(),
             &rtol.to_string(),
         ])
-        .arg(scenario_file(s)));
+        .arg(&scenario));
+    // Written for this run only.
+    let _ = std::fs::remove_file(&scenario);
     assert!(o.status.success(), "FMPy {kind}: {}", text(&o.stderr));
     Table::parse(&text(&o.stdout))
 }
 
 /// libcosim's Co-Simulation of an FMI 2.0 FMU, the inputs held over each communication step of `s.dt`.
 pub fn libcosim_simulate(fmu: &Path, s: &Scenario) -> Table {
+    let scenario = scenario_file(s);
     let o = run(Command::new(python())
         .arg(driver())
         .arg("libcosim")
         .arg(fmu)
         .args([&s.t_end.to_string(), &s.dt.to_string()])
-        .arg(scenario_file(s)));
+        .arg(&scenario));
+    // Written for this run only.
+    let _ = std::fs::remove_file(&scenario);
     assert!(o.status.success(), "libcosim: {}", text(&o.stderr));
     Table::parse(&text(&o.stdout))
 }
@@ -309,11 +352,14 @@ pub struct Jacobians {
 }
 
 pub fn fmpy_jacobian(fmu: &Path, s: &Scenario) -> Jacobians {
+    let scenario = scenario_file(s);
     let o = run(Command::new(python())
         .arg(driver())
         .arg("jacobian")
         .arg(fmu)
-        .arg(scenario_file(s)));
+        .arg(&scenario));
+    // Written for this run only.
+    let _ = std::fs::remove_file(&scenario);
     assert!(o.status.success(), "FMPy jacobian: {}", text(&o.stderr));
     let v: serde_json::Value =
         serde_json::from_str(&text(&o.stdout)).unwrap_or_else(|e| panic!("{e}"));

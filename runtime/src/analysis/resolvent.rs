@@ -28,6 +28,8 @@ pub struct Resolvent {
     c: DMatrix<f64>,
     d: DMatrix<f64>,
     dt: Option<f64>,
+    /// The reduction overflowed (entries near `f64::MAX` whose squares are not finite): no point can be trusted.
+    overflowed: bool,
 }
 
 impl Resolvent {
@@ -39,12 +41,16 @@ impl Resolvent {
             let (q, h) = Hessenberg::new(sys.a().clone()).unpack();
             (h, q.tr_mul(sys.b()), sys.c() * q)
         };
+        let overflowed = [&h, &b, &c]
+            .iter()
+            .any(|m| m.iter().any(|v| !v.is_finite()));
         Self {
             h,
             b,
             c,
             d: sys.d().clone(),
             dt: sys.dt(),
+            overflowed,
         }
     }
 
@@ -91,6 +97,9 @@ impl Resolvent {
         let n = self.h.nrows();
         if n == 0 {
             return Ok(Vec::new());
+        }
+        if self.overflowed {
+            return Err(AnalysisError::Overflow { omega });
         }
         let b: Vec<C64> = self.b.iter().map(|&v| real(v)).collect();
         let mut u = self.shifted(p);
@@ -347,5 +356,19 @@ mod tests {
             g,
             DMatrix::from_row_slice(2, 1, &[C64::new(3.0, 0.0), C64::new(-0.5, 0.0)])
         );
+    }
+
+    #[test]
+    fn entries_whose_squares_overflow_are_an_overflow_not_a_number() {
+        let a = DMatrix::from_fn(4, 4, |i, j| if i == j { -1e300 } else { 1e300 });
+        let sys = StateSpace::new(
+            a,
+            DMatrix::from_element(4, 1, 1.0),
+            DMatrix::from_element(1, 4, 1.0),
+            DMatrix::zeros(1, 1),
+        )
+        .expect("a valid model");
+        let e = Resolvent::new(&sys).response(1.0).expect_err("overflows");
+        assert!(matches!(e, AnalysisError::Overflow { .. }), "{e:?}");
     }
 }

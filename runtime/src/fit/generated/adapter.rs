@@ -87,33 +87,37 @@ where
             (Err(e), _) => Err(e),
         }
     }
-}
 
-/// The `rows × free.len()` matrix of the parameter columns of `free`: from the model's exact columns when it
-/// has them (`false` means an index that is no parameter), else column by column from `difference`.
-fn param_columns(
-    rows: usize,
-    free: &[usize],
-    exact: Option<impl FnOnce(&mut [f64]) -> bool>,
-    difference: impl Fn(usize) -> Result<DMatrix<f64>, String>,
-) -> Result<DMatrix<f64>, String> {
-    let mut m = DMatrix::zeros(rows, free.len());
-    if free.is_empty() {
-        return Ok(m);
-    }
-    match exact {
-        Some(fill) => {
-            if !fill(m.as_mut_slice()) {
-                return Err(format!("no parameter among {free:?}"));
+    /// The columns of `∂f/∂p` (of `∂h/∂p` for `output`) of the parameters `free`: all from one call of the
+    /// model's exact columns when it has them (`false` there means an index that is no parameter), else column
+    /// by column by central differences.
+    fn param_matrix(
+        &self,
+        (t, x, u): (f64, &SVector<f64, NX>, &SVector<f64, NU>),
+        free: &[usize],
+        output: bool,
+    ) -> Result<DMatrix<f64>, String> {
+        let mut m = DMatrix::zeros(if output { NY } else { NX }, free.len());
+        if free.is_empty() {
+            return Ok(m);
+        }
+        match self.exact {
+            Some((rate, out)) => {
+                let columns = if output { out } else { rate };
+                if !columns(&self.model, t, x, u, free, m.as_mut_slice()) {
+                    return Err(format!("no parameter among {free:?}"));
+                }
+            }
+            None => {
+                for (c, &k) in free.iter().enumerate() {
+                    let (f, h) = self.difference(t, x, u, k)?;
+                    let column = if output { h.as_slice() } else { f.as_slice() };
+                    m.column_mut(c).copy_from_slice(column);
+                }
             }
         }
-        None => {
-            for (c, &k) in free.iter().enumerate() {
-                m.column_mut(c).copy_from(&difference(k)?);
-            }
-        }
+        Ok(m)
     }
-    Ok(m)
 }
 
 fn fixed<const N: usize>(v: &[f64]) -> SVector<f64, N> {
@@ -175,16 +179,7 @@ where
         // On the heap, written there: an `NX × NX` matrix takes 8 MB at 1,000 states.
         let mut a: Box<SMatrix<f64, NX, NX>> = bytemuck::zeroed_box();
         self.model.jac_x(t, &x, &u, &mut a);
-        let exact = self
-            .exact
-            .map(|(columns, _)| move |out: &mut [f64]| columns(&self.model, t, &x, &u, free, out));
-        let fp = param_columns(NX, free, exact, |k| {
-            Ok(DMatrix::from_column_slice(
-                NX,
-                1,
-                self.difference(t, &x, &u, k)?.0.as_slice(),
-            ))
-        })?;
+        let fp = self.param_matrix((t, &x, &u), free, false)?;
         Ok((DMatrix::from_column_slice(NX, NX, a.as_slice()), fp))
     }
 
@@ -198,16 +193,7 @@ where
         let (x, u) = (fixed::<NX>(x), fixed::<NU>(u));
         let mut c_mat: Box<SMatrix<f64, NY, NX>> = bytemuck::zeroed_box();
         self.model.output_jac_x(t, &x, &u, &mut c_mat);
-        let exact = self
-            .exact
-            .map(|(_, columns)| move |out: &mut [f64]| columns(&self.model, t, &x, &u, free, out));
-        let hp = param_columns(NY, free, exact, |k| {
-            Ok(DMatrix::from_column_slice(
-                NY,
-                1,
-                self.difference(t, &x, &u, k)?.1.as_slice(),
-            ))
-        })?;
+        let hp = self.param_matrix((t, &x, &u), free, true)?;
         Ok((DMatrix::from_column_slice(NY, NX, c_mat.as_slice()), hp))
     }
 }

@@ -70,12 +70,7 @@ fn prepare_python() {
 /// without a pip of its own when it can (`pip --python`, pip 22.3 and later), which saves bootstrapping a second
 /// pip; otherwise the environment's own pip does.
 fn make_venv(venv: &Path, python: &Path) {
-    let install = [
-        "install",
-        "--quiet",
-        "--no-compile",
-        "--disable-pip-version-check",
-    ];
+    let install = ["install", "--quiet", "--disable-pip-version-check"];
     let packages = ["fmpy", "libcosimpy"];
     let bare = run(Command::new("python3")
         .args(["-m", "venv", "--clear", "--without-pip"])

@@ -176,11 +176,20 @@ pub fn unwrap_degrees(phase: &[f64]) -> Vec<f64> {
 }
 
 pub(crate) fn check_siso(sys: &StateSpace, what: &'static str) -> Result<(), AnalysisError> {
-    if sys.n_inputs() != 1 || sys.n_outputs() != 1 {
+    check_siso_shape(what, sys.n_outputs(), sys.n_inputs())
+}
+
+/// [`check_siso`] for a model of `outputs` outputs and `inputs` inputs.
+pub(super) fn check_siso_shape(
+    what: &'static str,
+    outputs: usize,
+    inputs: usize,
+) -> Result<(), AnalysisError> {
+    if (outputs, inputs) != (1, 1) {
         return Err(AnalysisError::NotSiso {
             what,
-            inputs: sys.n_inputs(),
-            outputs: sys.n_outputs(),
+            inputs,
+            outputs,
         });
     }
     Ok(())

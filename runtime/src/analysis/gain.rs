@@ -1,9 +1,9 @@
 //! Gain-based figures of a SISO model: the bandwidth relative to the DC gain, the first crossing of an
 //! absolute level, and the peak gain.
 //!
-//! All three scan the grid of [`search_grid`](super::margins::search_grid) (dense logarithmic, pole frequencies inserted) and refine by
-//! Brent's method (crossings) or golden-section search (the peak). Frequencies are in rad/s; divide by `2π`
-//! for Hz (the back-support paper quotes its disturbance-rejection bandwidth, 52 Hz, in Hz).
+//! All three scan the grid of [`search_grid`](super::margins::search_grid) (dense logarithmic, pole frequencies
+//! inserted) and refine by Brent's method (crossings) or golden-section search (the peak). Frequencies are in
+//! rad/s; divide by `2π` for Hz (the back-support paper quotes its disturbance-rejection bandwidth, 52 Hz, in Hz).
 
 use super::error::AnalysisError;
 use super::freqresp::{Resolvent, check_siso, dc_gain};
@@ -18,7 +18,6 @@ use crate::statespace::StateSpace;
 /// definition ("the first frequency in which the gain descends to below −3 dB of its DC value").
 pub fn bandwidth(sys: &StateSpace, drop_db: f64) -> Result<Option<f64>, AnalysisError> {
     check_siso(sys, "bandwidth")?;
-    let resolvent = Resolvent::new(sys);
     if !(drop_db.is_finite() && drop_db < 0.0) {
         return Err(AnalysisError::BadParameter {
             name: "drop_db",
@@ -30,6 +29,7 @@ pub fn bandwidth(sys: &StateSpace, drop_db: f64) -> Result<Option<f64>, Analysis
     if g0 == 0.0 {
         return Err(AnalysisError::ZeroDcGain);
     }
+    let resolvent = Resolvent::new(sys);
     let level = |w: f64| -> Result<f64, AnalysisError> {
         Ok(20.0 * (resolvent.siso(w)?.norm() / g0).log10() - drop_db)
     };
@@ -70,7 +70,6 @@ pub fn first_level_crossing(
     level_db: f64,
 ) -> Result<Option<LevelCrossing>, AnalysisError> {
     check_siso(sys, "first_level_crossing")?;
-    let resolvent = Resolvent::new(sys);
     if !level_db.is_finite() {
         return Err(AnalysisError::BadParameter {
             name: "level_db",
@@ -78,6 +77,7 @@ pub fn first_level_crossing(
             reason: "the level must be a finite number of dB",
         });
     }
+    let resolvent = Resolvent::new(sys);
     let level = |w: f64| -> Result<f64, AnalysisError> {
         Ok(20.0 * resolvent.siso(w)?.norm().log10() - level_db)
     };

@@ -257,11 +257,10 @@ pub(super) fn grid_of(sys: &StateSpace, resolvent: &Resolvent) -> Result<Vec<f64
     Ok(grid)
 }
 
-/// The largest gain of the model at `w`, if it can be evaluated.
+/// The largest gain of the continuous model at `w`, if it can be evaluated.
 fn largest_gain(resolvent: &Resolvent, w: f64) -> Option<f64> {
-    let p = C64::new(0.0, w);
     resolvent
-        .transfer_at(p, w)
+        .response(w)
         .ok()
         .map(|g| g.iter().map(|v| v.norm()).fold(0.0, f64::max))
 }

@@ -14,7 +14,7 @@ use nalgebra::DMatrix;
 use nalgebra::linalg::Hessenberg;
 
 use super::error::AnalysisError;
-use super::freqresp::{C64, RESIDUAL_LIMIT, point_of};
+use super::freqresp::{C64, RESIDUAL_LIMIT, check_siso_shape, point_of};
 use crate::statespace::StateSpace;
 
 /// A model prepared for evaluating its transfer matrix at many points.
@@ -62,13 +62,7 @@ impl Resolvent {
     /// The response of a SISO model at frequency `omega` (rad/s).
     pub fn siso(&self, omega: f64) -> Result<C64, AnalysisError> {
         let (outputs, inputs) = self.d.shape();
-        if (outputs, inputs) != (1, 1) {
-            return Err(AnalysisError::NotSiso {
-                what: "Resolvent::siso",
-                inputs,
-                outputs,
-            });
-        }
+        check_siso_shape("Resolvent::siso", outputs, inputs)?;
         Ok(self.response(omega)?[(0, 0)])
     }
 
@@ -102,14 +96,14 @@ impl Resolvent {
             return Err(AnalysisError::Overflow { omega });
         }
         let b: Vec<C64> = self.b.iter().map(|&v| real(v)).collect();
-        let mut u = self.shifted(p);
+        let shifted = self.shifted(p);
+        let mut u = shifted.clone();
         let mut x = b.clone();
         eliminate_subdiagonal(n, &mut u, &mut x);
         back_substitute(n, &u, &mut x).ok_or(AnalysisError::PoleOnContour { omega })?;
         if x.iter().any(|v| !is_finite(*v)) {
             return Err(AnalysisError::PoleOnContour { omega });
         }
-        let shifted = self.shifted(p);
         let residual = residual_norm(n, &shifted, &x, &b);
         let scale = frobenius(&shifted) * frobenius(&x) + frobenius(&b);
         if !(residual.is_finite() && scale.is_finite()) {
@@ -139,6 +133,8 @@ impl Resolvent {
 
 // Complex arithmetic written out on `f64`. In lightly optimised builds (the test profile) the generic
 // operators of `Complex` stay function calls, and these loops are the whole cost of a margin search.
+
+const ZERO: C64 = C64 { re: 0.0, im: 0.0 };
 
 #[inline(always)]
 fn real(v: f64) -> C64 {
@@ -203,7 +199,6 @@ fn frobenius(m: &[C64]) -> f64 {
 /// operations to the columns of `x`. Only rows `k` and `k + 1` meet at step `k`, so the partial pivoting
 /// chooses between those two.
 fn eliminate_subdiagonal(n: usize, u: &mut [C64], x: &mut [C64]) {
-    let zero = C64 { re: 0.0, im: 0.0 };
     for k in 0..n.saturating_sub(1) {
         let (diag, below) = (k * n + k, k * n + k + 1);
         if abs2(u[below]) > abs2(u[diag]) {
@@ -215,12 +210,12 @@ fn eliminate_subdiagonal(n: usize, u: &mut [C64], x: &mut [C64]) {
                 column.swap(k, k + 1);
             }
         }
-        if u[below] == zero || u[diag] == zero {
+        if u[below] == ZERO || u[diag] == ZERO {
             // Nothing to eliminate; a zero pivot with a zero below it is caught by the back substitution.
             continue;
         }
         let f = div(u[below], u[diag]);
-        u[below] = zero;
+        u[below] = ZERO;
         for j in k + 1..n {
             u[j * n + k + 1] = sub(u[j * n + k + 1], mul(f, u[j * n + k]));
         }
@@ -233,11 +228,10 @@ fn eliminate_subdiagonal(n: usize, u: &mut [C64], x: &mut [C64]) {
 /// Solves the `n × n` upper triangular `u` (column-major) in place of the columns of `x`; `None` on a zero
 /// pivot (a singular matrix).
 fn back_substitute(n: usize, u: &[C64], x: &mut [C64]) -> Option<()> {
-    let zero = C64 { re: 0.0, im: 0.0 };
     for column in x.chunks_mut(n) {
         for i in (0..n).rev() {
             let pivot = u[i * n + i];
-            if pivot == zero {
+            if pivot == ZERO {
                 return None;
             }
             column[i] = div(column[i], pivot);

@@ -9,7 +9,8 @@
 //! counted into a C, I, R and out of a source (docs/language.md). bgc's `C (sI − A)⁻¹ B + D` must agree.
 //!
 //! The graphs: a random tree of 0- and 1-junctions joined by bonds, TFs or GYs in random directions, one-ports of
-//! every kind hung on them in random directions, an effort and a flow source; structures that give storages in
+//! every kind hung on them in random directions, an effort and a flow source, and up to two more bonds, TFs or GYs
+//! between junctions that close loops in the junction structure; structures that give storages in
 //! derivative causality and resistive loops occur. Cases that bgc rightly refuses (an output that needs an input's
 //! derivative, causal conflicts) are skipped.
 
@@ -83,6 +84,24 @@ fn random_model(seed: u64) -> (Model, Vec<(String, K)>) {
         let j = junctions[g.below(junctions.len() as u64) as usize];
         bond(&mut b, &mut g, node, j);
         ports.push((name, kind));
+    }
+    // Loops in the junction structure: bonds (or TFs and GYs) between junctions the tree already joins.
+    for k in 0..g.below(3) {
+        let x = junctions[g.below(junctions.len() as u64) as usize];
+        let y = junctions[g.below(junctions.len() as u64) as usize];
+        if x == y {
+            continue;
+        }
+        match g.below(3) {
+            0 => bond(&mut b, &mut g, x, y),
+            kind => {
+                let modulus = b.param(&format!("l{k}"), g.value());
+                let two = if kind == 1 { K::TF } else { K::GY };
+                let node = b.node(two, &format!("tl{k}"), linear_modulus(modulus));
+                b.bond(x, node);
+                b.bond(node, y);
+            }
+        }
     }
     let nodes: Vec<_> = b.model.graph.node_indices().collect();
     for (name, _) in &ports {
@@ -334,14 +353,20 @@ proptest! {
     }
 }
 
-/// The generator produces enough well-posed cases to mean something: of 64 fixed seeds, most are compared.
+/// The generator produces enough well-posed cases to mean something: of 64 fixed seeds, most are compared, some
+/// with a loop in the junction structure.
 #[test]
 fn most_random_graphs_are_compared() {
-    let mut compared = 0;
+    let (mut compared, mut loops) = (0, 0);
     for seed in 0..64u64 {
         if compare(seed).unwrap_or_else(|e| panic!("{e}")) {
             compared += 1;
+            loops += usize::from(has_junction_loop(&random_model(seed).0));
         }
     }
     assert!(compared >= 20, "only {compared} of 64 graphs were compared");
+    assert!(
+        loops >= 10,
+        "only {loops} compared graphs have a loop in the junction structure"
+    );
 }

@@ -4,7 +4,8 @@
 //! The graphs: a random tree of 0- and 1-junctions joined by bonds, TFs, GYs, MTFs and MGYs in random directions
 //! (an MTF or MGY modulus `n (1 + 0.3 cos(q(C)))`, `n (1 + 0.3 sin(p(I)))` or `n (1 + 0.3 cos(w))` of an input
 //! `w`), one-ports hung on them in random directions with linear or cubic laws (`C { e = q/c + k q^3 }`,
-//! `I { f = p/m + k p^3 }`, `R { e = r f + k f^3 }` or `R { f = e/r + k e^3 }`), an effort and a flow source.
+//! `I { f = p/m + k p^3 }`, `R { e = r f + k f^3 }` or `R { f = e/r + k e^3 }`), an effort and a flow source,
+//! and up to two more bonds or two-ports between junctions that close loops in the junction structure.
 //!
 //! The reference (`reference.rs`) knows nothing of causality. At a point `(x, u, t)` every storage state bgc keeps
 //! is given, so its law gives its effort (C) or its flow (I); every bond's effort and flow is an unknown, solved by
@@ -160,6 +161,33 @@ fn random_model(seed: u64, rewrite: &Rewrite) -> Model {
             continue;
         };
         b.model.graph[node].relation = Relation::Modulus(mul(n, add(c(1.0), mul(c(0.3), wave))));
+    }
+    // Loops in the junction structure: bonds and two-ports between junctions the tree already joins.
+    for k in 0..g.below(3) {
+        let x = junctions[g.below(junctions.len() as u64) as usize];
+        let y = junctions[g.below(junctions.len() as u64) as usize];
+        if x == y {
+            continue;
+        }
+        let kind =
+            [None, Some(K::TF), Some(K::GY), Some(K::MTF), Some(K::MGY)][g.below(5) as usize];
+        let Some(kind) = kind else {
+            b.bond(x, y);
+            continue;
+        };
+        let mut modulus = b.param(&format!("l{k}"), g.value());
+        if matches!(kind, K::MTF | K::MGY) {
+            let pick = g.below(storages.len() as u64 + 1) as usize;
+            let wave = match storages.get(pick) {
+                Some(&(s, K::C)) => call(Func::Cos, q(s)),
+                Some(&(s, _)) => call(Func::Sin, p(s)),
+                None => call(Func::Cos, w.clone()),
+            };
+            modulus = mul(modulus, add(c(1.0), mul(c(0.3), wave)));
+        }
+        let node = b.node(kind, &format!("tl{k}"), Relation::Modulus(modulus));
+        b.bond(x, node);
+        b.bond(node, y);
     }
     for node in one_ports {
         let name = b.model.graph[node].name.clone();
@@ -322,11 +350,15 @@ fn check(case: &Case, flip: Flip) -> Result<(), Mismatch> {
 }
 
 /// Compares the first graph of a seed that bgc accepts and the reference solves: `Ok(None)` when there is none,
-/// else whether the compared graph has a storage in derivative causality.
-fn compare(seed: u64) -> Result<Option<bool>, String> {
+/// else whether the compared graph has a storage in derivative causality and whether it has a loop in its junction
+/// structure.
+fn compare(seed: u64) -> Result<Option<(bool, bool)>, String> {
     for case in prepare(seed) {
         match check(&case, Flip::Nothing) {
-            Ok(()) => return Ok(Some(!case.dependent.is_empty())),
+            Ok(()) => {
+                let dependent = !case.dependent.is_empty();
+                return Ok(Some((dependent, has_junction_loop(&case.model))));
+            }
             Err(Mismatch::Unsolved) => continue,
             Err(Mismatch::Differs(why)) => return Err(format!("seed {seed}: {why}")),
         }
@@ -344,16 +376,21 @@ proptest! {
 }
 
 /// Of 64 fixed seeds, enough are compared (within their eight draws) for the property to mean something, graphs
-/// with a storage in derivative causality among them.
+/// with a storage in derivative causality and graphs with a loop in the junction structure among them.
 #[test]
 fn most_modulated_graphs_are_compared() {
-    let (mut compared, mut derivative) = (0, 0);
+    let (mut compared, mut derivative, mut loops) = (0, 0, 0);
     for seed in 0..64u64 {
-        if let Some(dependent) = compare(seed).unwrap_or_else(|e| panic!("{e}")) {
+        if let Some((dependent, with_loop)) = compare(seed).unwrap_or_else(|e| panic!("{e}")) {
             compared += 1;
             derivative += usize::from(dependent);
+            loops += usize::from(with_loop);
         }
     }
+    assert!(
+        loops >= 10,
+        "only {loops} compared graphs have a loop in the junction structure"
+    );
     assert!(compared >= 48, "only {compared} of 64 seeds were compared");
     assert!(
         derivative >= 8,

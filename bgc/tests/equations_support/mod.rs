@@ -166,6 +166,26 @@ impl Builder {
     }
 }
 
+/// Whether the junction structure (junctions and two-ports, and the bonds between them) has a loop: it is
+/// connected in the generated graphs, so it has one exactly when it has as many bonds as nodes.
+pub fn has_junction_loop(model: &bgc::ir::Model) -> bool {
+    use ElementKind as K;
+    let g = &model.graph;
+    let inside = |n: NodeIndex| {
+        matches!(
+            g[n].kind,
+            K::Zero | K::One | K::TF | K::GY | K::MTF | K::MGY
+        )
+    };
+    let nodes = g.node_indices().filter(|&n| inside(n)).count();
+    let bonds = g
+        .edge_indices()
+        .filter_map(|b| g.edge_endpoints(b))
+        .filter(|&(x, y)| inside(x) && inside(y))
+        .count();
+    bonds >= nodes
+}
+
 pub fn e(n: NodeIndex) -> Expr {
     Expr::Effort(Target::Node(n))
 }

@@ -6,11 +6,14 @@
 //! their value; a 0-junction equal efforts and `Σ ±f = 0`; a 1-junction equal flows and `Σ ±e = 0`; TF
 //! `f_in = n f_out`, `e_out = n e_in`; GY `e_in = m f_out`, `e_out = m f_in`), and the dense complex system is solved
 //! by LU for each input at several complex `s`. The outputs are `e(x)` and `f(x)` of every one-port, the flow
-//! counted into a C, I, R and out of a source (docs/language.md). bgc's `C (sI − A)⁻¹ B + D` must agree.
+//! counted into a C, I, R and out of a source (docs/language.md), and the effort and flow (as the bond is drawn) of
+//! the bond on each port of a field. bgc's `C (sI − A)⁻¹ B + D` must agree.
 //!
 //! The graphs: a random tree of 0- and 1-junctions joined by bonds, TFs or GYs in random directions, one-ports of
 //! every kind hung on them in random directions, an effort and a flow source, and up to two more bonds, TFs or GYs
-//! between junctions that close loops in the junction structure; structures that give storages in
+//! between junctions that close loops in the junction structure, and in half the graphs a two-port `IF`, `CF` or
+//! `RF` with a constant symmetric matrix on random junctions (an `IF`: `e = s M f`; a `CF`: `s e = K f`; an `RF`:
+//! `e = R f`, with each port's flow counted into the field); structures that give storages in
 //! derivative causality and resistive loops occur. Cases that bgc rightly refuses (an output that needs an input's
 //! derivative, causal conflicts) are skipped.
 
@@ -25,6 +28,7 @@ use bgc::ir::Model;
 use bgc::syntax::ast::ElementKind as K;
 use equations_support::*;
 use petgraph::Direction;
+use petgraph::graph::NodeIndex;
 use petgraph::visit::EdgeRef;
 use proptest::prelude::*;
 
@@ -103,6 +107,9 @@ fn random_model(seed: u64) -> (Model, Vec<(String, K)>) {
             }
         }
     }
+    if g.coin() {
+        add_field(&mut b, &mut g, &junctions);
+    }
     let nodes: Vec<_> = b.model.graph.node_indices().collect();
     for (name, _) in &ports {
         let n = nodes
@@ -115,6 +122,107 @@ fn random_model(seed: u64) -> (Model, Vec<(String, K)>) {
         }
     }
     (b.finish(), ports)
+}
+
+/// A two-port `IF`, `CF` or `RF` with the constant symmetric matrix `[[a, c], [c, d]]` (`c` small enough for it to
+/// be definite), its ports bonded to random junctions in random directions, and the effort and flow of each port's
+/// bond as outputs.
+fn add_field(b: &mut Builder, g: &mut Gen, junctions: &[NodeIndex]) {
+    use bgc::ir::{Expr, Law, PortVar, Relation, Target};
+    let kind = [K::IF, K::CF, K::RF][g.below(3) as usize];
+    let node = b.field(kind, "fld", 2);
+    let a = b.param("fa", g.value());
+    let c = b.param("fc", 0.1 * g.value());
+    let d = b.param("fd", g.value());
+    let port = |var, port| Expr::FieldPort { node, var, port };
+    let row =
+        |x: &Expr, y: &Expr, var| add(mul(x.clone(), port(var, 0)), mul(y.clone(), port(var, 1)));
+    let laws = |var| {
+        Relation::Laws(vec![
+            Law {
+                lhs: PortVar::Effort,
+                port: 0,
+                rhs: row(&a, &c, var),
+            },
+            Law {
+                lhs: PortVar::Effort,
+                port: 1,
+                rhs: row(&c, &d, var),
+            },
+        ])
+    };
+    b.model.graph[node].relation = match kind {
+        K::IF => Relation::MassMatrix {
+            n: 2,
+            entries: vec![a.clone(), c.clone(), c.clone(), d.clone()],
+        },
+        K::CF => laws(PortVar::Displacement),
+        _ => laws(PortVar::Flow),
+    };
+    for k in 0..2 {
+        let j = junctions[g.below(junctions.len() as u64) as usize];
+        let bond = if g.coin() {
+            b.port_bond((j, 0), (node, k))
+        } else {
+            b.port_bond((node, k), (j, 0))
+        };
+        b.output(&format!("e_fld{k}_y"), Expr::Effort(Target::Bond(bond)));
+        b.output(&format!("f_fld{k}_y"), Expr::Flow(Target::Bond(bond)));
+    }
+}
+
+/// The rows of a two-port field at `s`: with `X` its matrix, `v` the own flow of each port (into the field) and
+/// `w = v / s` its displacement, an `IF` has `e = s X v`, a `CF` `e = X w` and an `RF` `e = X v`; `None` for
+/// another relation.
+fn field_rows(model: &Model, n: NodeIndex, params: &[f64], s: Cx) -> Option<Vec<Vec<Cx>>> {
+    use bgc::ir::{Expr, Law, Relation};
+    let value = |e: &Expr| match e {
+        Expr::Param(p) => params.get(*p).copied(),
+        _ => None,
+    };
+    let x: Vec<f64> = match &model.graph[n].relation {
+        Relation::MassMatrix { entries, .. } => entries.iter().map(value).collect::<Option<_>>()?,
+        Relation::Laws(laws) => laws
+            .iter()
+            .flat_map(|Law { rhs, .. }| match rhs {
+                Expr::Binary(_, l, r) => [l, r].map(|t| match &**t {
+                    Expr::Binary(_, coefficient, _) => value(coefficient),
+                    _ => None,
+                }),
+                _ => [None, None],
+            })
+            .collect::<Option<_>>()?,
+        _ => return None,
+    };
+    // The bond and own-flow sign of each port.
+    let mut ports = [(usize::MAX, 0.0); 2];
+    for e in model.graph.edges_directed(n, Direction::Incoming) {
+        *ports.get_mut(e.weight().to_port as usize)? = (e.id().index(), 1.0);
+    }
+    for e in model.graph.edges_directed(n, Direction::Outgoing) {
+        *ports.get_mut(e.weight().from_port as usize)? = (e.id().index(), -1.0);
+    }
+    if ports.iter().any(|p| p.0 == usize::MAX) {
+        return None;
+    }
+    let nb = model.graph.edge_count();
+    let kind = model.graph[n].kind;
+    let rows = (0..2)
+        .map(|k| {
+            let mut r = vec![Cx::re(0.0); 2 * nb];
+            r[2 * ports[k].0] = if kind == K::CF { s } else { Cx::re(1.0) };
+            for (j, &(bond, so)) in ports.iter().enumerate() {
+                let coefficient = Cx::re(-x[2 * k + j] * so);
+                r[2 * bond + 1] = if kind == K::IF {
+                    s.mul(coefficient)
+                } else {
+                    coefficient
+                };
+            }
+            r
+        })
+        .collect();
+    Some(rows)
 }
 
 fn linear_modulus(e: bgc::ir::Expr) -> bgc::ir::Relation {
@@ -238,6 +346,13 @@ fn descriptor_transfer(model: &Model, params: &[f64], s: Cx) -> Option<Vec<Vec<C
                 rows.push((r1, None));
                 rows.push((r2, None));
             }
+            K::IF | K::CF | K::RF => {
+                rows.extend(
+                    field_rows(model, n, params, s)?
+                        .into_iter()
+                        .map(|r| (r, None)),
+                );
+            }
             _ => return None,
         }
     }
@@ -259,6 +374,15 @@ fn descriptor_transfer(model: &Model, params: &[f64], s: Cx) -> Option<Vec<Vec<C
         let (is_effort, node) = match &o.value {
             bgc::ir::Expr::Effort(bgc::ir::Target::Node(n)) => (true, *n),
             bgc::ir::Expr::Flow(bgc::ir::Target::Node(n)) => (false, *n),
+            // A bond's effort and its flow as the bond is drawn.
+            bgc::ir::Expr::Effort(bgc::ir::Target::Bond(b)) => {
+                out.push(columns.iter().map(|x| x[ei(b.index())]).collect());
+                continue;
+            }
+            bgc::ir::Expr::Flow(bgc::ir::Target::Bond(b)) => {
+                out.push(columns.iter().map(|x| x[fi(b.index())]).collect());
+                continue;
+            }
             _ => return None,
         };
         let (b, so) = own(node);
@@ -353,20 +477,35 @@ proptest! {
     }
 }
 
-/// The generator produces enough well-posed cases to mean something: of 64 fixed seeds, most are compared, some
-/// with a loop in the junction structure.
+/// The generator produces enough well-posed cases to mean something: of 256 fixed seeds, many are compared, with
+/// loops in the junction structure and with fields of each kind among them.
 #[test]
 fn most_random_graphs_are_compared() {
-    let (mut compared, mut loops) = (0, 0);
-    for seed in 0..64u64 {
+    let (mut compared, mut loops, mut fields) = (0, 0, [0; 3]);
+    for seed in 0..256u64 {
         if compare(seed).unwrap_or_else(|e| panic!("{e}")) {
             compared += 1;
-            loops += usize::from(has_junction_loop(&random_model(seed).0));
+            let model = random_model(seed).0;
+            loops += usize::from(has_junction_loop(&model));
+            for (count, kind) in fields.iter_mut().zip([K::IF, K::CF, K::RF]) {
+                *count += model
+                    .graph
+                    .node_weights()
+                    .filter(|w| w.kind == kind)
+                    .count();
+            }
         }
     }
-    assert!(compared >= 20, "only {compared} of 64 graphs were compared");
     assert!(
-        loops >= 10,
+        compared >= 50,
+        "only {compared} of 256 graphs were compared"
+    );
+    assert!(
+        loops >= 20,
         "only {loops} compared graphs have a loop in the junction structure"
+    );
+    assert!(
+        fields.iter().all(|&n| n >= 3),
+        "compared graphs with an IF, a CF, an RF: {fields:?}"
     );
 }

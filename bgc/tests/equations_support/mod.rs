@@ -116,6 +116,21 @@ impl Builder {
         )
     }
 
+    /// A field of `ports` ports (its relation set by the caller, who needs the node for its laws).
+    pub fn field(&mut self, kind: ElementKind, name: &str, ports: u32) -> NodeIndex {
+        let n = self.node(kind, name, Relation::Junction);
+        self.model.graph[n].ports = ports;
+        n
+    }
+
+    /// A bond from port `from.1` of `from.0` to port `to.1` of `to.0` (0-based ports).
+    pub fn port_bond(&mut self, from: (NodeIndex, u32), to: (NodeIndex, u32)) -> EdgeIndex {
+        let e = self.bond(from.0, to.0);
+        self.model.graph[e].from_port = from.1;
+        self.model.graph[e].to_port = to.1;
+        e
+    }
+
     pub fn named_bond(&mut self, name: &str, a: NodeIndex, b: NodeIndex) -> EdgeIndex {
         let e = self.bond(a, b);
         self.model.graph[e].name = Some(name.into());

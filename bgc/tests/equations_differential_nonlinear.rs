@@ -4,8 +4,10 @@
 //! The graphs: a random tree of 0- and 1-junctions joined by bonds, TFs, GYs, MTFs and MGYs in random directions
 //! (an MTF or MGY modulus `n (1 + 0.3 cos(q(C)))`, `n (1 + 0.3 sin(p(I)))` or `n (1 + 0.3 cos(w))` of an input
 //! `w`), one-ports hung on them in random directions with linear or cubic laws (`C { e = q/c + k q^3 }`,
-//! `I { f = p/m + k p^3 }`, `R { e = r f + k f^3 }` or `R { f = e/r + k e^3 }`), an effort and a flow source,
-//! and up to two more bonds or two-ports between junctions that close loops in the junction structure.
+//! `I { f = p/m + k p^3 }`, `R { e = r f + k f^3 }` or `R { f = e/r + k e^3 }`), an effort and a flow source
+//! (each, with even odds, an `MSe` or `MSf` whose value `u (1 + 0.3 cos(q(C)))`, `u (1 + 0.3 sin(p(I)))` or
+//! `u (1 + 0.3 cos(w))` is modulated), and up to two more bonds or two-ports between junctions that close loops in
+//! the junction structure.
 //!
 //! The reference (`reference.rs`) knows nothing of causality. At a point `(x, u, t)` every storage state bgc keeps
 //! is given, so its law gives its effort (C) or its flow (I); every bond's effort and flow is an unknown, solved by
@@ -89,6 +91,16 @@ fn one_port_law(
 
 /// A random modulated or nonlinear graph; outputs `e(x)` and `f(x)` of every one-port. The cubic laws of the Rs in
 /// `rewrite` are written in the other causal form, its storages get linear laws.
+/// A modulating signal: `cos(q)` of a C or `sin(p)` of an I among `storages`, or `cos(w)` of the input `w`.
+fn wave(g: &mut Gen, storages: &[(NodeIndex, K)], w: &Expr) -> Expr {
+    let pick = g.below(storages.len() as u64 + 1) as usize;
+    match storages.get(pick) {
+        Some(&(s, K::C)) => call(Func::Cos, q(s)),
+        Some(&(s, _)) => call(Func::Sin, p(s)),
+        None => call(Func::Cos, w.clone()),
+    }
+}
+
 fn random_model(seed: u64, rewrite: &Rewrite) -> Model {
     let mut g = Gen(seed);
     let mut b = Builder::new("modulated");
@@ -139,6 +151,7 @@ fn random_model(seed: u64, rewrite: &Rewrite) -> Model {
             storages.push((node, kind));
         }
     }
+    let mut sources = Vec::new();
     for (k, kind) in [K::Se, K::Sf].into_iter().enumerate() {
         let u = b.input(&format!("u{k}"));
         let node = b.node(kind, &format!("src{k}"), source(u));
@@ -149,14 +162,10 @@ fn random_model(seed: u64, rewrite: &Rewrite) -> Model {
             b.bond(j, node);
         }
         one_ports.push(node);
+        sources.push(node);
     }
     for node in modulated {
-        let pick = g.below(storages.len() as u64 + 1) as usize;
-        let wave = match storages.get(pick) {
-            Some(&(s, K::C)) => call(Func::Cos, q(s)),
-            Some(&(s, _)) => call(Func::Sin, p(s)),
-            None => call(Func::Cos, w.clone()),
-        };
+        let wave = wave(&mut g, &storages, &w);
         let Relation::Modulus(n) = b.model.graph[node].relation.clone() else {
             continue;
         };
@@ -177,17 +186,29 @@ fn random_model(seed: u64, rewrite: &Rewrite) -> Model {
         };
         let mut modulus = b.param(&format!("l{k}"), g.value());
         if matches!(kind, K::MTF | K::MGY) {
-            let pick = g.below(storages.len() as u64 + 1) as usize;
-            let wave = match storages.get(pick) {
-                Some(&(s, K::C)) => call(Func::Cos, q(s)),
-                Some(&(s, _)) => call(Func::Sin, p(s)),
-                None => call(Func::Cos, w.clone()),
-            };
+            let wave = wave(&mut g, &storages, &w);
             modulus = mul(modulus, add(c(1.0), mul(c(0.3), wave)));
         }
         let node = b.node(kind, &format!("tl{k}"), Relation::Modulus(modulus));
         b.bond(x, node);
         b.bond(node, y);
+    }
+    // Modulated sources: each source, with even odds, an MSe or MSf whose value a state or the input `w` modulates.
+    for node in sources {
+        if g.coin() {
+            continue;
+        }
+        let wave = wave(&mut g, &storages, &w);
+        let element = &mut b.model.graph[node];
+        let Relation::Source(u) = element.relation.clone() else {
+            continue;
+        };
+        element.kind = if element.kind == K::Se {
+            K::MSe
+        } else {
+            K::MSf
+        };
+        element.relation = Relation::Source(mul(u, add(c(1.0), mul(c(0.3), wave))));
     }
     for node in one_ports {
         let name = b.model.graph[node].name.clone();
@@ -209,12 +230,14 @@ enum Flip {
     OwnFlow,
 }
 
-const FLIPS: [Flip; 11] = [
+const FLIPS: [Flip; 13] = [
     Flip::Kind(K::C),
     Flip::Kind(K::I),
     Flip::Kind(K::R),
     Flip::Kind(K::Se),
     Flip::Kind(K::Sf),
+    Flip::Kind(K::MSe),
+    Flip::Kind(K::MSf),
     Flip::Kind(K::TF),
     Flip::Kind(K::GY),
     Flip::Kind(K::MTF),

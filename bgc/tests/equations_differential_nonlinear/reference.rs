@@ -24,7 +24,7 @@ use petgraph::visit::EdgeRef;
 
 /// A one-port's bond and the sign of its own flow relative to the bond's flow (docs/language.md).
 fn own(model: &Model, n: NodeIndex, flip: Flip) -> Option<(usize, f64)> {
-    let source = matches!(model.graph[n].kind, K::Se | K::Sf);
+    let source = matches!(model.graph[n].kind, K::Se | K::Sf | K::MSe | K::MSf);
     if let Some(b) = model.graph.edges_directed(n, Direction::Incoming).next() {
         return Some((b.id().index(), if source { -1.0 } else { 1.0 }));
     }
@@ -124,8 +124,12 @@ impl At<'_> {
                     );
                     rows.push(sum.zip(&incident).map(|(d, i)| d * z[summed(i.0)]).sum());
                 }
-                (K::Se, Relation::Source(x)) => rows.push(own_effort()? - sign * self.eval(x)?),
-                (K::Sf, Relation::Source(x)) => rows.push(own_flow()? - sign * self.eval(x)?),
+                (K::Se | K::MSe, Relation::Source(x)) => {
+                    rows.push(own_effort()? - sign * self.eval(x)?)
+                }
+                (K::Sf | K::MSf, Relation::Source(x)) => {
+                    rows.push(own_flow()? - sign * self.eval(x)?)
+                }
                 (K::C, Relation::Linear(c)) => {
                     let q = self.states.iter().find(|s| s.0 == n)?.1;
                     rows.push(own_effort()? - sign * q / self.eval(c)?);

@@ -11,6 +11,7 @@ mod causality_models;
 mod cli;
 mod cli_energy_balance;
 mod cli_equations;
+mod cli_examples;
 mod cli_fit;
 mod cli_hostile;
 mod cli_messages;

@@ -323,3 +323,23 @@ proptest::proptest! {
         proptest::prop_assert!(r.variance <= v.min() * (1.0 + 1e-15));
     }
 }
+
+/// An undetectable unstable mode (`A = diag(1.1, 0.5)`, `C = [0 1]`): the Riccati recursion diverges, its `P`
+/// growing by 1.21 per step. The relative change was measured in Frobenius norms, and the norm of a `P` with
+/// entries of 1e154 overflows to infinity, so the change read as 0 and the recursion returned `Ok` with
+/// `P₀₀ = 1.4e154` and a gain that ignores the unstable state. Now it is an error.
+#[test]
+fn steady_state_gain_of_an_undetectable_mode_is_an_error() {
+    use bgc_runtime::estimation::kalman::steady_state_gain;
+    let a = Matrix2::new(1.1, 0.0, 0.0, 0.5);
+    let c = nalgebra::Matrix1x2::new(0.0, 1.0);
+    let q = Matrix2::identity() * 1e-3;
+    let r = Matrix1::new(1e-2);
+    for max_iterations in [100, 10_000, 100_000] {
+        let got = steady_state_gain(&a, &c, &q, &r, 1e-12, max_iterations);
+        assert!(
+            matches!(got, Err(EstimationError::NotConverged { .. })),
+            "{max_iterations}: {got:?}"
+        );
+    }
+}

@@ -130,3 +130,40 @@ fn a_time_constant_running_off_to_infinity_is_not_converged() {
     assert_ne!(report.convergence, Convergence::Converged, "{report:?}");
     assert!(report.estimates[0].value > 100.0 * TRUTH[0]);
 }
+
+#[test]
+fn records_and_specs_that_do_not_fit_the_model_are_refused_with_the_reason() {
+    let spec = FitSpec::new(vec![FreeParam::new(1, "K", false)], 1);
+    let refused = |model_p: [f64; 3], r: &Record, x0: &[f64], spec: &FitSpec| {
+        let got = fit(&mut Lag { p: model_p }, r, &model_p, x0, spec);
+        match got {
+            Err(bgc_runtime::fit::FitError::Spec(why)) => why,
+            other => panic!("expected a refusal, got {other:?}"),
+        }
+    };
+    // A ragged row of inputs: refused by Record::new, and by fit for a record whose public fields were edited
+    // (the fit checked the first row only and panicked copying the short row into the model's input).
+    let ragged = Record::new(
+        vec![0.0, 1.0],
+        vec![vec![1.0], vec![]],
+        vec![0],
+        vec![vec![1.0]; 2],
+    );
+    assert!(ragged.is_err(), "{ragged:?}");
+    let mut r = record();
+    r.inputs[7].clear();
+    assert!(refused(TRUTH, &r, &[0.0], &spec).contains("inputs"));
+    // A parameter named twice gave two estimates of it, one with a NaN standard error.
+    let twice = FitSpec::new(
+        vec![FreeParam::new(1, "K", false), FreeParam::new(1, "K", false)],
+        1,
+    );
+    assert!(refused(TRUTH, &record(), &[0.0], &twice).contains("twice"));
+    // A NaN fixed parameter or initial state reached the ODE solver, which failed with "step size too small".
+    assert!(refused([0.5, 2.0, f64::NAN], &record(), &[0.0], &spec).contains("parameter 2"));
+    assert!(refused(TRUTH, &record(), &[f64::NAN], &spec).contains("initial state 0"));
+    // A NaN tolerance switched its test off silently.
+    let mut nan_opts = spec.clone();
+    nan_opts.lm.max_log_step = f64::NAN;
+    assert!(refused(TRUTH, &record(), &[0.0], &nan_opts).contains("max_log_step"));
+}

@@ -73,6 +73,31 @@ impl Default for LmOptions {
     }
 }
 
+impl LmOptions {
+    /// Refuses tolerances that would silently disable a test (a NaN compares false with everything) or make
+    /// every point pass it.
+    pub fn check(&self) -> Result<(), String> {
+        let settings = [
+            ("gtol", self.gtol),
+            ("xtol", self.xtol),
+            ("ftol", self.ftol),
+            ("optimality", self.optimality),
+        ];
+        if let Some((name, v)) = settings.iter().find(|(_, v)| !(v.is_finite() && *v >= 0.0)) {
+            return Err(format!(
+                "LmOptions::{name} = {v}: it must be finite and not negative"
+            ));
+        }
+        if self.max_log_step.is_nan() || self.max_log_step <= 0.0 {
+            return Err(format!(
+                "LmOptions::max_log_step = {}: it must be positive (infinite for no limit)",
+                self.max_log_step
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Why the minimisation stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -156,6 +181,23 @@ pub fn minimise(
     upper: &[f64],
     opts: &LmOptions,
 ) -> Result<Minimum, String> {
+    opts.check()?;
+    if lower.len() != z0.len() || upper.len() != z0.len() {
+        return Err(format!(
+            "{} coordinates with {} lower and {} upper bounds",
+            z0.len(),
+            lower.len(),
+            upper.len()
+        ));
+    }
+    // `clamp` below needs ordered, non-NaN bounds; a NaN start would be clamped to NaN and never move.
+    for (k, ((&z, &lo), &hi)) in z0.iter().zip(lower).zip(upper).enumerate() {
+        if lo.is_nan() || hi.is_nan() || lo > hi || !z.is_finite() {
+            return Err(format!(
+                "coordinate {k}: start {z} with bounds [{lo}, {hi}]"
+            ));
+        }
+    }
     let project = |z: &mut [f64]| {
         for ((v, lo), hi) in z.iter_mut().zip(lower).zip(upper) {
             *v = v.clamp(*lo, *hi);
@@ -164,6 +206,9 @@ pub fn minimise(
     let mut z = z0.to_vec();
     project(&mut z);
     let (mut r, mut j) = problem.evaluate(&z)?;
+    if !(r.iter().all(|v| v.is_finite()) && j.iter().all(|v| v.is_finite())) {
+        return Err("the residuals or their Jacobian at the start are not finite".into());
+    }
     let mut cost = 0.5 * r.norm_squared();
     // λ multiplies the diagonal D of JᵀJ (Marquardt's scaling): it is dimensionless.
     let mut lambda = 1e-3;
@@ -211,7 +256,7 @@ pub fn minimise(
         }
         let predicted = -(step.dot(&g)) - 0.5 * step.dot(&(&jtj * &step));
         let accepted = match problem.evaluate(&trial) {
-            Ok((r_new, j_new)) if r_new.iter().all(|v| v.is_finite()) => {
+            Ok((r_new, j_new)) if r_new.iter().chain(j_new.iter()).all(|v| v.is_finite()) => {
                 let new_cost = 0.5 * r_new.norm_squared();
                 let rho = (cost - new_cost) / predicted.max(f64::MIN_POSITIVE);
                 (new_cost < cost && rho > 0.0).then_some((r_new, j_new, new_cost, rho))
@@ -427,6 +472,50 @@ mod tests {
             m.z
         );
         assert_eq!(m.convergence, Convergence::Converged);
+    }
+
+    #[test]
+    fn bad_bounds_starts_and_options_are_errors() {
+        // Inverted or NaN bounds made `clamp` panic, bounds shorter than the start panicked on an index, and a NaN
+        // tolerance silently switched its test off.
+        let inf = f64::INFINITY;
+        let opts = LmOptions::default();
+        let z0 = [-1.2, 1.0];
+        for (lower, upper) in [([1.0, -inf], [0.0, inf]), ([f64::NAN, -inf], [inf, inf])] {
+            assert!(minimise(&mut Rosenbrock, &z0, &lower, &upper, &opts).is_err());
+        }
+        assert!(minimise(&mut Rosenbrock, &z0, &[-inf], &[inf], &opts).is_err());
+        assert!(
+            minimise(
+                &mut Rosenbrock,
+                &[f64::NAN, 1.0],
+                &[-inf; 2],
+                &[inf; 2],
+                &opts
+            )
+            .is_err()
+        );
+        for bad in [
+            LmOptions {
+                gtol: f64::NAN,
+                ..opts
+            },
+            LmOptions {
+                optimality: -1.0,
+                ..opts
+            },
+            LmOptions {
+                max_log_step: f64::NAN,
+                ..opts
+            },
+            LmOptions {
+                max_log_step: 0.0,
+                ..opts
+            },
+        ] {
+            let got = minimise(&mut Rosenbrock, &z0, &[-inf; 2], &[inf; 2], &bad);
+            assert!(got.is_err(), "{bad:?}");
+        }
     }
 
     #[test]

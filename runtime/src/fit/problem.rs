@@ -176,7 +176,8 @@ pub fn fit(
         objective.set(&min.z);
         let scales = objective.scales();
         let jac_rel = relative(&min.jacobian, &objective, &scales);
-        let st = stats::statistics(min.residuals.norm_squared(), &jac_rel, &scales);
+        let st = stats::statistics(min.residuals.norm_squared(), &jac_rel, &scales)
+            .map_err(FitError::Model)?;
         let found = objective.name_directions(&st.undetermined);
         // Statistics away from a minimum say nothing about what the record determines, and a fit needs at least
         // one quantity: then the combinations are reported without holding anything. A fit that did not converge
@@ -220,11 +221,33 @@ fn check(
             x0.len()
         ));
     }
-    if record.inputs.first().map_or(0, Vec::len) != model.input_count()
+    // Every row, not only the first: the record's fields are public, and a short row would be copied into the
+    // model's input buffer.
+    let n = record.times.len();
+    if record.inputs.len() != n
+        || record.measured.len() != n
+        || record.inputs.iter().any(|u| u.len() != model.input_count())
+        || record
+            .measured
+            .iter()
+            .any(|y| y.len() != record.outputs.len())
         || record.outputs.iter().any(|&o| o >= model.output_count())
     {
         return bad("the record's inputs or outputs do not match the model".into());
     }
+    if let Some(k) = params.iter().position(|v| !v.is_finite()) {
+        return bad(format!(
+            "parameter {k} is {}; every parameter must be finite",
+            params[k]
+        ));
+    }
+    if let Some(k) = x0.iter().position(|v| !v.is_finite()) {
+        return bad(format!(
+            "initial state {k} is {}; every initial state must be finite",
+            x0[k]
+        ));
+    }
+    spec.lm.check().map_err(FitError::Spec)?;
     if spec.weights.len() != record.outputs.len()
         || spec.weights.iter().any(|w| !(w.is_finite() && *w > 0.0))
     {
@@ -237,7 +260,13 @@ fn check(
     if spec.params.is_empty() && spec.x0.is_empty() {
         return bad("nothing to fit: name at least one parameter or initial state".into());
     }
-    for p in &spec.params {
+    for (k, p) in spec.params.iter().enumerate() {
+        if spec.params[..k].iter().any(|q| q.index == p.index) {
+            return bad(format!(
+                "parameter `{}` (index {}) is named twice",
+                p.name, p.index
+            ));
+        }
         let Some(&v) = params.get(p.index) else {
             return bad(format!("parameter `{}` has no index {}", p.name, p.index));
         };
@@ -265,6 +294,14 @@ fn check(
             "initial state `{}` has no index {}",
             s.name, s.index
         ));
+    }
+    for (k, s) in spec.x0.iter().enumerate() {
+        if spec.x0[..k].iter().any(|t| t.index == s.index) {
+            return bad(format!(
+                "initial state `{}` (index {}) is named twice",
+                s.name, s.index
+            ));
+        }
     }
     let measured = record.sample_count();
     let fitted = spec.params.len() + spec.x0.len();

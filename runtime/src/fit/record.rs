@@ -107,6 +107,15 @@ impl Record {
                 ),
             });
         }
+        let width = inputs.first().map_or(0, Vec::len);
+        if let Some(k) = inputs.iter().position(|u| u.len() != width) {
+            return Err(RecordError::Shape {
+                what: format!(
+                    "input row {k} has {} values, the first has {width}",
+                    inputs[k].len()
+                ),
+            });
+        }
         if measured.iter().any(|r| r.len() != outputs.len()) {
             return Err(RecordError::Shape {
                 what: format!("a measured row does not have {} values", outputs.len()),

@@ -37,20 +37,28 @@ pub struct Statistics {
     pub undetermined: Vec<Direction>,
 }
 
-/// The statistics at an optimum from the residuals' sum of squares, the relative Jacobian and the scales `c_k`.
-pub fn statistics(ssr: f64, jac_rel: &DMatrix<f64>, scales: &[f64]) -> Statistics {
+/// The statistics at an optimum from the residuals' sum of squares, the relative Jacobian and the scales `c_k`
+/// (one per column); an error when these do not match or are not finite.
+pub fn statistics(ssr: f64, jac_rel: &DMatrix<f64>, scales: &[f64]) -> Result<Statistics, String> {
     let (m, n) = jac_rel.shape();
+    if scales.len() != n {
+        return Err(format!("{n} Jacobian columns but {} scales", scales.len()));
+    }
+    let finite = |v: &f64| v.is_finite();
+    if !(ssr.is_finite() && jac_rel.iter().all(finite) && scales.iter().all(finite)) {
+        return Err("the residuals, the Jacobian or the scales are not finite".into());
+    }
     let dof = m.saturating_sub(n);
     let s2 = if dof > 0 { ssr / dof as f64 } else { f64::NAN };
     let s = s2.sqrt();
     if n == 0 || m == 0 {
-        return Statistics {
+        return Ok(Statistics {
             residual_variance: s2,
             degrees_of_freedom: dof,
             std_errors: Vec::new(),
             correlation: DMatrix::zeros(n, n),
             undetermined: Vec::new(),
-        };
+        });
     }
     let svd = jac_rel.clone().svd(false, true);
     let sigma = &svd.singular_values;
@@ -97,7 +105,7 @@ pub fn statistics(ssr: f64, jac_rel: &DMatrix<f64>, scales: &[f64]) -> Statistic
             cov[(a, b)] / (rel_se[a] * rel_se[b])
         }
     });
-    Statistics {
+    Ok(Statistics {
         residual_variance: s2,
         degrees_of_freedom: dof,
         std_errors: rel_se
@@ -107,7 +115,7 @@ pub fn statistics(ssr: f64, jac_rel: &DMatrix<f64>, scales: &[f64]) -> Statistic
             .collect(),
         correlation,
         undetermined,
-    }
+    })
 }
 
 fn direction(v: &[f64], rel: f64) -> Direction {
@@ -140,7 +148,7 @@ mod tests {
         let x = [0.0, 1.0, 2.0, 3.0, 4.0];
         let j = DMatrix::from_fn(5, 2, |i, k| if k == 0 { 1.0 } else { x[i] });
         let ssr = 0.3;
-        let st = statistics(ssr, &j, &[1.0, 1.0]);
+        let st = statistics(ssr, &j, &[1.0, 1.0]).unwrap();
         let s = (ssr / 3.0f64).sqrt();
         let sxx: f64 = 10.0;
         assert!((st.std_errors[1] - s / sxx.sqrt()).abs() < 1e-12);
@@ -151,10 +159,21 @@ mod tests {
     }
 
     #[test]
+    fn a_non_finite_jacobian_or_mismatched_scales_are_errors() {
+        // A NaN entry made the singular value decomposition panic; scales shorter than the columns gave a
+        // shorter list of standard errors.
+        let mut j = DMatrix::from_element(3, 2, 1.0);
+        assert!(statistics(1.0, &j, &[1.0]).is_err());
+        assert!(statistics(f64::NAN, &j, &[1.0, 1.0]).is_err());
+        j[(1, 1)] = f64::NAN;
+        assert!(statistics(1.0, &j, &[1.0, 1.0]).is_err());
+    }
+
+    #[test]
     fn a_product_that_only_enters_together_is_named() {
         // Two columns equal: only θ₀θ₁ is determined, θ₀/θ₁ is not.
         let j = DMatrix::from_fn(6, 2, |i, _| (i as f64).sin());
-        let st = statistics(0.01, &j, &[1.0, 1.0]);
+        let st = statistics(0.01, &j, &[1.0, 1.0]).unwrap();
         assert_eq!(st.undetermined.len(), 1);
         let c = &st.undetermined[0].combination;
         assert_eq!(c.len(), 2);

@@ -95,3 +95,32 @@ proptest::proptest! {
         }
     }
 }
+
+/// A pole at `s = 0` (`z = 1`) makes the peak gain infinite. It lies below the search grid, whose points are all
+/// finite, and `peak_gain` of `1/s` returned `Ok((1000, 0.001))`, the gain at the grid's lowest point.
+#[test]
+fn the_peak_gain_of_a_loop_with_an_integrator_is_a_pole_on_the_contour() {
+    let integrator =
+        StateSpace::new(dmatrix![0.0], dmatrix![1.0], dmatrix![1.0], dmatrix![0.0]).unwrap();
+    let got = peak_gain(&integrator);
+    assert_eq!(got, Err(AnalysisError::PoleOnContour { omega: 0.0 }));
+    let summer = StateSpace::new_discrete(
+        dmatrix![1.0],
+        dmatrix![1.0],
+        dmatrix![0.1],
+        dmatrix![0.0],
+        0.01,
+    )
+    .unwrap();
+    assert_eq!(
+        peak_gain(&summer),
+        Err(AnalysisError::PoleOnContour { omega: 0.0 })
+    );
+    // A stable lag keeps its peak at ω = 0.
+    let lag = StateSpace::new(dmatrix![-2.0], dmatrix![1.0], dmatrix![4.0], dmatrix![0.0]).unwrap();
+    let (gain, omega) = peak_gain(&lag).unwrap();
+    assert!(
+        (gain - 2.0).abs() < 1e-14 && omega == 0.0,
+        "{gain} at {omega}"
+    );
+}

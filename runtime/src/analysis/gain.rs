@@ -105,8 +105,9 @@ pub fn first_level_crossing(
     Ok(None)
 }
 
-/// The largest gain `max |G(jω)|` over the search grid (and `ω = 0` when finite), refined; returns
-/// `(gain, frequency)`.
+/// The largest gain `max |G(jω)|` over the search grid and `ω = 0`, refined; returns `(gain, frequency)`. A
+/// pole on the imaginary axis (the unit circle), including one at `s = 0` (`z = 1`), makes the peak infinite:
+/// [`AnalysisError::PoleOnContour`].
 pub fn peak_gain(sys: &StateSpace) -> Result<(f64, f64), AnalysisError> {
     check_siso(sys, "peak_gain")?;
     let resolvent = Resolvent::new(sys);
@@ -136,11 +137,16 @@ pub fn peak_gain(sys: &StateSpace) -> Result<(f64, f64), AnalysisError> {
             best = (-neg, w);
         }
     }
-    if let Ok(g0) = dc_gain(sys) {
-        let g0 = g0[(0, 0)].abs();
-        if g0 > best.0 {
-            best = (g0, 0.0);
+    // A pole at s = 0 (z = 1) makes the peak infinite, below the grid's lowest frequency; ignoring it reported
+    // the gain at the bottom of the grid as the peak.
+    let g0 = match dc_gain(sys) {
+        Err(AnalysisError::InfiniteDcGain) => {
+            return Err(AnalysisError::PoleOnContour { omega: 0.0 });
         }
+        g0 => g0?[(0, 0)].abs(),
+    };
+    if g0 > best.0 {
+        best = (g0, 0.0);
     }
     Ok(best)
 }

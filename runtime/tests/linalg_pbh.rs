@@ -102,3 +102,18 @@ fn back_support_plant_is_controllable_and_observable() {
     assert!(uncontrollable_modes(&a, &b).unwrap().is_empty());
     assert!(unobservable_modes(&a, &c).unwrap().is_empty());
 }
+
+/// A NaN rank tolerance compared false with every singular value and gave rank 0 for the identity; a
+/// non-square "quasi-triangular" matrix made `diagonal_blocks` index out of range.
+#[test]
+fn a_nan_rank_tolerance_and_a_non_square_schur_factor_are_errors() {
+    use bgc_runtime::linalg::pbh::numerical_rank;
+    use bgc_runtime::linalg::schur::diagonal_blocks;
+    let i2 = DMatrix::<f64>::identity(2, 2);
+    for tol in [f64::NAN, -1e-10, f64::INFINITY] {
+        assert!(numerical_rank(&i2, tol).is_err(), "{tol}");
+    }
+    assert_eq!(numerical_rank(&i2, 1e-10), Ok(2));
+    assert!(diagonal_blocks(&DMatrix::from_element(3, 1, 1.0)).is_err());
+    assert!(diagonal_blocks(&DMatrix::from_element(1, 3, 1.0)).is_err());
+}

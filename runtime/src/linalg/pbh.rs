@@ -238,6 +238,8 @@ pub fn observability_matrix(a: &DMatrix<f64>, c: &DMatrix<f64>) -> Result<DMatri
 /// models; the Kalman matrices of stiff models are badly scaled, for which the PBH tests are more reliable).
 pub fn numerical_rank(m: &DMatrix<f64>, rel_tol: f64) -> Result<usize, PbhError> {
     check::finite("M", m)?;
+    // A NaN tolerance compared false with every singular value and gave rank 0.
+    check::positive_scalar("relative rank tolerance", rel_tol)?;
     let (rows, cols) = m.shape();
     let svd = nalgebra::SVD::try_new(m.clone(), false, false, f64::EPSILON, 10_000)
         .ok_or(PbhError::Svd { rows, cols })?;

@@ -40,6 +40,9 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, SchurError> {
 /// block; two consecutive non-zero subdiagonal entries mean `t` is not quasi-triangular.
 pub fn diagonal_blocks(t: &DMatrix<f64>) -> Result<Vec<(usize, usize)>, SchurError> {
     let n = t.nrows();
+    if n != t.ncols() {
+        return Err(SchurError { n });
+    }
     let mut blocks = Vec::new();
     let mut j = 0;
     while j < n {

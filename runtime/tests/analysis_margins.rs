@@ -183,3 +183,45 @@ fn static_crossing_at_zero_frequency_and_lead_loop() {
     assert!(rel(m.phase_margin, 128.07461366165205) < 1e-6, "{m:?}");
     assert!(rel(m.gain_crossover.unwrap(), 2.6251028535207204) < 1e-6);
 }
+
+#[test]
+fn margins_of_a_third_order_loop_with_a_pade_delay_match_python_control() {
+    // L(s) = 20 / ((s+1)(s+2)(s+3)) · pade(0.1 s, 2): a 0.1 s dead time by its second-order Padé approximant.
+    // num, den = control.pade(0.1, 2)                      # (s² − 60 s + 1200) / (s² + 60 s + 1200)
+    // L = control.tf([20], np.polymul([1, 1], np.polymul([1, 2], [1, 3]))) * control.tf(num, den)
+    // gm, pm, sm, wpc, wgc, wms = control.stability_margins(L)
+    // -> (1.926681922958983, 33.93084700248076, 0.365060587701181,
+    //     2.6819191479231526, 1.8382084255998228, 2.251526846838493)
+    // np.deg2rad(pm) / wgc -> 0.3221642279169167
+    let num = [20.0, -1200.0, 24000.0];
+    let den = [1.0, 66.0, 1571.0, 7866.0, 13560.0, 7200.0];
+    let m = stability_margins(&tf(&num, &den)).unwrap();
+    assert!(rel(m.gain_margin, 1.926681922958983) < 1e-6, "{m:?}");
+    assert!(rel(m.phase_margin, 33.93084700248076) < 1e-6, "{m:?}");
+    assert!(rel(m.stability_margin, 0.365060587701181) < 1e-6, "{m:?}");
+    assert!(rel(m.phase_crossover.unwrap(), 2.6819191479231526) < 1e-6);
+    assert!(rel(m.gain_crossover.unwrap(), 1.8382084255998228) < 1e-6);
+    assert!(rel(m.stability_margin_frequency.unwrap(), 2.251526846838493) < 1e-4);
+    assert!(rel(m.delay_margin, 0.3221642279169167) < 1e-6, "{m:?}");
+}
+
+#[test]
+fn margins_of_a_discrete_loop_with_two_samples_of_delay_match_python_control() {
+    // L(z) = 0.2 / (z² (z − 0.9)), T = 0.05 s:
+    // L = control.tf([0.2], [1, -0.9, 0, 0], 0.05); control.stability_margins(L)
+    // -> (3.232928049865329, 93.67369066570518, 0.6609814857310075,
+    //     13.735563974603346, 3.6565743348818955, 11.267428787710632)
+    // np.deg2rad(pm) / wgc -> 0.4471163922513395 (s)
+    let a = DMatrix::from_row_slice(3, 3, &[0.9, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
+    let b = DMatrix::from_row_slice(3, 1, &[1.0, 0.0, 0.0]);
+    let c = DMatrix::from_row_slice(1, 3, &[0.0, 0.0, 0.2]);
+    let sys = StateSpace::new_discrete(a, b, c, DMatrix::zeros(1, 1), 0.05).unwrap();
+    let m = stability_margins(&sys).unwrap();
+    assert!(rel(m.gain_margin, 3.232928049865329) < 1e-6, "{m:?}");
+    assert!(rel(m.phase_margin, 93.67369066570518) < 1e-6, "{m:?}");
+    assert!(rel(m.stability_margin, 0.6609814857310075) < 1e-6, "{m:?}");
+    assert!(rel(m.phase_crossover.unwrap(), 13.735563974603346) < 1e-6);
+    assert!(rel(m.gain_crossover.unwrap(), 3.6565743348818955) < 1e-6);
+    assert!(rel(m.stability_margin_frequency.unwrap(), 11.267428787710632) < 1e-4);
+    assert!(rel(m.delay_margin, 0.4471163922513395) < 1e-6, "{m:?}");
+}

@@ -413,3 +413,119 @@ fn back_support_observer_with_encoder_matches_high_precision_reference() {
     assert!(k.relative_residual < 1e-12);
     assert!(k.observer_eigenvalues.iter().all(|l| l.re < 0.0));
 }
+
+/// Two inputs, two integrated outputs, a full `R`: python-control 0.10.2 augments with `ż = C x` (no minus sign),
+/// so its state gains are `K_x` and its integral gains `−K_z`.
+/// ```python
+/// import numpy as np, control as ct
+/// A = np.array([[-1.0, 0.5, 0.0], [0.0, -2.0, 1.0], [0.3, 0.0, -0.5]])
+/// B = np.array([[1.0, 0.0], [0.0, 1.0], [0.5, -0.2]]); C = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+/// Q = np.diag([1.0, 2.0, 0.5, 10.0, 5.0]); R = np.array([[1.0, 0.1], [0.1, 2.0]])
+/// K, S, E = ct.lqr(ct.ss(A, B, C, np.zeros((2, 2))), Q, R, integral_action=C)
+/// ```
+#[test]
+fn two_input_lqi_matches_python_control() {
+    let a = DMatrix::from_row_slice(3, 3, &[-1.0, 0.5, 0.0, 0.0, -2.0, 1.0, 0.3, 0.0, -0.5]);
+    let b = DMatrix::from_row_slice(3, 2, &[1.0, 0.0, 0.0, 1.0, 0.5, -0.2]);
+    let c = DMatrix::from_row_slice(2, 3, &[1.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
+    let q = DMatrix::from_diagonal(&nalgebra::dvector![1.0, 2.0, 0.5, 10.0, 5.0]);
+    let r = DMatrix::from_row_slice(2, 2, &[1.0, 0.1, 0.1, 2.0]);
+    let d = lqi(&a, &b, &c, &q, &r, IntegralAction::Single).unwrap();
+    let kx_ref = [
+        1.571449656535021,
+        0.244297914328466,
+        1.223425908060075,
+        0.7270587259468726,
+        0.34428968567007984,
+        -1.6062666781046981,
+    ];
+    let ki_ref = [
+        2.530984589338937,
+        1.349883006932497,
+        1.2199548409848031,
+        -1.3298187496983396,
+    ];
+    assert!(close(&d.kx, &kx_ref, 1e-9), "K_x = {}", d.kx);
+    assert!(close(&(-&d.kz1), &ki_ref, 1e-9), "K_z = {}", d.kz1);
+    let mut eig: Vec<(f64, f64)> = d
+        .closed_loop_eigenvalues
+        .iter()
+        .map(|l| (l.re, l.im.abs()))
+        .collect();
+    eig.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let eig_ref = [
+        (-2.1431510437729284, 0.0),
+        (-1.4762067065085045, 1.0471019223798848),
+        (-1.4762067065085045, 1.0471019223798848),
+        (-0.6265705875330716, 0.2674431144018271),
+        (-0.6265705875330716, 0.2674431144018271),
+    ];
+    for (got, want) in eig.iter().zip(&eig_ref) {
+        assert!(
+            (got.0 - want.0).abs() < 1e-9 && (got.1 - want.1).abs() < 1e-9,
+            "{eig:?}"
+        );
+    }
+}
+
+/// Three states, two outputs, a noise input matrix `G` of two columns and correlated `Q_n`, `R_n`:
+/// python-control's predictor gain and covariance, and the innovation gain `M` that filterpy 2.0.0's
+/// `KalmanFilter` reaches after 2,000 steps from `P = I`.
+/// ```python
+/// import numpy as np, control as ct
+/// from filterpy.kalman import KalmanFilter
+/// A = np.array([[0.95, 0.1, 0.0], [0.0, 0.9, 0.05], [0.02, 0.0, 1.01]])
+/// G = np.array([[1.0, 0.0], [0.2, 1.0], [0.0, 0.5]]); C = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 1.0]])
+/// Qn = np.array([[0.2, 0.05], [0.05, 0.1]]); Rn = np.array([[0.01, 0.002], [0.002, 0.04]])
+/// L, P, E = ct.dlqe(A, G, C, Qn, Rn)
+/// kf = KalmanFilter(dim_x=3, dim_z=2); kf.F = A; kf.H = C; kf.Q = G @ Qn @ G.T; kf.R = Rn; kf.P = np.eye(3)
+/// for _ in range(2000): kf.predict(); kf.update(np.zeros(2))
+/// kf.K
+/// ```
+#[test]
+fn correlated_noise_dlqe_matches_python_control_and_filterpy() {
+    let a = DMatrix::from_row_slice(3, 3, &[0.95, 0.1, 0.0, 0.0, 0.9, 0.05, 0.02, 0.0, 1.01]);
+    let g = DMatrix::from_row_slice(3, 2, &[1.0, 0.0, 0.2, 1.0, 0.0, 0.5]);
+    let c = DMatrix::from_row_slice(2, 3, &[1.0, 0.0, 0.0, 0.0, 1.0, 1.0]);
+    let qn = DMatrix::from_row_slice(2, 2, &[0.2, 0.05, 0.05, 0.1]);
+    let rn = DMatrix::from_row_slice(2, 2, &[0.01, 0.002, 0.002, 0.04]);
+    let f = dlqe(&a, &g, &c, &qn, &rn).unwrap();
+    let l_ref = [
+        0.9108271851098548,
+        0.06933904912942983,
+        0.09846184461369131,
+        0.5249452310312642,
+        -0.02146553388455385,
+        0.2901208392803863,
+    ];
+    let p_ref = [
+        0.20915441285041148,
+        0.09337314920420645,
+        0.02609102247266637,
+        0.09337314920420645,
+        0.14130284544856772,
+        0.0618996764496359,
+        0.02609102247266637,
+        0.0618996764496359,
+        0.02917330721091255,
+    ];
+    let m_filterpy = [
+        0.9470155008272481,
+        0.01326964802975259,
+        0.11162459323969551,
+        0.5673288350116471,
+        -0.04000578604069184,
+        0.2869855904156349,
+    ];
+    assert!(
+        close(&f.predictor_gain, &l_ref, 1e-9),
+        "L = {}",
+        f.predictor_gain
+    );
+    assert!(close(&f.p, &p_ref, 1e-9), "P = {}", f.p);
+    assert!(
+        close(&f.filter_gain, &m_filterpy, 1e-9),
+        "M = {}",
+        f.filter_gain
+    );
+}

@@ -327,7 +327,8 @@ proptest::proptest! {
 /// An undetectable unstable mode (`A = diag(1.1, 0.5)`, `C = [0 1]`): the Riccati recursion diverges, its `P`
 /// growing by 1.21 per step. The relative change was measured in Frobenius norms, and the norm of a `P` with
 /// entries of 1e154 overflows to infinity, so the change read as 0 and the recursion returned `Ok` with
-/// `P₀₀ = 1.4e154` and a gain that ignores the unstable state. Now it is an error.
+/// `P₀₀ = 1.4e154` and a gain that ignores the unstable state. The pair is now refused before the recursion,
+/// naming the mode.
 #[test]
 fn steady_state_gain_of_an_undetectable_mode_is_an_error() {
     use bgc_runtime::estimation::kalman::steady_state_gain;
@@ -338,8 +339,29 @@ fn steady_state_gain_of_an_undetectable_mode_is_an_error() {
     for max_iterations in [100, 10_000, 100_000] {
         let got = steady_state_gain(&a, &c, &q, &r, 1e-12, max_iterations);
         assert!(
-            matches!(got, Err(EstimationError::NotConverged { .. })),
+            got == Err(EstimationError::NotDetectable { re: 1.1, im: 0.0 }),
             "{max_iterations}: {got:?}"
         );
     }
+}
+
+/// The same measure of change on a detectable problem in large units (`Q`, `R` scaled by 1e160, so `P` is too):
+/// the Frobenius norm of `P` overflowed while that of the change did not, so the change read as 0 long before
+/// convergence and the recursion stopped early, its gain and `P` off by more than 1e-10 relative. The largest
+/// entries do not overflow: `P` is 1e160 times that of the unit problem and the gain is the same.
+#[test]
+fn steady_state_gain_in_large_units_converges_to_the_scaled_solution() {
+    use bgc_runtime::estimation::kalman::steady_state_gain;
+    let a = Matrix2::new(1.0, 0.1, 0.0, 1.0);
+    let c = nalgebra::Matrix1x2::new(1.0, 0.0);
+    let (q, r) = (Matrix2::identity() * 1e-3, Matrix1::new(1e-2));
+    let unit = steady_state_gain(&a, &c, &q, &r, 1e-13, 10_000).unwrap();
+    let big = steady_state_gain(&a, &c, &(q * 1e160), &(r * 1e160), 1e-13, 10_000).unwrap();
+    let gain_error = (big.filter_gain - unit.filter_gain).amax() / unit.filter_gain.amax();
+    let p_error = (big.predicted_covariance / 1e160 - unit.predicted_covariance).amax()
+        / unit.predicted_covariance.amax();
+    assert!(
+        gain_error < 1e-10 && p_error < 1e-10,
+        "{gain_error:e} {p_error:e}"
+    );
 }

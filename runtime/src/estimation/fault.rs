@@ -90,6 +90,13 @@ pub enum EstimationError {
         "Riccati iteration did not converge in {iterations} iterations (last relative change {change:e})"
     )]
     NotConverged { iterations: usize, change: f64 },
+    /// A mode of `A` on or outside the unit circle is not seen by any measurement (`(A, C)` is not detectable),
+    /// so the error covariance of that mode grows without bound and no steady-state gain exists.
+    #[error(
+        "the mode of A at {re} + {im}i is not asymptotically stable and no measurement sees it: (A, C) is not \
+         detectable"
+    )]
+    NotDetectable { re: f64, im: f64 },
     /// A dynamically sized matrix does not have the filter's fixed size.
     #[error("matrix {name} is {rows}x{cols}, expected {expected_rows}x{expected_cols}")]
     Shape {

@@ -70,6 +70,7 @@ use super::fault::{
     check_estimate, check_finite, check_positive_definite, check_positive_semidefinite,
     repair_covariance_in,
 };
+use crate::linalg::pbh::{Domain, undetectable_mode};
 use crate::matrix::{boxed_copy, product_sum, zeroed_box};
 use crate::statespace::StateSpace;
 use definite::{DefinitePrediction, DefiniteUpdate, InnovationFloor, UpdateNorms};
@@ -585,8 +586,9 @@ pub struct SteadyStateGain<const NX: usize, const NY: usize> {
 }
 
 /// Iterates the Riccati recursion `P ← A (P − P Cᵀ S⁻¹ C P) Aᵀ + Q` from `P = Q + I` until the relative change
-/// is below `tol`, then checks the DARE residual. Converges when `(A, C)` is detectable and `(A, Q^½)`
-/// stabilisable; otherwise [`EstimationError::NotConverged`].
+/// is below `tol`, then checks the DARE residual. An undetectable `(A, C)` is refused first
+/// ([`EstimationError::NotDetectable`], by the PBH test of [`crate::linalg::pbh`]); the recursion converges
+/// when moreover `(A, Q^½)` is stabilisable, otherwise [`EstimationError::NotConverged`].
 pub fn steady_state_gain<const NX: usize, const NY: usize>(
     a: &SMatrix<f64, NX, NX>,
     c: &SMatrix<f64, NY, NX>,
@@ -604,6 +606,14 @@ pub fn steady_state_gain<const NX: usize, const NY: usize>(
             name: "tol",
             value: tol,
             reason: "the tolerance must be positive and finite",
+        });
+    }
+    // Without this the recursion diverges until P overflows and reports only that it did not converge.
+    let (a_dyn, c_dyn) = (crate::matrix::dynamic(a), crate::matrix::dynamic(c));
+    if let Ok(Some(mode)) = undetectable_mode(&a_dyn, &c_dyn, Domain::Discrete) {
+        return Err(EstimationError::NotDetectable {
+            re: mode.eigenvalue.re,
+            im: mode.eigenvalue.im,
         });
     }
     let singular = EstimationError::SingularInnovation {

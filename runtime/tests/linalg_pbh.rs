@@ -114,6 +114,41 @@ fn a_nan_rank_tolerance_and_a_non_square_schur_factor_are_errors() {
         assert!(numerical_rank(&i2, tol).is_err(), "{tol}");
     }
     assert_eq!(numerical_rank(&i2, 1e-10), Ok(2));
-    assert!(diagonal_blocks(&DMatrix::from_element(3, 1, 1.0)).is_err());
-    assert!(diagonal_blocks(&DMatrix::from_element(1, 3, 1.0)).is_err());
+    use bgc_runtime::linalg::SchurError;
+    let not_square = |rows, cols| Err(SchurError::NotSquare { rows, cols });
+    assert_eq!(
+        diagonal_blocks(&DMatrix::from_element(3, 1, 1.0)),
+        not_square(3, 1)
+    );
+    assert_eq!(
+        diagonal_blocks(&DMatrix::from_element(1, 3, 1.0)),
+        not_square(1, 3)
+    );
+    // Two 2x2 blocks that overlap (non-zero subdiagonal entries at rows 1 and 2).
+    let overlapping = DMatrix::from_row_slice(3, 3, &[1.0, 2.0, 0.0, 3.0, 1.0, 2.0, 0.0, 3.0, 1.0]);
+    assert_eq!(
+        diagonal_blocks(&overlapping),
+        Err(SchurError::NotQuasiTriangular { row: 1 })
+    );
+}
+
+/// The QR iteration of a matrix with a NaN or infinite entry returned NaN "eigenvalues" and a NaN factor as if
+/// they were a decomposition; both now name the entry.
+#[test]
+fn schur_and_eigenvalues_of_a_non_finite_matrix_name_the_entry() {
+    use bgc_runtime::linalg::SchurError;
+    use bgc_runtime::linalg::eigenvalues;
+    use bgc_runtime::linalg::schur::real_schur;
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        let mut a = DMatrix::<f64>::identity(3, 3);
+        a[(2, 1)] = bad;
+        let want = SchurError::NonFinite { row: 2, col: 1 };
+        assert_eq!(eigenvalues(&a), Err(want), "{bad}");
+        assert_eq!(real_schur(&a).err(), Some(want), "{bad}");
+    }
+    let rect = DMatrix::<f64>::zeros(2, 3);
+    assert_eq!(
+        eigenvalues(&rect),
+        Err(SchurError::NotSquare { rows: 2, cols: 3 })
+    );
 }

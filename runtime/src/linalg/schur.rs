@@ -5,33 +5,49 @@
 
 use nalgebra::{Complex, DMatrix, Schur};
 
-/// The QR iteration of the real Schur decomposition did not converge.
+/// Why a Schur decomposition, or the reading of a quasi-triangular factor, failed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("the real Schur decomposition of a {n}x{n} matrix did not converge")]
-pub struct SchurError {
-    pub n: usize,
+pub enum SchurError {
+    #[error("a Schur decomposition needs a square matrix, got {rows}x{cols}")]
+    NotSquare { rows: usize, cols: usize },
+    #[error("entry ({row}, {col}) of the matrix is not a finite number")]
+    NonFinite { row: usize, col: usize },
+    #[error("the matrix is not upper quasi-triangular: 2x2 blocks overlap at row {row}")]
+    NotQuasiTriangular { row: usize },
+    #[error("the real Schur decomposition of a {n}x{n} matrix did not converge")]
+    NoConvergence { n: usize },
+}
+
+/// `a`'s size when it is square with finite entries: the QR iteration would otherwise return NaN factors as if
+/// they were a decomposition.
+fn checked(a: &DMatrix<f64>) -> Result<usize, SchurError> {
+    let (rows, cols) = a.shape();
+    if rows != cols {
+        return Err(SchurError::NotSquare { rows, cols });
+    }
+    if let Some(k) = a.iter().position(|v| !v.is_finite()) {
+        return Err(SchurError::NonFinite {
+            row: k % rows,
+            col: k / rows,
+        });
+    }
+    Ok(rows)
 }
 
 /// `a = u t uᵀ` with `u` orthogonal and `t` upper quasi-triangular.
 pub fn real_schur(a: &DMatrix<f64>) -> Result<(DMatrix<f64>, DMatrix<f64>), SchurError> {
-    let n = a.nrows();
-    if n != a.ncols() {
-        return Err(SchurError { n });
-    }
+    let n = checked(a)?;
     Schur::try_new(a.clone(), f64::EPSILON, 1000 * n.max(10))
         .map(|s| s.unpack())
-        .ok_or(SchurError { n })
+        .ok_or(SchurError::NoConvergence { n })
 }
 
 /// The eigenvalues of a square matrix, in the order of the diagonal of its real Schur form.
 pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, SchurError> {
-    let n = a.nrows();
-    if n != a.ncols() {
-        return Err(SchurError { n });
-    }
+    let n = checked(a)?;
     Schur::try_new(a.clone(), f64::EPSILON, 1000 * n.max(10))
         .map(|s| s.complex_eigenvalues().iter().copied().collect())
-        .ok_or(SchurError { n })
+        .ok_or(SchurError::NoConvergence { n })
 }
 
 /// The diagonal blocks of an upper quasi-triangular matrix as `(start, size)` with size 1 or 2.
@@ -39,16 +55,16 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, SchurError> {
 /// nalgebra sets deflated subdiagonal entries to exactly zero, so any non-zero subdiagonal entry starts a 2x2
 /// block; two consecutive non-zero subdiagonal entries mean `t` is not quasi-triangular.
 pub fn diagonal_blocks(t: &DMatrix<f64>) -> Result<Vec<(usize, usize)>, SchurError> {
-    let n = t.nrows();
-    if n != t.ncols() {
-        return Err(SchurError { n });
+    let (n, cols) = t.shape();
+    if n != cols {
+        return Err(SchurError::NotSquare { rows: n, cols });
     }
     let mut blocks = Vec::new();
     let mut j = 0;
     while j < n {
         if j + 1 < n && t[(j + 1, j)] != 0.0 {
             if j + 2 < n && t[(j + 2, j + 1)] != 0.0 {
-                return Err(SchurError { n });
+                return Err(SchurError::NotQuasiTriangular { row: j + 1 });
             }
             blocks.push((j, 2));
             j += 2;

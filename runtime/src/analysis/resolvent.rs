@@ -30,6 +30,8 @@ pub struct Resolvent {
     dt: Option<f64>,
     /// The reduction overflowed (entries near `f64::MAX` whose squares are not finite): no point can be trusted.
     overflowed: bool,
+    /// `‖H‖` (Frobenius), the scale of the rounding in forming `pI − H`.
+    h_norm: f64,
 }
 
 impl Resolvent {
@@ -44,6 +46,7 @@ impl Resolvent {
         let overflowed = [&h, &b, &c]
             .iter()
             .any(|m| m.iter().any(|v| !v.is_finite()));
+        let h_norm = h.norm();
         Self {
             h,
             b,
@@ -51,6 +54,7 @@ impl Resolvent {
             d: sys.d().clone(),
             dt: sys.dt(),
             overflowed,
+            h_norm,
         }
     }
 
@@ -85,8 +89,8 @@ impl Resolvent {
         Ok(g)
     }
 
-    /// `(pI − H)⁻¹ QᵀB` (column-major), refused when its relative residual shows that `p` is (numerically)
-    /// a pole.
+    /// `(pI − H)⁻¹ QᵀB` (column-major), refused when its relative residual, or the size of the solution against
+    /// the rounding of `pI − H`, shows that `p` is (numerically) a pole.
     fn solve(&self, p: C64, omega: f64) -> Result<Vec<C64>, AnalysisError> {
         let n = self.h.nrows();
         if n == 0 {
@@ -117,7 +121,25 @@ impl Resolvent {
                 residual: relative,
             });
         }
+        if self.within_rounding_of_a_pole(p, &x, &b) {
+            return Err(AnalysisError::PoleOnContour { omega });
+        }
         Ok(x)
+    }
+
+    /// Whether `pI − H` is singular to within the rounding of its own entries. A backward-stable solve keeps the
+    /// residual small even there, so the residual cannot tell; but `‖b‖ / ‖x‖` bounds the smallest singular value
+    /// of `pI − H` from above, and when that is below the error of forming `pI − H` (`n ε (|p| + ‖H‖)`, with a
+    /// factor 16 of margin) some matrix within rounding of it is singular: `p` is a pole as far as `f64` can tell
+    /// (`z = e^{jπ}` of a discrete pole at −1 is `−1 + 1.2e−16 j`, and its "response" was `4e15`).
+    fn within_rounding_of_a_pole(&self, p: C64, x: &[C64], b: &[C64]) -> bool {
+        let n = self.h.nrows();
+        let size = p.norm() + self.h_norm;
+        let floor = 16.0 * n as f64 * f64::EPSILON * size;
+        x.chunks(n).zip(b.chunks(n)).any(|(xj, bj)| {
+            let (x_norm, b_norm) = (frobenius(xj), frobenius(bj));
+            b_norm > 0.0 && b_norm < floor * x_norm
+        })
     }
 
     /// `pI − H`, column-major.
@@ -333,6 +355,45 @@ mod tests {
             );
         }
         assert!(r.response(1.0).is_ok());
+    }
+
+    #[test]
+    fn a_point_within_rounding_of_a_pole_is_refused() {
+        // A discrete pole at −1 (T = 0.1 s): at ω = π/T the point e^{jπ} is −1 + 1.2e−16 j, a non-zero pivot with
+        // a tiny residual, and the "response" was −4e15 j.
+        let sys = StateSpace::new_discrete(
+            DMatrix::from_element(1, 1, -1.0),
+            DMatrix::from_element(1, 1, 1.0),
+            DMatrix::from_element(1, 1, 0.5),
+            DMatrix::zeros(1, 1),
+            0.1,
+        )
+        .expect("a valid model");
+        let r = Resolvent::new(&sys);
+        let nyquist = std::f64::consts::PI / 0.1;
+        assert!(
+            matches!(
+                r.response(nyquist),
+                Err(AnalysisError::PoleOnContour { .. })
+            ),
+            "{:?}",
+            r.response(nyquist)
+        );
+        // Near it, where the pole is 1e-6 away, the response is a number: 0.5 / |e^{jωT} + 1|.
+        let near = nyquist * (1.0 - 1e-6 / std::f64::consts::PI);
+        let g = r.response(near).expect("not a pole")[(0, 0)];
+        assert!((g.norm() / (0.5 / 1e-6) - 1.0).abs() < 1e-6, "{g}");
+        // A continuous lightly damped pair (ζ = 1e−9 at 1 rad/s) is not mistaken for a pole at its peak.
+        let a = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -1.0, -2e-9]);
+        let lightly = StateSpace::new(
+            a,
+            DMatrix::from_row_slice(2, 1, &[0.0, 1.0]),
+            DMatrix::from_row_slice(1, 2, &[1.0, 0.0]),
+            DMatrix::zeros(1, 1),
+        )
+        .expect("a valid model");
+        let peak = Resolvent::new(&lightly).response(1.0).expect("a number")[(0, 0)];
+        assert!((peak.norm() / 5e8 - 1.0).abs() < 1e-6, "{peak}");
     }
 
     #[test]

@@ -14,6 +14,7 @@ mod cli_equations;
 mod cli_examples;
 mod cli_fit;
 mod cli_hostile;
+mod cli_hostile_numbers;
 mod cli_messages;
 mod cli_root_files;
 mod cli_simulate;

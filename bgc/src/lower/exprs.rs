@@ -7,7 +7,7 @@
 //! dimension may only be raised to a constant whole power (or a half power when every exponent is even).
 
 use super::builder::Builder;
-use super::consteval::{eval, is_literal};
+use super::consteval::{eval, is_literal, not_finite};
 use super::scope::{Entity, closest};
 use crate::diagnostic::Diagnostic;
 use crate::ir::{self, Func, PortVar};
@@ -274,7 +274,29 @@ impl Builder<'_> {
         let rb = self.expr(b, cx);
         let ((ea, qa), (eb, qb)) = (ra?, rb?);
         let q = self.binary_dim(op, (qa, qb), &eb, a, b, e)?;
-        Some((ir::Expr::Binary(op, Box::new(ea), Box::new(eb)), q))
+        self.finite(ir::Expr::Binary(op, Box::new(ea), Box::new(eb)), e, cx)
+            .map(|x| (x, q))
+    }
+
+    /// BG0403: `x` (resolved from `e`) with a part that has no finite value ([`not_finite`]), which would put an
+    /// infinite or NaN coefficient into the equations. A parameter's default (or override) is checked whole, by its
+    /// value, in a message that names the parameter.
+    fn finite(&mut self, x: ir::Expr, e: &ast::Expr, cx: Cx) -> Option<ir::Expr> {
+        if matches!(cx.allow, Allow::Constant) {
+            return Some(x);
+        }
+        let Some(why) = not_finite(&x) else {
+            return Some(x);
+        };
+        self.diags.push(
+            Diagnostic::error("BG0403", format!("{} has a part with no finite value", cx.what))
+                .with_primary(e.span, why)
+                .with_help(
+                    "check for a division by zero, the logarithm of zero, the square root of a negative number or an \
+                     overflow",
+                ),
+        );
+        None
     }
 
     /// The dimension of `a op b` from those of its operands (`eb` is `b` resolved, for the exponent of a power).
@@ -316,7 +338,8 @@ impl Builder<'_> {
                 let rb = self.dimensionless_arg(b, cx);
                 let ((ea, qa), (eb, qb)) = (ra?, rb?);
                 let q = self.same_dims(qa, qb, a, b, e, "added")?;
-                Some((ir::Expr::Binary(*op, Box::new(ea), Box::new(eb)), q))
+                self.finite(ir::Expr::Binary(*op, Box::new(ea), Box::new(eb)), e, cx)
+                    .map(|x| (x, q))
             }
             ExprKind::Binary(op @ (BinOp::Mul | BinOp::Div), a, b) => {
                 let ra = self.expr(a, cx);
@@ -335,7 +358,8 @@ impl Builder<'_> {
                 } else {
                     self.binary_dim(*op, (qa, qb), &eb, a, b, e)?
                 };
-                Some((ir::Expr::Binary(*op, Box::new(ea), Box::new(eb)), q))
+                self.finite(ir::Expr::Binary(*op, Box::new(ea), Box::new(eb)), e, cx)
+                    .map(|x| (x, q))
             }
             _ => self.expr(e, cx),
         }
@@ -527,7 +551,8 @@ impl Builder<'_> {
             },
         };
         let exprs = resolved.into_iter().map(|(x, _)| x).collect();
-        Some((ir::Expr::Call(func, exprs), q))
+        self.finite(ir::Expr::Call(func, exprs), e, cx)
+            .map(|x| (x, q))
     }
 
     fn arity(&mut self, f: &ast::Ident, want: usize, found: usize, e: &ast::Expr) {

@@ -1,0 +1,71 @@
+//! Numbers out of range, in the model or on the command line: a part of an expression that is infinite or NaN, a
+//! linearisation or a symbolic entry that overflows, a fit whose squared error overflows or underflows. Each is an
+//! error that names the place and the cause (exit 1), never an `inf`, a `NaN` or a `null` printed with exit 0.
+
+use crate::cli_support;
+
+use cli_support::bgc;
+
+/// Writes `text` to a fresh file of the temporary directory and returns its path.
+fn temp_file(name: &str, text: &str) -> String {
+    let path = std::env::temp_dir().join(format!("bgc-numbers-{}-{name}", std::process::id()));
+    std::fs::write(&path, text).expect("temporary file written");
+    path.display().to_string()
+}
+
+/// A damped mass driven by a force, with the damper's law given in braces.
+fn with_law(law: &str) -> String {
+    format!(
+        "model a {{\n    domain translational;\n    param d = 1 [N s/m];\n    input F [N];\n    Se s = F;\n    \
+         I m = 1;\n    1 j;\n    R r {{ {law} }}\n    bond s -> j -> m, r;\n}}\n"
+    )
+}
+
+/// `e = d*f/0`, `ln(0)`, `sqrt(-1)`, `(-8)^(1/3)` in a law: before, `bgc check` passed and `bgc equations` printed
+/// `e_r = inf*d*f_m` or `e_r = NaN` with exit 0 (the engine folded the numbers). Now BG0403 at the part.
+#[test]
+fn a_part_of_a_law_with_no_finite_value_is_bg0403_at_the_part() {
+    for (law, part, label) in [
+        ("e = d * f / 0;", "d * f / 0", "this divides by zero"),
+        ("e = ln(0) * d * f;", "ln(0)", "this is -inf"),
+        ("e = sqrt(-1) * d * f;", "sqrt(-1)", "this is NaN"),
+        (
+            "e = (-8) ^ (1 / 3) * d * f;",
+            "(-8) ^ (1 / 3)",
+            "this is NaN",
+        ),
+        (
+            "e = 0 * d * f / 0 + d * f;",
+            "0 * d * f / 0",
+            "this divides by zero",
+        ),
+    ] {
+        let text = with_law(law);
+        let path = temp_file("law.bg", &text);
+        for cmd in ["check", "equations", "rust"] {
+            let (code, out, err) = bgc(&[cmd, &path]);
+            assert_eq!(code, 1, "{cmd} {law}: {err}\n{out}");
+            assert!(err.contains("error[BG0403]"), "{cmd} {law}: {err}");
+            assert!(err.contains(label), "{cmd} {law}: {err}");
+            let line = text.lines().position(|l| l.contains(part)).expect("line") + 1;
+            let col = text
+                .lines()
+                .nth(line - 1)
+                .and_then(|l| l.find(part))
+                .expect("col")
+                + 1;
+            assert!(
+                err.contains(&format!(":{line}:{col}")),
+                "{cmd} {law}: {err}"
+            );
+            assert!(
+                !out.contains("inf") && !out.contains("NaN"),
+                "{cmd} {law}: {out}"
+            );
+        }
+    }
+    // A finite part, a division by a parameter and a zero numerator are not findings.
+    let path = temp_file("fine.bg", &with_law("e = 0 / 2 * d * f + d * f / 1e-300;"));
+    let (code, _, err) = bgc(&["check", &path]);
+    assert_eq!(code, 0, "{err}");
+}

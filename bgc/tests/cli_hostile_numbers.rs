@@ -69,3 +69,19 @@ fn a_part_of_a_law_with_no_finite_value_is_bg0403_at_the_part() {
     let (code, _, err) = bgc(&["check", &path]);
     assert_eq!(code, 0, "{err}");
 }
+
+/// An infinite resistance said "a resistance cannot be negative".
+#[test]
+fn an_infinite_resistance_is_called_infinite() {
+    let path = temp_file(
+        "inf_r.bg",
+        "model a {\n    domain translational;\n    param big = 1e300 [N s/m];\n    input F [N];\n    Se s = F;\n    \
+         I m = 1;\n    R r = big * big;\n    1 j;\n    bond s -> j -> m, r;\n}\n",
+    );
+    let (code, _, err) = bgc(&["check", &path]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("`r` has a resistance of inf (it must be finite)"),
+        "{err}"
+    );
+}

@@ -281,6 +281,14 @@ impl Builder<'_> {
             K::C if v <= 0.0 => Some(format!(
                 "a compliance of {v} (a compliance and its stiffness must be positive)"
             )),
+            K::I | K::R if !v.is_finite() => Some(format!(
+                "{} of {v} (it must be finite)",
+                if kind == K::I {
+                    "an inertia"
+                } else {
+                    "a resistance"
+                }
+            )),
             K::I if !(v.is_finite() && v > 0.0) => {
                 Some(format!("an inertia of {v} (an inertia must be positive)"))
             }

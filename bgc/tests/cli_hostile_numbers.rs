@@ -4,7 +4,7 @@
 
 use crate::cli_support;
 
-use cli_support::bgc;
+use cli_support::{bgc, corpus};
 
 /// Writes `text` to a fresh file of the temporary directory and returns its path.
 fn temp_file(name: &str, text: &str) -> String {
@@ -84,4 +84,24 @@ fn an_infinite_resistance_is_called_infinite() {
         err.contains("`r` has a resistance of inf (it must be finite)"),
         "{err}"
     );
+}
+
+/// `--param b=1e308 --at theta=1` on the pendulum (a mass-matrix model): A[0][0] overflowed in the solve with the
+/// mass matrix and was printed as `null`, exit 0.
+#[test]
+fn a_linearisation_through_a_mass_matrix_that_overflows_is_refused() {
+    let (code, out, err) = bgc(&[
+        "statespace",
+        &corpus("pendulum.bg"),
+        "--param",
+        "b=1e308",
+        "--at",
+        "theta=1",
+    ]);
+    assert_eq!(code, 1, "{out}");
+    assert!(
+        err.contains("error: no state space: A[0][0] evaluates to a non-finite number"),
+        "{err}"
+    );
+    assert!(!out.contains("null"), "{out}");
 }

@@ -210,6 +210,11 @@ pub(crate) fn solve_mass_rows(
             .collect();
         let sol = solve_block(block, &m, &rhs)?;
         for (&j, row) in block.states.iter().zip(sol) {
+            if row.first().is_some_and(|v| !v.is_finite()) {
+                return Err(LinearError::NonFinite {
+                    what: format!("the rate of `{}`", eqs.sym_name(Sym::State(j))),
+                });
+            }
             if let (Some(slot), Some(v)) = (dx.get_mut(j), row.first()) {
                 *slot = *v;
             }
@@ -276,6 +281,17 @@ pub(crate) fn correct_mass_rows(
             }
         }
         let sol = solve_block(block, &m, &rhs)?;
+        // A non-singular but badly scaled `M` (or huge forces) can overflow the solve: an entry of A or B that is
+        // not finite is an error, as it is for the rows evaluated directly.
+        for (&row, srow) in block.states.iter().zip(&sol) {
+            if let Some(c) = srow.iter().position(|v| !v.is_finite()) {
+                let what = match c.checked_sub(n) {
+                    None => format!("A[{row}][{c}]"),
+                    Some(k) => format!("B[{row}][{k}]"),
+                };
+                return Err(LinearError::NonFinite { what });
+            }
+        }
         for (&row, srow) in block.states.iter().zip(sol) {
             if let Some(a) = ss.a.get_mut(row) {
                 a.iter_mut().zip(&srow).for_each(|(x, v)| *x = *v);

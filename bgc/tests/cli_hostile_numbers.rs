@@ -105,3 +105,27 @@ fn a_linearisation_through_a_mass_matrix_that_overflows_is_refused() {
     );
     assert!(!out.contains("null"), "{out}");
 }
+
+/// `--symbolic --param d=1e308 --param m=1e-308`: `d/m` was folded to `inf` and printed as the entry `-inf`.
+#[test]
+fn a_symbolic_entry_that_overflows_is_refused() {
+    let (code, out, err) = bgc(&[
+        "statespace",
+        &corpus("oscillator.bg"),
+        "--symbolic",
+        "--param",
+        "d=1e308",
+        "--param",
+        "m=1e-308",
+    ]);
+    assert_eq!(code, 1, "{out}");
+    assert!(
+        err.contains("no symbolic state space: A[0][0] holds the number -inf"),
+        "{err}"
+    );
+    assert!(!out.contains("inf"), "{out}");
+    // In range, the same command still prints the entries.
+    let (code, out, err) = bgc(&["statespace", &corpus("oscillator.bg"), "--symbolic"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("\"-d/m\""), "{out}");
+}

@@ -141,11 +141,7 @@ fn state_space(d: &Derived, args: &StateSpaceArgs<'_>) -> Result<Value, String> 
             };
             if args.symbolic {
                 let j = equations::declared_state_space_symbolic(eqs).map_err(declared)?;
-                Ok(symbolic_json(
-                    eqs,
-                    &j,
-                    &fixed_params(eqs, args.params, &params),
-                ))
+                symbolic_json(eqs, &j, &fixed_params(eqs, args.params, &params))
             } else {
                 // The exact elimination, evaluated at the parameters, keeps structural zeros exactly zero; the
                 // numeric path (null spaces by floating-point elimination) leaves rounding residue such as 5e-11
@@ -215,7 +211,7 @@ fn energy_coords(
                 at_point(&j, &x0, &u0)
             }
         };
-        return Ok(symbolic_json(eqs, &j, &fixed));
+        return symbolic_json(eqs, &j, &fixed);
     }
     let no_state_space = |e: LinearError| format!("no state space: {e}");
     let plain = eqs.tear_blocks.is_empty() && eqs.mass.is_empty();
@@ -386,25 +382,40 @@ fn in_free_params(eqs: &Equations, e: &Expr, fixed: &[Option<f64>]) -> Expr {
     e
 }
 
-fn symbolic_json(eqs: &Equations, j: &Jacobians, fixed: &[Option<f64>]) -> Value {
-    let render = |m: &[Vec<Expr>]| -> Vec<Vec<String>> {
-        m.iter()
-            .map(|row| {
-                row.iter()
-                    .map(|e| equations::expr_text(eqs, &in_free_params(eqs, e, fixed)))
-                    .collect()
-            })
-            .collect()
+/// The symbolic state space as text. An entry holding a number that is not finite (parameters given with `--param`
+/// whose product overflows, `1e308 / 1e-308`, or a division by an expression that is zero by structure) is
+/// refused: printed, `-inf` would read as a coefficient.
+fn symbolic_json(eqs: &Equations, j: &Jacobians, fixed: &[Option<f64>]) -> Result<Value, String> {
+    let render = |name: &str, m: &[Vec<Expr>]| -> Result<Vec<Vec<String>>, String> {
+        let mut rows = Vec::with_capacity(m.len());
+        for (r, row) in m.iter().enumerate() {
+            let mut texts = Vec::with_capacity(row.len());
+            for (c, e) in row.iter().enumerate() {
+                let e = in_free_params(eqs, e, fixed);
+                let bad = symbols::post_order(std::slice::from_ref(&e))
+                    .iter()
+                    .find_map(|x| x.as_const().filter(|v| !v.is_finite()));
+                if let Some(v) = bad {
+                    return Err(format!(
+                        "no symbolic state space: {name}[{r}][{c}] holds the number {v}, which is not finite (with \
+                         the values given by --param, or a division by zero in the model)"
+                    ));
+                }
+                texts.push(equations::expr_text(eqs, &e));
+            }
+            rows.push(texts);
+        }
+        Ok(rows)
     };
-    json!({
+    Ok(json!({
         "states": j.states,
         "inputs": j.inputs,
         "outputs": j.outputs,
-        "A": render(&j.dfdx),
-        "B": render(&j.dfdu),
-        "C": render(&j.dhdx),
-        "D": render(&j.dhdu),
-    })
+        "A": render("A", &j.dfdx)?,
+        "B": render("B", &j.dfdu)?,
+        "C": render("C", &j.dhdx)?,
+        "D": render("D", &j.dhdu)?,
+    }))
 }
 
 fn numeric_json(ss: &NumericStateSpace) -> Value {

@@ -129,3 +129,28 @@ fn a_symbolic_entry_that_overflows_is_refused() {
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("\"-d/m\""), "{out}");
 }
+
+const OSC: &str = "model osc {\n    domain translational;\n    param m = 2 [kg];\n    param k = 800 [N/m];\n    \
+param d = 4 [N s/m];\n    input F [N];\n    Se push = F;\n    I mass = m;\n    C spring = 1 / k;\n    \
+R damper = d;\n    1 v;\n    bond push -> v -> mass, spring, damper;\n    output x [m] = q(spring);\n}\n";
+
+/// A record saved as "CSV UTF-8" by a spreadsheet starts with a byte-order mark: it was refused with "no `t`
+/// column (the header is `\u{feff}t,F,x`)".
+#[test]
+fn a_record_with_a_byte_order_mark_is_read() {
+    let model = temp_file("osc_bom.bg", OSC);
+    let mut csv = String::from("\u{feff}t,F,x\r\n");
+    for i in 0..=20 {
+        let t = i as f64 * 0.01;
+        // The static deflection F/k under a held unit force, far from it at the start: a record the model can fit.
+        csv.push_str(&format!(
+            "{t},1,{}\r\n",
+            if i == 0 { 0.0 } else { 1.0 / 800.0 }
+        ));
+    }
+    let data = temp_file("bom.csv", &csv);
+    let (code, out, err) = bgc(&["fit", &model, "--data", &data, "--free", "k"]);
+    assert!(!err.contains("no `t` column"), "{err}");
+    assert!(code == 0 || code == 3, "{err}\n{out}");
+    assert!(out.contains("fit of `osc` to 21 samples"), "{out}");
+}

@@ -137,6 +137,8 @@ impl Record {
         input_names: &[&str],
         output_names: &[&str],
     ) -> Result<Record, RecordError> {
+        // A spreadsheet's "CSV UTF-8" begins with a byte-order mark, which is not part of the first column's name.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let mut lines = text
             .lines()
             .enumerate()

@@ -134,6 +134,26 @@ const OSC: &str = "model osc {\n    domain translational;\n    param m = 2 [kg];
 param d = 4 [N s/m];\n    input F [N];\n    Se push = F;\n    I mass = m;\n    C spring = 1 / k;\n    \
 R damper = d;\n    1 v;\n    bond push -> v -> mass, spring, damper;\n    output x [m] = q(spring);\n}\n";
 
+/// A record whose squared errors overflow (values of 1e308), or a weight so small that they underflow, made the fit
+/// stop at its start with "the gradient vanished (a minimum); converged", exit 0, and a residual RMS of `inf`.
+#[test]
+fn a_fit_whose_squared_error_is_out_of_range_is_refused() {
+    let model = temp_file("osc.bg", OSC);
+    let huge = temp_file("huge.csv", "t,F,x\n0,0,1e308\n0.1,1,1e308\n0.2,1,1e308\n");
+    let (code, out, err) = bgc(&["fit", &model, "--data", &huge, "--free", "k"]);
+    assert_eq!(code, 1, "{err}\n{out}");
+    assert!(
+        err.contains("the weighted squared error at the start is inf"),
+        "{err}"
+    );
+    let fine = temp_file("fine.csv", "t,F,x\n0,0,0\n0.1,1,1e-3\n0.2,1,3e-3\n");
+    let (code, out, err) = bgc(&[
+        "fit", &model, "--data", &fine, "--free", "k", "--weight", "x=1e-320",
+    ]);
+    assert_eq!(code, 1, "{err}\n{out}");
+    assert!(err.contains("out of the range of f64"), "{err}");
+}
+
 /// A record saved as "CSV UTF-8" by a spreadsheet starts with a byte-order mark: it was refused with "no `t`
 /// column (the header is `\u{feff}t,F,x`)".
 #[test]

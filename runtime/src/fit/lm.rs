@@ -210,6 +210,7 @@ pub fn minimise(
         return Err("the residuals or their Jacobian at the start are not finite".into());
     }
     let mut cost = 0.5 * r.norm_squared();
+    check_start(&r, &j, cost)?;
     // λ multiplies the diagonal D of JᵀJ (Marquardt's scaling): it is dimensionless.
     let mut lambda = 1e-3;
     let mut nu = 2.0;
@@ -311,6 +312,28 @@ pub fn minimise(
         convergence,
         optimality,
     })
+}
+
+/// The start must be a point the optimality tests can read: residuals, Jacobian and cost finite, and a cost that
+/// is zero only when the residuals are. Otherwise the gradient test sees `|Jᵀr| / (‖J‖ ‖r‖) = 0` (an infinite or
+/// underflowed norm) and reports a minimum at the start.
+fn check_start(r: &DVector<f64>, j: &DMatrix<f64>, cost: f64) -> Result<(), String> {
+    if let Some(k) = r.iter().position(|v| !v.is_finite()) {
+        return Err(format!(
+            "the weighted residual {k} is {} at the start",
+            r[k]
+        ));
+    }
+    if j.iter().any(|v| !v.is_finite()) {
+        return Err("the Jacobian of the residuals is not finite at the start".into());
+    }
+    if !cost.is_finite() || (cost == 0.0 && r.iter().any(|v| *v != 0.0)) {
+        return Err(format!(
+            "the weighted squared error at the start is {cost:e}, out of the range of f64: scale the record, the \
+             weights or the starting values"
+        ));
+    }
+    Ok(())
 }
 
 /// MINPACK's first-order optimality: the largest `|J_kᵀ r| / (‖J_k‖ ‖r‖)` over the columns free to move
@@ -588,5 +611,41 @@ mod tests {
         // There s² is that of the displaced residuals: ‖r‖² = 0.2 + 5 se² = 0.3, s = √(0.3/2).
         let want = (5.0f64).sqrt() * se / (0.3f64 / 2.0).sqrt();
         assert!((d - want).abs() < 1e-12, "{d} vs {want}");
+    }
+
+    /// `r = scale (z − 1, z − 2)`: with `scale` 1e200 the squared norm overflows, with 1e-170 it underflows to 0.
+    /// Either way the gradient test read `|Jᵀr| / (‖J‖ ‖r‖)` as 0 and returned the start as a converged minimum.
+    struct Scaled(f64);
+
+    impl Residuals for Scaled {
+        fn evaluate(&mut self, z: &[f64]) -> Result<(DVector<f64>, DMatrix<f64>), String> {
+            let r = DVector::from_vec(vec![self.0 * (z[0] - 1.0), self.0 * (z[0] - 2.0)]);
+            Ok((r, DMatrix::from_element(2, 1, self.0)))
+        }
+    }
+
+    #[test]
+    fn a_start_whose_squared_error_is_out_of_range_is_an_error_not_a_minimum() {
+        let inf = f64::INFINITY;
+        for scale in [1e200, 1e-170] {
+            let got = minimise(
+                &mut Scaled(scale),
+                &[0.0],
+                &[-inf],
+                &[inf],
+                &LmOptions::default(),
+            );
+            let err = got.expect_err("refused");
+            assert!(err.contains("out of the range of f64"), "{scale}: {err}");
+        }
+        let m = minimise(
+            &mut Scaled(1.0),
+            &[0.0],
+            &[-inf],
+            &[inf],
+            &LmOptions::default(),
+        )
+        .unwrap();
+        assert!((m.z[0] - 1.5).abs() < 1e-9, "{m:?}");
     }
 }

@@ -174,3 +174,30 @@ fn a_record_with_a_byte_order_mark_is_read() {
     assert!(code == 0 || code == 3, "{err}\n{out}");
     assert!(out.contains("fit of `osc` to 21 samples"), "{out}");
 }
+
+/// `--param n=0` on a gear's ratio: the file's own default would be BG0401, but on the command line the ratio was
+/// taken, and `statespace` printed B = 0 and `simulate` a load that never moves, with exit 0.
+#[test]
+fn a_zero_transformer_ratio_on_the_command_line_is_refused() {
+    let path = temp_file(
+        "gear.bg",
+        "model gear {\n    domain rotational;\n    param n = 10 [1];\n    param J = 1 [kg m^2];\n    \
+         input tau [N m];\n    Se s = tau;\n    1 j1;\n    TF g = n;\n    1 j2;\n    I load = J;\n    \
+         bond s -> j1 -> g -> j2 -> load;\n}\n",
+    );
+    for args in [
+        vec!["statespace", &path, "--param", "n=0"],
+        vec![
+            "simulate", &path, "--t-end", "1", "--input", "tau=1", "--param", "n=-0",
+        ],
+    ] {
+        let (code, out, err) = bgc(&args);
+        assert_eq!(code, 1, "{args:?}: {out}");
+        assert!(
+            err.contains("TF `g` =") && err.contains("a transformer ratio must not be zero"),
+            "{args:?}: {err}"
+        );
+    }
+    let (code, _, err) = bgc(&["statespace", &path, "--param", "n=2"]);
+    assert_eq!(code, 0, "{err}");
+}

@@ -99,10 +99,12 @@ pub fn param_values(
 
 /// Checks the coefficients of the linear storages and resistors: an inertia or a compliance must be positive
 /// (otherwise the stored energy is not positive definite), a resistance must not be negative (it would create
-/// energy). Coefficients that depend on more than parameters are not checked here.
+/// energy); and, as BG0401 does for the defaults, the modulus of a TF or GY must not be zero (it would cut the
+/// graph in two, and a model on either side would run as if the other did not exist). Coefficients that depend on
+/// more than parameters are not checked here.
 pub fn check_physical(model: &Model, params: &[f64]) -> Result<(), String> {
     for node in model.graph.node_weights() {
-        let Relation::Linear(e) = &node.relation else {
+        let (Relation::Linear(e) | Relation::Modulus(e)) = &node.relation else {
             continue;
         };
         let Some(v) = eval_params(e, params) else {
@@ -112,11 +114,18 @@ pub fn check_physical(model: &Model, params: &[f64]) -> Result<(), String> {
             ElementKind::I => (v > 0.0, "an inertia must be positive"),
             ElementKind::C => (v > 0.0, "a compliance must be positive"),
             ElementKind::R => (v >= 0.0, "a resistance must not be negative"),
+            ElementKind::TF => (v != 0.0, "a transformer ratio must not be zero"),
+            ElementKind::GY => (v != 0.0, "a gyrator modulus must not be zero"),
             _ => continue,
         };
         if !ok || !v.is_finite() {
+            let rule = if v.is_finite() {
+                rule
+            } else {
+                "the value must be finite"
+            };
             return Err(format!(
-                "{} `{}` = {v} with these parameter values: {rule} and finite",
+                "{} `{}` = {v} with these parameter values: {rule}",
                 node.kind.keyword(),
                 node.name
             ));

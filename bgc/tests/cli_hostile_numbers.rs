@@ -201,3 +201,15 @@ fn a_zero_transformer_ratio_on_the_command_line_is_refused() {
     let (code, _, err) = bgc(&["statespace", &path, "--param", "n=2"]);
     assert_eq!(code, 0, "{err}");
 }
+
+/// `--data /dev/zero` read without end (the run was killed after 20 s with its memory growing); a device and a
+/// directory are refused without being read.
+#[test]
+fn a_record_that_is_a_device_is_refused_without_being_read() {
+    let model = temp_file("osc_dev.bg", OSC);
+    for data in ["/dev/zero", "/"] {
+        let (code, _, err) = bgc(&["fit", &model, "--data", data, "--free", "k"]);
+        assert_eq!(code, 2, "{data}: {err}");
+        assert!(err.contains("not a regular file"), "{data}: {err}");
+    }
+}

@@ -33,7 +33,7 @@ pub fn run(path: &Path, wanted: Option<&str>, args: &FitArgs<'_>, color: bool) -
         Ok(x) => x,
         Err(s) => return s,
     };
-    let text = match std::fs::read_to_string(args.data) {
+    let text = match super::io::read_record(args.data) {
         Ok(t) => t,
         Err(e) => {
             stderrln(&format!("error: cannot read {}: {e}", args.data.display()));

@@ -41,6 +41,43 @@ pub fn read_source(
     }
 }
 
+/// The largest measured record `bgc fit --data` reads.
+pub const MAX_RECORD_BYTES: u64 = 256 << 20;
+
+/// Reads a measured record: a regular file or a pipe (`--data <(...)`), up to [`MAX_RECORD_BYTES`]. A device
+/// (`/dev/zero` never ends), a directory or a socket is refused without being read.
+pub fn read_record(path: &Path) -> std::io::Result<String> {
+    use std::io::Read;
+    let refuse = |why: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, why);
+    let kind = std::fs::metadata(path)?.file_type();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_char_device() || kind.is_block_device() || kind.is_socket() {
+            return Err(refuse("not a regular file (a device or a socket)".into()));
+        }
+    }
+    if kind.is_dir() {
+        return Err(refuse("not a regular file (a directory)".into()));
+    }
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(MAX_RECORD_BYTES + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_RECORD_BYTES {
+        return Err(refuse(format!(
+            "the record is larger than the {} MiB it may have",
+            MAX_RECORD_BYTES >> 20
+        )));
+    }
+    String::from_utf8(bytes).map_err(|_| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            "stream did not contain valid UTF-8",
+        )
+    })
+}
+
 /// Writes to standard output. A closed pipe (`bgc ... | head`) is not an error: the output is simply no longer
 /// wanted, and the command ends quietly (status 0, as `head` expects). Any other failure (a full disk, `>
 /// /dev/full`) ends the command with status 2 and the OS error, because the result was not delivered.

@@ -91,3 +91,39 @@ fn a_session_over_stdio_ends_with_status_zero() {
         .unwrap_or_default();
     assert_eq!(codes, ["BG0510", "BG0510"]);
 }
+
+/// A client that sends a document before `initialized` breaks the protocol. The server stops with status 2; its
+/// message said "the connection failed: sending on a disconnected channel" (the reader thread's failure to hand
+/// over the messages that followed), and now names the protocol error.
+#[test]
+fn a_protocol_error_is_named_not_the_reader_thread_that_fails_after_it() {
+    let session = [
+        serde_json::json!({"jsonrpc": "2.0", "id": 1, "method": "initialize",
+            "params": {"processId": null, "rootUri": null, "capabilities": {}}}),
+        serde_json::json!({"jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {"textDocument":
+            {"uri": "file:///tmp/early.bg", "languageId": "bg", "version": 1, "text": "model a { }"}}}),
+        serde_json::json!({"jsonrpc": "2.0", "id": 2, "method": "shutdown", "params": null}),
+        serde_json::json!({"jsonrpc": "2.0", "method": "exit", "params": null}),
+    ];
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bgc"))
+        .arg("lsp")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("bgc lsp starts");
+    let mut stdin = child.stdin.take().expect("stdin");
+    for m in &session {
+        // The server may stop reading at the violation: a closed pipe is part of the outcome.
+        let _ = stdin.write_all(&frame(m));
+    }
+    drop(stdin);
+    let out = child.wait_with_output().expect("bgc lsp ends");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("initialisation failed: expected initialized notification"),
+        "{err}"
+    );
+    assert!(!err.contains("disconnected channel"), "{err}");
+}

@@ -107,7 +107,9 @@ pub fn run_stdio(options: Options) -> Result<(), String> {
     let (connection, io) = Connection::stdio();
     let served = serve(&connection, options);
     drop(connection);
-    io.join()
-        .map_err(|e| format!("the connection failed: {e}"))?;
-    served
+    let joined = io.join();
+    // When the server stops on a protocol error, the reader thread fails next ("sending on a disconnected
+    // channel", for the messages the client had already sent): the server's error is the one that names the cause.
+    served?;
+    joined.map_err(|e| format!("the connection failed: {e}"))
 }

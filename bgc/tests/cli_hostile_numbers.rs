@@ -213,3 +213,19 @@ fn a_record_that_is_a_device_is_refused_without_being_read() {
         assert!(err.contains("not a regular file"), "{data}: {err}");
     }
 }
+
+/// `--dt-out 1e-300` was refused with the row count written out in 301 digits.
+#[test]
+fn too_many_rows_are_counted_in_scientific_notation() {
+    let (code, _, err) = bgc(&[
+        "simulate",
+        &corpus("oscillator.bg"),
+        "--t-end",
+        "1",
+        "--dt-out",
+        "1e-300",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("the sampling gives 1.000e300 rows"), "{err}");
+    assert!(err.lines().all(|l| l.len() < 200), "{err}");
+}

@@ -70,7 +70,7 @@ pub enum SimError {
         reason: &'static str,
     },
     #[error(
-        "the sampling gives {rows} rows, more than the limit of {limit}; choose a larger --dt-out"
+        "the sampling gives {rows:.3e} rows, more than the limit of {limit}; choose a larger --dt-out"
     )]
     TooManyRows { rows: f64, limit: usize },
     #[error("the initial {what} is not finite")]

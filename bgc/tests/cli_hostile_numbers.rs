@@ -229,3 +229,42 @@ fn too_many_rows_are_counted_in_scientific_notation() {
     assert!(err.contains("the sampling gives 1.000e300 rows"), "{err}");
     assert!(err.lines().all(|l| l.len() < 200), "{err}");
 }
+
+/// A part that is zero for every parameter value only once simplified (`big - big`) passed lowering, and
+/// `bgc equations` printed `speed = inf*e_r` (or a rate `inf*d*f_m`) with exit 0; `bgc rust` generated
+/// `f64::INFINITY * e_r`. Now BG0608 at the output or the element whose rate it is, for every command that
+/// derives equations.
+#[test]
+fn a_rate_or_output_with_no_finite_value_after_simplification_is_bg0608() {
+    let head = "model a {\n    domain translational;\n    param d = 1 [N s/m];\n    param big = 2 [1];\n    \
+                input F [N];\n    Se s = F;\n    I m = 1;\n    1 j;\n    bond s -> j -> m, r;\n";
+    for (body, subject, place) in [
+        (
+            "    R r { e = d * f; }\n    output speed [N] = e(r) / (big - big);\n",
+            "output `speed`",
+            "output speed",
+        ),
+        (
+            "    R r { e = d * f / (big - big); }\n",
+            "the rate of `p_m`",
+            "I m = 1",
+        ),
+        (
+            "    R r { e = d * f * ln(big - big); }\n",
+            "the rate of `p_m`",
+            "I m = 1",
+        ),
+    ] {
+        let text = format!("{head}{body}}}\n");
+        let path = temp_file("simplified.bg", &text);
+        let line = text.lines().position(|l| l.contains(place)).expect("line") + 1;
+        for cmd in ["equations", "rust", "statespace"] {
+            let (code, out, err) = bgc(&[cmd, &path]);
+            assert_eq!(code, 1, "{cmd} {body}: {err}\n{out}");
+            assert!(err.contains("error[BG0608]"), "{cmd} {body}: {err}");
+            assert!(err.contains(subject), "{cmd} {body}: {err}");
+            assert!(err.contains(&format!(":{line}:")), "{cmd} {body}: {err}");
+            assert!(!out.contains("INFINITY"), "{cmd} {body}: {out}");
+        }
+    }
+}

@@ -112,6 +112,7 @@ pub mod codes {
     pub const UNSUPPORTED: &str = "BG0605";
     pub const COORDS: &str = "BG0606";
     pub const ENERGY: &str = "BG0607";
+    pub const NOT_FINITE: &str = "BG0608";
 }
 
 /// What a state is.
@@ -600,6 +601,7 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
         }
         None => resolver_rates(&built, &solved, &implicit),
     };
+    not_finite(model, &built.states, &eqs.f, &eqs.outputs, &mut diags);
     let readable = print::readable(&built, &shown_rates, &output_values, taken);
     for o in &mut eqs.outputs {
         o.value = readable.alias(&o.value);
@@ -716,6 +718,56 @@ fn inline_leading(built: &build::Built) -> Vec<Option<Expr>> {
         }
     }
     inlined
+}
+
+/// BG0608 for each rate and output that holds a constant that is not finite: a part that reads no parameter or
+/// variable and has no value, such as a division by `big − big`, which simplifies to `1/0`. Lowering refuses such
+/// parts as written (BG0403); these appear only once the equations are simplified.
+fn not_finite(
+    model: &Model,
+    states: &[StateSpec],
+    rates: &[Option<Expr>],
+    outputs: &[OutputEq],
+    diags: &mut Vec<Diagnostic>,
+) {
+    // The explicit forms: a readable one holds intermediates, whose definitions hold the constant.
+    let values: Vec<Expr> = rates
+        .iter()
+        .map(|r| r.clone().unwrap_or_else(Expr::zero))
+        .chain(
+            outputs
+                .iter()
+                .map(|o| o.explicit.clone().unwrap_or_else(Expr::zero)),
+        )
+        .collect();
+    let held = Expr::holding_non_finite(&values);
+    let why = "it divides by a part that is zero whatever the parameters are, or takes a function outside its domain there";
+    for (k, _) in held.iter().enumerate().filter(|&(_, &bad)| bad) {
+        let d = match (
+            states.get(k),
+            k.checked_sub(rates.len())
+                .and_then(|j| Some((j, outputs.get(j)?))),
+        ) {
+            (Some(s), _) => {
+                let d = Diagnostic::error(
+                    codes::NOT_FINITE,
+                    format!("the rate of `{}` has no finite value: {why}", s.name),
+                );
+                with_span(d, state_span(model, s), "this element")
+            }
+            (None, Some((j, o))) => {
+                let d = Diagnostic::error(
+                    codes::NOT_FINITE,
+                    format!("output `{}` has no finite value: {why}", o.name),
+                );
+                with_span(d, model.spans.outputs.get(j), "this output")
+            }
+            _ => continue,
+        };
+        diags.push(d.with_help(
+            "look for a difference of equal terms in a denominator or under a logarithm",
+        ));
+    }
 }
 
 fn state_span<'m>(model: &'m Model, s: &StateSpec) -> Option<&'m crate::span::Span> {

@@ -139,6 +139,23 @@ impl Expr {
         Ok(values.last().copied().unwrap_or(f64::NAN))
     }
 
+    /// For each expression, whether it holds a constant that is not finite: an `inf` or `NaN` folded from a part
+    /// that reads no symbol, such as `1/(a − a)`. One walk of their distinct nodes together.
+    pub fn holding_non_finite(exprs: &[Expr]) -> Vec<bool> {
+        let dag = Dag::new(exprs);
+        let mut held = vec![false; dag.len()];
+        for (i, e) in dag.order.iter().enumerate() {
+            let mut bad = matches!(e.node(), Node::Const(c) if !c.is_finite());
+            e.node()
+                .for_each_child(|c| bad |= dag.index(c).is_some_and(|k| held[k]));
+            held[i] = bad;
+        }
+        exprs
+            .iter()
+            .map(|e| dag.index(e).is_some_and(|k| held[k]))
+            .collect()
+    }
+
     /// The symbols the expression depends on, in [`Symbol`] order.
     pub fn free_symbols(&self) -> BTreeSet<Symbol> {
         Dag::new([self])

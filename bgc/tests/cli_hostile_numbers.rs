@@ -268,3 +268,24 @@ fn a_rate_or_output_with_no_finite_value_after_simplification_is_bg0608() {
         }
     }
 }
+
+/// An explicit method under a forcing of 1e150 at 1 MHz made steps too short to advance `t`: the run went on for
+/// minutes, bounded only by the budget of 10,000,000 steps. Now the pace of each 10,000 steps is checked as it
+/// is for BDF, and a run that cannot finish at that pace stops at once, saying so.
+#[test]
+fn an_explicit_run_too_slow_to_finish_stops_at_once() {
+    let model = corpus("oscillator.bg");
+    let (code, _, err) = bgc(&[
+        "simulate",
+        &model,
+        "--t-end",
+        "1e-3",
+        "--solver",
+        "tsit45",
+        "--input",
+        "F=1e150*sin(1e6*t)",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("advanced too slowly"), "{err}");
+    assert!(err.contains("--solver bdf"), "{err}");
+}

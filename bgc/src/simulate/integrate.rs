@@ -449,6 +449,7 @@ fn segment_once(
         wanted,
         max_steps: opts.max_steps,
         may_stall: opts.method == Method::Bdf,
+        explicit: opts.method == Method::Tsit45,
     };
     if let Some(full) = system.jacobian_pattern().filter(|_| dim >= SPARSE_FROM) {
         // The rows of the energy quadratures (dissipated, supplied) are left out of the sparse Jacobian: a
@@ -541,8 +542,12 @@ struct Drive<'c> {
     to: f64,
     wanted: &'c Wanted,
     max_steps: usize,
-    /// Whether a stall ends the drive with [`Outcome::Stalled`] (BDF) instead of running into `max_steps`.
+    /// Whether a stall ends the drive with [`Outcome::Stalled`] (BDF, which goes on with TR-BDF2).
     may_stall: bool,
+    /// Whether the method is explicit, whose step a stiff mode or a fast forcing holds short for the rest of the
+    /// run: a stall ends it with [`SimError::TooSlow`]. An implicit method's slow start may be a transient it
+    /// leaves behind (TR-BDF2 after BDF's stall on the stiff oscillator), so it keeps its whole step budget.
+    explicit: bool,
 }
 
 /// The steps between two looks at BDF's progress.
@@ -633,7 +638,19 @@ impl Drive<'_> {
                 return Ok(Outcome::Reached(y));
             }
             if (step + 1) % STALL_WINDOW == 0 {
-                if self.may_stall && self.stalled(window_start, t_now, step + 1) {
+                if (self.may_stall || self.explicit) && self.stalled(window_start, t_now, step + 1)
+                {
+                    if !self.may_stall {
+                        // An explicit method under a fast forcing or a stiff mode: it would spend the whole step
+                        // budget (minutes) before failing.
+                        return Err(SimError::TooSlow {
+                            from: self.from,
+                            to: self.to,
+                            time: t_now,
+                            steps: step + 1,
+                            max_steps: self.max_steps,
+                        });
+                    }
                     return Ok(Outcome::Stalled {
                         t: t_now,
                         y,

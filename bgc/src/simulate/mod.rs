@@ -103,6 +103,18 @@ pub enum SimError {
         time: f64,
         max_steps: usize,
     },
+    #[error(
+        "the solver advanced too slowly: {steps} steps from t = {from} reached t = {time}, and at that pace t = {to} \
+         needs more than the {max_steps} steps allowed (a stiff or fast-forced model: try --solver bdf, or looser \
+         tolerances)"
+    )]
+    TooSlow {
+        from: f64,
+        to: f64,
+        time: f64,
+        steps: usize,
+        max_steps: usize,
+    },
 }
 
 /// The compiled equations of a model at fixed parameter values, with its input signals.

@@ -10,6 +10,24 @@ fn frame(message: &serde_json::Value) -> Vec<u8> {
     format!("Content-Length: {}\r\n\r\n{body}", body.len()).into_bytes()
 }
 
+/// Runs `bgc ARGS` with the framed `session` on its standard input and returns what it wrote and its status. A
+/// server may stop reading at a protocol violation: a closed pipe is part of the outcome, which the caller checks.
+fn serve(args: &[&str], session: &[serde_json::Value]) -> std::process::Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bgc"))
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("bgc lsp starts");
+    let mut stdin = child.stdin.take().expect("stdin");
+    for m in session {
+        let _ = stdin.write_all(&frame(m));
+    }
+    drop(stdin);
+    child.wait_with_output().expect("bgc lsp ends")
+}
+
 /// Splits the framed output into messages.
 fn messages(mut out: &[u8]) -> Vec<serde_json::Value> {
     let mut found = Vec::new();
@@ -41,19 +59,7 @@ fn a_session_over_stdio_ends_with_status_zero() {
         serde_json::json!({"jsonrpc": "2.0", "id": 3, "method": "shutdown", "params": null}),
         serde_json::json!({"jsonrpc": "2.0", "method": "exit", "params": null}),
     ];
-    let mut child = Command::new(env!("CARGO_BIN_EXE_bgc"))
-        .args(["lsp", "--stdio"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("bgc lsp starts");
-    let mut stdin = child.stdin.take().expect("stdin");
-    for m in &session {
-        stdin.write_all(&frame(m)).expect("the server reads");
-    }
-    drop(stdin);
-    let out = child.wait_with_output().expect("bgc lsp ends");
+    let out = serve(&["lsp", "--stdio"], &session);
     assert_eq!(
         out.status.code(),
         Some(0),
@@ -105,20 +111,7 @@ fn a_protocol_error_is_named_not_the_reader_thread_that_fails_after_it() {
         serde_json::json!({"jsonrpc": "2.0", "id": 2, "method": "shutdown", "params": null}),
         serde_json::json!({"jsonrpc": "2.0", "method": "exit", "params": null}),
     ];
-    let mut child = Command::new(env!("CARGO_BIN_EXE_bgc"))
-        .arg("lsp")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("bgc lsp starts");
-    let mut stdin = child.stdin.take().expect("stdin");
-    for m in &session {
-        // The server may stop reading at the violation: a closed pipe is part of the outcome.
-        let _ = stdin.write_all(&frame(m));
-    }
-    drop(stdin);
-    let out = child.wait_with_output().expect("bgc lsp ends");
+    let out = serve(&["lsp"], &session);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(

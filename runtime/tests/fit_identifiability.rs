@@ -167,3 +167,30 @@ fn records_and_specs_that_do_not_fit_the_model_are_refused_with_the_reason() {
     nan_opts.lm.max_log_step = f64::NAN;
     assert!(refused(TRUTH, &record(), &[0.0], &nan_opts).contains("max_log_step"));
 }
+
+/// `Record::input_at` panicked on a buffer of the wrong length (`copy_from_slice`) and gave NaN inputs for a NaN
+/// time; it now writes nothing and says so. Within the record, a linear input is interpolated: 1 + 2·0.25 at
+/// t = 0.25 between (0, 1) and (1, 3), and the held one is the sample's.
+#[test]
+fn inputs_at_a_time_refuse_a_wrong_buffer_and_a_nan_time() {
+    use bgc_runtime::fit::Interp;
+    let record = Record::new(
+        vec![0.0, 1.0],
+        vec![vec![1.0, 10.0], vec![3.0, 10.0]],
+        vec![0],
+        vec![vec![0.0], vec![0.0]],
+    )
+    .expect("a valid record");
+    let mut u = [0.0; 2];
+    assert!(record.input_at(Interp::Linear, 0.25, &mut u));
+    assert_eq!(u, [1.5, 10.0]);
+    assert!(record.input_at(Interp::Zoh, 0.25, &mut u));
+    assert_eq!(u, [1.0, 10.0]);
+    let mut short = [7.0; 1];
+    assert!(!record.input_at(Interp::Linear, 0.25, &mut short));
+    assert_eq!(short, [7.0]);
+    let mut long = [7.0; 3];
+    assert!(!record.input_at(Interp::Zoh, 0.25, &mut long));
+    assert!(!record.input_at(Interp::Linear, f64::NAN, &mut u));
+    assert_eq!(u, [1.0, 10.0]);
+}

@@ -249,10 +249,17 @@ impl Record {
             .sum()
     }
 
-    /// The inputs at time `t` in `[t_0, t_end]`.
-    pub fn input_at(&self, interp: Interp, t: f64, u: &mut [f64]) {
+    /// Writes the inputs at time `t` in `[t_0, t_end]` (held outside it) into `u`. Returns `false`, and writes
+    /// nothing, when `t` is not finite or `u` is not as long as a row of inputs.
+    #[must_use]
+    pub fn input_at(&self, interp: Interp, t: f64, u: &mut [f64]) -> bool {
         let k = self.times.partition_point(|&s| s <= t).saturating_sub(1);
-        let here = &self.inputs[k];
+        let Some(here) = self.inputs.get(k) else {
+            return false;
+        };
+        if !t.is_finite() || u.len() != here.len() {
+            return false;
+        }
         match (interp, self.times.get(k + 1), self.inputs.get(k + 1)) {
             (Interp::Linear, Some(&t1), Some(next)) => {
                 let s = ((t - self.times[k]) / (t1 - self.times[k])).clamp(0.0, 1.0);
@@ -262,6 +269,7 @@ impl Record {
             }
             _ => u.copy_from_slice(here),
         }
+        true
     }
 
     /// The sample indices at which a held input changes (where an integration segment must end), and the last

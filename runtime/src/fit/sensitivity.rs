@@ -145,7 +145,10 @@ pub(super) fn sample_outputs(
         jacobians: Vec::with_capacity(states.len()),
     };
     for (&t, y) in record.times.iter().zip(states) {
-        record.input_at(interp, t, &mut u);
+        if !record.input_at(interp, t, &mut u) {
+            // Not reached: `fit` checks the record's width against the model, and its times are finite.
+            u.fill(f64::NAN);
+        }
         let x = &y[..nx];
         let mut h = vec![0.0; ny];
         let fail = |message| SensitivityError::Model { time: t, message };
@@ -204,7 +207,12 @@ impl Segment<'_> {
         match self.interp {
             // Within a segment the held input is that of its first sample (times just before its end included).
             Interp::Zoh => u.copy_from_slice(&self.record.inputs[self.from]),
-            Interp::Linear => self.record.input_at(self.interp, t, &mut u),
+            Interp::Linear => {
+                if !self.record.input_at(self.interp, t, &mut u) {
+                    // Not reached (as above); a NaN input fails the step with a located error.
+                    u.fill(f64::NAN);
+                }
+            }
         }
         u
     }

@@ -289,3 +289,18 @@ fn an_explicit_run_too_slow_to_finish_stops_at_once() {
     assert!(err.contains("advanced too slowly"), "{err}");
     assert!(err.contains("--solver bdf"), "{err}");
 }
+
+/// `--rtol 1e10` was accepted: the run went on with a tolerance that bounds nothing, and the energy-balance warning
+/// (at 1000 × rtol) could never fire. A relative tolerance of 1 or more is refused, naming the setting.
+#[test]
+fn a_relative_tolerance_of_one_or_more_is_refused() {
+    let model = corpus("oscillator.bg");
+    for rtol in ["1", "1e10"] {
+        let (code, _, err) = bgc(&["simulate", &model, "--t-end", "0.1", "--rtol", rtol]);
+        assert_eq!(code, 1, "{rtol}: {err}");
+        assert!(err.contains("rtol"), "{rtol}: {err}");
+        assert!(err.contains("100 %"), "{rtol}: {err}");
+    }
+    let (code, _, err) = bgc(&["simulate", &model, "--t-end", "0.1", "--rtol", "0.5"]);
+    assert_eq!(code, 0, "{err}");
+}

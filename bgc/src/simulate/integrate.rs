@@ -93,6 +93,14 @@ impl RunOptions {
                          f64 arithmetic can hold a step: the solver could only fail or stall on rounding errors",
             });
         }
+        if self.rtol >= 1.0 {
+            return Err(SimError::BadSetting {
+                name: "rtol",
+                value: self.rtol,
+                reason: "a relative error of 100 % or more bounds nothing (and the energy balance, checked to 1000 \
+                         times rtol, could never be reported off)",
+            });
+        }
         let rows = (self.t_end / self.dt_out).floor() + 2.0;
         if rows > MAX_ROWS as f64 {
             return Err(SimError::TooManyRows {

@@ -387,25 +387,26 @@ fn in_free_params(eqs: &Equations, e: &Expr, fixed: &[Option<f64>]) -> Expr {
 /// refused: printed, `-inf` would read as a coefficient.
 fn symbolic_json(eqs: &Equations, j: &Jacobians, fixed: &[Option<f64>]) -> Result<Value, String> {
     let render = |name: &str, m: &[Vec<Expr>]| -> Result<Vec<Vec<String>>, String> {
-        let mut rows = Vec::with_capacity(m.len());
+        let entries: Vec<Expr> = m
+            .iter()
+            .flatten()
+            .map(|e| in_free_params(eqs, e, fixed))
+            .collect();
+        let mut held = Expr::non_finite_constants(&entries).into_iter();
         for (r, row) in m.iter().enumerate() {
-            let mut texts = Vec::with_capacity(row.len());
-            for (c, e) in row.iter().enumerate() {
-                let e = in_free_params(eqs, e, fixed);
-                let bad = symbols::post_order(std::slice::from_ref(&e))
-                    .iter()
-                    .find_map(|x| x.as_const().filter(|v| !v.is_finite()));
-                if let Some(v) = bad {
+            for (c, v) in held.by_ref().take(row.len()).enumerate() {
+                if let Some(v) = v {
                     return Err(format!(
                         "no symbolic state space: {name}[{r}][{c}] holds the number {v}, which is not finite (with \
                          the values given by --param, or a division by zero in the model)"
                     ));
                 }
-                texts.push(equations::expr_text(eqs, &e));
             }
-            rows.push(texts);
         }
-        Ok(rows)
+        let mut texts = entries.iter().map(|e| equations::expr_text(eqs, e));
+        Ok(m.iter()
+            .map(|row| texts.by_ref().take(row.len()).collect())
+            .collect())
     };
     Ok(json!({
         "states": j.states,

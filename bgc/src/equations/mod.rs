@@ -740,33 +740,28 @@ fn not_finite(
                 .map(|o| o.explicit.clone().unwrap_or_else(Expr::zero)),
         )
         .collect();
-    let held = Expr::holding_non_finite(&values);
+    let held = Expr::non_finite_constants(&values);
+    let (rates_held, outputs_held) = held.split_at(rates.len().min(held.len()));
     let why = "it divides by a part that is zero whatever the parameters are, or takes a function outside its domain there";
-    for (k, _) in held.iter().enumerate().filter(|&(_, &bad)| bad) {
-        let d = match (
-            states.get(k),
-            k.checked_sub(rates.len())
-                .and_then(|j| Some((j, outputs.get(j)?))),
-        ) {
-            (Some(s), _) => {
-                let d = Diagnostic::error(
-                    codes::NOT_FINITE,
-                    format!("the rate of `{}` has no finite value: {why}", s.name),
-                );
-                with_span(d, state_span(model, s), "this element")
-            }
-            (None, Some((j, o))) => {
-                let d = Diagnostic::error(
-                    codes::NOT_FINITE,
-                    format!("output `{}` has no finite value: {why}", o.name),
-                );
-                with_span(d, model.spans.outputs.get(j), "this output")
-            }
-            _ => continue,
-        };
-        diags.push(d.with_help(
-            "look for a difference of equal terms in a denominator or under a logarithm",
-        ));
+    let help = "look for a difference of equal terms in a denominator or under a logarithm";
+    for (s, _) in states.iter().zip(rates_held).filter(|(_, v)| v.is_some()) {
+        let d = Diagnostic::error(
+            codes::NOT_FINITE,
+            format!("the rate of `{}` has no finite value: {why}", s.name),
+        );
+        diags.push(with_span(d, state_span(model, s), "this element").with_help(help));
+    }
+    for (k, (o, _)) in outputs
+        .iter()
+        .zip(outputs_held)
+        .enumerate()
+        .filter(|(_, (_, v))| v.is_some())
+    {
+        let d = Diagnostic::error(
+            codes::NOT_FINITE,
+            format!("output `{}` has no finite value: {why}", o.name),
+        );
+        diags.push(with_span(d, model.spans.outputs.get(k), "this output").with_help(help));
     }
 }
 

@@ -456,8 +456,7 @@ fn segment_once(
         to: b,
         wanted,
         max_steps: opts.max_steps,
-        may_stall: opts.method == Method::Bdf,
-        explicit: opts.method == Method::Tsit45,
+        method: opts.method,
     };
     if let Some(full) = system.jacobian_pattern().filter(|_| dim >= SPARSE_FROM) {
         // The rows of the energy quadratures (dissipated, supplied) are left out of the sparse Jacobian: a
@@ -550,12 +549,11 @@ struct Drive<'c> {
     to: f64,
     wanted: &'c Wanted,
     max_steps: usize,
-    /// Whether a stall ends the drive with [`Outcome::Stalled`] (BDF, which goes on with TR-BDF2).
-    may_stall: bool,
-    /// Whether the method is explicit, whose step a stiff mode or a fast forcing holds short for the rest of the
-    /// run: a stall ends it with [`SimError::TooSlow`]. An implicit method's slow start may be a transient it
-    /// leaves behind (TR-BDF2 after BDF's stall on the stiff oscillator), so it keeps its whole step budget.
-    explicit: bool,
+    /// What a stall ([`Drive::stalled`]) does: BDF ends the drive with [`Outcome::Stalled`] and goes on with
+    /// TR-BDF2; the explicit method, whose step a stiff mode or a fast forcing holds short for the rest of the run,
+    /// ends it with [`SimError::TooSlow`]. An implicit method's slow start may be a transient it leaves behind
+    /// (TR-BDF2 after BDF's stall on the stiff oscillator), so those keep their whole step budget.
+    method: Method,
 }
 
 /// The steps between two looks at BDF's progress.
@@ -646,11 +644,18 @@ impl Drive<'_> {
                 return Ok(Outcome::Reached(y));
             }
             if (step + 1) % STALL_WINDOW == 0 {
-                if (self.may_stall || self.explicit) && self.stalled(window_start, t_now, step + 1)
-                {
-                    if !self.may_stall {
-                        // An explicit method under a fast forcing or a stiff mode: it would spend the whole step
-                        // budget (minutes) before failing.
+                let stalled = self.stalled(window_start, t_now, step + 1);
+                match self.method {
+                    Method::Bdf if stalled => {
+                        return Ok(Outcome::Stalled {
+                            t: t_now,
+                            y,
+                            delivered: next,
+                            steps: step + 1,
+                        });
+                    }
+                    // It would spend the whole step budget (minutes) before failing.
+                    Method::Tsit45 if stalled => {
                         return Err(SimError::TooSlow {
                             from: self.from,
                             to: self.to,
@@ -659,12 +664,7 @@ impl Drive<'_> {
                             max_steps: self.max_steps,
                         });
                     }
-                    return Ok(Outcome::Stalled {
-                        t: t_now,
-                        y,
-                        delivered: next,
-                        steps: step + 1,
-                    });
+                    _ => {}
                 }
                 window_start = t_now;
             }

@@ -139,20 +139,22 @@ impl Expr {
         Ok(values.last().copied().unwrap_or(f64::NAN))
     }
 
-    /// For each expression, whether it holds a constant that is not finite: an `inf` or `NaN` folded from a part
-    /// that reads no symbol, such as `1/(a − a)`. One walk of their distinct nodes together.
-    pub fn holding_non_finite(exprs: &[Expr]) -> Vec<bool> {
+    /// For each expression, the first constant in it that is not finite (children before parents, in their order):
+    /// an `inf` or `NaN` folded from a part that reads no symbol, such as `1/(a − a)`. One walk of their distinct
+    /// nodes together.
+    pub fn non_finite_constants(exprs: &[Expr]) -> Vec<Option<f64>> {
         let dag = Dag::new(exprs);
-        let mut held = vec![false; dag.len()];
+        let mut held: Vec<Option<f64>> = vec![None; dag.len()];
         for (i, e) in dag.order.iter().enumerate() {
-            let mut bad = matches!(e.node(), Node::Const(c) if !c.is_finite());
-            e.node()
-                .for_each_child(|c| bad |= dag.index(c).is_some_and(|k| held[k]));
-            held[i] = bad;
+            let mut found = None;
+            e.node().for_each_child(|c| {
+                found = found.or_else(|| dag.index(c).and_then(|k| held[k]));
+            });
+            held[i] = found.or_else(|| e.as_const().filter(|v| !v.is_finite()));
         }
         exprs
             .iter()
-            .map(|e| dag.index(e).is_some_and(|k| held[k]))
+            .map(|e| dag.index(e).and_then(|k| held[k]))
             .collect()
     }
 

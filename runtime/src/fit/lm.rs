@@ -206,9 +206,6 @@ pub fn minimise(
     let mut z = z0.to_vec();
     project(&mut z);
     let (mut r, mut j) = problem.evaluate(&z)?;
-    if !(r.iter().all(|v| v.is_finite()) && j.iter().all(|v| v.is_finite())) {
-        return Err("the residuals or their Jacobian at the start are not finite".into());
-    }
     let mut cost = 0.5 * r.norm_squared();
     check_start(&r, &j, cost)?;
     // λ multiplies the diagonal D of JᵀJ (Marquardt's scaling): it is dimensionless.

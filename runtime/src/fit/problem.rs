@@ -260,13 +260,13 @@ fn check(
     if spec.params.is_empty() && spec.x0.is_empty() {
         return bad("nothing to fit: name at least one parameter or initial state".into());
     }
-    for (k, p) in spec.params.iter().enumerate() {
-        if spec.params[..k].iter().any(|q| q.index == p.index) {
-            return bad(format!(
-                "parameter `{}` (index {}) is named twice",
-                p.name, p.index
-            ));
-        }
+    if let Some(p) = first_repeat(spec.params.iter().map(|p| p.index)).map(|k| &spec.params[k]) {
+        return bad(format!(
+            "parameter `{}` (index {}) is named twice",
+            p.name, p.index
+        ));
+    }
+    for p in &spec.params {
         let Some(&v) = params.get(p.index) else {
             return bad(format!("parameter `{}` has no index {}", p.name, p.index));
         };
@@ -295,13 +295,11 @@ fn check(
             s.name, s.index
         ));
     }
-    for (k, s) in spec.x0.iter().enumerate() {
-        if spec.x0[..k].iter().any(|t| t.index == s.index) {
-            return bad(format!(
-                "initial state `{}` (index {}) is named twice",
-                s.name, s.index
-            ));
-        }
+    if let Some(s) = first_repeat(spec.x0.iter().map(|s| s.index)).map(|k| &spec.x0[k]) {
+        return bad(format!(
+            "initial state `{}` (index {}) is named twice",
+            s.name, s.index
+        ));
     }
     let measured = record.sample_count();
     let fitted = spec.params.len() + spec.x0.len();
@@ -609,4 +607,12 @@ impl Residuals for Objective<'_> {
         }
         Ok((r, j))
     }
+}
+
+/// The position of the first index that an earlier one repeats.
+fn first_repeat(indices: impl Iterator<Item = usize>) -> Option<usize> {
+    let mut seen = std::collections::HashSet::new();
+    indices
+        .enumerate()
+        .find_map(|(k, i)| (!seen.insert(i)).then_some(k))
 }

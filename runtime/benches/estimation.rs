@@ -33,11 +33,12 @@ fn joints(x: &SVector<f64, 6>) -> SVector<f64, 3> {
 /// Flops (a multiply-add counted as two; the derivation is in `bgc_runtime::estimation::kalman`'s docs): the
 /// arithmetic a step cannot do without, `3 n³ + 4 n² m + 5 n m² + 3 n² + 7 n m + 2 p (n + m)` with `n = 7`,
 /// `m = 2`, `p = 1`, is 1,029 + 392 + 140 + 147 + 98 + 18 = 1,824, about 1,850 with the factor and solves of
-/// the 2 × 2 `S`; the step executes about 2,500 (whole columns of the symmetric products, the certificates
-/// that replace the definiteness test of `P`). At 4 flops per cycle (two multiplies and two adds per cycle,
-/// scalar) the bound of 1,850 flops is 462 cycles, and 1.5 times it 694 cycles; `clock_3000_cycles` in the same
-/// bench converts cycles to nanoseconds on the machine that runs it (`support/clock.rs`). With two-wide vectors
-/// (SSE2, the default target) the hardware's peak is twice that.
+/// the 2 × 2 `S`; the step executes about 2,000 (whole columns of `P Aᵀ`, blocks of four rows down to the
+/// diagonal of the symmetric products, the certificates that replace the definiteness test of `P`). At 4 flops
+/// per cycle (two multiplies and two adds per cycle, scalar) the bound of 1,850 flops is 462 cycles, and 1.5
+/// times it 694 cycles; `clock_3000_cycles` in the same bench converts cycles to nanoseconds on the machine
+/// that runs it (`support/clock.rs`). The hardware's peak is higher: twice that with two-wide vectors (SSE2,
+/// the default target), four times with AVX2 and FMA, which the step uses where the processor has them.
 fn kalman_step(c: &mut Criterion) {
     let mut a = SMatrix::<f64, 7, 7>::identity();
     for i in 0..6 {

@@ -61,6 +61,7 @@ pub fn symmetrise<const N: usize>(m: &mut SMatrix<f64, N, N>) {
 /// survives any sum, so the sum of those products is zero exactly when all entries are finite. The products are
 /// summed row by row across the columns (whole columns at a time, in vector registers) and the row sums added
 /// at the end: no branch per entry, as a search that stops at the first non-finite entry would compile to.
+#[inline(always)]
 pub fn all_finite<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> bool {
     let mut row_sums = [0.0_f64; R];
     for column in &m.data.0 {
@@ -72,6 +73,7 @@ pub fn all_finite<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> boo
 }
 
 /// Index of the first non-finite entry of a vector.
+#[inline(always)]
 pub fn first_non_finite<const N: usize>(v: &SVector<f64, N>) -> Option<usize> {
     if all_finite(v) {
         return None;

@@ -11,15 +11,19 @@
 //!
 //! # Cost
 //!
-//! With `n` states, `m` measurements and `p` inputs a step (predict and update) executes about
-//! `4 n³ + 6 n² m + 5 n m² + 2 n² + 13 n m + 2 n p` flops (a multiply-add counted as two) and terms of lower
-//! order: `2 n³` for `T = P Aᵀ` and `2 n³` for `A T + Q` (whole columns, not the triangle: see `products` in
-//! the source), `2 n² m` for `P⁻ Cᵀ`, `4 n² m` for the Joseph form, `2 n m²` each for the gain and `W`,
-//! `n m²` for `S`, and `O(n m)` for the innovation, the correction, the singularity floor of `S` and the
-//! definiteness certificates. The arithmetic a step cannot do without (only the upper triangles of the two
-//! covariances, no checks) is `3 n³ + 4 n² m + 5 n m² + 3 n² + 7 n m + 2 p (n + m)` and terms of lower order.
-//! At `n = 7`, `m = 2`, `p = 1` (`runtime/benches/estimation.rs`) that is about 1,850 flops, and about 2,500
-//! are executed.
+//! With `n` states, `m` measurements and `p` inputs the arithmetic a step cannot do without (only the upper
+//! triangles of the two covariances, no checks) is `3 n³ + 4 n² m + 5 n m² + 3 n² + 7 n m + 2 p (n + m)` flops
+//! (a multiply-add counted as two) and terms of lower order. A step executes `2 n³` for `T = P Aᵀ` (whole
+//! columns: `A T` needs all of `T`), and for `A T + Q` and the Joseph form `2 n` and `4 m` flops per entry of
+//! their upper triangles, computed in blocks of four rows down to the diagonal (the block that holds the
+//! diagonal whole; see `products` in the source), about `n³ + 4 n²` and `2 n² m + 8 n m`; then `2 n² m` for
+//! `P⁻ Cᵀ`, `2 n m²` each for the gain and `W`, `n m²` for `S`, and `O(n m)` for the innovation, the
+//! correction, the singularity floor of `S` and the definiteness certificates. At `n = 7`, `m = 2`, `p = 1`
+//! (`runtime/benches/estimation.rs`) that is about 1,850 flops needed and about 2,000 executed (37 of the 49
+//! entries of each 7 × 7 product are computed).
+//!
+//! On an x86-64 processor with AVX2 and FMA the step runs through a copy of its code compiled for them, with
+//! fused multiply-adds; elsewhere through the portable code (`kalman/isa.rs`). The two agree to rounding.
 //!
 //! Every result is checked: the covariance must stay symmetric positive definite, and a test of that
 //! (an `LDLᵀ` factorisation, `n³/3` flops, latency-bound by its divisions) runs only when no certificate
@@ -62,6 +66,7 @@
 //! works on stack values: for a large model, `crate::design::dlqe` solves the same DARE on `DMatrix`.
 
 mod definite;
+mod isa;
 mod products;
 
 use super::dense::{all_finite, cholesky_lower, cholesky_solve, first_non_finite, symmetrise};
@@ -71,12 +76,16 @@ use super::fault::{
     repair_covariance_in,
 };
 use crate::linalg::pbh::{Domain, undetectable_mode};
-use crate::matrix::{boxed_copy, product_sum, zeroed_box};
+use crate::matrix::{boxed_copy, zeroed_box};
 use crate::statespace::StateSpace;
 use definite::{DefinitePrediction, DefiniteUpdate, InnovationFloor, UpdateNorms};
+#[cfg(target_arch = "x86_64")]
+use isa::Fused;
+use isa::{Isa, MulAdd, Separate};
 use nalgebra::{DMatrix, SMatrix, SVector};
 use products::{
-    InnovationFactor, congruence_plus, covariance_times_ct, innovation_covariance, joseph,
+    InnovationFactor, congruence_plus, covariance_times_ct, frobenius, innovation_covariance,
+    joseph, plus_product,
 };
 
 const FILTER: &str = "Kalman filter";
@@ -181,6 +190,8 @@ struct ModelTerms<const NX: usize, const NY: usize> {
     definite_prediction: DefinitePrediction,
     definite_update: DefiniteUpdate,
     innovation_floor: InnovationFloor<NY>,
+    /// The instruction set of the step (`kalman/isa.rs`).
+    isa: Isa,
 }
 
 impl<const NX: usize, const NY: usize> Clone for ModelTerms<NX, NY> {
@@ -197,6 +208,7 @@ impl<const NX: usize, const NY: usize> Clone for ModelTerms<NX, NY> {
         self.definite_prediction = source.definite_prediction;
         self.definite_update = source.definite_update;
         self.innovation_floor = source.innovation_floor;
+        self.isa = source.isa;
     }
 }
 
@@ -214,6 +226,7 @@ impl<const NX: usize, const NY: usize> ModelTerms<NX, NY> {
             definite_prediction: DefinitePrediction::of(&model.a, q),
             definite_update: DefiniteUpdate::of(&model.c, r),
             innovation_floor: InnovationFloor::of(&model.c),
+            isa: Isa::detect(),
         }
     }
 }
@@ -375,11 +388,37 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         &mut self,
         u: &SVector<f64, NU>,
     ) -> Result<Option<CovarianceRepair>, EstimationError> {
+        match self.fixed.isa {
+            Isa::Portable => self.predict_with::<Separate>(u),
+            // SAFETY: `Isa::Avx2Fma` is made only by `Isa::detect`, after this processor reported AVX2 and FMA.
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2Fma => unsafe { self.predict_avx2_fma(u) },
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn predict_avx2_fma(
+        &mut self,
+        u: &SVector<f64, NU>,
+    ) -> Result<Option<CovarianceRepair>, EstimationError> {
+        self.predict_with::<Fused>(u)
+    }
+
+    #[inline(always)]
+    fn predict_with<M: MulAdd>(
+        &mut self,
+        u: &SVector<f64, NU>,
+    ) -> Result<Option<CovarianceRepair>, EstimationError> {
         if let Some(index) = first_non_finite(u) {
             return Err(EstimationError::NonFiniteInput { index });
         }
         let m = &*self.model;
-        let x = product_sum(&m.a, &self.x, &m.b, u);
+        let x = plus_product::<M, NX, NU>(
+            &plus_product::<M, NX, NX>(&SVector::zeros(), &m.a, &self.x),
+            &m.b,
+            u,
+        );
         if first_non_finite(&x).is_some() {
             return Err(EstimationError::Overflow {
                 filter: FILTER,
@@ -387,7 +426,7 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
             });
         }
         let p = &mut *self.next_p;
-        congruence_plus(&m.a, &self.fixed.at, &self.p, &self.q, p, &mut self.work);
+        congruence_plus::<M, NX>(&m.a, &self.fixed.at, &self.p, &self.q, p, &mut self.work);
         // A certificate also bounds every entry of `p` far below overflow; without one, `repair_covariance`
         // checks that they are finite.
         let certified = self
@@ -410,6 +449,30 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         y: &SVector<f64, NY>,
         u: &SVector<f64, NU>,
     ) -> Result<UpdateOutcome, EstimationError> {
+        match self.fixed.isa {
+            Isa::Portable => self.update_with::<Separate>(y, u),
+            // SAFETY: as in `predict`.
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2Fma => unsafe { self.update_avx2_fma(y, u) },
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn update_avx2_fma(
+        &mut self,
+        y: &SVector<f64, NY>,
+        u: &SVector<f64, NU>,
+    ) -> Result<UpdateOutcome, EstimationError> {
+        self.update_with::<Fused>(y, u)
+    }
+
+    #[inline(always)]
+    fn update_with<M: MulAdd>(
+        &mut self,
+        y: &SVector<f64, NY>,
+        u: &SVector<f64, NU>,
+    ) -> Result<UpdateOutcome, EstimationError> {
         if let Some(index) = first_non_finite(y) {
             return Ok(UpdateOutcome::Rejected {
                 reason: super::fault::RejectReason::NonFiniteMeasurement { index },
@@ -419,15 +482,20 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
             return Err(EstimationError::NonFiniteInput { index });
         }
         let m = &*self.model;
-        let e = y - product_sum(&m.c, &self.x, &m.d, u);
+        let e = y - plus_product::<M, NY, NU>(
+            &plus_product::<M, NY, NX>(&SVector::zeros(), &m.c, &self.x),
+            &m.d,
+            u,
+        );
         // P Cᵀ = (C P)ᵀ serves the innovation covariance, the gain and the Joseph form.
-        let pct = covariance_times_ct(&self.p, &self.fixed.ct);
-        let s = innovation_covariance(&pct, &self.fixed.ct, &self.r);
+        let pct = covariance_times_ct::<M, NX, NY>(&self.p, &self.fixed.ct);
+        let s = innovation_covariance::<M, NX, NY>(&pct, &self.fixed.ct, &self.r);
         let singular = EstimationError::SingularInnovation { filter: FILTER };
         let ls = cholesky_lower(&s).ok_or(singular.clone())?;
         let pivots = SVector::<f64, NY>::from_fn(|j, _| ls[(j, j)] * ls[(j, j)]);
         let floor = &self.fixed.innovation_floor;
-        if !floor.pivots_clear(&pivots, &m.c, &self.p, &self.r) {
+        let trace_p = self.p.trace();
+        if !floor.pivots_clear(&pivots, &self.fixed.ct, &self.p, trace_p, &self.r) {
             return Err(singular);
         }
         let overflow = |quantity| EstimationError::Overflow {
@@ -450,28 +518,28 @@ impl<const NX: usize, const NU: usize, const NY: usize> KalmanFilter<NX, NU, NY>
         let k = match self.gain_mode {
             GainMode::Fixed(k) => k,
             GainMode::TimeVarying => {
-                let k = factor.gain(&pct);
+                let k = factor.gain::<M, NX>(&pct);
                 if !all_finite(&k) {
                     return Err(singular);
                 }
                 k
             }
         };
-        let x = self.x + k * e;
+        let x = plus_product::<M, NX, NY>(&self.x, &k, &e);
         if first_non_finite(&x).is_some() {
             return Err(overflow("corrected state"));
         }
         let p = &mut *self.next_p;
-        let w = joseph(&self.p, &k, &pct, &s, p);
+        let w = joseph::<M, NX, NY>(&self.p, &k, &pct, &s, p);
         let certified = self.eigenvalue_floor > 0.0
             && self.fixed.definite_update.holds(
                 self.eigenvalue_floor,
                 &UpdateNorms {
-                    trace_p: self.p.trace(),
-                    pct: pct.norm(),
-                    s: s.norm(),
-                    k: k.norm(),
-                    w: w.norm(),
+                    trace_p,
+                    pct: frobenius::<M, NX, NY>(&pct),
+                    s: frobenius::<M, NY, NY>(&s),
+                    k: frobenius::<M, NX, NY>(&k),
+                    w: frobenius::<M, NX, NY>(&w),
                 },
             );
         let repair = if certified {
@@ -668,128 +736,4 @@ pub fn steady_state_gain<const NX: usize, const NY: usize>(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::super::dense::symmetric_eigen;
-    use super::*;
-    use nalgebra::dmatrix;
-
-    #[test]
-    fn model_from_state_space_checks_shape_and_sampling() {
-        let ss = StateSpace::new_discrete(
-            dmatrix![1.0, 0.1; 0.0, 1.0],
-            dmatrix![0.0; 0.1],
-            dmatrix![1.0, 0.0],
-            dmatrix![0.0],
-            0.1,
-        )
-        .unwrap();
-        let m = LinearDiscreteModel::<2, 1, 1>::from_state_space(&ss).unwrap();
-        assert_eq!(m.a[(0, 1)], 0.1);
-        assert_eq!(m.b[(1, 0)], 0.1);
-        assert!(matches!(
-            LinearDiscreteModel::<3, 1, 1>::from_state_space(&ss),
-            Err(EstimationError::Shape {
-                name: "A",
-                rows: 2,
-                expected_rows: 3,
-                ..
-            })
-        ));
-        let (a, b, c, d, _) = ss.into_parts();
-        let cont = StateSpace::new(a, b, c, d).unwrap();
-        assert_eq!(
-            LinearDiscreteModel::<2, 1, 1>::from_state_space(&cont),
-            Err(EstimationError::NotDiscrete)
-        );
-    }
-
-    /// The benchmark's filter (7 states, 2 sensors, `Q` and `R` definite): the prediction leaves a certified
-    /// eigenvalue floor that is below the true smallest eigenvalue of `P⁻`, the update's certificate holds
-    /// (no factorisation of `P` in the step), and a new estimate drops the floor, so that the next update
-    /// tests its result again.
-    #[test]
-    fn a_step_with_definite_noise_is_certified_and_a_new_estimate_is_tested_again() {
-        let mut a = SMatrix::<f64, 7, 7>::identity();
-        for i in 0..6 {
-            a[(i, i + 1)] = 0.001;
-        }
-        a[(6, 0)] = -0.002;
-        let model = LinearDiscreteModel {
-            a,
-            b: SMatrix::<f64, 7, 1>::from_fn(|i, _| 0.001 * (i + 1) as f64),
-            c: SMatrix::<f64, 2, 7>::from_fn(|i, j| if j == 3 * i { 1.0 } else { 0.0 }),
-            d: SMatrix::<f64, 2, 1>::zeros(),
-        };
-        let (q, r) = (SMatrix::identity() * 1e-4, SMatrix::identity() * 1e-2);
-        let mut kf = KalmanFilter::new(model, q, r, SVector::zeros(), SMatrix::identity()).unwrap();
-        let (u, y) = (
-            SVector::<f64, 1>::new(0.3),
-            SVector::<f64, 2>::new(0.01, -0.02),
-        );
-        for _ in 0..50 {
-            assert_eq!(kf.predict(&u), Ok(None));
-            let floor = kf.eigenvalue_floor;
-            let lowest = symmetric_eigen(&kf.p).unwrap().0.min();
-            assert!(
-                floor > 0.0 && floor <= lowest,
-                "floor {floor:e}, λ_min {lowest:e}"
-            );
-            // The update's certificate for this step, from the quantities `update` computes.
-            let ct = model.c.transpose();
-            let pct = covariance_times_ct(&kf.p, &ct);
-            let s = innovation_covariance(&pct, &ct, &kf.r);
-            let k = InnovationFactor::new(cholesky_lower(&s).unwrap()).gain(&pct);
-            let mut next = SMatrix::zeros();
-            let w = joseph(&kf.p, &k, &pct, &s, &mut next);
-            let norms = UpdateNorms {
-                trace_p: kf.p.trace(),
-                pct: pct.norm(),
-                s: s.norm(),
-                k: k.norm(),
-                w: w.norm(),
-            };
-            assert!(kf.fixed.definite_update.holds(floor, &norms));
-            let outcome = kf.update(&y, &u).unwrap();
-            assert!(matches!(
-                outcome,
-                UpdateOutcome::Accepted { repair: None, .. }
-            ));
-            assert_eq!(*kf.covariance(), next);
-            assert_eq!(kf.eigenvalue_floor, 0.0);
-        }
-        kf.predict(&u).unwrap();
-        kf.set_state(SVector::zeros(), SMatrix::identity()).unwrap();
-        assert_eq!(kf.eigenvalue_floor, 0.0);
-    }
-
-    /// A prediction whose covariance overflows (`A = 10²⁰⁰ I`, so `A P Aᵀ = 10⁴⁰⁰ I`) is not certified, even
-    /// with a definite `Q`: it is an error and the filter keeps its estimate.
-    #[test]
-    fn a_prediction_that_overflows_is_an_error_with_a_definite_q() {
-        let model = LinearDiscreteModel {
-            a: SMatrix::<f64, 2, 2>::identity() * 1e200,
-            b: SMatrix::<f64, 2, 1>::zeros(),
-            c: SMatrix::<f64, 1, 2>::new(1.0, 0.0),
-            d: SMatrix::<f64, 1, 1>::zeros(),
-        };
-        let q = SMatrix::<f64, 2, 2>::identity() * 1e-4;
-        let r = SMatrix::<f64, 1, 1>::new(1e-2);
-        let mut kf = KalmanFilter::new(model, q, r, SVector::zeros(), SMatrix::identity()).unwrap();
-        assert_eq!(
-            kf.predict(&SVector::zeros()),
-            Err(EstimationError::NonFiniteCovariance { filter: FILTER })
-        );
-        assert_eq!(*kf.covariance(), SMatrix::<f64, 2, 2>::identity());
-    }
-
-    /// `A` singular: a predictor gain cannot be turned back into a filter gain.
-    #[test]
-    fn filter_gain_from_predictor_needs_invertible_a() {
-        let a = SMatrix::<f64, 2, 2>::new(1.0, 2.0, 2.0, 4.0);
-        let l = SMatrix::<f64, 2, 1>::new(0.1, 0.2);
-        assert_eq!(
-            filter_gain_from_predictor(&a, &l),
-            Err(EstimationError::SingularMatrix { name: "A" })
-        );
-    }
-}
+mod tests;

@@ -86,10 +86,15 @@ pub(super) struct DefiniteUpdate {
     /// `λ_min(R)` less its rounding error; not positive when `R` is singular (then no certificate).
     r_min: f64,
     c_frobenius: f64,
+    /// `‖C‖_F² / λ_min(R)`, the part of `1/μ` that does not change.
+    c_sq_over_r_min: f64,
     r_frobenius: f64,
     r_asymmetry: f64,
-    nx: usize,
-    ny: usize,
+    /// `γₙ`, `γₙ₊₁`, `γₘ₊₁` and `γ₂ₘ₊₁` for `n = NX`, `m = NY`, fixed by the sizes.
+    gamma_n: f64,
+    gamma_n1: f64,
+    gamma_m1: f64,
+    gamma_2m1: f64,
 }
 
 /// The norms of the quantities of one update that its rounding bound needs.
@@ -106,38 +111,42 @@ impl DefiniteUpdate {
         c: &SMatrix<f64, NY, NX>,
         r: &SMatrix<f64, NY, NY>,
     ) -> Self {
+        let r_min = smallest_eigenvalue(r);
         DefiniteUpdate {
-            r_min: smallest_eigenvalue(r),
+            r_min,
             c_frobenius: c.norm(),
+            c_sq_over_r_min: c.norm_squared() / r_min,
             r_frobenius: r.norm(),
             r_asymmetry: (r - r.transpose()).norm(),
-            nx: NX,
-            ny: NY,
+            gamma_n: gamma(NX),
+            gamma_n1: gamma(NX + 1),
+            gamma_m1: gamma(NY + 1),
+            gamma_2m1: gamma(2 * NY + 1),
         }
     }
 
     /// Whether the computed Joseph-form result is positive definite with the margin of the test, given the
     /// eigenvalue floor `ell` of `P` (not positive: unknown) and the norms of the step.
+    #[inline(always)]
     pub(super) fn holds(&self, ell: f64, n: &UpdateNorms) -> bool {
         if !(ell > 0.0 && self.r_min > 0.0) {
             return false;
         }
         let c = self.c_frobenius;
-        let mu = 1.0 / (1.0 / ell + c * c / self.r_min);
         let sqrt2 = std::f64::consts::SQRT_2;
-        let e1 = gamma(self.nx) * n.trace_p * c;
+        let e1 = self.gamma_n * n.trace_p * c;
         let f = sqrt2
-            * (e1 * c
-                + gamma(self.nx + 1) * (self.r_frobenius + n.pct * c)
-                + 0.5 * self.r_asymmetry);
-        let e3 = gamma(self.ny + 1) * (n.pct + n.k * n.s);
-        let e4 = gamma(2 * self.ny + 1) * (n.trace_p + n.k * (n.pct + n.w));
+            * (e1 * c + self.gamma_n1 * (self.r_frobenius + n.pct * c) + 0.5 * self.r_asymmetry);
+        let e3 = self.gamma_m1 * (n.pct + n.k * n.s);
+        let e4 = self.gamma_2m1 * (n.trace_p + n.k * (n.pct + n.w));
         let bound = 2.0 * n.k * e1 + n.k * n.k * f + sqrt2 * (e3 * n.k + e4);
         // Every partial sum of an entry of the result is at most `tr P + ‖K‖ (‖P Cᵀ‖ + ‖W‖)` (Cauchy–Schwarz
         // over the measurements), so below `NO_OVERFLOW` every entry is finite. NaN norms (a non-finite
         // quantity) fail both comparisons: the test then runs and reports them.
         let size = n.trace_p + n.k * (n.pct + n.w);
-        size < NO_OVERFLOW && mu > 2.0 * bound
+        // `μ > 2 bound` with `μ = 1 / (1/ℓ + ‖C‖²/λ_min(R))`, multiplied out by the positive `1/μ` and `ℓ` so
+        // that a step divides by nothing.
+        size < NO_OVERFLOW && ell > 2.0 * bound * (1.0 + ell * self.c_sq_over_r_min)
     }
 }
 
@@ -145,42 +154,58 @@ impl DefiniteUpdate {
 /// error with which `diag(C P Cᵀ + R)` is known: a pivot at or below it means `S` is singular to working
 /// accuracy). Its `O(NX² NY)` sum is needed only for a pivot near it: for a positive-semidefinite `P`,
 /// `|pₐ_b| ≤ √(pₐₐ p_bb) ≤ (pₐₐ + p_bb)/2`, so `(|C| |P| |C|ᵀ)ⱼⱼ ≤ (Σₐ |cⱼₐ| pₐₐ) (Σ_b |cⱼ_b|)`, an
-/// `O(NX NY)` bound; a pivot above twice the bound is above the floor.
+/// `O(NX NY)` bound, and `Σₐ |cⱼₐ| pₐₐ ≤ maxₐ |cⱼₐ| tr P`, an `O(NY)` one given `tr P`; a pivot above twice
+/// either bound is above the floor, and the tighter bound is computed only when the looser one is not enough.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct InnovationFloor<const NY: usize> {
     /// `Σ_b |cⱼ_b|` for each measurement `j`.
     c_abs_row_sums: [f64; NY],
+    /// `maxₐ |cⱼₐ| Σ_b |cⱼ_b|` for each measurement `j`.
+    c_abs_row_max_sums: [f64; NY],
 }
 
 impl<const NY: usize> InnovationFloor<NY> {
     pub(super) fn of<const NX: usize>(c: &SMatrix<f64, NY, NX>) -> Self {
+        let c_abs_row_sums = std::array::from_fn(|j| c.row(j).iter().map(|v| v.abs()).sum());
         InnovationFloor {
-            c_abs_row_sums: std::array::from_fn(|j| c.row(j).iter().map(|v| v.abs()).sum()),
+            c_abs_row_sums,
+            c_abs_row_max_sums: std::array::from_fn(|j| {
+                c.row(j).iter().fold(0.0_f64, |m, v| m.max(v.abs())) * c_abs_row_sums[j]
+            }),
         }
     }
 
-    /// Whether every pivot `pivots[j]` (`l_jj²` of the factor of `S`) lies above its floor.
+    /// Whether every pivot `pivots[j]` (`l_jj²` of the factor of `S`) lies above its floor; `ct` is `Cᵀ`, whose
+    /// column `j` is row `j` of `C`, contiguous, and `trace_p` is `tr P`.
+    #[inline(always)]
     pub(super) fn pivots_clear<const NX: usize>(
         &self,
         pivots: &SVector<f64, NY>,
-        c: &SMatrix<f64, NY, NX>,
+        ct: &SMatrix<f64, NX, NY>,
         p: &SMatrix<f64, NX, NX>,
+        trace_p: f64,
         r: &SMatrix<f64, NY, NY>,
     ) -> bool {
         let n = NX.max(1) as f64;
+        let above =
+            |j: usize, spread: f64| pivots[j] > 2.0 * f64::EPSILON * (n * spread + r[(j, j)].abs());
         (0..NY).all(|j| {
-            let weighted_diagonal: f64 = (0..NX).map(|a| c[(j, a)].abs() * p[(a, a)]).sum();
-            let cheap =
-                f64::EPSILON * (n * weighted_diagonal * self.c_abs_row_sums[j] + r[(j, j)].abs());
-            pivots[j] > 2.0 * cheap || pivots[j] > exact_floor(j, c, p, r)
+            above(j, self.c_abs_row_max_sums[j] * trace_p) || {
+                let mut weighted_diagonal = 0.0;
+                for (a, c) in ct.data.0[j].iter().enumerate() {
+                    weighted_diagonal += c.abs() * p.data.0[a][a];
+                }
+                above(j, weighted_diagonal * self.c_abs_row_sums[j])
+                    || pivots[j] > exact_floor(j, ct, p, r)
+            }
         })
     }
 }
 
-/// `NX ε (|C| |P| |C|ᵀ)ⱼⱼ + ε |Rⱼⱼ|` by its `O(NX²)` sum.
+/// `NX ε (|C| |P| |C|ᵀ)ⱼⱼ + ε |Rⱼⱼ|` by its `O(NX²)` sum, from `ct = Cᵀ`.
 fn exact_floor<const NX: usize, const NY: usize>(
     j: usize,
-    c: &SMatrix<f64, NY, NX>,
+    ct: &SMatrix<f64, NX, NY>,
     p: &SMatrix<f64, NX, NX>,
     r: &SMatrix<f64, NY, NY>,
 ) -> f64 {
@@ -188,15 +213,16 @@ fn exact_floor<const NX: usize, const NY: usize>(
     for a in 0..NX {
         let mut row = 0.0;
         for b in 0..NX {
-            row += p[(a, b)].abs() * c[(j, b)].abs();
+            row += p[(a, b)].abs() * ct[(b, j)].abs();
         }
-        spread += c[(j, a)].abs() * row;
+        spread += ct[(a, j)].abs() * row;
     }
     f64::EPSILON * (NX.max(1) as f64 * spread + r[(j, j)].abs())
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::isa::Separate;
     use super::super::products::{
         InnovationFactor, covariance_times_ct, innovation_covariance, joseph,
     };
@@ -250,16 +276,17 @@ mod tests {
             let ell = min_eigenvalue(&p);
             let r_min = min_eigenvalue(&r);
             let mu = 1.0 / (1.0 / ell + c.norm_squared() / r_min);
-            let pct = covariance_times_ct(&p, &c.transpose());
-            let s = innovation_covariance(&pct, &c.transpose(), &r);
-            let optimal = InnovationFactor::new(cholesky_lower(&s).unwrap()).gain(&pct);
+            let pct = covariance_times_ct::<Separate, _, _>(&p, &c.transpose());
+            let s = innovation_covariance::<Separate, _, _>(&pct, &c.transpose(), &r);
+            let optimal =
+                InnovationFactor::new(cholesky_lower(&s).unwrap()).gain::<Separate, _>(&pct);
             for k in [
                 optimal,
                 rng.matrix::<5, 2>(3.0),
                 optimal + rng.matrix::<5, 2>(1e-3),
             ] {
                 let mut out = SMatrix::zeros();
-                joseph(&p, &k, &pct, &s, &mut out);
+                joseph::<Separate, _, _>(&p, &k, &pct, &s, &mut out);
                 let lowest = min_eigenvalue(&out);
                 // Rounding of the Jacobi sweep and of the product: a few ε of the largest entry.
                 let slack = 1e-12 * out.amax();
@@ -285,14 +312,14 @@ mod tests {
             let r = rng.definite::<2, 1>(0.3, floor);
             let c = rng.matrix::<2, 6>(1.0);
             let ct = c.transpose();
-            let pct = covariance_times_ct(&p, &ct);
-            let s = innovation_covariance(&pct, &ct, &r);
+            let pct = covariance_times_ct::<Separate, _, _>(&p, &ct);
+            let s = innovation_covariance::<Separate, _, _>(&pct, &ct, &r);
             let Some(l) = cholesky_lower(&s) else {
                 continue;
             };
-            let k = InnovationFactor::new(l).gain(&pct);
+            let k = InnovationFactor::new(l).gain::<Separate, _>(&pct);
             let mut out = SMatrix::zeros();
-            let w = joseph(&p, &k, &pct, &s, &mut out);
+            let w = joseph::<Separate, _, _>(&p, &k, &pct, &s, &mut out);
             let norms = UpdateNorms {
                 trace_p: p.trace(),
                 pct: pct.norm(),
@@ -341,12 +368,13 @@ mod tests {
             let c = rng.matrix::<2, 4>(3.0);
             let r = rng.definite::<2, 2>(0.1, 1e-8);
             let floor = InnovationFloor::of(&c);
-            let exact = [exact_floor(0, &c, &p, &r), exact_floor(1, &c, &p, &r)];
+            let ct = c.transpose();
+            let exact = [exact_floor(0, &ct, &p, &r), exact_floor(1, &ct, &p, &r)];
             for factor in [0.5, 0.999, 1.0, 1.001, 2.0, 10.0, 1e6] {
                 let pivots = SVector::<f64, 2>::new(exact[0] * factor, 1.0);
                 let expected = pivots[0] > exact[0] && pivots[1] > exact[1];
                 assert_eq!(
-                    floor.pivots_clear(&pivots, &c, &p, &r),
+                    floor.pivots_clear(&pivots, &ct, &p, p.trace(), &r),
                     expected,
                     "case {case}, factor {factor}"
                 );

@@ -26,7 +26,7 @@ use nalgebra::{SMatrix, SVector};
 /// Why a linearisation failed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum LinearizeError {
-    #[error("the operating point is not finite: {what}[{index}] = {value}")]
+    #[error("the operating point is not finite: {what}[{index}] = {value:?}")]
     NonFinitePoint {
         what: &'static str,
         index: usize,
@@ -35,7 +35,7 @@ pub enum LinearizeError {
     /// A Jacobian entry is NaN or infinite at the point (outside the model's domain, a singular mass matrix or
     /// an algebraic loop without a solution there).
     #[error(
-        "{name}[({row}, {col})] = {value} at the operating point: the model has no linearisation there"
+        "{name}[({row}, {col})] = {value:?} at the operating point: the model has no linearisation there"
     )]
     NonFiniteJacobian {
         name: &'static str,

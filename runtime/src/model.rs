@@ -121,7 +121,7 @@ pub trait Parametric {
 pub enum ParamError {
     #[error("no parameter with index {index}")]
     NoSuchParam { index: usize },
-    #[error("parameter `{name}` = {value} is not physical: {reason}")]
+    #[error("parameter `{name}` = {value:?} is not physical: {reason}")]
     NonPhysical {
         name: &'static str,
         value: f64,

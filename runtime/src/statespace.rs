@@ -56,7 +56,7 @@ pub enum StateSpaceError {
         row: usize,
         col: usize,
     },
-    #[error("sample time {dt} is not a positive finite number")]
+    #[error("sample time {dt:?} is not a positive finite number")]
     BadSampleTime { dt: f64 },
 }
 

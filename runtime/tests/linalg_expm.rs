@@ -145,6 +145,11 @@ fn expm_identities_and_errors() {
         expm(&DMatrix::from_element(1, 1, 1000.0)),
         Err(ExpmError::Overflow { .. })
     ));
+    // An error names an extreme number in a few characters (Display of 1e300 is 301 digits long).
+    let message = expm(&DMatrix::from_element(1, 1, 1e300))
+        .unwrap_err()
+        .to_string();
+    assert_eq!(message, "the exponential overflows (‖A‖₁ = 1e300)");
 }
 
 /// Lightly damped oscillator sampled at 50 ms:

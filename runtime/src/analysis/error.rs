@@ -7,26 +7,26 @@ use crate::statespace::StateSpaceError;
 pub enum AnalysisError {
     /// `s I − A` (or `z I − A`) is singular at this frequency: the model has a pole on the evaluation contour.
     #[error(
-        "the model has a pole at (or numerically at) frequency {omega} rad/s: sI - A is singular there"
+        "the model has a pole at (or numerically at) frequency {omega:?} rad/s: sI - A is singular there"
     )]
     PoleOnContour { omega: f64 },
     /// The linear solve at this frequency left a residual too large to trust the result.
     #[error(
-        "frequency response at {omega} rad/s is ill-conditioned (relative residual {residual:e})"
+        "frequency response at {omega:?} rad/s is ill-conditioned (relative residual {residual:e})"
     )]
     IllConditioned { omega: f64, residual: f64 },
     /// The response at this frequency exceeds the range of `f64` (the model's entries are finite but their
     /// products overflow).
     #[error(
-        "the frequency response at {omega} rad/s overflows f64: the model's entries are too large for its products to be represented"
+        "the frequency response at {omega:?} rad/s overflows f64: the model's entries are too large for its products to be represented"
     )]
     Overflow { omega: f64 },
     /// A frequency was negative, zero where not allowed, or non-finite.
-    #[error("frequency {omega} is not a valid evaluation frequency: {reason}")]
+    #[error("frequency {omega:?} is not a valid evaluation frequency: {reason}")]
     BadFrequency { omega: f64, reason: &'static str },
     /// A discrete-time model was evaluated above its Nyquist frequency `π / dt`.
     #[error(
-        "frequency {omega} rad/s is above the Nyquist frequency {nyquist} rad/s of the discrete model"
+        "frequency {omega:?} rad/s is above the Nyquist frequency {nyquist:?} rad/s of the discrete model"
     )]
     AboveNyquist { omega: f64, nyquist: f64 },
     /// A frequency grid was asked with invalid bounds or length.

@@ -11,9 +11,9 @@ pub enum ControlError {
     },
     #[error("the impedance inertia M_r is singular; Eq. (29) needs its inverse")]
     SingularInertiaGain,
-    #[error("torque limit of joint {joint} is {value}; limits must be finite and non-negative")]
+    #[error("torque limit of joint {joint} is {value:?}; limits must be finite and non-negative")]
     BadTorqueLimit { joint: usize, value: f64 },
-    #[error("controller input `{name}`[{index}] = {value} is not finite")]
+    #[error("controller input `{name}`[{index}] = {value:?} is not finite")]
     NonFiniteInput {
         name: &'static str,
         index: usize,
@@ -21,7 +21,7 @@ pub enum ControlError {
     },
     #[error("the manipulator model returned a non-finite {term}")]
     NonFiniteModel { term: &'static str },
-    #[error("gait threshold `{name}` = {value} is invalid: {reason}")]
+    #[error("gait threshold `{name}` = {value:?} is invalid: {reason}")]
     BadThreshold {
         name: &'static str,
         value: f64,

@@ -41,16 +41,16 @@ pub struct ObserverNoise<'a> {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum LtrError {
     /// A recovery weight was negative or not finite.
-    #[error("recovery weight q = {q} is not a finite number ≥ 0")]
+    #[error("recovery weight q = {q:?} is not a finite number ≥ 0")]
     BadWeight { q: f64 },
     /// The plant is discrete; the recovery here designs the continuous observer of [`lqe`].
-    #[error("loop transfer recovery needs a continuous-time plant (got sample time {dt} s)")]
+    #[error("loop transfer recovery needs a continuous-time plant (got sample time {dt:?} s)")]
     Discrete { dt: f64 },
     /// The Kalman design at this `q` failed.
-    #[error("Kalman design with recovery weight q = {q}: {source}")]
+    #[error("Kalman design with recovery weight q = {q:?}: {source}")]
     Kalman { q: f64, source: RiccatiError },
     /// The loop or its margins at this `q` could not be computed.
-    #[error("loop at the plant input with recovery weight q = {q}: {source}")]
+    #[error("loop at the plant input with recovery weight q = {q:?}: {source}")]
     Analysis { q: f64, source: AnalysisError },
 }
 

@@ -28,7 +28,7 @@ use nalgebra::{SMatrix, SVector};
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum EstimationError {
     /// A constructor argument or setting is out of its domain.
-    #[error("{name} = {value} is invalid: {reason}")]
+    #[error("{name} = {value:?} is invalid: {reason}")]
     InvalidSetting {
         name: &'static str,
         value: f64,

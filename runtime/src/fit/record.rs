@@ -75,7 +75,7 @@ pub enum RecordError {
         what: &'static str,
     },
     #[error(
-        "line {line}: time {t} does not follow the previous time {previous}; times must be strictly increasing"
+        "line {line}: time {t:?} does not follow the previous time {previous:?}; times must be strictly increasing"
     )]
     Unsorted { line: usize, t: f64, previous: f64 },
     #[error("the record has no measured sample: every output cell is empty")]

@@ -84,13 +84,13 @@ pub struct Simulated {
 /// Why a simulation over the record failed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SensitivityError {
-    #[error("the model failed at t = {time}: {message}")]
+    #[error("the model failed at t = {time:?}: {message}")]
     Model { time: f64, message: String },
-    #[error("the ODE solver failed at t = {time}: {message}")]
+    #[error("the ODE solver failed at t = {time:?}: {message}")]
     Solver { time: f64, message: String },
-    #[error("the simulation became non-finite at t = {time}")]
+    #[error("the simulation became non-finite at t = {time:?}")]
     NonFinite { time: f64 },
-    #[error("more than {max_steps} solver steps before t = {time}")]
+    #[error("more than {max_steps} solver steps before t = {time:?}")]
     TooManySteps { time: f64, max_steps: usize },
 }
 

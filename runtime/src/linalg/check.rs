@@ -24,7 +24,7 @@ pub enum MatrixError {
     },
     #[error("matrix {name} is empty")]
     Empty { name: &'static str },
-    #[error("matrix {name} has a non-finite entry {value} at ({row}, {col})")]
+    #[error("matrix {name} has a non-finite entry {value:?} at ({row}, {col})")]
     NonFinite {
         name: &'static str,
         row: usize,
@@ -40,19 +40,21 @@ pub enum MatrixError {
         col: usize,
         difference: f64,
     },
-    #[error("matrix {name} is not positive definite: its smallest eigenvalue is {min_eigenvalue}")]
+    #[error(
+        "matrix {name} is not positive definite: its smallest eigenvalue is {min_eigenvalue:?}"
+    )]
     NotPositiveDefinite {
         name: &'static str,
         min_eigenvalue: f64,
     },
     #[error(
-        "matrix {name} is not positive semidefinite: its smallest eigenvalue is {min_eigenvalue}"
+        "matrix {name} is not positive semidefinite: its smallest eigenvalue is {min_eigenvalue:?}"
     )]
     NotPositiveSemidefinite {
         name: &'static str,
         min_eigenvalue: f64,
     },
-    #[error("{what} is not a positive finite number: {value}")]
+    #[error("{what} is not a positive finite number: {value:?}")]
     BadScalar { what: &'static str, value: f64 },
 }
 

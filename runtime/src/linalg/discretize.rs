@@ -18,7 +18,7 @@ use crate::statespace::{StateSpace, StateSpaceError};
 pub enum DiscretizeError {
     #[error(transparent)]
     Input(#[from] MatrixError),
-    #[error("the model is already discrete (sample time {dt})")]
+    #[error("the model is already discrete (sample time {dt:?})")]
     AlreadyDiscrete { dt: f64 },
     #[error(transparent)]
     Expm(#[from] ExpmError),

@@ -20,9 +20,9 @@ use super::check::{self, MatrixError};
 pub enum ExpmError {
     #[error(transparent)]
     Input(#[from] MatrixError),
-    #[error("the Padé denominator is singular (‖A‖₁ = {norm})")]
+    #[error("the Padé denominator is singular (‖A‖₁ = {norm:?})")]
     SingularDenominator { norm: f64 },
-    #[error("the exponential overflows (‖A‖₁ = {norm})")]
+    #[error("the exponential overflows (‖A‖₁ = {norm:?})")]
     Overflow { norm: f64 },
 }
 

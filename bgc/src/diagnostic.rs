@@ -9,6 +9,17 @@ pub mod render;
 use crate::span::Span;
 use serde::Serialize;
 
+/// A number as a message shows it: as Rust writes it (`2`, `-0.5`, `1200`) where that is short, in exponent
+/// form outside `[1e-5, 1e16)` (`1e-320`, which Rust writes as `0.000…01` with 320 digits).
+pub fn number(v: f64) -> String {
+    let magnitude = v.abs();
+    if v == 0.0 || !v.is_finite() || (1e-5..1e16).contains(&magnitude) {
+        v.to_string()
+    } else {
+        format!("{v:e}")
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Severity {

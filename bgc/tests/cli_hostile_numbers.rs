@@ -16,7 +16,7 @@ fn temp_file(name: &str, text: &str) -> String {
 /// A damped mass driven by a force, with the damper's law given in braces.
 fn with_law(law: &str) -> String {
     format!(
-        "model a {{\n    domain translational;\n    param d = 1 [N s/m];\n    input F [N];\n    Se s = F;\n    \
+        "model a {{\n    domain translational;\n    param d = 1 [N s/m];\n    input v [m/s];\n    Sf s = v;\n    \
          I m = 1;\n    1 j;\n    R r {{ {law} }}\n    bond s -> j -> m, r;\n}}\n"
     )
 }
@@ -75,7 +75,7 @@ fn a_part_of_a_law_with_no_finite_value_is_bg0403_at_the_part() {
 fn an_infinite_resistance_is_called_infinite() {
     let path = temp_file(
         "inf_r.bg",
-        "model a {\n    domain translational;\n    param big = 1e300 [N s/m];\n    input F [N];\n    Se s = F;\n    \
+        "model a {\n    domain translational;\n    param big = 1e300 [N s/m];\n    input v [m/s];\n    Sf s = v;\n    \
          I m = 1;\n    R r = big * big;\n    1 j;\n    bond s -> j -> m, r;\n}\n",
     );
     let (code, _, err) = bgc(&["check", &path]);
@@ -200,6 +200,57 @@ fn a_zero_transformer_ratio_on_the_command_line_is_refused() {
     }
     let (code, _, err) = bgc(&["statespace", &path, "--param", "n=2"]);
     assert_eq!(code, 0, "{err}");
+}
+
+/// `--param m=1e-320` (a positive inertia whose reciprocal overflows) ran into "the initial energy is not finite",
+/// which named neither the element nor the parameter; `--param k=1e-320` likewise for a compliance `1/k`
+/// (`k = 1e320` is refused as not finite). Now each is refused at the element, with the value written short.
+#[test]
+fn a_coefficient_whose_reciprocal_overflows_is_refused_at_the_element() {
+    for (param, element) in [("m=1e-320", "I `mass` = 1e-320"), ("k=1e308", "")] {
+        let (code, out, err) = bgc(&[
+            "simulate",
+            &corpus("oscillator.bg"),
+            "--t-end",
+            "0.01",
+            "--param",
+            param,
+        ]);
+        if element.is_empty() {
+            // 1/k = 1e-308 is a compliance whose reciprocal is finite: it runs.
+            assert_eq!(code, 0, "{param}: {err}");
+            continue;
+        }
+        assert_eq!(code, 1, "{param}: {out}");
+        assert!(
+            err.contains(element) && err.contains("its reciprocal is not finite"),
+            "{param}: {err}"
+        );
+    }
+    let path = temp_file(
+        "tiny_c.bg",
+        "model tiny {\n    domain translational;\n    param c = 1 [m/N];\n    input v [m/s];\n    Sf s = v;\n    \
+         C spring = c;\n    1 j;\n    bond s -> j -> spring;\n}\n",
+    );
+    let (code, _, err) = bgc(&["statespace", &path, "--param", "c=4e-324"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("C `spring` = 5e-324"), "{err}");
+    assert!(err.lines().all(|l| l.len() < 200), "{err}");
+    // The same value as a default is BG0401 at the element (`bgc check` passed it), written short.
+    let text = std::fs::read_to_string(corpus("oscillator.bg")).expect("corpus model");
+    let path = temp_file(
+        "tiny_m.bg",
+        &text.replace("param m = 2 [kg]", "param m = 1e-320 [kg]"),
+    );
+    let (code, _, err) = bgc(&["check", &path]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains(
+            "error[BG0401]: `mass` has an inertia of 1e-320, whose reciprocal is not finite"
+        ) && err.contains("`m` is 1e-320"),
+        "{err}"
+    );
+    assert!(err.lines().all(|l| l.len() < 200), "{err}");
 }
 
 /// `--data /dev/zero` read without end (the run was killed after 20 s with its memory growing); a device and a

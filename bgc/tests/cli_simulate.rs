@@ -499,7 +499,7 @@ fn a_loop_without_a_solution_stops_the_run_with_its_residual() {
     assert_eq!(code, 1, "{err}");
     assert!(out.is_empty());
     assert!(
-        err.contains("the algebraic loop for `loop_f_valve` could not be solved at t = 0:"),
+        err.contains("the algebraic loop for `loop_f_valve` could not be solved at t = 0.0:"),
         "{err}"
     );
     assert!(

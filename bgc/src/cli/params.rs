@@ -118,18 +118,24 @@ pub fn check_physical(model: &Model, params: &[f64]) -> Result<(), String> {
             ElementKind::GY => (v != 0.0, "a gyrator modulus must not be zero"),
             _ => continue,
         };
-        if !ok || !v.is_finite() {
-            let rule = if v.is_finite() {
-                rule
-            } else {
-                "the value must be finite"
-            };
-            return Err(format!(
-                "{} `{}` = {v} with these parameter values: {rule}",
-                node.kind.keyword(),
-                node.name
-            ));
-        }
+        // The equations divide by an inertia, a compliance or a modulus (`f = p/m`, `e = q/C`): one so small
+        // that its reciprocal overflows (`1e-320`) would make them infinite, far from where the error shows.
+        let divided = node.kind != ElementKind::R;
+        let rule = if !v.is_finite() {
+            "the value must be finite"
+        } else if !ok {
+            rule
+        } else if divided && !(1.0 / v).is_finite() {
+            "the equations divide by it, and its reciprocal is not finite"
+        } else {
+            continue;
+        };
+        return Err(format!(
+            "{} `{}` = {} with these parameter values: {rule}",
+            node.kind.keyword(),
+            node.name,
+            bgc::diagnostic::number(v)
+        ));
     }
     Ok(())
 }

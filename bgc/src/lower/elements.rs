@@ -11,7 +11,7 @@ use super::builder::Builder;
 use super::consteval::{eval, params_of};
 use super::exprs::{Allow, Cx, Q, port_var, var_letter};
 use super::unit_hints::Place;
-use crate::diagnostic::Diagnostic;
+use crate::diagnostic::{Diagnostic, number};
 use crate::ir::{self, Domain, Law, PortVar, Relation};
 use crate::span::Span;
 use crate::syntax::ast::{self, ElementBody, ElementKind as K};
@@ -276,43 +276,57 @@ impl Builder<'_> {
         let Some(v) = eval(expr, &self.model.params) else {
             return;
         };
+        let shown = number(v);
         let problem = match kind {
             K::C if !v.is_finite() => Some("an infinite compliance (a zero stiffness)".to_string()),
             K::C if v <= 0.0 => Some(format!(
-                "a compliance of {v} (a compliance and its stiffness must be positive)"
+                "a compliance of {shown} (a compliance and its stiffness must be positive)"
             )),
             K::I | K::R if !v.is_finite() => Some(format!(
-                "{} of {v} (it must be finite)",
+                "{} of {shown} (it must be finite)",
                 if kind == K::I {
                     "an inertia"
                 } else {
                     "a resistance"
                 }
             )),
-            K::I if !(v.is_finite() && v > 0.0) => {
-                Some(format!("an inertia of {v} (an inertia must be positive)"))
-            }
+            K::I if !(v.is_finite() && v > 0.0) => Some(format!(
+                "an inertia of {shown} (an inertia must be positive)"
+            )),
             K::R if !(v.is_finite() && v >= 0.0) => Some(format!(
-                "a resistance of {v} (a resistance cannot be negative)"
+                "a resistance of {shown} (a resistance cannot be negative)"
             )),
             K::TF if !(v.is_finite() && v != 0.0) => Some(format!(
-                "a transformer ratio of {v} (it must be finite and non-zero)"
+                "a transformer ratio of {shown} (it must be finite and non-zero)"
             )),
             K::GY if !(v.is_finite() && v != 0.0) => Some(format!(
-                "a gyrator modulus of {v} (it must be finite and non-zero)"
+                "a gyrator modulus of {shown} (it must be finite and non-zero)"
+            )),
+            // The equations divide by these (`f = p/m`, `e = q/C`, a modulus in one causality).
+            K::I | K::C | K::TF | K::GY if !(1.0 / v).is_finite() => Some(format!(
+                "{} of {shown}, whose reciprocal is not finite (the equations divide by it)",
+                match kind {
+                    K::I => "an inertia",
+                    K::C => "a compliance",
+                    K::TF => "a transformer ratio",
+                    _ => "a gyrator modulus",
+                }
             )),
             _ => None,
         };
         let Some(problem) = problem else { return };
         let mut d = Diagnostic::error("BG0401", format!("`{name}` has {problem}")).with_primary(
             span,
-            format!("this is {v} with the default parameter values"),
+            format!("this is {shown} with the default parameter values"),
         );
         let mut used = Vec::new();
         params_of(expr, &mut used);
         for id in used {
             if let (Some(p), Some(info)) = (self.model.params.get(id), self.params.get(id)) {
-                d = d.with_secondary(info.value_span, format!("`{}` is {}", p.name, p.default));
+                d = d.with_secondary(
+                    info.value_span,
+                    format!("`{}` is {}", p.name, number(p.default)),
+                );
             }
         }
         self.diags

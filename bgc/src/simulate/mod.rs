@@ -63,7 +63,7 @@ pub enum SimError {
         expected: usize,
         got: usize,
     },
-    #[error("{name} = {value} is not allowed: {reason}")]
+    #[error("{name} = {value:?} is not allowed: {reason}")]
     BadSetting {
         name: &'static str,
         value: f64,
@@ -75,12 +75,12 @@ pub enum SimError {
     TooManyRows { rows: f64, limit: usize },
     #[error("the initial {what} is not finite")]
     NonFiniteStart { what: String },
-    #[error("the derivative of `{state}` became non-finite at t = {time}")]
+    #[error("the derivative of `{state}` became non-finite at t = {time:?}")]
     NonFiniteDerivative { time: f64, state: String },
-    #[error("`{state}` became non-finite at t = {time}")]
+    #[error("`{state}` became non-finite at t = {time:?}")]
     NonFiniteState { time: f64, state: String },
     #[error(
-        "the algebraic loop for `{tears}` could not be solved at t = {time}: after {iterations} Newton iterations {reason}; the residual of `{worst}` is {residual:.3e}"
+        "the algebraic loop for `{tears}` could not be solved at t = {time:?}: after {iterations} Newton iterations {reason}; the residual of `{worst}` is {residual:.3e}"
     )]
     AlgebraicLoop {
         tears: String,
@@ -92,10 +92,10 @@ pub enum SimError {
     },
     #[error("the algebraic loop for `{tears}` cannot be solved: {reason}")]
     LoopSetup { tears: String, reason: String },
-    #[error("the solver failed at t = {time}: {message}")]
+    #[error("the solver failed at t = {time:?}: {message}")]
     Solver { time: f64, message: String },
     #[error(
-        "the solver took {max_steps} steps between t = {from} and t = {to} and stopped at t = {time}"
+        "the solver took {max_steps} steps between t = {from:?} and t = {to:?} and stopped at t = {time:?}"
     )]
     TooManySteps {
         from: f64,
@@ -104,7 +104,7 @@ pub enum SimError {
         max_steps: usize,
     },
     #[error(
-        "the solver advanced too slowly: {steps} steps from t = {from} reached t = {time}, and at that pace t = {to} \
+        "the solver advanced too slowly: {steps} steps from t = {from:?} reached t = {time:?}, and at that pace t = {to:?} \
          needs more than the {max_steps} steps allowed (a stiff or fast-forced model: try --solver bdf, or looser \
          tolerances)"
     )]

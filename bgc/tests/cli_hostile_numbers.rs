@@ -253,6 +253,20 @@ fn a_coefficient_whose_reciprocal_overflows_is_refused_at_the_element() {
     assert!(err.lines().all(|l| l.len() < 200), "{err}");
 }
 
+/// A record with times 0 and 1e308 said "the exact discretisation failed: matrix A has a non-finite entry -inf at
+/// (0, 0)", a matrix the user never wrote; the error now names the sample interval.
+#[test]
+fn a_sample_interval_too_long_to_discretise_is_named() {
+    let model = temp_file("osc_long.bg", OSC);
+    let long = temp_file("long.csv", "t,F,x\n0,1,0\n1e308,1,1e-3\n");
+    let (code, out, err) = bgc(&["fit", &model, "--data", &long, "--free", "k"]);
+    assert_eq!(code, 1, "{err}\n{out}");
+    assert!(
+        err.contains("the sample interval of 1e308 s is too long for the exact discretisation"),
+        "{err}"
+    );
+}
+
 /// `--data /dev/zero` read without end (the run was killed after 20 s with its memory growing); a device and a
 /// directory are refused without being read.
 #[test]

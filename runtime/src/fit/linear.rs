@@ -99,7 +99,14 @@ fn discretise(sys: &Augmented, dt: f64) -> Result<(DMatrix<f64>, DMatrix<f64>), 
     let mut big = DMatrix::zeros(n + p, n + p);
     big.view_mut((0, 0), (n, n)).copy_from(&(&sys.a * dt));
     big.view_mut((0, n), (n, p)).copy_from(&(&sys.b * dt));
-    let e = expm(&big).map_err(|e| format!("the exact discretisation failed: {e}"))?;
+    if big.iter().any(|v| !v.is_finite()) {
+        return Err(format!(
+            "the sample interval of {dt:?} s is too long for the exact discretisation: A dt or B dt overflows"
+        ));
+    }
+    let e = expm(&big).map_err(|e| {
+        format!("the exact discretisation over the sample interval of {dt:?} s failed: {e}")
+    })?;
     Ok((
         e.view((0, 0), (n, n)).clone_owned(),
         e.view((0, n), (n, p)).clone_owned(),

@@ -29,11 +29,16 @@ pub enum Domain {
 
 impl Domain {
     /// Whether `λ` is asymptotically stable in this domain with a margin, so that modes on the stability
-    /// boundary (computed with rounding error) count as unstable: `Re λ < −1e-12 · max(1, scale)` in continuous
-    /// time, where `scale` is the norm of the balanced matrix the eigenvalue came from (eigenvalue errors are
-    /// proportional to it), and `|λ| < 1 − 1e-12 · max(1, scale)` in discrete time (pass `scale = 1`).
+    /// boundary (computed with rounding error) count as unstable: `Re λ < −1e-12 · scale` in continuous time,
+    /// where `scale` is the norm of the balanced matrix the eigenvalue came from (eigenvalue errors are
+    /// proportional to it, and a margin in absolute units would depend on the unit of time: a model in
+    /// 10⁻²⁰ of its rates' units was called unstable), and `|λ| < 1 − 1e-12 · max(1, scale)` in discrete time
+    /// (pass `scale = 1`).
     pub fn is_stable(self, lambda: Complex<f64>, scale: f64) -> bool {
-        let margin = 1e-12 * scale.max(1.0);
+        let margin = match self {
+            Domain::Continuous => 1e-12 * scale,
+            Domain::Discrete => 1e-12 * scale.max(1.0),
+        };
         match self {
             Domain::Continuous => lambda.re < -margin,
             Domain::Discrete => lambda.norm() < 1.0 - margin,

@@ -178,7 +178,7 @@ fn a_large_chain_runs_on_a_default_thread_stack_with_the_hand_derived_rates() {
     assert_eq!(
         lines[STATES + 2],
         format!(
-            "error parameter `m` = -1 is not physical: the inertia of `mass1` (m) and of {} other \
+            "error parameter `m` = -1.0 is not physical: the inertia of `mass1` (m) and of {} other \
              elements with the same value must be positive and finite",
             MASSES - 1
         )

@@ -42,7 +42,10 @@ impl core::fmt::Display for ParamError {
                 name,
                 value,
                 reason,
-            } => write!(f, \"parameter `{name}` = {value} is not physical: {reason}\"),
+            } => write!(
+                f,
+                \"parameter `{name}` = {value:?} is not physical: {reason}\"
+            ),
         }
     }
 }

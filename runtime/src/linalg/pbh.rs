@@ -35,13 +35,9 @@ impl Domain {
     /// 10⁻²⁰ of its rates' units was called unstable), and `|λ| < 1 − 1e-12 · max(1, scale)` in discrete time
     /// (pass `scale = 1`).
     pub fn is_stable(self, lambda: Complex<f64>, scale: f64) -> bool {
-        let margin = match self {
-            Domain::Continuous => 1e-12 * scale,
-            Domain::Discrete => 1e-12 * scale.max(1.0),
-        };
         match self {
-            Domain::Continuous => lambda.re < -margin,
-            Domain::Discrete => lambda.norm() < 1.0 - margin,
+            Domain::Continuous => lambda.re < -1e-12 * scale,
+            Domain::Discrete => lambda.norm() < 1.0 - 1e-12 * scale.max(1.0),
         }
     }
 }

@@ -383,18 +383,7 @@ pub(crate) fn stabilising_solution(
     refinement_steps: usize,
 ) -> Result<Riccati, RiccatiError> {
     let closed_loop = a - b * &k;
-    // The eigenvalues of the closed loop scaled to entries of order one, scaled back: the QR iteration's
-    // products of entries of 1e-200 would underflow to zero (and read as eigenvalues on the boundary).
-    let largest = closed_loop.amax();
-    let unit = if largest > 0.0 && largest.is_finite() {
-        largest
-    } else {
-        1.0
-    };
-    let closed_loop_eigenvalues: Vec<_> = eigenvalues(&(&closed_loop / unit))?
-        .into_iter()
-        .map(|l| l * unit)
-        .collect();
+    let closed_loop_eigenvalues = eigenvalues(&closed_loop)?;
     // A stabilising X puts the closed loop clearly inside; only rounding-level margins (relative to the closed
     // loop's own scale) are tolerated here.
     let scale = pbh::stability_scale(&closed_loop, domain);

@@ -34,19 +34,37 @@ fn checked(a: &DMatrix<f64>) -> Result<usize, SchurError> {
     Ok(rows)
 }
 
+/// A power of two that brings the largest entry of `a` near one. The QR iteration runs on `a / s` and its
+/// results are scaled back by `s`: dividing and multiplying by a power of two rounds nothing, and on a matrix
+/// of entries near 1e-200 the iteration's products would underflow (eigenvalues of 0, on the stability
+/// boundary).
+fn unit_scale(a: &DMatrix<f64>) -> f64 {
+    let largest = a.amax();
+    if largest > 0.0 && largest.is_finite() {
+        2f64.powi(largest.log2().round() as i32)
+    } else {
+        1.0
+    }
+}
+
 /// `a = u t uᵀ` with `u` orthogonal and `t` upper quasi-triangular.
 pub fn real_schur(a: &DMatrix<f64>) -> Result<(DMatrix<f64>, DMatrix<f64>), SchurError> {
     let n = checked(a)?;
-    Schur::try_new(a.clone(), f64::EPSILON, 1000 * n.max(10))
-        .map(|s| s.unpack())
+    let scale = unit_scale(a);
+    Schur::try_new(a / scale, f64::EPSILON, 1000 * n.max(10))
+        .map(|s| {
+            let (u, t) = s.unpack();
+            (u, t * scale)
+        })
         .ok_or(SchurError::NoConvergence { n })
 }
 
 /// The eigenvalues of a square matrix, in the order of the diagonal of its real Schur form.
 pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, SchurError> {
     let n = checked(a)?;
-    Schur::try_new(a.clone(), f64::EPSILON, 1000 * n.max(10))
-        .map(|s| s.complex_eigenvalues().iter().copied().collect())
+    let scale = unit_scale(a);
+    Schur::try_new(a / scale, f64::EPSILON, 1000 * n.max(10))
+        .map(|s| s.complex_eigenvalues().iter().map(|l| l * scale).collect())
         .ok_or(SchurError::NoConvergence { n })
 }
 

@@ -1,12 +1,11 @@
 //! The matrix products of a Kalman step, written for the shapes and symmetries of the filter.
 //!
-//! Every product is built column by column as a sum of columns scaled by scalars (`y[:, j] += x[:, k] s`):
-//! the innermost loop runs down a contiguous column of the fixed length `NX`, which compiles to straight
-//! vector code without branches, and each column is written once, in place. A symmetric result is computed
-//! in full columns and then made exactly symmetric by copying its upper triangle onto the lower one: the
-//! product of the lower triangle is work thrown away, but rows cut at the diagonal compile to a loop of
-//! varying length per column, which costs more than the arithmetic it saves at these sizes. The matrices
-//! are read through nalgebra's column-major arrays (`data.0[column][row]`), whose bounds are the const sizes.
+//! Every product is built column by column as a sum of columns scaled by scalars (`y[:, j] += x[:, k] s`,
+//! [`combine`]): the innermost loop runs down a contiguous column of the fixed length `NX`, which compiles to
+//! straight vector code without branches, and each column is written once, in place. A symmetric result is
+//! computed down to the diagonal in blocks of four rows ([`upper_combination`]) and then made exactly symmetric
+//! by copying its upper triangle onto the lower one. The matrices are read through nalgebra's column-major
+//! arrays (`data.0[column][row]`), whose bounds are the const sizes.
 //!
 //! Each product forms its `a b + c` through `M` (`isa`) and is inlined into the step, so that it is compiled
 //! with the instruction set the step runs on.
@@ -16,7 +15,7 @@ use nalgebra::{ArrayStorage, SMatrix, SVector};
 
 /// `A P Aᵀ + Q` for symmetric `P` and `Q`, from `A` and `Aᵀ` (kept with the filter): `T = P Aᵀ` (written into
 /// `t`, the filter's work matrix: an `NX × NX` local would not fit the stack of a large filter), then
-/// `A T + Q`, its upper triangle mirrored (`4 NX³` flops).
+/// `A T + Q` down to the diagonal, its upper triangle mirrored (about `3 NX³` flops).
 #[inline(always)]
 pub(super) fn congruence_plus<M: MulAdd, const NX: usize>(
     a: &SMatrix<f64, NX, NX>,
@@ -49,13 +48,8 @@ pub(super) fn covariance_times_ct<M: MulAdd, const NX: usize, const NY: usize>(
 ) -> SMatrix<f64, NX, NY> {
     let (p, ct) = (&p.data.0, &ct.data.0);
     let mut out = [[0.0_f64; NX]; NY];
-    for a in 0..NY {
-        for k in 0..NX {
-            let s = ct[a][k];
-            for i in 0..NX {
-                out[a][i] = M::mul_add(p[k][i], s, out[a][i]);
-            }
-        }
+    for (column, row_of_c) in out.iter_mut().zip(ct) {
+        combine::<M, NX, NX>(p, row_of_c, [0.0; NX], column);
     }
     SMatrix::from_data(ArrayStorage(out))
 }
@@ -249,12 +243,8 @@ pub(super) fn plus_product<M: MulAdd, const R: usize, const C: usize>(
     m: &SMatrix<f64, R, C>,
     v: &SVector<f64, C>,
 ) -> SVector<f64, R> {
-    let mut sum = y.data.0[0];
-    for (column, s) in m.data.0.iter().zip(v.iter()) {
-        for (out, entry) in sum.iter_mut().zip(column) {
-            *out = M::mul_add(*entry, *s, *out);
-        }
-    }
+    let mut sum = [0.0; R];
+    combine::<M, R, C>(&m.data.0, &v.data.0[0], y.data.0[0], &mut sum);
     SVector::from_data(ArrayStorage([sum]))
 }
 

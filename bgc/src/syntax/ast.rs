@@ -67,17 +67,17 @@ pub struct ModelDecl {
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub enum Stmt {
-    Domain(DomainStmt),
-    Param(ParamDecl),
-    Input(InputDecl),
-    Output(OutputDecl),
-    Var(VarDecl),
-    Coords(CoordsDecl),
-    Element(ElementDecl),
-    Instance(InstanceDecl),
-    Bond(BondStmt),
-    Port(PortDecl),
-    Allow(AllowDecl),
+    Domain(Box<DomainStmt>),
+    Param(Box<ParamDecl>),
+    Input(Box<InputDecl>),
+    Output(Box<OutputDecl>),
+    Var(Box<VarDecl>),
+    Coords(Box<CoordsDecl>),
+    Element(Box<ElementDecl>),
+    Instance(Box<InstanceDecl>),
+    Bond(Box<BondStmt>),
+    Port(Box<PortDecl>),
+    Allow(Box<AllowDecl>),
 }
 
 impl Stmt {

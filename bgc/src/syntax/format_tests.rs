@@ -320,7 +320,7 @@ mod generated_trees {
                     kind: ModelKind::Model,
                     doc: vec![],
                     name: ident("m"),
-                    body: vec![Stmt::Coords(CoordsDecl { coords: vec![x.clone()], span: Span::default() })],
+                    body: vec![Stmt::Coords(Box::new(CoordsDecl { coords: vec![x.clone()], span: Span::default() }))],
                     span: Span::default(),
                 })],
                 ..File::default()

@@ -72,10 +72,8 @@ fn outline(file: &File) -> String {
                 );
                 for s in &m.body {
                     let _ = writeln!(o, "  {}", stmt(s));
-                    if let Stmt::Element(ElementDecl {
-                        body: ElementBody::Laws(laws),
-                        ..
-                    }) = s
+                    if let Stmt::Element(e) = s
+                        && let ElementBody::Laws(laws) = &e.body
                     {
                         for l in laws {
                             let idx: Vec<u32> = l.indices.iter().map(|i| i.0).collect();

@@ -31,7 +31,7 @@ impl<'a> Parser<'a> {
         if t.kind == Tok::Number {
             let text = self.tok_text(t);
             return match ElementKind::from_keyword(text) {
-                Some(kind) => self.element(docs, kind).map(Stmt::Element),
+                Some(kind) => self.element(docs, kind).map(|e| Stmt::Element(Box::new(e))),
                 None => Err(self.expected(
                     "a statement",
                     "a junction is `0 NAME;` or `1 NAME;`; other statements start with a keyword",
@@ -47,7 +47,7 @@ impl<'a> Parser<'a> {
         }
         let word = self.tok_text(t);
         if let Some(kind) = ElementKind::from_keyword(word) {
-            return self.element(docs, kind).map(Stmt::Element);
+            return self.element(docs, kind).map(|e| Stmt::Element(Box::new(e)));
         }
         let docs = match word {
             "domain" | "coords" | "bond" | "port" | "allow" => {
@@ -63,25 +63,25 @@ impl<'a> Parser<'a> {
                 self.bump();
                 let domain = self.expect_name("a domain name")?;
                 self.expect_semi("the domain")?;
-                Stmt::Domain(DomainStmt {
+                Stmt::Domain(Box::new(DomainStmt {
                     domain,
                     span: self.span_from(start),
-                })
+                }))
             }
-            "param" => Stmt::Param(self.param(docs)?),
+            "param" => Stmt::Param(Box::new(self.param(docs)?)),
             "input" => {
                 self.bump();
                 let name = self.expect_name("the name of the input")?;
                 let unit = self.unit()?;
                 let description = self.description();
                 self.expect_semi("the input")?;
-                Stmt::Input(InputDecl {
+                Stmt::Input(Box::new(InputDecl {
                     doc: doc_text(docs),
                     name,
                     unit,
                     description,
                     span: self.span_from(start),
-                })
+                }))
             }
             "output" => {
                 self.bump();
@@ -95,16 +95,16 @@ impl<'a> Parser<'a> {
                 let value = self.expr()?;
                 let description = self.description();
                 self.expect_semi("the output")?;
-                Stmt::Output(OutputDecl {
+                Stmt::Output(Box::new(OutputDecl {
                     doc: doc_text(docs),
                     name,
                     unit,
                     value,
                     description,
                     span: self.span_from(start),
-                })
+                }))
             }
-            "var" => Stmt::Var(self.var(docs)?),
+            "var" => Stmt::Var(Box::new(self.var(docs)?)),
             "coords" => {
                 self.bump();
                 let open = self.expect(
@@ -118,13 +118,13 @@ impl<'a> Parser<'a> {
                 }
                 self.close(Tok::RBracket, open, "the list of coordinates")?;
                 self.expect_semi("the coordinates")?;
-                Stmt::Coords(CoordsDecl {
+                Stmt::Coords(Box::new(CoordsDecl {
                     coords,
                     span: self.span_from(start),
-                })
+                }))
             }
-            "bond" => Stmt::Bond(self.bond()?),
-            "allow" => Stmt::Allow(self.allow()?),
+            "bond" => Stmt::Bond(Box::new(self.bond()?)),
+            "allow" => Stmt::Allow(Box::new(self.allow()?)),
             "port" => {
                 self.bump();
                 let name = self.expect_name("the name of the port")?;
@@ -135,11 +135,11 @@ impl<'a> Parser<'a> {
                 )?;
                 let target = self.node_ref()?;
                 self.expect_semi("the port")?;
-                Stmt::Port(PortDecl {
+                Stmt::Port(Box::new(PortDecl {
                     name,
                     target,
                     span: self.span_from(start),
-                })
+                }))
             }
             _ if super::parser::is_keyword(word) => {
                 return Err(self.expected(
@@ -147,7 +147,7 @@ impl<'a> Parser<'a> {
                     "`model`, `component` and `import` belong at the top level of a file",
                 ));
             }
-            _ => Stmt::Instance(self.instance(docs)?),
+            _ => Stmt::Instance(Box::new(self.instance(docs)?)),
         };
         Ok(stmt)
     }

@@ -25,14 +25,14 @@ pub(crate) struct Readable {
 impl Readable {
     /// Replaces copies by the variable they copy (a junction's velocity by its state).
     pub fn alias(&self, e: &Expr) -> Expr {
+        // `None` for a variable that stays as it is, so that an unchanged expression is not rebuilt.
         symbols::subst(e, &mut |s| match s {
             Sym::Var(v) => {
-                self.rep
-                    .get(v)
-                    .map(|&r| match self.velocity.get(r).copied().flatten() {
-                        Some(k) => symbols::leaf(Sym::State(k)),
-                        None => symbols::leaf(Sym::Var(r)),
-                    })
+                let r = *self.rep.get(v)?;
+                match self.velocity.get(r).copied().flatten() {
+                    Some(k) => Some(symbols::leaf(Sym::State(k))),
+                    None => (r != v).then(|| symbols::leaf(Sym::Var(r))),
+                }
             }
             _ => None,
         })

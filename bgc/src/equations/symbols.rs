@@ -246,9 +246,17 @@ pub fn subst(e: &Expr, f: &mut dyn FnMut(Sym) -> Option<Expr>) -> Expr {
 
 /// [`subst`] of a small tree (depth at most [`SMALL`]), rebuilding only what changes.
 fn subst_small(e: &Expr, f: &mut dyn FnMut(Sym) -> Option<Expr>) -> Expr {
+    // The children from the first one that changes; `None`, and nothing allocated, when none does.
     let all = |xs: &[Expr], f: &mut dyn FnMut(Sym) -> Option<Expr>| -> Option<Vec<Expr>> {
-        let ys: Vec<Expr> = xs.iter().map(|x| subst_small(x, f)).collect();
-        (ys.as_slice() != xs).then_some(ys)
+        let (first, changed) = xs.iter().enumerate().find_map(|(i, x)| {
+            let y = subst_small(x, f);
+            (y != *x).then_some((i, y))
+        })?;
+        let mut ys = Vec::with_capacity(xs.len());
+        ys.extend_from_slice(&xs[..first]);
+        ys.push(changed);
+        ys.extend(xs[first + 1..].iter().map(|x| subst_small(x, f)));
+        Some(ys)
     };
     match e.node() {
         Node::Const(_) => e.clone(),

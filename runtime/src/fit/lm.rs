@@ -85,12 +85,12 @@ impl LmOptions {
         ];
         if let Some((name, v)) = settings.iter().find(|(_, v)| !(v.is_finite() && *v >= 0.0)) {
             return Err(format!(
-                "LmOptions::{name} = {v}: it must be finite and not negative"
+                "LmOptions::{name} = {v:?}: it must be finite and not negative"
             ));
         }
         if self.max_log_step.is_nan() || self.max_log_step <= 0.0 {
             return Err(format!(
-                "LmOptions::max_log_step = {}: it must be positive (infinite for no limit)",
+                "LmOptions::max_log_step = {:?}: it must be positive (infinite for no limit)",
                 self.max_log_step
             ));
         }
@@ -194,7 +194,7 @@ pub fn minimise(
     for (k, ((&z, &lo), &hi)) in z0.iter().zip(lower).zip(upper).enumerate() {
         if lo.is_nan() || hi.is_nan() || lo > hi || !z.is_finite() {
             return Err(format!(
-                "coordinate {k}: start {z} with bounds [{lo}, {hi}]"
+                "coordinate {k}: start {z:?} with bounds [{lo:?}, {hi:?}]"
             ));
         }
     }
@@ -317,7 +317,7 @@ pub fn minimise(
 fn check_start(r: &DVector<f64>, j: &DMatrix<f64>, cost: f64) -> Result<(), String> {
     if let Some(k) = r.iter().position(|v| !v.is_finite()) {
         return Err(format!(
-            "the weighted residual {k} is {} at the start",
+            "the weighted residual {k} is {:?} at the start",
             r[k]
         ));
     }
@@ -644,5 +644,39 @@ mod tests {
         )
         .unwrap();
         assert!((m.z[0] - 1.5).abs() < 1e-9, "{m:?}");
+    }
+
+    #[test]
+    fn settings_and_starts_are_named_with_their_exact_value() {
+        // Display would write 1e300 as 301 digits and drop the sign of -0.0; Debug writes `1e300` and `-0.0`.
+        let opts = LmOptions {
+            gtol: -1e300,
+            ..LmOptions::default()
+        };
+        assert_eq!(
+            opts.check().expect_err("negative"),
+            "LmOptions::gtol = -1e300: it must be finite and not negative"
+        );
+        let opts = LmOptions {
+            max_log_step: -0.0,
+            ..LmOptions::default()
+        };
+        assert!(
+            opts.check()
+                .expect_err("not positive")
+                .starts_with("LmOptions::max_log_step = -0.0:")
+        );
+        let err = minimise(
+            &mut Scaled(1.0),
+            &[f64::INFINITY],
+            &[-1e300],
+            &[1e300],
+            &LmOptions::default(),
+        )
+        .expect_err("an infinite start");
+        assert!(
+            err.contains("start inf with bounds [-1e300, 1e300]"),
+            "{err}"
+        );
     }
 }

@@ -237,13 +237,13 @@ fn check(
     }
     if let Some(k) = params.iter().position(|v| !v.is_finite()) {
         return bad(format!(
-            "parameter {k} is {}; every parameter must be finite",
+            "parameter {k} is {:?}; every parameter must be finite",
             params[k]
         ));
     }
     if let Some(k) = x0.iter().position(|v| !v.is_finite()) {
         return bad(format!(
-            "initial state {k} is {}; every initial state must be finite",
+            "initial state {k} is {:?}; every initial state must be finite",
             x0[k]
         ));
     }
@@ -272,19 +272,19 @@ fn check(
         };
         if p.lower >= p.upper || p.lower.is_nan() || p.upper.is_nan() {
             return bad(format!(
-                "the bounds of `{}` are empty: [{}, {}]",
+                "the bounds of `{}` are empty: [{:?}, {:?}]",
                 p.name, p.lower, p.upper
             ));
         }
         if !(v >= p.lower && v <= p.upper && v.is_finite()) {
             return bad(format!(
-                "the start of `{}`, {v}, is not within its bounds [{}, {}]",
+                "the start of `{}`, {v:?}, is not within its bounds [{:?}, {:?}]",
                 p.name, p.lower, p.upper
             ));
         }
         if p.log && v <= 0.0 {
             return bad(format!(
-                "`{}` is fitted in log space (a positive quantity) but starts at {v}; give a positive start",
+                "`{}` is fitted in log space (a positive quantity) but starts at {v:?}; give a positive start",
                 p.name
             ));
         }

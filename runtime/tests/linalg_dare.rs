@@ -163,3 +163,37 @@ mod random {
         }
     }
 }
+
+/// `x⁺ = s·[1 0.1; 0 1] x + s·[0; 0.1] u` with `Q = s·I`, `R = s`: as `s` grows the optimal gain tends to the
+/// deadbeat gain `[100, 20]` (`A − BK` nilpotent: trace `s(2 − 0.1 k₂) = 0`, determinant `s²(0.01 k₁ − 1) = 0`).
+fn scaled_double_integrator(s: f64) -> [DMatrix<f64>; 4] {
+    [
+        DMatrix::from_row_slice(2, 2, &[1.0, 0.1, 0.0, 1.0]) * s,
+        DMatrix::from_row_slice(2, 1, &[0.0, 0.1]) * s,
+        DMatrix::identity(2, 2) * s,
+        DMatrix::identity(1, 1) * s,
+    ]
+}
+
+#[test]
+fn a_fast_growing_open_loop_gives_the_deadbeat_gain_or_says_it_is_out_of_range() {
+    // scipy 1.17's solve_discrete_are returns K = [100.00000074, 20.00000007] at s = 1e5 with a relative residual
+    // of 73 (and a wrong sign of X); bgc's gain must be the deadbeat limit with its residual checked.
+    let [a, b, q, r] = scaled_double_integrator(1e5);
+    let sol = dare(&a, &b, &q, &r).expect("solvable at 1e5");
+    for (k, want) in sol.k.iter().zip([100.0, 20.0]) {
+        assert!((k - want).abs() <= 1e-7 * want, "K = {}", sol.k);
+    }
+    assert!(sol.relative_residual < 1e-8, "{}", sol.relative_residual);
+    // Further out the doubling iterates grow past f64 (or past 1/ε, where `I + GH` loses its identity): a named
+    // error, never a non-convergence with an infinite residual.
+    for s in [1e50, 1e100, 1e150] {
+        let [a, b, q, r] = scaled_double_integrator(s);
+        let err = dare(&a, &b, &q, &r).expect_err("out of range");
+        assert!(
+            matches!(err, RiccatiError::OutOfRange { .. }),
+            "{s:e}: {err:?}"
+        );
+        assert!(err.to_string().contains("rescale"), "{err}");
+    }
+}

@@ -7,7 +7,7 @@ use super::lyapunov::{dlyap, symmetrize};
 use super::pbh::Domain;
 use super::refine::{Evaluated, refine, relative_residual};
 use super::riccati::{
-    Problem, Riccati, RiccatiError, Scaled, finite_solution, stabilising_solution,
+    Problem, Riccati, RiccatiError, Scaled, finite_solution, overflowed, stabilising_solution,
 };
 
 /// Doubling steps at most (each squares the convergence factor).
@@ -60,15 +60,35 @@ pub fn dare_with_cross(
     let mut converged = false;
     while doubling < MAX_DOUBLING_STEPS {
         doubling += 1;
-        let lu = (&identity + &gk * &hk).lu();
+        let pivot = &identity + &gk * &hk;
+        if !pivot.iter().chain(ak.iter()).all(|v| v.is_finite()) {
+            return Err(overflowed(
+                &p,
+                Domain::Discrete,
+                "the doubling iterates",
+                doubling,
+            ));
+        }
+        // `I + GₖHₖ` with entries beyond 1/ε has lost its identity to rounding: singular for range, not data.
+        let lost_identity = pivot.amax() > 1.0 / f64::EPSILON;
+        let lu = pivot.lu();
         let (Some(w_a), Some(w_g)) = (lu.solve(&ak), lu.solve(&gk)) else {
-            return Err(p.diagnose(Domain::Discrete, f64::INFINITY, doubling));
+            return Err(if lost_identity {
+                overflowed(&p, Domain::Discrete, "the doubling iterates", doubling)
+            } else {
+                p.diagnose(Domain::Discrete, f64::INFINITY, doubling)
+            });
         };
         let h_next = symmetrize(&(&hk + ak.transpose() * &hk * &w_a));
         let g_next = symmetrize(&(&gk + &ak * w_g * ak.transpose()));
         let a_next = &ak * w_a;
         if !h_next.iter().all(|v| v.is_finite()) {
-            return Err(p.diagnose(Domain::Discrete, f64::INFINITY, doubling));
+            return Err(overflowed(
+                &p,
+                Domain::Discrete,
+                "the doubling iterates",
+                doubling,
+            ));
         }
         let change = (&h_next - &hk).norm() / h_next.norm().max(f64::MIN_POSITIVE);
         hk = h_next;

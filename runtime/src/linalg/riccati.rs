@@ -64,6 +64,16 @@ pub enum RiccatiError {
         "the solver did not converge: relative residual {residual:e} after {iterations} iterations"
     )]
     NoConvergence { residual: f64, iterations: usize },
+    /// `what` left the range where f64 can carry it: entries that overflow, or so large that the identity added
+    /// to them is lost in rounding. The data are too far out of scale for the solver: a discrete open loop that
+    /// grows by many orders of magnitude per step, or a solution beyond 1.8e308.
+    #[error(
+        "{what} left the range of f64 after {iterations} iterations: the data are too far out of scale for the solver; rescale the states, the inputs or the weights"
+    )]
+    OutOfRange {
+        what: &'static str,
+        iterations: usize,
+    },
     #[error("the closed loop A − BK is not stable: eigenvalue {eigenvalue}")]
     ClosedLoopUnstable { eigenvalue: Complex<f64> },
     #[error("{what} is singular")]
@@ -402,14 +412,34 @@ pub(crate) fn stabilising_solution(
     })
 }
 
-/// Refuses a solution with non-finite entries.
+/// Refuses a solution with non-finite entries: out of range when some entry is infinite, else (NaN) a failure
+/// to converge.
 pub(crate) fn finite_solution(x: &DMatrix<f64>, iterations: usize) -> Result<(), RiccatiError> {
     if x.iter().all(|v| v.is_finite()) {
         Ok(())
+    } else if x.iter().any(|v| v.is_infinite()) {
+        Err(RiccatiError::OutOfRange {
+            what: "the solution X",
+            iterations,
+        })
     } else {
         Err(RiccatiError::NoConvergence {
             residual: f64::INFINITY,
             iterations,
         })
+    }
+}
+
+/// The error for iterates that left the range of f64: what [`Problem::diagnose`] finds in the data (a mode that
+/// cannot be stabilised or detected) or, failing that, [`RiccatiError::OutOfRange`].
+pub(crate) fn overflowed(
+    p: &Problem,
+    domain: Domain,
+    what: &'static str,
+    iterations: usize,
+) -> RiccatiError {
+    match p.diagnose(domain, f64::INFINITY, iterations) {
+        RiccatiError::NoConvergence { .. } => RiccatiError::OutOfRange { what, iterations },
+        found => found,
     }
 }

@@ -12,6 +12,10 @@
 //! - every expression's names resolve, and its unit is consistent;
 //! - `spans` has an entry for every node, bond, parameter, input, output and var.
 
+mod coefficient;
+
+pub use coefficient::{CoefficientFault, coefficient_fault};
+
 use crate::span::Span;
 use crate::syntax::ast::{BinOp, ElementKind};
 use crate::units::Unit;

@@ -2,7 +2,7 @@
 //! parameter values.
 
 use super::quantities::{self, Declared};
-use bgc::ir::{Expr, Model, Relation};
+use bgc::ir::{CoefficientFault, Expr, Model, Relation, coefficient_fault};
 use bgc::simulate::input::Signal;
 use bgc::syntax::ast::ElementKind;
 
@@ -110,25 +110,19 @@ pub fn check_physical(model: &Model, params: &[f64]) -> Result<(), String> {
         let Some(v) = eval_params(e, params) else {
             continue;
         };
-        let (ok, rule) = match node.kind {
-            ElementKind::I => (v > 0.0, "an inertia must be positive"),
-            ElementKind::C => (v > 0.0, "a compliance must be positive"),
-            ElementKind::R => (v >= 0.0, "a resistance must not be negative"),
-            ElementKind::TF => (v != 0.0, "a transformer ratio must not be zero"),
-            ElementKind::GY => (v != 0.0, "a gyrator modulus must not be zero"),
-            _ => continue,
-        };
-        // The equations divide by an inertia, a compliance or a modulus (`f = p/m`, `e = q/C`): one so small
-        // that its reciprocal overflows (`1e-320`) would make them infinite, far from where the error shows.
-        let divided = node.kind != ElementKind::R;
-        let rule = if !v.is_finite() {
-            "the value must be finite"
-        } else if !ok {
-            rule
-        } else if divided && !(1.0 / v).is_finite() {
-            "the equations divide by it, and its reciprocal is not finite"
-        } else {
+        let Some(fault) = coefficient_fault(node.kind, v) else {
             continue;
+        };
+        let rule = match (fault, node.kind) {
+            (CoefficientFault::NotFinite, _) => "the value must be finite",
+            (CoefficientFault::NotPositive, ElementKind::I) => "an inertia must be positive",
+            (CoefficientFault::NotPositive, _) => "a compliance must be positive",
+            (CoefficientFault::Negative, _) => "a resistance must not be negative",
+            (CoefficientFault::Zero, ElementKind::TF) => "a transformer ratio must not be zero",
+            (CoefficientFault::Zero, _) => "a gyrator modulus must not be zero",
+            (CoefficientFault::ReciprocalNotFinite, _) => {
+                "the equations divide by it, and its reciprocal is not finite"
+            }
         };
         return Err(format!(
             "{} `{}` = {} with these parameter values: {rule}",

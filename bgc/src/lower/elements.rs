@@ -12,7 +12,7 @@ use super::consteval::{eval, params_of};
 use super::exprs::{Allow, Cx, Q, port_var, var_letter};
 use super::unit_hints::Place;
 use crate::diagnostic::{Diagnostic, number};
-use crate::ir::{self, Domain, Law, PortVar, Relation};
+use crate::ir::{self, CoefficientFault, Domain, Law, PortVar, Relation};
 use crate::span::Span;
 use crate::syntax::ast::{self, ElementBody, ElementKind as K};
 use crate::units::{Dim, domain_units, storage_parameter_unit};
@@ -276,45 +276,40 @@ impl Builder<'_> {
         let Some(v) = eval(expr, &self.model.params) else {
             return;
         };
-        let shown = number(v);
-        let problem = match kind {
-            K::C if !v.is_finite() => Some("an infinite compliance (a zero stiffness)".to_string()),
-            K::C if v <= 0.0 => Some(format!(
-                "a compliance of {shown} (a compliance and its stiffness must be positive)"
-            )),
-            K::I | K::R if !v.is_finite() => Some(format!(
-                "{} of {shown} (it must be finite)",
-                if kind == K::I {
-                    "an inertia"
-                } else {
-                    "a resistance"
-                }
-            )),
-            K::I if !(v.is_finite() && v > 0.0) => Some(format!(
-                "an inertia of {shown} (an inertia must be positive)"
-            )),
-            K::R if !(v.is_finite() && v >= 0.0) => Some(format!(
-                "a resistance of {shown} (a resistance cannot be negative)"
-            )),
-            K::TF if !(v.is_finite() && v != 0.0) => Some(format!(
-                "a transformer ratio of {shown} (it must be finite and non-zero)"
-            )),
-            K::GY if !(v.is_finite() && v != 0.0) => Some(format!(
-                "a gyrator modulus of {shown} (it must be finite and non-zero)"
-            )),
-            // The equations divide by these (`f = p/m`, `e = q/C`, a modulus in one causality).
-            K::I | K::C | K::TF | K::GY if !(1.0 / v).is_finite() => Some(format!(
-                "{} of {shown}, whose reciprocal is not finite (the equations divide by it)",
-                match kind {
-                    K::I => "an inertia",
-                    K::C => "a compliance",
-                    K::TF => "a transformer ratio",
-                    _ => "a gyrator modulus",
-                }
-            )),
-            _ => None,
+        let Some(fault) = ir::coefficient_fault(kind, v) else {
+            return;
         };
-        let Some(problem) = problem else { return };
+        let shown = number(v);
+        let what = match kind {
+            K::I => "an inertia",
+            K::C => "a compliance",
+            K::R => "a resistance",
+            K::TF => "a transformer ratio",
+            _ => "a gyrator modulus",
+        };
+        let problem = match (fault, kind) {
+            (CoefficientFault::NotFinite, K::C) => {
+                "an infinite compliance (a zero stiffness)".to_string()
+            }
+            (CoefficientFault::NotFinite, K::I | K::R) => {
+                format!("{what} of {shown} (it must be finite)")
+            }
+            (CoefficientFault::NotFinite | CoefficientFault::Zero, _) => {
+                format!("{what} of {shown} (it must be finite and non-zero)")
+            }
+            (CoefficientFault::NotPositive, K::C) => {
+                format!("{what} of {shown} (a compliance and its stiffness must be positive)")
+            }
+            (CoefficientFault::NotPositive, _) => {
+                format!("{what} of {shown} (an inertia must be positive)")
+            }
+            (CoefficientFault::Negative, _) => {
+                format!("{what} of {shown} (a resistance cannot be negative)")
+            }
+            (CoefficientFault::ReciprocalNotFinite, _) => format!(
+                "{what} of {shown}, whose reciprocal is not finite (the equations divide by it)"
+            ),
+        };
         let mut d = Diagnostic::error("BG0401", format!("`{name}` has {problem}")).with_primary(
             span,
             format!("this is {shown} with the default parameter values"),

@@ -58,23 +58,20 @@ pub fn dare_with_cross(
     let (mut ak, mut gk, mut hk) = (s.a.clone(), s.g.clone(), s.q.clone());
     let mut doubling = 0;
     let mut converged = false;
+    let out_of_range =
+        |doubling| overflowed(&p, Domain::Discrete, "the doubling iterates", doubling);
     while doubling < MAX_DOUBLING_STEPS {
         doubling += 1;
         let pivot = &identity + &gk * &hk;
         if !pivot.iter().chain(ak.iter()).all(|v| v.is_finite()) {
-            return Err(overflowed(
-                &p,
-                Domain::Discrete,
-                "the doubling iterates",
-                doubling,
-            ));
+            return Err(out_of_range(doubling));
         }
         // `I + GₖHₖ` with entries beyond 1/ε has lost its identity to rounding: singular for range, not data.
         let lost_identity = pivot.amax() > 1.0 / f64::EPSILON;
         let lu = pivot.lu();
         let (Some(w_a), Some(w_g)) = (lu.solve(&ak), lu.solve(&gk)) else {
             return Err(if lost_identity {
-                overflowed(&p, Domain::Discrete, "the doubling iterates", doubling)
+                out_of_range(doubling)
             } else {
                 p.diagnose(Domain::Discrete, f64::INFINITY, doubling)
             });
@@ -83,12 +80,7 @@ pub fn dare_with_cross(
         let g_next = symmetrize(&(&gk + &ak * w_g * ak.transpose()));
         let a_next = &ak * w_a;
         if !h_next.iter().all(|v| v.is_finite()) {
-            return Err(overflowed(
-                &p,
-                Domain::Discrete,
-                "the doubling iterates",
-                doubling,
-            ));
+            return Err(out_of_range(doubling));
         }
         let change = (&h_next - &hk).norm() / h_next.norm().max(f64::MIN_POSITIVE);
         hk = h_next;

@@ -262,14 +262,12 @@ fn sparse_entries(m: &mut SparseMatrix) -> Vec<&mut Expr> {
 pub(crate) const MAX_LETS: usize = 256;
 
 /// The readable block for `roots` (in intermediates), or the explicit expressions when the readable form cannot be
-/// computed in order.
+/// computed in order or needs more than [`MAX_LETS`] intermediates.
 fn block(eqs: &Equations, roots: &[Expr], explicit: &[Expr]) -> Block {
-    readable_block(eqs, roots)
-        .filter(|b| b.lets.len() <= MAX_LETS)
-        .unwrap_or_else(|| Block {
-            lets: Vec::new(),
-            results: explicit.to_vec(),
-        })
+    readable_block(eqs, roots).unwrap_or_else(|| Block {
+        lets: Vec::new(),
+        results: explicit.to_vec(),
+    })
 }
 
 fn intermediates_of(e: &Expr) -> impl Iterator<Item = Symbol> {
@@ -294,6 +292,9 @@ fn readable_block(eqs: &Equations, roots: &[Expr]) -> Option<Block> {
         let k = *position.get(s.name())?;
         if !needed.insert(k) {
             continue;
+        }
+        if needed.len() > MAX_LETS {
+            return None;
         }
         let def = eqs.intermediates.get(k)?;
         if def.derivative {

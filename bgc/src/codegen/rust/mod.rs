@@ -71,7 +71,13 @@ use super::format::{self, Wrap};
 use super::layout::MAX_WIDTH;
 use super::names::{Namer, comment, string_literal};
 use super::{CompiledFile, CompiledModel};
-use crate::symbolic::{Expr, RustCode, Symbol, rust_helpers_used, to_rust_code};
+use crate::symbolic::{
+    Expr, RUST_MAX_FN, RUST_MIN_FN, RUST_POWI_FN, RUST_SIGN_FN, RustCode, Symbol,
+    rust_helpers_used, to_rust_code,
+};
+
+/// The helpers generated code may call.
+const HELPERS: [&str; 4] = [RUST_SIGN_FN, RUST_MIN_FN, RUST_MAX_FN, RUST_POWI_FN];
 use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 use std::fmt::Write;
@@ -130,7 +136,7 @@ pub fn generate_with(file: &CompiledFile, source_name: &str, options: Options) -
     match file.models.as_slice() {
         [single] => {
             out.push('\n');
-            out.push_str(&model_code(single, options, 0));
+            model_code_into(&mut out, single, options, 0);
         }
         many => {
             let mut namer = Namer::with_reserved();
@@ -145,7 +151,9 @@ pub fn generate_with(file: &CompiledFile, source_name: &str, options: Options) -
                     out.push_str("#[allow(non_snake_case)]\n");
                 }
                 let _ = writeln!(out, "pub mod {name} {{");
-                for line in model_code(m, options, 4).lines() {
+                let mut code = String::new();
+                model_code_into(&mut code, m, options, 4);
+                for line in code.lines() {
                     if line.is_empty() {
                         out.push('\n');
                     } else {
@@ -159,10 +167,11 @@ pub fn generate_with(file: &CompiledFile, source_name: &str, options: Options) -
     out
 }
 
-/// The code of one model (items at the top level), for lines of `MAX_WIDTH - base_indent` columns.
-fn model_code(m: &CompiledModel, options: Options, base_indent: usize) -> String {
+/// Appends the code of one model (items at the top level), for lines of `MAX_WIDTH - base_indent` columns, to
+/// `out`.
+fn model_code_into(out: &mut String, m: &CompiledModel, options: Options, base_indent: usize) {
     let width = MAX_WIDTH - base_indent;
-    allow_dead_code(&Writer::new(m, &m.plan, options, width).write())
+    Writer::new(m, &m.plan, options, width).write_into(out);
 }
 
 /// The item keywords that start a line of a model's code at the top level.
@@ -183,13 +192,17 @@ const ITEM_STARTS: &[&str] = &[
     "impl<",
 ];
 
-/// `code` (a model's items at the top level) with `dead_code` allowed on each item, right above its keyword line
-/// (below its documentation and other attributes; joined to an `#[allow(...)]` line already there), so that a
-/// crate that uses some of them builds without warnings.
-fn allow_dead_code(code: &str) -> String {
-    let mut out = String::with_capacity(code.len() + code.len() / 8);
-    // Where the last line written starts (lines are joined by `\n`, the last one without).
-    let mut last = 0;
+/// Appends the lines of `code` (a model's items at the top level) to `out`, with `dead_code` allowed on each item,
+/// right above its keyword line (below its documentation and other attributes; joined to an `#[allow(...)]` line
+/// already there), so that a crate that uses some of them builds without warnings. The lines are joined by `\n`,
+/// and a `\n` ends the last one when `ends_with_newline`.
+fn allow_dead_code_into<'a>(
+    out: &mut String,
+    code: impl Iterator<Item = &'a str>,
+    ends_with_newline: bool,
+) {
+    // Where the last line written starts.
+    let mut last = out.len();
     let mut first = true;
     let mut push_line = |out: &mut String, last: &mut usize, line: &str| {
         if !std::mem::take(&mut first) {
@@ -198,22 +211,21 @@ fn allow_dead_code(code: &str) -> String {
         *last = out.len();
         out.push_str(line);
     };
-    for line in code.lines() {
+    for line in code {
         if ITEM_STARTS.iter().any(|k| line.starts_with(k)) {
             let prev = out.get(last..).unwrap_or("");
             if prev.starts_with("#[allow(") && prev.ends_with(")]") {
                 out.truncate(out.len() - 2);
                 out.push_str(", dead_code)]");
             } else {
-                push_line(&mut out, &mut last, "#[allow(dead_code)]");
+                push_line(out, &mut last, "#[allow(dead_code)]");
             }
         }
-        push_line(&mut out, &mut last, line);
+        push_line(out, &mut last, line);
     }
-    if code.ends_with('\n') {
+    if ends_with_newline {
         out.push('\n');
     }
-    out
 }
 
 fn rust_f64(v: f64) -> String {
@@ -517,39 +529,49 @@ impl<'a> Writer<'a> {
         }
     }
 
-    fn write(mut self) -> String {
+    /// Appends the model's code to `out`: the helpers it calls, then its items, each allowed `dead_code`. The items
+    /// are written once and copied once (a large model's text is hundreds of megabytes).
+    fn write_into(mut self, out: &mut String) {
         self.sizes();
         self.params();
         self.functions();
         self.param_terms_struct();
         self.model();
-        // The helpers the code calls (comments and documentation, the model's text, left out).
-        let mut code = String::with_capacity(self.out.len());
+        let mut prelude = String::from("use nalgebra::{SMatrix, SVector};\n");
+        let helpers = rust_helpers_used(&self.helper_calls());
+        if !helpers.is_empty() {
+            prelude.push('\n');
+            prelude.push_str(helpers.trim_end());
+            prelude.push('\n');
+        }
+        if !self.plan.mass.is_empty() || self.plan.loops.is_some() {
+            prelude.push_str(super::mass::SOLVE_FN);
+        }
+        if self.plan.loops.is_some() {
+            prelude.push_str(super::loops::NEWTON_FN);
+        }
+        // Every piece of the prelude ends its last line, so its lines and the items' lines are those of the two
+        // texts joined.
+        out.reserve(prelude.len() + self.out.len() + self.out.len() / 8);
+        allow_dead_code_into(
+            out,
+            prelude.lines().chain(self.out.lines()),
+            self.out.ends_with('\n') || (self.out.is_empty() && prelude.ends_with('\n')),
+        );
+    }
+
+    /// The lines of code (not comments or documentation, which quote the model's text) that may call a helper.
+    fn helper_calls(&self) -> String {
+        let mut code = String::new();
         for line in self
             .out
             .lines()
-            .filter(|l| !l.trim_start().starts_with("//"))
+            .filter(|l| HELPERS.iter().any(|h| l.contains(h)) && !l.trim_start().starts_with("//"))
         {
             code.push_str(line);
             code.push('\n');
         }
-        let helpers = rust_helpers_used(&code);
-        drop(code);
-        let mut out = String::with_capacity(self.out.len() + 4096);
-        out.push_str("use nalgebra::{SMatrix, SVector};\n");
-        if !helpers.is_empty() {
-            out.push('\n');
-            out.push_str(helpers.trim_end());
-            out.push('\n');
-        }
-        if !self.plan.mass.is_empty() || self.plan.loops.is_some() {
-            out.push_str(super::mass::SOLVE_FN);
-        }
-        if self.plan.loops.is_some() {
-            out.push_str(super::loops::NEWTON_FN);
-        }
-        out.push_str(&self.out);
-        out
+        code
     }
 }
 

@@ -15,8 +15,7 @@
 //! the candidate (holding only clones of children that the caller also holds) is dropped after the lock is released.
 
 use super::expr::{Inner, Node};
-use std::collections::HashMap;
-use std::collections::hash_map::Entry;
+use hashbrown::{HashTable, hash_table};
 use std::hash::{BuildHasherDefault, Hasher};
 use std::sync::{Arc, LazyLock, Mutex, PoisonError, Weak};
 
@@ -53,89 +52,86 @@ impl Hasher for PassThrough {
 
 pub(super) type PassThroughState = BuildHasherDefault<PassThrough>;
 
-/// The nodes with one structural hash: almost always one.
-enum Bucket {
-    One(Weak<Inner>),
-    Many(Vec<Weak<Inner>>),
+/// A node of the table, with its structural hash: the table grows and sweeps without reading the nodes, and a
+/// lookup upgrades only the entries whose whole hash matches.
+struct Entry {
+    hash: u64,
+    node: Weak<Inner>,
 }
 
 #[derive(Default)]
 struct Shard {
-    map: HashMap<u64, Bucket, PassThroughState>,
-    entries: usize,
+    /// The entries, several for one hash when distinct nodes collide (or dead ones wait for the sweep).
+    table: HashTable<Entry>,
     sweep_at: usize,
 }
 
 impl Shard {
     /// The live node equal to `node` under `hash` with the candidate handed back (to be dropped by the caller), or
-    /// the candidate made a node and recorded under `hash`: one probe of the map either way.
+    /// the candidate made a node and recorded under `hash` (in the entry of a dead node with the same hash, if
+    /// the probe sequence holds one).
     fn find_or_insert(
         &mut self,
         hash: u64,
         node: Node,
         tree_size: u64,
     ) -> (Arc<Inner>, Option<Node>) {
-        let matches = |w: &Weak<Inner>| w.upgrade().filter(|a| shallow_eq(&a.node, &node));
-        let fresh = |node| {
-            Arc::new(Inner {
-                node,
-                hash,
-                tree_size,
-            })
-        };
-        let made = match self.map.entry(hash) {
-            Entry::Vacant(slot) => {
-                let made = fresh(node);
-                slot.insert(Bucket::One(Arc::downgrade(&made)));
-                made
+        let mut found = None;
+        let equal = |e: &Entry| {
+            e.hash == hash && {
+                found = e.node.upgrade().filter(|a| shallow_eq(&a.node, &node));
+                found.is_some()
             }
-            Entry::Occupied(mut slot) => {
-                let bucket = slot.get_mut();
-                let found = match bucket {
-                    Bucket::One(w) => matches(w),
-                    Bucket::Many(ws) => ws.iter().find_map(matches),
-                };
-                if let Some(found) = found {
-                    return (found, Some(node));
-                }
-                let made = fresh(node);
-                let weak = Arc::downgrade(&made);
-                match bucket {
-                    Bucket::One(old) if old.strong_count() == 0 => *old = weak,
-                    Bucket::One(old) => *bucket = Bucket::Many(vec![old.clone(), weak]),
-                    Bucket::Many(ws) => {
-                        ws.retain(|w| w.strong_count() > 0);
-                        ws.push(weak);
+        };
+        let slot = match self.table.entry(hash, equal, |e| e.hash) {
+            hash_table::Entry::Vacant(slot) => Some(slot),
+            hash_table::Entry::Occupied(_) => None,
+        };
+        // An occupied entry is one that `equal` accepted, which set `found`.
+        if let Some(found) = found {
+            return (found, Some(node));
+        }
+        let made = Arc::new(Inner {
+            node,
+            hash,
+            tree_size,
+        });
+        let entry = Entry {
+            hash,
+            node: Arc::downgrade(&made),
+        };
+        // A node that is built, dropped and built again (a constant, a temporary of a pass) would leave a dead
+        // entry behind each time, all on one probe sequence: reuse one of them.
+        let dead = |e: &Entry| e.hash == hash && e.node.strong_count() == 0;
+        match slot {
+            Some(slot) => {
+                let table = slot.into_table();
+                match table.find_mut(hash, dead) {
+                    Some(old) => *old = entry,
+                    None => {
+                        table.insert_unique(hash, entry, |e| e.hash);
+                        self.after_insert();
                     }
                 }
-                made
             }
-        };
-        self.entries += 1;
-        if self.entries >= self.sweep_at.max(MIN_SWEEP) {
-            self.sweep();
+            None => {
+                self.table.insert_unique(hash, entry, |e| e.hash);
+                self.after_insert();
+            }
         }
         (made, None)
     }
 
+    fn after_insert(&mut self) {
+        if self.table.len() >= self.sweep_at.max(MIN_SWEEP) {
+            self.sweep();
+        }
+    }
+
     /// Drops the entries of dead nodes.
     fn sweep(&mut self) {
-        self.map.retain(|_, bucket| match bucket {
-            Bucket::One(w) => w.strong_count() > 0,
-            Bucket::Many(ws) => {
-                ws.retain(|w| w.strong_count() > 0);
-                !ws.is_empty()
-            }
-        });
-        self.entries = self
-            .map
-            .values()
-            .map(|b| match b {
-                Bucket::One(_) => 1,
-                Bucket::Many(ws) => ws.len(),
-            })
-            .sum();
-        self.sweep_at = 2 * self.entries;
+        self.table.retain(|e| e.node.strong_count() > 0);
+        self.sweep_at = 2 * self.table.len();
     }
 }
 
@@ -144,7 +140,9 @@ static TABLE: LazyLock<[Mutex<Shard>; SHARDS]> =
 
 /// The one node equal to `node` (whose structural hash is `hash`), built now if it did not exist.
 pub(super) fn intern(node: Node, hash: u64, tree_size: u64) -> Arc<Inner> {
-    let shard = &TABLE[(hash >> 60) as usize % SHARDS];
+    // The shard from bits the shard's table does not use: it indexes by the low bits and tags each entry with the
+    // top seven.
+    let shard = &TABLE[(hash >> 32) as usize % SHARDS];
     // A panic cannot leave a shard inconsistent (each update is one map operation), so a poisoned lock is usable.
     let mut guard = shard.lock().unwrap_or_else(PoisonError::into_inner);
     let (found, candidate) = guard.find_or_insert(hash, node, tree_size);
@@ -164,5 +162,67 @@ fn shallow_eq(a: &Node, b: &Node) -> bool {
         (Node::Pow(b1, e1), Node::Pow(b2, e2)) => b1.same_node(b2) && e1.same_node(e2),
         (Node::Call(f, xs), Node::Call(g, ys)) => f == g && super::Expr::same_nodes(xs, ys),
         _ => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn constant(shard: &mut Shard, hash: u64, v: f64) -> (Arc<Inner>, bool) {
+        let (node, candidate) = shard.find_or_insert(hash, Node::Const(v), 1);
+        (node, candidate.is_none())
+    }
+
+    #[test]
+    fn a_node_built_and_dropped_again_and_again_reuses_its_entry() {
+        let mut shard = Shard::default();
+        let keep = constant(&mut shard, 7, 0.5).0;
+        for _ in 0..10_000 {
+            let (node, new) = constant(&mut shard, 9, 1.5);
+            assert!(new, "the node was dropped, so it is built again");
+            drop(node);
+        }
+        // The live node and one entry for the dropped one, whose slot each rebuild reused.
+        assert_eq!(shard.table.len(), 2);
+        let (again, new) = constant(&mut shard, 7, 0.5);
+        assert!(!new && Arc::ptr_eq(&again, &keep));
+    }
+
+    #[test]
+    fn nodes_whose_hashes_collide_stay_distinct_and_are_found() {
+        let mut shard = Shard::default();
+        let nodes: Vec<Arc<Inner>> = (0..50)
+            .map(|k| constant(&mut shard, 42, f64::from(k)).0)
+            .collect();
+        for (k, node) in nodes.iter().enumerate() {
+            let (found, new) = constant(&mut shard, 42, k as f64);
+            assert!(!new && Arc::ptr_eq(&found, node), "node {k}");
+        }
+        // A dead node with the same hash does not hide a live one behind it.
+        let (dead, _) = constant(&mut shard, 42, 100.0);
+        drop(dead);
+        let (found, new) = constant(&mut shard, 42, 49.0);
+        assert!(!new && Arc::ptr_eq(&found, &nodes[49]));
+    }
+
+    #[test]
+    fn the_table_stays_within_a_constant_factor_of_the_live_nodes() {
+        let mut shard = Shard::default();
+        let live: Vec<Arc<Inner>> = (0..100)
+            .map(|k| constant(&mut shard, k, k as f64).0)
+            .collect();
+        for k in 0..100_000u64 {
+            drop(constant(&mut shard, 1_000 + k, k as f64));
+        }
+        assert!(
+            shard.table.len() <= 2 * MIN_SWEEP,
+            "{} entries",
+            shard.table.len()
+        );
+        assert_eq!(
+            live.iter().filter(|n| Arc::strong_count(n) == 1).count(),
+            100
+        );
     }
 }

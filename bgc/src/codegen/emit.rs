@@ -109,12 +109,60 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
         .iter()
         .map(|i| Symbol::input(i.as_str()))
         .collect();
-    let rhs = block(eqs, &eqs.rates, &f);
-    let readable_outputs: Vec<Expr> = eqs.outputs.iter().map(|o| o.value.clone()).collect();
-    let outputs = block(eqs, &readable_outputs, &h);
+    let free: Vec<usize> = (0..eqs.params.len())
+        .filter(|&k| eqs.derived.get(k).is_none_or(Option::is_none))
+        .collect();
+    let chain = ParamChain::new(eqs, &free, &[]).map_err(|e| e.to_string())?;
+    let chain = named_chain(eqs, chain).map_err(|e| e.to_string())?;
+    let mass = super::mass::plan(eqs, &states, &chain)?;
+    let loops = super::loops::plan(eqs, &f, &h, (&states, &inputs), &chain)?;
+    if let Some(l) = &loops {
+        let in_mass = mass
+            .iter()
+            .flat_map(|b| b.matrix.iter().flatten())
+            .any(|e| e.free_symbols().iter().any(|s| l.tears.contains(s)));
+        if in_mass {
+            return Err(
+                "an inertia matrix depends on the tear of a nonlinear algebraic loop".into(),
+            );
+        }
+    }
+    // The linear state space and the parameter Jacobians on a second thread; the rest here.
+    let ((linear_selection, linear_ss, params), mut p) = super::concurrent::join(
+        || {
+            let (selection, linear_ss) = linear_state_space(eqs);
+            (selection, linear_ss, ParamJacobians::new(&chain, &f, &h))
+        },
+        || PointPlan::new(eqs, (&f, &h), (&states, &inputs)),
+    );
+    p.shared.insert("jac_p_into", params.dfdp_shared);
+    p.shared.insert("output_jac_p_into", params.dhdp_shared);
+    Ok(Plan {
+        loops,
+        mass,
+        dfdx: p.dfdx,
+        dfdu: p.dfdu,
+        dhdx: p.dhdx,
+        dhdu: p.dhdu,
+        dfdp: params.dfdp,
+        dhdp: params.dhdp,
+        shared: p.shared,
+        states,
+        inputs,
+        rhs: p.rhs,
+        outputs: p.outputs,
+        linear_ss,
+        linear_selection,
+        declared_ss: p.declared_ss,
+        energy: p.energy,
+    })
+}
+
+/// The linear state space `A, B, C, D` and the states it is in.
+fn linear_state_space(eqs: &Equations) -> (StateSelection, Result<StateSpace, String>) {
     let rows = ModelRows::new(eqs);
-    let linear_selection = state_selection(eqs, &rows);
-    let linear_ss = sparse_linear_state_space(eqs, &rows, linear_selection)
+    let selection = state_selection(eqs, &rows);
+    let linear_ss = sparse_linear_state_space(eqs, &rows, selection)
         .map_err(|e| e.to_string())
         .and_then(|j| {
             let named = |m| named_matrix(eqs, m).map_err(|e| e.to_string());
@@ -126,11 +174,99 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
                 d: named(j.dhdu)?,
             })
         });
-    let declared_ss = eqs.coords.as_ref().map(|_| {
-        declared_state_space_symbolic(eqs)
-            .map_err(|e| e.to_string())
-            .and_then(|j| state_space(eqs, j.states, &j.dfdx, &j.dfdu, &j.dhdx, &j.dhdu))
-    });
+    (selection, linear_ss)
+}
+
+/// `∂f/∂p` and `∂h/∂p`, with their shared subexpressions.
+struct ParamJacobians {
+    dfdp: Vec<Vec<Expr>>,
+    dhdp: Vec<Vec<Expr>>,
+    dfdp_shared: Lets,
+    dhdp_shared: Lets,
+}
+
+impl ParamJacobians {
+    fn new(chain: &ParamChain, f: &[Expr], h: &[Expr]) -> ParamJacobians {
+        let mut dfdp = chain.jacobian(f);
+        let mut dhdp = chain.jacobian(h);
+        let dfdp_shared = share("dfdp_", dfdp.iter_mut().flatten());
+        let dhdp_shared = share("dhdp_", dhdp.iter_mut().flatten());
+        ParamJacobians {
+            dfdp,
+            dhdp,
+            dfdp_shared,
+            dhdp_shared,
+        }
+    }
+}
+
+/// What the plan holds about the model at a point: the blocks, the declared state space, the energy terms, and the
+/// Jacobians in the states and inputs with their shared subexpressions.
+struct PointPlan {
+    rhs: Block,
+    outputs: Block,
+    declared_ss: Option<Result<StateSpace, String>>,
+    energy: Vec<(EnergyKind, EnergyTerms)>,
+    dfdx: SparseMatrix,
+    dfdu: SparseMatrix,
+    dhdx: SparseMatrix,
+    dhdu: SparseMatrix,
+    shared: BTreeMap<&'static str, Lets>,
+}
+
+impl PointPlan {
+    fn new(
+        eqs: &Equations,
+        (f, h): (&[Expr], &[Expr]),
+        (states, inputs): (&[Symbol], &[Symbol]),
+    ) -> PointPlan {
+        let rhs = block(eqs, &eqs.rates, f);
+        let readable_outputs: Vec<Expr> = eqs.outputs.iter().map(|o| o.value.clone()).collect();
+        let outputs = block(eqs, &readable_outputs, h);
+        let declared_ss = eqs.coords.as_ref().map(|_| {
+            declared_state_space_symbolic(eqs)
+                .map_err(|e| e.to_string())
+                .and_then(|j| state_space(eqs, j.states, &j.dfdx, &j.dfdu, &j.dhdx, &j.dhdu))
+        });
+        let energy = energy_terms(eqs);
+        let mut dfdx = SparseMatrix::jacobian(f, states);
+        let mut dfdu = SparseMatrix::jacobian(f, inputs);
+        let mut dhdx = SparseMatrix::jacobian(h, states);
+        let mut dhdu = SparseMatrix::jacobian(h, inputs);
+        let shared = BTreeMap::from([
+            (
+                "jac_x_into",
+                share("dfdx_", sparse_entries(&mut dfdx).into_iter()),
+            ),
+            (
+                "jac_u_into",
+                share("dfdu_", sparse_entries(&mut dfdu).into_iter()),
+            ),
+            (
+                "output_jac_x_into",
+                share("dhdx_", sparse_entries(&mut dhdx).into_iter()),
+            ),
+            (
+                "output_jac_u_into",
+                share("dhdu_", sparse_entries(&mut dhdu).into_iter()),
+            ),
+        ]);
+        PointPlan {
+            rhs,
+            outputs,
+            declared_ss,
+            energy,
+            dfdx,
+            dfdu,
+            dhdx,
+            dhdu,
+            shared,
+        }
+    }
+}
+
+/// Stored energy, dissipated and supplied power: each kind's terms, or the elements without a closed form.
+fn energy_terms(eqs: &Equations) -> Vec<(EnergyKind, EnergyTerms)> {
     let mut energy = Vec::new();
     for kind in [
         EnergyKind::Stored,
@@ -157,72 +293,7 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
             },
         ));
     }
-    let free: Vec<usize> = (0..eqs.params.len())
-        .filter(|&k| eqs.derived.get(k).is_none_or(Option::is_none))
-        .collect();
-    let chain = ParamChain::new(eqs, &free, &[]).map_err(|e| e.to_string())?;
-    let chain = named_chain(eqs, chain).map_err(|e| e.to_string())?;
-    let mass = super::mass::plan(eqs, &states, &chain)?;
-    let loops = super::loops::plan(eqs, &f, &h, (&states, &inputs), &chain)?;
-    if let Some(l) = &loops {
-        let in_mass = mass
-            .iter()
-            .flat_map(|b| b.matrix.iter().flatten())
-            .any(|e| e.free_symbols().iter().any(|s| l.tears.contains(s)));
-        if in_mass {
-            return Err(
-                "an inertia matrix depends on the tear of a nonlinear algebraic loop".into(),
-            );
-        }
-    }
-    let mut dfdx = SparseMatrix::jacobian(&f, &states);
-    let mut dfdu = SparseMatrix::jacobian(&f, &inputs);
-    let mut dhdx = SparseMatrix::jacobian(&h, &states);
-    let mut dhdu = SparseMatrix::jacobian(&h, &inputs);
-    let mut dfdp = chain.jacobian(&f);
-    let mut dhdp = chain.jacobian(&h);
-    let shared = BTreeMap::from([
-        (
-            "jac_x_into",
-            share("dfdx_", sparse_entries(&mut dfdx).into_iter()),
-        ),
-        (
-            "jac_u_into",
-            share("dfdu_", sparse_entries(&mut dfdu).into_iter()),
-        ),
-        (
-            "output_jac_x_into",
-            share("dhdx_", sparse_entries(&mut dhdx).into_iter()),
-        ),
-        (
-            "output_jac_u_into",
-            share("dhdu_", sparse_entries(&mut dhdu).into_iter()),
-        ),
-        ("jac_p_into", share("dfdp_", dfdp.iter_mut().flatten())),
-        (
-            "output_jac_p_into",
-            share("dhdp_", dhdp.iter_mut().flatten()),
-        ),
-    ]);
-    Ok(Plan {
-        loops,
-        mass,
-        dfdx,
-        dfdu,
-        dhdx,
-        dhdu,
-        dfdp,
-        dhdp,
-        shared,
-        states,
-        inputs,
-        rhs,
-        outputs,
-        linear_ss,
-        linear_selection,
-        declared_ss,
-        energy,
-    })
+    energy
 }
 
 fn state_space(

@@ -8,6 +8,7 @@
 pub mod build;
 pub mod causality;
 pub mod codegen;
+mod concurrent;
 pub mod diagnostic;
 pub mod draw;
 pub mod equations;

@@ -128,7 +128,7 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
         }
     }
     // The linear state space and the parameter Jacobians on a second thread; the rest here.
-    let ((linear_selection, linear_ss, params), mut p) = super::concurrent::join(
+    let ((linear_selection, linear_ss, params), mut p) = crate::concurrent::join(
         || {
             let (selection, linear_ss) = linear_state_space(eqs);
             (selection, linear_ss, ParamJacobians::new(&chain, &f, &h))

@@ -17,7 +17,6 @@
 //! | BG0701 | equations that cannot be generated (incomplete, or an expression with no value in code) |
 
 mod adapter;
-mod concurrent;
 pub(crate) mod emit;
 mod format;
 mod layout;

@@ -234,7 +234,33 @@ pub(crate) fn terms(
             value,
         });
     }
+    drop_needing_acceleration(model, &mut out, diags);
     out
+}
+
+/// Leaves out (with a warning) the power of each element that needs an acceleration the equations give only
+/// through a mass matrix.
+fn drop_needing_acceleration(model: &Model, terms: &mut [EnergyTerm], diags: &mut Vec<Diagnostic>) {
+    for term in terms {
+        if term
+            .value
+            .as_ref()
+            .is_some_and(|v| v.any_sym(&|s| matches!(s, Sym::StateDot(_))))
+        {
+            term.value = None;
+            let d = Diagnostic::warning(
+                codes::ENERGY,
+                format!(
+                    "the power of `{}` is not computed: it needs an acceleration that the equations give only through a mass matrix",
+                    term.element
+                ),
+            );
+            let span = model
+                .node_by_name(&term.element)
+                .and_then(|n| model.spans.nodes.get(n.index()));
+            diags.push(super::with_span(d, span, "this element"));
+        }
+    }
 }
 
 #[cfg(test)]

@@ -279,7 +279,11 @@ impl Equations {
     }
 }
 
-fn with_span(d: Diagnostic, span: Option<&crate::span::Span>, label: &str) -> Diagnostic {
+pub(super) fn with_span(
+    d: Diagnostic,
+    span: Option<&crate::span::Span>,
+    label: &str,
+) -> Diagnostic {
     match span {
         Some(s) => d.with_primary(*s, label),
         None => d,
@@ -553,35 +557,6 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
         );
     }
 
-    eqs.energy = energy::terms(
-        model,
-        &ctx,
-        &mut resolver,
-        &rate_of,
-        &built.mass,
-        &mut diags,
-    );
-    for term in &mut eqs.energy {
-        if term
-            .value
-            .as_ref()
-            .is_some_and(|v| v.any_sym(&|s| matches!(s, Sym::StateDot(_))))
-        {
-            term.value = None;
-            let d = Diagnostic::warning(
-                codes::ENERGY,
-                format!(
-                    "the power of `{}` is not computed: it needs an acceleration that the equations give only through a mass matrix",
-                    term.element
-                ),
-            );
-            let span = model
-                .node_by_name(&term.element)
-                .and_then(|n| model.spans.nodes.get(n.index()));
-            diags.push(with_span(d, span, "this element"));
-        }
-    }
-
     // Readable forms.
     let output_values: Vec<Expr> = eqs.outputs.iter().map(|o| o.value.clone()).collect();
     let mut taken = naming::user_names(model);
@@ -601,8 +576,21 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
         }
         None => resolver_rates(&built, &solved, &implicit),
     };
-    not_finite(model, &built.states, &eqs.f, &eqs.outputs, &mut diags);
-    let readable = print::readable(&built, &shown_rates, &output_values, taken);
+    // The readable form on a second thread while this one derives the energy terms: neither reads the other.
+    let (readable, ()) = crate::concurrent::join(
+        || print::readable(&built, &shown_rates, &output_values, taken.clone()),
+        || {
+            eqs.energy = energy::terms(
+                model,
+                &ctx,
+                &mut resolver,
+                &rate_of,
+                &built.mass,
+                &mut diags,
+            );
+            not_finite(model, &built.states, &eqs.f, &eqs.outputs, &mut diags);
+        },
+    );
     for o in &mut eqs.outputs {
         o.value = readable.alias(&o.value);
     }

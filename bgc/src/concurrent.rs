@@ -1,8 +1,8 @@
-//! Two independent computations of the plan at once: the machines bgc runs on have at least two cores, and the
-//! plan of a large model spends seconds in Jacobians that do not depend on each other. The results do not depend
-//! on which thread computed them (expressions are hash-consed values, and nothing here reads addresses), so the
-//! generated text is the same as when they run one after the other, which is what happens when no thread can be
-//! started.
+//! Two independent computations at once: the machines bgc runs on have at least two cores, and a large model's
+//! derivation and code generation spend seconds in passes that do not depend on each other (the readable form
+//! and the energy terms; the Jacobians of the code generation plan). The results do not depend on which thread
+//! computed them (expressions are hash-consed values, and nothing reads their addresses), so the output is the
+//! same as when they run one after the other, which is what happens when no thread can be started.
 
 use std::thread;
 
@@ -12,13 +12,13 @@ const STACK_BYTES: usize = 8 << 20;
 
 /// `(background(), foreground())`, the first on a helper thread while the calling thread computes the second (or
 /// after it, when no thread can be started). A panic in either is propagated, as if they had run in turn.
-pub(super) fn join<A: Send, B>(
+pub(crate) fn join<A: Send, B>(
     background: impl Fn() -> A + Sync,
     foreground: impl FnOnce() -> B,
 ) -> (A, B) {
     thread::scope(|scope| {
         let helper = thread::Builder::new()
-            .name("bgc-plan".into())
+            .name("bgc-worker".into())
             .stack_size(STACK_BYTES)
             .spawn_scoped(scope, &background);
         let b = foreground();

@@ -1,8 +1,8 @@
-//! Two independent computations at once: the machines bgc runs on have at least two cores, and a large model's
-//! derivation and code generation spend seconds in passes that do not depend on each other (the readable form
-//! and the energy terms; the Jacobians of the code generation plan). The results do not depend on which thread
-//! computed them (expressions are hash-consed values, and nothing reads their addresses), so the output is the
-//! same as when they run one after the other, which is what happens when no thread can be started.
+//! Two independent computations at once. A large model's derivation and code generation spend seconds in passes
+//! that do not depend on each other (the readable form and the energy terms; the Jacobians of the code generation
+//! plan), and most machines have a second core for one of them. The results do not depend on which thread
+//! computed them (expressions are hash-consed values, and no order or name is taken from an address), so the
+//! output is the same as when they run one after the other, which is what happens when no thread can be started.
 
 use std::thread;
 

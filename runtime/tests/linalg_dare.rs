@@ -196,4 +196,29 @@ fn a_fast_growing_open_loop_gives_the_deadbeat_gain_or_says_it_is_out_of_range()
         );
         assert!(err.to_string().contains("rescale"), "{err}");
     }
+    // At 1e10 X meets the equation, but the near-deadbeat gain computed from it does not stabilise: said as an
+    // ill-conditioned problem.
+    let [a, b, q, r] = scaled_double_integrator(1e10);
+    match dare(&a, &b, &q, &r) {
+        Ok(sol) => {
+            let cl = &a - &b * &sol.k;
+            let radius = cl
+                .complex_eigenvalues()
+                .iter()
+                .map(|l| l.norm())
+                .fold(0.0, f64::max);
+            assert!(
+                radius < 1.0,
+                "K = {} gives a spectral radius of {radius}",
+                sol.k
+            );
+        }
+        Err(err) => {
+            assert!(
+                matches!(err, RiccatiError::ClosedLoopUnstable { .. }),
+                "1e10: {err:?}"
+            );
+            assert!(err.to_string().contains("ill-conditioned"), "{err}");
+        }
+    }
 }

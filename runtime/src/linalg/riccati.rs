@@ -74,7 +74,12 @@ pub enum RiccatiError {
         what: &'static str,
         iterations: usize,
     },
-    #[error("the closed loop A − BK is not stable: eigenvalue {eigenvalue}")]
+    /// The solution meets the equation (its residual was checked) and the modes passed the PBH tests, yet
+    /// `A − BK` is not stable: the gain is too sensitive to the rounding of `X` at this scaling, as near a deadbeat
+    /// gain of a fast open loop.
+    #[error(
+        "the closed loop A − BK is not stable: eigenvalue {eigenvalue}, although X meets the equation (its residual is within the tolerance); the gain is too sensitive to rounding at this scaling (the problem is ill-conditioned); rescale the states and inputs"
+    )]
     ClosedLoopUnstable { eigenvalue: Complex<f64> },
     #[error("{what} is singular")]
     Singular { what: &'static str },

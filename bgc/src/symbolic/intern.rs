@@ -15,7 +15,7 @@
 //! the candidate (holding only clones of children that the caller also holds) is dropped after the lock is released.
 
 use super::expr::{Inner, Node};
-use hashbrown::{HashTable, hash_table};
+use hashbrown::HashTable;
 use std::hash::{BuildHasherDefault, Hasher};
 use std::sync::{Arc, LazyLock, Mutex, PoisonError, Weak};
 
@@ -77,17 +77,12 @@ impl Shard {
         tree_size: u64,
     ) -> (Arc<Inner>, Option<Node>) {
         let mut found = None;
-        let equal = |e: &Entry| {
+        self.table.find(hash, |e| {
             e.hash == hash && {
                 found = e.node.upgrade().filter(|a| shallow_eq(&a.node, &node));
                 found.is_some()
             }
-        };
-        let slot = match self.table.entry(hash, equal, |e| e.hash) {
-            hash_table::Entry::Vacant(slot) => Some(slot),
-            hash_table::Entry::Occupied(_) => None,
-        };
-        // An occupied entry is one that `equal` accepted, which set `found`.
+        });
         if let Some(found) = found {
             return (found, Some(node));
         }
@@ -103,29 +98,15 @@ impl Shard {
         // A node that is built, dropped and built again (a constant, a temporary of a pass) would leave a dead
         // entry behind each time, all on one probe sequence: reuse one of them.
         let dead = |e: &Entry| e.hash == hash && e.node.strong_count() == 0;
-        match slot {
-            Some(slot) => {
-                let table = slot.into_table();
-                match table.find_mut(hash, dead) {
-                    Some(old) => *old = entry,
-                    None => {
-                        table.insert_unique(hash, entry, |e| e.hash);
-                        self.after_insert();
-                    }
-                }
-            }
-            None => {
-                self.table.insert_unique(hash, entry, |e| e.hash);
-                self.after_insert();
+        if let Some(old) = self.table.find_mut(hash, dead) {
+            *old = entry;
+        } else {
+            self.table.insert_unique(hash, entry, |e| e.hash);
+            if self.table.len() >= self.sweep_at.max(MIN_SWEEP) {
+                self.sweep();
             }
         }
         (made, None)
-    }
-
-    fn after_insert(&mut self) {
-        if self.table.len() >= self.sweep_at.max(MIN_SWEEP) {
-            self.sweep();
-        }
     }
 
     /// Drops the entries of dead nodes.

@@ -71,13 +71,7 @@ use super::format::{self, Wrap};
 use super::layout::MAX_WIDTH;
 use super::names::{Namer, comment, string_literal};
 use super::{CompiledFile, CompiledModel};
-use crate::symbolic::{
-    Expr, RUST_MAX_FN, RUST_MIN_FN, RUST_POWI_FN, RUST_SIGN_FN, RustCode, Symbol,
-    rust_helpers_used, to_rust_code,
-};
-
-/// The helpers generated code may call.
-const HELPERS: [&str; 4] = [RUST_SIGN_FN, RUST_MIN_FN, RUST_MAX_FN, RUST_POWI_FN];
+use crate::symbolic::{Expr, RUST_HELPER_FNS, RustCode, Symbol, rust_helpers_used, to_rust_code};
 use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 use std::fmt::Write;
@@ -563,11 +557,9 @@ impl<'a> Writer<'a> {
     /// The lines of code (not comments or documentation, which quote the model's text) that may call a helper.
     fn helper_calls(&self) -> String {
         let mut code = String::new();
-        for line in self
-            .out
-            .lines()
-            .filter(|l| HELPERS.iter().any(|h| l.contains(h)) && !l.trim_start().starts_with("//"))
-        {
+        for line in self.out.lines().filter(|l| {
+            RUST_HELPER_FNS.iter().any(|h| l.contains(h)) && !l.trim_start().starts_with("//")
+        }) {
             code.push_str(line);
             code.push('\n');
         }

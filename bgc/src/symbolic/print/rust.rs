@@ -42,16 +42,17 @@ pub const RUST_POWI_FN: &str = "bgc_powi";
 /// Items are separated by one blank line, each starting with its doc comment.
 pub const RUST_HELPERS: &str = include_str!("rust_helpers.rs");
 
+/// The names of the helpers generated code may call.
+pub const RUST_HELPER_FNS: [&str; 4] = [RUST_SIGN_FN, RUST_MIN_FN, RUST_MAX_FN, RUST_POWI_FN];
+
 /// The helpers of [`RUST_HELPERS`] that `code` calls, in their order there, each followed by a blank line.
 pub fn rust_helpers_used(code: &str) -> String {
     let mut out = String::new();
     for item in RUST_HELPERS.split("\n\n") {
         let item = item.trim_end_matches('\n');
-        let called = [RUST_SIGN_FN, RUST_MIN_FN, RUST_MAX_FN, RUST_POWI_FN]
-            .into_iter()
-            .any(|name| {
-                item.contains(&format!("fn {name}(")) && code.contains(&format!("{name}("))
-            });
+        let called = RUST_HELPER_FNS.into_iter().any(|name| {
+            item.contains(&format!("fn {name}(")) && code.contains(&format!("{name}("))
+        });
         if called {
             out.push_str(item);
             out.push_str("\n\n");

@@ -536,3 +536,29 @@ fn a_care_is_invariant_under_a_common_scaling() {
         }
     }
 }
+
+/// `ẋ = s·[1 0.1; 0 1] x + s·[0; 0.1] u`, `Q = s·I`, `R = s`: `s` is a change of the unit of time (and of the
+/// cost), which leaves `X` and `K` unchanged, so every `s` that f64 holds gives scipy's gain at `s = 1`:
+///
+/// ```python
+/// A = np.array([[1, .1], [0, 1]]); B = np.array([[0], [.1]])
+/// X = scipy.linalg.solve_continuous_are(A, B, np.eye(2), np.eye(1)); K = B.T @ X   # scipy 1.17.1
+/// ```
+#[test]
+fn a_change_of_the_unit_of_time_keeps_the_gain() {
+    let k_ref = DMatrix::from_row_slice(1, 2, &[401.0049688133984, 40.05012375393605]);
+    for e in [-300, -200, -150, -50, 0, 50, 150, 200, 300] {
+        let s = 10f64.powi(e);
+        let a = DMatrix::from_row_slice(2, 2, &[1.0, 0.1, 0.0, 1.0]) * s;
+        let b = DMatrix::from_row_slice(2, 1, &[0.0, 0.1]) * s;
+        let q = DMatrix::identity(2, 2) * s;
+        let r = DMatrix::identity(1, 1) * s;
+        let sol = care(&a, &b, &q, &r).unwrap_or_else(|e| panic!("s = {s:e}: {e}"));
+        assert!(
+            max_rel_diff(&sol.k, &k_ref) < 1e-10,
+            "s = {s:e}: K = {}",
+            sol.k
+        );
+        assert!(sol.relative_residual < 1e-12, "s = {s:e}");
+    }
+}

@@ -187,7 +187,7 @@ fn a_fast_growing_open_loop_gives_the_deadbeat_gain_or_says_it_is_out_of_range()
     assert!(sol.relative_residual < 1e-8, "{}", sol.relative_residual);
     // Further out the doubling iterates grow past f64 (or past 1/ε, where `I + GH` loses its identity): a named
     // error, never a non-convergence with an infinite residual.
-    for s in [1e50, 1e100, 1e150] {
+    for s in [1e15, 1e20, 1e25, 1e50, 1e100, 1e150, 1e200, 1e300] {
         let [a, b, q, r] = scaled_double_integrator(s);
         let err = dare(&a, &b, &q, &r).expect_err("out of range");
         assert!(
@@ -219,6 +219,24 @@ fn a_fast_growing_open_loop_gives_the_deadbeat_gain_or_says_it_is_out_of_range()
                 "1e10: {err:?}"
             );
             assert!(err.to_string().contains("ill-conditioned"), "{err}");
+        }
+    }
+}
+
+/// The same family shrinking: `X = s·I + O(s³)`, so `K = R⁻¹BᵀXA (1 + O(s²)) = [0.01 s⁴, 0.1 s²] (1 + O(s²))`
+/// (the first entry from the `s³` term of `X`). Each entry is checked wherever f64 holds it; multiplying `BᵀXA`
+/// before the solve underflowed at `s = 1e-150` (`K₂ = 1e-301` came out 0).
+#[test]
+fn a_slow_shrinking_open_loop_keeps_its_small_gain() {
+    for s in [1e-5f64, 1e-20, 1e-50, 1e-100, 1e-150, 1e-154] {
+        let [a, b, q, r] = scaled_double_integrator(s);
+        let sol = dare(&a, &b, &q, &r).unwrap_or_else(|e| panic!("s = {s:e}: {e}"));
+        for (k, want) in sol.k.iter().zip([0.01 * s.powi(4), 0.1 * s * s]) {
+            if want > f64::MIN_POSITIVE {
+                assert!((k - want).abs() <= 1e-9 * want, "s = {s:e}: K = {}", sol.k);
+            } else {
+                assert!(k.abs() <= f64::MIN_POSITIVE, "s = {s:e}: K = {}", sol.k);
+            }
         }
     }
 }

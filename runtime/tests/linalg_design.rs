@@ -529,3 +529,33 @@ fn correlated_noise_dlqe_matches_python_control_and_filterpy() {
         f.filter_gain
     );
 }
+
+/// Finite `G` and `Q_n` whose product `G Q_n Gᵀ` overflows: said to be out of range, not blamed on a NaN in a
+/// matrix the caller never passed; a NaN in `G` itself is named as such.
+#[test]
+fn process_noise_beyond_f64_is_out_of_range() {
+    let a = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -1.0, -0.5]);
+    let c = DMatrix::from_row_slice(1, 2, &[1.0, 0.0]);
+    let g = DMatrix::from_row_slice(2, 1, &[0.0, 1e200]);
+    let (qn, rn) = (DMatrix::identity(1, 1), DMatrix::identity(1, 1));
+    for result in [
+        lqe(&a, &g, &c, &qn, &rn).map(|_| ()),
+        dlqe(&a, &g, &c, &qn, &rn).map(|_| ()),
+    ] {
+        match result {
+            Err(err @ RiccatiError::OutOfRange { what, .. }) => {
+                assert_eq!(what, "G Qn Gᵀ");
+                assert!(err.to_string().contains("rescale"), "{err}");
+            }
+            other => panic!("expected OutOfRange, got {other:?}"),
+        }
+    }
+    let mut bad = g.clone();
+    bad[(0, 0)] = f64::NAN;
+    match lqe(&a, &bad, &c, &qn, &rn) {
+        Err(RiccatiError::Input(MatrixError::NonFinite { name, row, col, .. })) => {
+            assert_eq!((name, row, col), ("G", 0, 0))
+        }
+        other => panic!("expected G's NaN, got {other:?}"),
+    }
+}

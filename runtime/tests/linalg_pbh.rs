@@ -152,3 +152,31 @@ fn schur_and_eigenvalues_of_a_non_finite_matrix_name_the_entry() {
         Err(SchurError::NotSquare { rows: 2, cols: 3 })
     );
 }
+
+/// Scaling `A` and `B` by the same factor moves every eigenvalue by that factor and changes no PBH margin (the
+/// test balances `A` and scales `B` to `A`'s norm). At 1e200 the norms of `A` overflowed, the scaled `B` became
+/// NaN and the SVD panicked; at 1e-200 they underflowed.
+#[test]
+fn margins_do_not_depend_on_the_magnitude_of_the_data() {
+    use bgc_runtime::linalg::pbh::controllability_margins;
+    let a = DMatrix::from_row_slice(2, 2, &[1.0, 0.1, 0.0, 1.0]);
+    let b = DMatrix::from_row_slice(2, 1, &[0.0, 0.1]);
+    let reference = controllability_margins(&a, &b).expect("unit scale");
+    assert_eq!(reference.len(), 2);
+    for s in [1e-300, 1e-200, 1e-100, 1e100, 1e200, 1e300] {
+        let modes = controllability_margins(&(&a * s), &(&b * s)).expect("any finite scale");
+        assert_eq!(modes.len(), reference.len(), "{s:e}");
+        for (m, r) in modes.iter().zip(&reference) {
+            assert!(
+                (m.margin - r.margin).abs() <= 1e-12 * r.margin,
+                "{s:e}: {m:?}"
+            );
+            assert!(
+                (m.eigenvalue / s - r.eigenvalue).norm() <= 1e-12,
+                "{s:e}: {m:?}"
+            );
+        }
+        let stabilizable = is_stabilizable(&(&a * s), &(&b * s), Domain::Continuous);
+        assert_eq!(stabilizable, Ok(true), "{s:e}");
+    }
+}

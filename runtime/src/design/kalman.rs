@@ -44,10 +44,20 @@ fn process_noise(
     let n = check::square("A", a)?;
     let w = g.ncols();
     check::shape("G", g, n, w)?;
+    if !g.is_empty() {
+        check::finite("G", g)?;
+    }
     check::shape("C", c, c.nrows(), n)?;
     check::shape("Qn", qn, w, w)?;
     check::positive_semidefinite("Qn", qn)?;
     let gqg = g * qn * g.transpose();
+    if !gqg.iter().all(|v| v.is_finite()) {
+        // Finite G and Qn whose product overflows: not a NaN the caller passed.
+        return Err(RiccatiError::OutOfRange {
+            what: "G Qn Gᵀ",
+            iterations: 0,
+        });
+    }
     Ok((&gqg + gqg.transpose()) * 0.5)
 }
 

@@ -383,7 +383,7 @@ fn gauss_newton_distance(
             free.column_mut(k).scale_mut(1.0 / norm);
         }
     }
-    let Some(svd) = nalgebra::SVD::try_new(free, true, false, f64::EPSILON, 1000) else {
+    let Some(svd) = crate::linalg::check::svd(free, true, false, 1000) else {
         return f64::INFINITY;
     };
     let Some(u) = svd.u.as_ref() else {
@@ -445,7 +445,7 @@ fn solve_damped(
     for (k, s) in scale.iter().enumerate() {
         scaled.column_mut(k).scale_mut(*s);
     }
-    let svd = nalgebra::SVD::try_new(scaled, true, true, f64::EPSILON, 1000)?;
+    let svd = crate::linalg::check::svd(scaled, true, true, 1000)?;
     let (u, v_t) = (svd.u.as_ref()?, svd.v_t.as_ref()?);
     let sigma_max = svd.singular_values.max();
     let mut delta = DVector::zeros(j.ncols());

@@ -60,7 +60,8 @@ pub fn statistics(ssr: f64, jac_rel: &DMatrix<f64>, scales: &[f64]) -> Result<St
             undetermined: Vec::new(),
         });
     }
-    let svd = jac_rel.clone().svd(false, true);
+    let svd = crate::linalg::check::svd(jac_rel.clone(), false, true, 10_000)
+        .ok_or("the singular value decomposition of the Jacobian did not converge")?;
     let sigma = &svd.singular_values;
     let sigma_max = sigma.max();
     let negligible = sigma_max * (m.max(n) as f64) * f64::EPSILON;

@@ -53,15 +53,21 @@ pub fn power_of_two(x: f64) -> f64 {
 /// units chosen for the states.
 pub fn balanced_norm(a: &DMatrix<f64>) -> f64 {
     let d = balancing_scales(a);
-    let n = a.nrows();
-    let mut sum = 0.0;
-    for j in 0..n {
-        for i in 0..n {
-            let v = a[(i, j)] * d[j] / d[i];
-            sum += v * v;
-        }
+    frobenius(&DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| {
+        a[(i, j)] * d[j] / d[i]
+    }))
+}
+
+/// The Frobenius norm of `m` without overflow or underflow of the squares: entries beyond about 1e154 (or below
+/// 1e-154) are squared after scaling by the largest one, so the norm is finite whenever it is representable.
+pub fn frobenius<C: nalgebra::ComplexField<RealField = f64>>(m: &DMatrix<C>) -> f64 {
+    let largest = m.iter().map(|v| v.clone().abs()).fold(0.0, f64::max);
+    if largest == 0.0 || !largest.is_finite() {
+        return m.norm();
     }
-    sum.sqrt()
+    let scale = power_of_two(largest);
+    let sum: f64 = m.iter().map(|v| (v.clone().abs() / scale).powi(2)).sum();
+    scale * sum.sqrt()
 }
 
 #[cfg(test)]

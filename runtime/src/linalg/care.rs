@@ -3,6 +3,7 @@
 
 use nalgebra::DMatrix;
 
+use super::balance::{frobenius, power_of_two};
 use super::lyapunov::{lyap, symmetrize};
 use super::pbh::Domain;
 use super::refine::{Evaluated, refine, relative_residual};
@@ -52,13 +53,25 @@ pub fn care_with_cross(
     p.check_modes(Domain::Continuous)?;
     let s = Scaled::new(&p);
     let nn = p.n;
+    // A change of the unit of time (by a power of two, exactly) divides Ã, G and Q̃ alike and keeps X: it brings
+    // the Hamiltonian to unit magnitude, so that rates of 1e200 per second neither overflow its iteration nor the
+    // residual's products.
+    let largest = [&s.a, &s.g, &s.q]
+        .iter()
+        .map(|m| m.amax())
+        .fold(0.0, f64::max);
+    let time_unit = if largest > 0.0 && largest.is_finite() {
+        power_of_two(largest)
+    } else {
+        1.0
+    };
+    let (sa, sg, sq) = (&s.a / time_unit, &s.g / time_unit, &s.q / time_unit);
 
     let mut h = DMatrix::<f64>::zeros(2 * nn, 2 * nn);
-    h.view_mut((0, 0), (nn, nn)).copy_from(&s.a);
-    h.view_mut((0, nn), (nn, nn)).copy_from(&(-&s.g));
-    h.view_mut((nn, 0), (nn, nn)).copy_from(&(-&s.q));
-    h.view_mut((nn, nn), (nn, nn))
-        .copy_from(&(-s.a.transpose()));
+    h.view_mut((0, 0), (nn, nn)).copy_from(&sa);
+    h.view_mut((0, nn), (nn, nn)).copy_from(&(-&sg));
+    h.view_mut((nn, 0), (nn, nn)).copy_from(&(-&sq));
+    h.view_mut((nn, nn), (nn, nn)).copy_from(&(-sa.transpose()));
     let Some((w, sign_iterations)) = hamiltonian_sign(&h) else {
         return Err(p.diagnose(Domain::Continuous, f64::INFINITY, 0));
     };
@@ -81,10 +94,10 @@ pub fn care_with_cross(
     finite_solution(&xs, sign_iterations)?;
 
     // Newton–Kleinman refinement in the scaled coordinates: (Ã − GX)ᵀ Δ + Δ (Ã − GX) + Res(X) = 0.
-    let evaluate = |x: &DMatrix<f64>| Some(Evaluation::new(&s.a, &s.g, &s.q, x));
-    let eval = Evaluation::new(&s.a, &s.g, &s.q, &xs);
+    let evaluate = |x: &DMatrix<f64>| Some(Evaluation::new(&sa, &sg, &sq, x));
+    let eval = Evaluation::new(&sa, &sg, &sq, &xs);
     let newton = |x: &DMatrix<f64>, eval: &Evaluation| {
-        lyap(&(&s.a - &s.g * x).transpose(), &eval.residual).ok()
+        lyap(&(&sa - &sg * x).transpose(), &eval.residual).ok()
     };
     let (xs, steps) = refine(xs, eval, MAX_NEWTON_STEPS, newton, evaluate);
 
@@ -109,7 +122,10 @@ impl Evaluation {
         let xgx = x * g * x;
         let residual = symmetrize(&(a.transpose() * x + &xa - &xgx + q));
         // ‖AᵀX‖ = ‖XA‖ for symmetric X.
-        let relative = relative_residual(&residual, 2.0 * xa.norm() + xgx.norm() + q.norm());
+        let relative = relative_residual(
+            &residual,
+            2.0 * frobenius(&xa) + frobenius(&xgx) + frobenius(q),
+        );
         Evaluation { residual, relative }
     }
 }

@@ -183,6 +183,27 @@ pub fn positive_scalar(what: &'static str, value: f64) -> Result<(), MatrixError
     }
 }
 
+/// The singular value decomposition of `m`, or `None` when it has no entries, a non-finite entry, or the iteration
+/// does not converge in `max_iterations` (at least one). nalgebra's own entry points panic on an empty matrix and when a singular
+/// value comes out NaN (which a non-finite entry causes), so every SVD of the crate goes through here.
+pub(crate) fn svd<C: nalgebra::ComplexField<RealField = f64>>(
+    m: DMatrix<C>,
+    compute_u: bool,
+    compute_v: bool,
+    max_iterations: usize,
+) -> Option<nalgebra::SVD<C, nalgebra::Dyn, nalgebra::Dyn>> {
+    if m.is_empty() || max_iterations == 0 || !m.iter().all(|v| v.clone().abs().is_finite()) {
+        return None;
+    }
+    let mut svd =
+        nalgebra::SVD::try_new_unordered(m, compute_u, compute_v, f64::EPSILON, max_iterations)?;
+    if !svd.singular_values.iter().all(|s| s.is_finite()) {
+        return None;
+    }
+    svd.sort_by_singular_values();
+    Some(svd)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -242,5 +263,19 @@ mod tests {
             positive_scalar("sample time", f64::NAN),
             Err(MatrixError::BadScalar { .. })
         ));
+    }
+
+    /// nalgebra's SVD panics when a singular value comes out NaN; the guard returns `None` instead, and the
+    /// singular values of a finite matrix come sorted: `diag(3, 4)` has 4 and 3.
+    #[test]
+    fn svd_refuses_non_finite_and_empty_matrices() {
+        for bad in [f64::NAN, f64::INFINITY] {
+            let m = DMatrix::from_row_slice(3, 2, &[1.0, 2.0, bad, 4.0, 5.0, 6.0]);
+            assert!(svd(m, true, true, 100).is_none(), "{bad}");
+        }
+        assert!(svd(DMatrix::<f64>::zeros(0, 0), false, false, 100).is_none());
+        let m = DMatrix::from_row_slice(2, 2, &[3.0, 0.0, 0.0, 4.0]);
+        let found = svd(m, false, false, 100).expect("finite");
+        assert_eq!(found.singular_values.as_slice(), &[4.0, 3.0]);
     }
 }

@@ -3,6 +3,7 @@
 
 use nalgebra::DMatrix;
 
+use super::balance::frobenius;
 use super::lyapunov::{dlyap, symmetrize};
 use super::pbh::Domain;
 use super::refine::{Evaluated, refine, relative_residual};
@@ -58,6 +59,9 @@ pub fn dare_with_cross(
     let (mut ak, mut gk, mut hk) = (s.a.clone(), s.g.clone(), s.q.clone());
     let mut doubling = 0;
     let mut converged = false;
+    // Whether some `I + GₖHₖ` had entries beyond 1/ε: its identity was lost to rounding, so a solution that then
+    // fails its residual check failed for range, not for a property of the data.
+    let mut identity_lost = false;
     let out_of_range =
         |doubling| overflowed(&p, Domain::Discrete, "the doubling iterates", doubling);
     while doubling < MAX_DOUBLING_STEPS {
@@ -68,6 +72,7 @@ pub fn dare_with_cross(
         }
         // `I + GₖHₖ` with entries beyond 1/ε has lost its identity to rounding: singular for range, not data.
         let lost_identity = pivot.amax() > 1.0 / f64::EPSILON;
+        identity_lost |= lost_identity;
         let lu = pivot.lu();
         let (Some(w_a), Some(w_g)) = (lu.solve(&ak), lu.solve(&gk)) else {
             return Err(if lost_identity {
@@ -92,7 +97,11 @@ pub fn dare_with_cross(
         }
     }
     if !converged {
-        return Err(p.diagnose(Domain::Discrete, f64::INFINITY, doubling));
+        return Err(if identity_lost {
+            out_of_range(doubling)
+        } else {
+            p.diagnose(Domain::Discrete, f64::INFINITY, doubling)
+        });
     }
     let xs = hk;
     finite_solution(&xs, doubling)?;
@@ -112,14 +121,34 @@ pub fn dare_with_cross(
     let Some(orig) = Evaluation::new(&p.a, &p.b, &p.q, &p.r, &x) else {
         return Err(RiccatiError::Singular { what: "R + BᵀXB" });
     };
-    p.check_residual(Domain::Discrete, orig.relative, doubling + steps)?;
+    p.check_residual(Domain::Discrete, orig.relative, doubling + steps)
+        .map_err(|e| match e {
+            RiccatiError::NoConvergence { .. } if identity_lost => out_of_range(doubling + steps),
+            e => e,
+        })?;
     // K for the original (cross-weighted) problem: (R + BᵀXB)⁻¹(BᵀXA + Nᵀ).
-    let btx = p.b.transpose() * &x;
-    let k = (&p.r + &btx * &p.b)
-        .lu()
-        .solve(&(&btx * a + &p.n_t))
+    let k = gain(&p.b, &p.r, &x, a, Some(&p.n_t))
         .ok_or(RiccatiError::Singular { what: "R + BᵀXB" })?;
     stabilising_solution(Domain::Discrete, a, b, x, k, orig.relative, steps)
+}
+
+/// `K = (R + BᵀXB)⁻¹(BᵀXA + Nᵀ)`, multiplied as `((R + BᵀXB)⁻¹Bᵀ)(XA)`: the first factor is of the size of `1/B`
+/// and the second of `K/A`-ish, so neither underflows where `K` is representable. `BᵀXA` first would: with weights
+/// of 1e-150 it is `(R + BᵀXB)·K`, below the range of f64 for a gain of 1e-301.
+fn gain(
+    b: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+    x: &DMatrix<f64>,
+    a: &DMatrix<f64>,
+    n_t: Option<&DMatrix<f64>>,
+) -> Option<DMatrix<f64>> {
+    let lu = (r + b.transpose() * x * b).lu();
+    let left = lu.solve(&b.transpose())?;
+    let mut k = left * (x * a);
+    if let Some(n_t) = n_t {
+        k += lu.solve(n_t)?;
+    }
+    Some(k)
 }
 
 /// The DARE residual at `X` with the gain `K = (R + BᵀXB)⁻¹BᵀXA` of the problem without cross term.
@@ -137,14 +166,13 @@ impl Evaluation {
         r: &DMatrix<f64>,
         x: &DMatrix<f64>,
     ) -> Option<Evaluation> {
-        let btx = b.transpose() * x;
-        let gain = (r + &btx * b).lu().solve(&(&btx * a))?;
+        let gain = gain(b, r, x, a, None)?;
         let atxa = a.transpose() * x * a;
-        let correction = symmetrize(&((btx * a).transpose() * &gain));
+        let correction = symmetrize(&((b.transpose() * x * a).transpose() * &gain));
         let residual = symmetrize(&(&atxa - x - &correction + q));
         let relative = relative_residual(
             &residual,
-            atxa.norm() + x.norm() + correction.norm() + q.norm(),
+            frobenius(&atxa) + frobenius(x) + frobenius(&correction) + frobenius(q),
         );
         Some(Evaluation {
             residual,

@@ -13,7 +13,7 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 
-use super::balance::{balanced_norm, balancing_scales};
+use super::balance::{balanced_norm, balancing_scales, frobenius, power_of_two};
 use super::check::{self, MatrixError};
 use super::schur::{SchurError, eigenvalues};
 
@@ -114,15 +114,22 @@ fn observability_margins_where(
             cb[(i, j)] *= d[j];
         }
     }
-    let a_norm = ab.norm();
-    let c_norm = cb.norm();
+    // A by a power of two (exact) to unit magnitude: the norms and the PBH matrices neither overflow nor underflow
+    // whatever the units, and the eigenvalues are scaled back when reported.
+    let a_scale = match ab.amax() {
+        largest if largest > 0.0 && largest.is_finite() => power_of_two(largest),
+        _ => 1.0,
+    };
+    ab /= a_scale;
+    let a_norm = frobenius(&ab);
+    let c_norm = frobenius(&cb);
     if c_norm > 0.0 && a_norm > 0.0 {
         cb *= a_norm / c_norm;
     }
     let p = cb.nrows();
     let mut modes = Vec::new();
     for lambda in eigenvalues(&ab)? {
-        if lambda.im < 0.0 || !keep(lambda) {
+        if lambda.im < 0.0 || !keep(lambda * a_scale) {
             continue;
         }
         let mut m = DMatrix::<Complex<f64>>::zeros(n + p, n);
@@ -135,10 +142,9 @@ fn observability_margins_where(
                 m[(n + i, j)] = Complex::new(cb[(i, j)], 0.0);
             }
         }
-        let scale = m.norm().max(f64::MIN_POSITIVE);
+        let scale = frobenius(&m).max(f64::MIN_POSITIVE);
         let (rows, cols) = m.shape();
-        let svd = nalgebra::SVD::try_new(m, false, true, f64::EPSILON, 10_000)
-            .ok_or(PbhError::Svd { rows, cols })?;
+        let svd = check::svd(m, false, true, 10_000).ok_or(PbhError::Svd { rows, cols })?;
         let sigma_min = svd.singular_values[n - 1];
         let v_t = svd.v_t.ok_or(PbhError::Svd { rows, cols })?;
         // The right singular vector for σ_min, mapped back through the balancing: v = D v_b.
@@ -149,7 +155,7 @@ fn observability_margins_where(
             direction /= Complex::new(norm, 0.0);
         }
         modes.push(Mode {
-            eigenvalue: lambda,
+            eigenvalue: lambda * a_scale,
             direction,
             margin: sigma_min / scale,
         });
@@ -242,8 +248,7 @@ pub fn numerical_rank(m: &DMatrix<f64>, rel_tol: f64) -> Result<usize, PbhError>
     // A NaN tolerance compared false with every singular value and gave rank 0.
     check::positive_scalar("relative rank tolerance", rel_tol)?;
     let (rows, cols) = m.shape();
-    let svd = nalgebra::SVD::try_new(m.clone(), false, false, f64::EPSILON, 10_000)
-        .ok_or(PbhError::Svd { rows, cols })?;
+    let svd = check::svd(m.clone(), false, false, 10_000).ok_or(PbhError::Svd { rows, cols })?;
     let s_max = svd.singular_values.max();
     Ok(svd
         .singular_values

@@ -9,6 +9,7 @@
 
 use nalgebra::DMatrix;
 
+use super::balance::frobenius;
 use super::lyapunov::symmetrize;
 
 /// Relative residual below which a Riccati iterate is not refined further (rounding level).
@@ -52,9 +53,6 @@ pub(crate) fn refine<E: Evaluated>(
 /// `‖residual‖_F / terms`, where `terms` is the sum of the norms of the equation's terms; the absolute norm
 /// when every term is zero, so that a nonzero residual is not hidden by a division by zero.
 pub(crate) fn relative_residual(residual: &DMatrix<f64>, terms: f64) -> f64 {
-    if terms > 0.0 {
-        residual.norm() / terms
-    } else {
-        residual.norm()
-    }
+    let norm = frobenius(residual);
+    if terms > 0.0 { norm / terms } else { norm }
 }

@@ -13,7 +13,7 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 
-use super::balance::power_of_two;
+use super::balance::{frobenius, power_of_two};
 use super::check::{self, MatrixError};
 use super::lyapunov::LyapunovError;
 use super::pbh::{self, Domain, PbhError};
@@ -335,7 +335,7 @@ impl Scaled {
 
 /// `α` (a power of two) with `‖Q‖/α = α‖G‖`; 1 when either is zero.
 fn weight_scale(q: &DMatrix<f64>, g: &DMatrix<f64>) -> f64 {
-    let (qn, gn) = (q.norm(), g.norm());
+    let (qn, gn) = (frobenius(q), frobenius(g));
     if qn > 0.0 && gn > 0.0 && qn.is_finite() && gn.is_finite() {
         power_of_two((qn / gn).sqrt())
     } else {

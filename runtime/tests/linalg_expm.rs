@@ -234,3 +234,28 @@ fn van_loan_matches_hand_computation() {
         ))
     ));
 }
+
+/// Finite data whose product with the sample time leaves f64: the error names the product and the sample time,
+/// not a non-finite entry of an `A` the caller never passed (as it did).
+#[test]
+fn a_sample_time_too_long_for_the_rates_is_named() {
+    let sys = StateSpace::new(
+        DMatrix::from_element(1, 1, -1.0),
+        DMatrix::from_element(1, 1, 1e300),
+        DMatrix::from_element(1, 1, 1.0),
+        DMatrix::zeros(1, 1),
+    )
+    .expect("finite model");
+    match c2d_zoh(&sys, 1e10) {
+        Err(err @ DiscretizeError::Overflow { what, dt }) => {
+            assert_eq!((what, dt), ("[A B]·dt", 1e10));
+            assert!(err.to_string().contains("sample time is too long"), "{err}");
+        }
+        other => panic!("expected Overflow, got {other:?}"),
+    }
+    let a = DMatrix::from_element(1, 1, -1e300);
+    match van_loan(&a, &DMatrix::from_element(1, 1, 1.0), 1e10) {
+        Err(DiscretizeError::Overflow { what, .. }) => assert!(what.starts_with("[−A")),
+        other => panic!("expected Overflow, got {other:?}"),
+    }
+}

@@ -179,4 +179,14 @@ fn margins_do_not_depend_on_the_magnitude_of_the_data() {
         let stabilizable = is_stabilizable(&(&a * s), &(&b * s), Domain::Continuous);
         assert_eq!(stabilizable, Ok(true), "{s:e}");
     }
+    // B alone in other units, down to a subnormal magnitude (whose norm made the scale of B infinite).
+    for s in [1e-310, 1e-300, 1e-150, 1e150, 1e300] {
+        let modes = controllability_margins(&a, &(&b * s)).expect("any finite scale of B");
+        for (m, r) in modes.iter().zip(&reference) {
+            assert!(
+                (m.margin - r.margin).abs() <= 1e-12 * r.margin,
+                "B·{s:e}: {m:?}"
+            );
+        }
+    }
 }

@@ -24,6 +24,22 @@ pub enum DiscretizeError {
     Expm(#[from] ExpmError),
     #[error(transparent)]
     StateSpace(#[from] StateSpaceError),
+    /// The matrix whose exponential is taken has entries beyond f64 although the data are finite: the sample
+    /// time is too long for the model's rates.
+    #[error(
+        "{what} overflows f64 (sample time {dt:?}): the sample time is too long for the model's rates; shorten it or rescale the model"
+    )]
+    Overflow { what: &'static str, dt: f64 },
+}
+
+/// Refuses a product with `dt` that left f64, naming it, before the exponential blames a matrix the caller
+/// never passed.
+fn finite_product(what: &'static str, m: &DMatrix<f64>, dt: f64) -> Result<(), DiscretizeError> {
+    if m.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(DiscretizeError::Overflow { what, dt })
+    }
 }
 
 /// The zero-order-hold equivalent of a continuous-time model with sample time `dt`.
@@ -38,6 +54,7 @@ pub fn c2d_zoh(sys: &StateSpace, dt: f64) -> Result<StateSpace, DiscretizeError>
     let mut big = DMatrix::<f64>::zeros(n + m, n + m);
     big.view_mut((0, 0), (n, n)).copy_from(&(sys.a() * dt));
     big.view_mut((0, n), (n, m)).copy_from(&(sys.b() * dt));
+    finite_product("[A B]·dt", &big, dt)?;
     let e = expm(&big)?;
     let ad = e.view((0, 0), (n, n)).clone_owned();
     let bd = e.view((0, n), (n, m)).clone_owned();
@@ -66,6 +83,7 @@ pub fn van_loan(
     big.view_mut((0, n), (n, n)).copy_from(&(g_qc_gt * dt));
     big.view_mut((n, n), (n, n))
         .copy_from(&(a.transpose() * dt));
+    finite_product("[−A, G Qc Gᵀ; 0, Aᵀ]·dt", &big, dt)?;
     let e = expm(&big)?;
     let ad = e.view((n, n), (n, n)).transpose();
     let qd = &ad * e.view((0, n), (n, n));

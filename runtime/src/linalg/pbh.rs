@@ -42,6 +42,14 @@ impl Domain {
     }
 }
 
+/// The power of two nearest the largest magnitude of `m`; 1 for a zero or non-finite `m`.
+fn unit_scale(m: &DMatrix<f64>) -> f64 {
+    match m.amax() {
+        largest if largest > 0.0 && largest.is_finite() => power_of_two(largest),
+        _ => 1.0,
+    }
+}
+
 /// An uncontrollable or unobservable mode.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mode {
@@ -105,7 +113,8 @@ fn observability_margins_where(
     check::shape("C", c, c.nrows(), n)?;
     let d = balancing_scales(a);
     let mut ab = a.clone();
-    let mut cb = c.clone();
+    // C at unit magnitude before the balancing multiplies its columns (1e300 times a scale of 2¹⁰⁰ overflowed).
+    let mut cb = c / unit_scale(c);
     for j in 0..n {
         for i in 0..n {
             ab[(i, j)] *= d[j] / d[i];
@@ -114,13 +123,12 @@ fn observability_margins_where(
             cb[(i, j)] *= d[j];
         }
     }
-    // A by a power of two (exact) to unit magnitude: the norms and the PBH matrices neither overflow nor underflow
-    // whatever the units, and the eigenvalues are scaled back when reported.
-    let a_scale = match ab.amax() {
-        largest if largest > 0.0 && largest.is_finite() => power_of_two(largest),
-        _ => 1.0,
-    };
+    // A and C by powers of two (exact) to unit magnitude: the norms, their ratio and the PBH matrices neither
+    // overflow nor underflow whatever the units (a subnormal C made the ratio infinite), and the eigenvalues are
+    // scaled back when reported.
+    let a_scale = unit_scale(&ab);
     ab /= a_scale;
+    cb /= unit_scale(&cb);
     let a_norm = frobenius(&ab);
     let c_norm = frobenius(&cb);
     if c_norm > 0.0 && a_norm > 0.0 {

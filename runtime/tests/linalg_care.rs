@@ -562,3 +562,34 @@ fn a_change_of_the_unit_of_time_keeps_the_gain() {
         assert!(sol.relative_residual < 1e-12, "s = {s:e}");
     }
 }
+
+/// Control far cheaper than the plant's rates: with `B` in units 1e10 times smaller, the fast closed-loop pole
+/// (about −1e10) and the slow ones (about −1) are 10 orders apart, the Hamiltonian's slow eigenvalues sit at its
+/// imaginary axis to working precision and the sign function fails (scipy 1.17.1 returns a gain with a relative
+/// residual of 2.4e-4 here). That is said as an ill-conditioned problem, not as a residual of `inf` after 0
+/// iterations. At 1e3 the gain is scipy's:
+///
+/// ```python
+/// A = np.array([[1, .1, 0], [0, 1, .2], [-.3, 0, .5]]); B = np.array([[0], [.1], [1]]) * 1e3
+/// X = scipy.linalg.solve_continuous_are(A, B, np.eye(3), np.eye(1)); K = B.T @ X
+/// ```
+#[test]
+fn control_far_cheaper_than_the_plant_is_named_ill_conditioned() {
+    let a = DMatrix::from_row_slice(3, 3, &[1.0, 0.1, 0.0, 0.0, 1.0, 0.2, -0.3, 0.0, 0.5]);
+    let b = DMatrix::from_row_slice(3, 1, &[0.0, 0.1, 1.0]);
+    let (q, r) = (DMatrix::identity(3, 3), DMatrix::identity(1, 1));
+    let k_ref = DMatrix::from_row_slice(
+        1,
+        3,
+        &[161.3484817781298, 9.683084793485538, 0.041185456229025696],
+    );
+    let sol = care(&a, &(&b * 1e3), &q, &r).expect("solvable at 1e3");
+    assert!(max_rel_diff(&sol.k, &k_ref) < 1e-8, "K = {}", sol.k);
+    match care(&a, &(&b * 1e10), &q, &r) {
+        Err(err @ RiccatiError::IllConditioned { .. }) => {
+            let text = err.to_string();
+            assert!(text.contains("rescale") && text.contains("PBH"), "{text}");
+        }
+        other => panic!("expected IllConditioned, got {other:?}"),
+    }
+}

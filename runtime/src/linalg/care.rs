@@ -73,7 +73,12 @@ pub fn care_with_cross(
     h.view_mut((nn, 0), (nn, nn)).copy_from(&(-&sq));
     h.view_mut((nn, nn), (nn, nn)).copy_from(&(-sa.transpose()));
     let Some((w, sign_iterations)) = hamiltonian_sign(&h) else {
-        return Err(p.diagnose(Domain::Continuous, f64::INFINITY, 0));
+        return Err(match p.diagnose(Domain::Continuous, f64::INFINITY, 0) {
+            RiccatiError::NoConvergence { .. } => RiccatiError::IllConditioned {
+                what: "the sign function of the Hamiltonian",
+            },
+            found => found,
+        });
     };
     let mut lhs = DMatrix::<f64>::zeros(2 * nn, nn);
     lhs.view_mut((0, 0), (nn, nn))

@@ -81,6 +81,13 @@ pub enum RiccatiError {
         "the closed loop A − BK is not stable: eigenvalue {eigenvalue}, although X meets the equation (its residual is within the tolerance); the gain is too sensitive to rounding at this scaling (the problem is ill-conditioned); rescale the states and inputs"
     )]
     ClosedLoopUnstable { eigenvalue: Complex<f64> },
+    /// The base solver could not separate the stable from the unstable modes, although every mode passed the PBH
+    /// tests: eigenvalues of the Hamiltonian lie at the imaginary axis to working precision, as when the
+    /// closed-loop poles would spread over more orders of magnitude than f64 resolves.
+    #[error(
+        "{what} did not converge although every mode passed the PBH tests: the Hamiltonian has eigenvalues at the imaginary axis to working precision, as when the closed-loop poles would spread over more orders of magnitude than f64 resolves (control far cheaper or dearer than the plant's own rates); rescale the weights Q and R, or the inputs"
+    )]
+    IllConditioned { what: &'static str },
     #[error("{what} is singular")]
     Singular { what: &'static str },
     #[error(transparent)]

@@ -190,3 +190,21 @@ fn margins_do_not_depend_on_the_magnitude_of_the_data() {
         }
     }
 }
+
+/// A matrix of subnormal entries has subnormal eigenvalues, not a failed decomposition: its scale to unit size
+/// is kept where the reciprocal is finite (nalgebra divides by multiplying with it; 2⁻¹⁰²⁸ gave inf · 0).
+#[test]
+fn eigenvalues_of_a_subnormal_matrix_are_found() {
+    use bgc_runtime::linalg::eigenvalues;
+    let a = DMatrix::from_row_slice(2, 2, &[1e-310, 0.0, 0.0, -2e-310]);
+    let mut found: Vec<f64> = eigenvalues(&a)
+        .expect("subnormal but finite")
+        .iter()
+        .map(|l| l.re)
+        .collect();
+    found.sort_by(f64::total_cmp);
+    assert!(
+        (found[0] + 2e-310).abs() <= 1e-322 && (found[1] - 1e-310).abs() <= 1e-322,
+        "{found:?}"
+    );
+}

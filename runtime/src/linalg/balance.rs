@@ -49,6 +49,19 @@ pub fn power_of_two(x: f64) -> f64 {
     2f64.powi(e as i32)
 }
 
+/// A power of two that brings magnitudes up to `largest` near one: dividing and multiplying by it rounds nothing,
+/// so a computation can run on `m / s` and scale its results back by `s`, away from overflow and underflow. 1 for a
+/// zero or non-finite `largest`. The scale stays between 2⁻¹⁰²² and 2¹⁰²³, so that its reciprocal is finite too
+/// (nalgebra divides a matrix by multiplying with the reciprocal): a subnormal `largest` is brought up as far as
+/// that allows, and 1.8e308 gives 2¹⁰²³, not infinity.
+pub fn unit_scale(largest: f64) -> f64 {
+    if largest > 0.0 && largest.is_finite() {
+        2f64.powi(largest.log2().round().clamp(-1022.0, 1023.0) as i32)
+    } else {
+        1.0
+    }
+}
+
 /// The Frobenius norm of the balanced `D⁻¹ A D`: the magnitude that eigenvalue errors scale with, free of the
 /// units chosen for the states.
 pub fn balanced_norm(a: &DMatrix<f64>) -> f64 {
@@ -89,6 +102,21 @@ mod tests {
         assert_eq!(b.trace(), a.trace());
         assert!((b.determinant() - a.determinant()).abs() < 1e-12 * a.determinant().abs());
         assert!(balanced_norm(&a) < 1e3);
+    }
+
+    /// The scale and its reciprocal are finite powers of two for every positive finite magnitude.
+    #[test]
+    fn unit_scale_stays_where_its_reciprocal_is_finite() {
+        assert_eq!(unit_scale(3.0), 4.0);
+        assert_eq!(unit_scale(0.3), 0.25);
+        assert_eq!(unit_scale(f64::MAX), 2f64.powi(1023));
+        assert_eq!(unit_scale(1e-310), 2f64.powi(-1022));
+        for bad in [0.0, f64::NAN, f64::INFINITY] {
+            assert_eq!(unit_scale(bad), 1.0);
+        }
+        for x in [f64::MAX, 1e-310, 5e-324] {
+            assert!((1.0 / unit_scale(x)).is_finite(), "{x:e}");
+        }
     }
 
     #[test]

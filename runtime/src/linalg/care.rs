@@ -3,7 +3,7 @@
 
 use nalgebra::DMatrix;
 
-use super::balance::{frobenius, power_of_two};
+use super::balance::{frobenius, unit_scale};
 use super::lyapunov::{lyap, symmetrize};
 use super::pbh::Domain;
 use super::refine::{Evaluated, refine, relative_residual};
@@ -60,11 +60,7 @@ pub fn care_with_cross(
         .iter()
         .map(|m| m.amax())
         .fold(0.0, f64::max);
-    let time_unit = if largest > 0.0 && largest.is_finite() {
-        power_of_two(largest)
-    } else {
-        1.0
-    };
+    let time_unit = unit_scale(largest);
     let (sa, sg, sq) = (&s.a / time_unit, &s.g / time_unit, &s.q / time_unit);
 
     let mut h = DMatrix::<f64>::zeros(2 * nn, 2 * nn);

@@ -13,7 +13,7 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 
-use super::balance::{balanced_norm, balancing_scales, frobenius, power_of_two};
+use super::balance::{balanced_norm, balancing_scales, frobenius, unit_scale};
 use super::check::{self, MatrixError};
 use super::schur::{SchurError, eigenvalues};
 
@@ -39,14 +39,6 @@ impl Domain {
             Domain::Continuous => lambda.re < -1e-12 * scale,
             Domain::Discrete => lambda.norm() < 1.0 - 1e-12 * scale.max(1.0),
         }
-    }
-}
-
-/// The power of two nearest the largest magnitude of `m`; 1 for a zero or non-finite `m`.
-fn unit_scale(m: &DMatrix<f64>) -> f64 {
-    match m.amax() {
-        largest if largest > 0.0 && largest.is_finite() => power_of_two(largest),
-        _ => 1.0,
     }
 }
 
@@ -114,7 +106,7 @@ fn observability_margins_where(
     let d = balancing_scales(a);
     let mut ab = a.clone();
     // C at unit magnitude before the balancing multiplies its columns (1e300 times a scale of 2¹⁰⁰ overflowed).
-    let mut cb = c / unit_scale(c);
+    let mut cb = c / unit_scale(c.amax());
     for j in 0..n {
         for i in 0..n {
             ab[(i, j)] *= d[j] / d[i];
@@ -126,9 +118,9 @@ fn observability_margins_where(
     // A and C by powers of two (exact) to unit magnitude: the norms, their ratio and the PBH matrices neither
     // overflow nor underflow whatever the units (a subnormal C made the ratio infinite), and the eigenvalues are
     // scaled back when reported.
-    let a_scale = unit_scale(&ab);
+    let a_scale = unit_scale(ab.amax());
     ab /= a_scale;
-    cb /= unit_scale(&cb);
+    cb /= unit_scale(cb.amax());
     let a_norm = frobenius(&ab);
     let c_norm = frobenius(&cb);
     if c_norm > 0.0 && a_norm > 0.0 {

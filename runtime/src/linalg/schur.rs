@@ -3,6 +3,7 @@
 //! nalgebra's `Schur::try_new` returns `None` when the QR iteration does not converge; these wrappers turn that
 //! into an error value and split the quasi-triangular factor into its 1x1 and 2x2 diagonal blocks.
 
+use super::balance::unit_scale;
 use nalgebra::{Complex, DMatrix, Schur};
 
 /// Why a Schur decomposition, or the reading of a quasi-triangular factor, failed.
@@ -34,23 +35,17 @@ fn checked(a: &DMatrix<f64>) -> Result<usize, SchurError> {
     Ok(rows)
 }
 
-/// A power of two that brings the largest entry of `a` near one. The QR iteration runs on `a / s` and its
-/// results are scaled back by `s`: dividing and multiplying by a power of two rounds nothing, and on a matrix
-/// of entries near 1e-200 the iteration's products would underflow (eigenvalues of 0, on the stability
-/// boundary).
-fn unit_scale(a: &DMatrix<f64>) -> f64 {
-    let largest = a.amax();
-    if largest > 0.0 && largest.is_finite() {
-        2f64.powi(largest.log2().round() as i32)
-    } else {
-        1.0
-    }
+/// The scale of [`unit_scale`] for `a`. The QR iteration runs on `a / s` and its results are scaled back by `s`:
+/// on a matrix of entries near 1e-200 the iteration's products would underflow (eigenvalues of 0, on the
+/// stability boundary).
+fn matrix_scale(a: &DMatrix<f64>) -> f64 {
+    unit_scale(a.amax())
 }
 
 /// `a = u t uᵀ` with `u` orthogonal and `t` upper quasi-triangular.
 pub fn real_schur(a: &DMatrix<f64>) -> Result<(DMatrix<f64>, DMatrix<f64>), SchurError> {
     let n = checked(a)?;
-    let scale = unit_scale(a);
+    let scale = matrix_scale(a);
     Schur::try_new(a / scale, f64::EPSILON, 1000 * n.max(10))
         .map(|s| {
             let (u, t) = s.unpack();
@@ -62,7 +57,7 @@ pub fn real_schur(a: &DMatrix<f64>) -> Result<(DMatrix<f64>, DMatrix<f64>), Schu
 /// The eigenvalues of a square matrix, in the order of the diagonal of its real Schur form.
 pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, SchurError> {
     let n = checked(a)?;
-    let scale = unit_scale(a);
+    let scale = matrix_scale(a);
     Schur::try_new(a / scale, f64::EPSILON, 1000 * n.max(10))
         .map(|s| s.complex_eigenvalues().iter().map(|l| l * scale).collect())
         .ok_or(SchurError::NoConvergence { n })

@@ -208,3 +208,15 @@ fn eigenvalues_of_a_subnormal_matrix_are_found() {
         "{found:?}"
     );
 }
+
+/// Finite entries near the top of f64 whose eigenvalues exceed it: an error, never an infinite eigenvalue.
+#[test]
+fn eigenvalues_beyond_f64_are_an_error() {
+    use bgc_runtime::linalg::SchurError;
+    use bgc_runtime::linalg::eigenvalues;
+    use bgc_runtime::linalg::schur::real_schur;
+    // [[M, M], [M, M]] has the eigenvalue 2M.
+    let a = DMatrix::from_element(2, 2, f64::MAX);
+    assert_eq!(eigenvalues(&a), Err(SchurError::OutOfRange { n: 2 }));
+    assert_eq!(real_schur(&a).err(), Some(SchurError::OutOfRange { n: 2 }));
+}

@@ -17,6 +17,9 @@ pub enum SchurError {
     NotQuasiTriangular { row: usize },
     #[error("the real Schur decomposition of a {n}x{n} matrix did not converge")]
     NoConvergence { n: usize },
+    /// Finite entries whose eigenvalues (at most `n` times the largest entry) exceed f64.
+    #[error("the eigenvalues of the {n}x{n} matrix leave the range of f64; rescale it")]
+    OutOfRange { n: usize },
 }
 
 /// `a`'s size when it is square with finite entries: the QR iteration would otherwise return NaN factors as if
@@ -46,21 +49,33 @@ fn matrix_scale(a: &DMatrix<f64>) -> f64 {
 pub fn real_schur(a: &DMatrix<f64>) -> Result<(DMatrix<f64>, DMatrix<f64>), SchurError> {
     let n = checked(a)?;
     let scale = matrix_scale(a);
-    Schur::try_new(a / scale, f64::EPSILON, 1000 * n.max(10))
-        .map(|s| {
-            let (u, t) = s.unpack();
-            (u, t * scale)
-        })
-        .ok_or(SchurError::NoConvergence { n })
+    let (u, t) = Schur::try_new(a / scale, f64::EPSILON, 1000 * n.max(10))
+        .ok_or(SchurError::NoConvergence { n })?
+        .unpack();
+    let t = t * scale;
+    if t.iter().chain(u.iter()).all(|v| v.is_finite()) {
+        Ok((u, t))
+    } else {
+        Err(SchurError::OutOfRange { n })
+    }
 }
 
 /// The eigenvalues of a square matrix, in the order of the diagonal of its real Schur form.
 pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, SchurError> {
     let n = checked(a)?;
     let scale = matrix_scale(a);
-    Schur::try_new(a / scale, f64::EPSILON, 1000 * n.max(10))
-        .map(|s| s.complex_eigenvalues().iter().map(|l| l * scale).collect())
-        .ok_or(SchurError::NoConvergence { n })
+    let values: Vec<Complex<f64>> = Schur::try_new(a / scale, f64::EPSILON, 1000 * n.max(10))
+        .ok_or(SchurError::NoConvergence { n })?
+        .complex_eigenvalues()
+        .iter()
+        .map(|l| l * scale)
+        .collect();
+    // A result is never NaN or infinite without an error.
+    if values.iter().all(|l| l.re.is_finite() && l.im.is_finite()) {
+        Ok(values)
+    } else {
+        Err(SchurError::OutOfRange { n })
+    }
 }
 
 /// The diagonal blocks of an upper quasi-triangular matrix as `(start, size)` with size 1 or 2.

@@ -20,7 +20,7 @@ use bgc::simulate::integrate::{Method, RunOptions, run};
 use bgc::span::SourceMap;
 use std::path::Path;
 
-fn fixture(name: &str) -> Equations {
+pub(crate) fn fixture(name: &str) -> Equations {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/fixtures/{name}.bg"));
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut sources = SourceMap::new();

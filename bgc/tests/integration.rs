@@ -59,5 +59,6 @@ mod lsp_props;
 mod lsp_session;
 mod lsp_stdio;
 mod pipeline_props;
+mod simulate_budget;
 mod syntax_fixtures;
 mod syntax_fuzz;

@@ -541,6 +541,13 @@ fn just_before(b: f64) -> f64 {
     b - b.abs() * 4.0 * f64::EPSILON
 }
 
+/// What to try when the explicit method advances too slowly.
+const STIFF_FOR_EXPLICIT: &str =
+    "a stiff or fast-forced model: try --solver bdf, or looser tolerances";
+/// What to try when an implicit method advances too slowly.
+const SMOOTHER_LAW: &str = "a law with a near-discontinuity, such as a friction regularised over a tiny velocity, \
+                            or a fast forcing: smooth the law, loosen the tolerances or shorten the run";
+
 struct Drive<'c> {
     system: &'c System,
     bad: &'c Cell<Option<(f64, usize)>>,
@@ -551,13 +558,18 @@ struct Drive<'c> {
     max_steps: usize,
     /// What a stall ([`Drive::stalled`]) does: BDF ends the drive with [`Outcome::Stalled`] and goes on with
     /// TR-BDF2; the explicit method, whose step a stiff mode or a fast forcing holds short for the rest of the run,
-    /// ends it with [`SimError::TooSlow`]. An implicit method's slow start may be a transient it leaves behind
-    /// (TR-BDF2 after BDF's stall on the stiff oscillator), so those keep their whole step budget.
+    /// ends it with [`SimError::TooSlow`]. An implicit one-step method's slow start may be a transient it leaves
+    /// behind (TR-BDF2 after BDF's stall on the stiff oscillator), so its pace is judged over a hundredth of the
+    /// budget ([`ONE_STEP_STALL_SHARE`]) before a stall ends it with [`SimError::TooSlow`] too.
     method: Method,
 }
 
 /// The steps between two looks at BDF's progress.
 const STALL_WINDOW: usize = 10_000;
+/// The share of the step budget between two looks at the progress of the implicit one-step methods (100,000 steps
+/// of the CLI's 10,000,000): ten times BDF's window there, so that a slow start they leave behind (TR-BDF2 after
+/// BDF's stall on a stiff oscillator) is not judged by its first steps.
+const ONE_STEP_STALL_SHARE: usize = 100;
 
 impl Drive<'_> {
     fn name(&self, i: usize) -> String {
@@ -573,10 +585,21 @@ impl Drive<'_> {
     /// lightly damped fast mode (eigenvalues near the imaginary axis) lies outside the stability region of its
     /// orders 3 to 5 and the tolerances resolve it: the error test holds the spurious growth at the tolerance by
     /// cutting the step to a fraction of that mode's period, for the rest of the run.
-    fn stalled(&self, window_start: f64, t_now: f64, steps: usize) -> bool {
-        let pace = (t_now - window_start) / STALL_WINDOW as f64;
+    fn stalled(&self, window_start: f64, t_now: f64, steps: usize, window: usize) -> bool {
+        let pace = (t_now - window_start) / window as f64;
         let left = self.max_steps.saturating_sub(steps) as f64;
         !(pace > 0.0 && (self.to - t_now) / pace <= left)
+    }
+
+    fn too_slow(&self, time: f64, steps: usize, hint: &'static str) -> SimError {
+        SimError::TooSlow {
+            from: self.from,
+            to: self.to,
+            time,
+            steps,
+            max_steps: self.max_steps,
+            hint,
+        }
     }
 
     /// A solver error, attributed to the model when its algebraic loops could not be solved or it had returned a
@@ -604,6 +627,8 @@ impl Drive<'_> {
             .map_err(|e| self.failure(self.from, e))?;
         let mut next = 0;
         let mut window_start = self.from;
+        let mut long_window_start = self.from;
+        let long_window = (self.max_steps / ONE_STEP_STALL_SHARE).max(1);
         for step in 0..self.max_steps {
             let reason = solver
                 .step()
@@ -643,8 +668,17 @@ impl Drive<'_> {
             if reached {
                 return Ok(Outcome::Reached(y));
             }
+            let one_step = matches!(self.method, Method::TrBdf2 | Method::Esdirk34);
+            if one_step && (step + 1) % long_window == 0 {
+                // A law that is nearly discontinuous (a friction regularised over 1e-9 rad/s) holds every method's
+                // step short for good: minutes of work before the budget runs out.
+                if self.stalled(long_window_start, t_now, step + 1, long_window) {
+                    return Err(self.too_slow(t_now, step + 1, SMOOTHER_LAW));
+                }
+                long_window_start = t_now;
+            }
             if (step + 1) % STALL_WINDOW == 0 {
-                let stalled = self.stalled(window_start, t_now, step + 1);
+                let stalled = self.stalled(window_start, t_now, step + 1, STALL_WINDOW);
                 match self.method {
                     Method::Bdf if stalled => {
                         return Ok(Outcome::Stalled {
@@ -656,13 +690,7 @@ impl Drive<'_> {
                     }
                     // It would spend the whole step budget (minutes) before failing.
                     Method::Tsit45 if stalled => {
-                        return Err(SimError::TooSlow {
-                            from: self.from,
-                            to: self.to,
-                            time: t_now,
-                            steps: step + 1,
-                            max_steps: self.max_steps,
-                        });
+                        return Err(self.too_slow(t_now, step + 1, STIFF_FOR_EXPLICIT));
                     }
                     _ => {}
                 }

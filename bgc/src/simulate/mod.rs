@@ -105,8 +105,7 @@ pub enum SimError {
     },
     #[error(
         "the solver advanced too slowly: {steps} steps from t = {from:?} reached t = {time:?}, and at that pace t = {to:?} \
-         needs more than the {max_steps} steps allowed (a stiff or fast-forced model: try --solver bdf, or looser \
-         tolerances)"
+         needs more than the {max_steps} steps allowed ({hint})"
     )]
     TooSlow {
         from: f64,
@@ -114,6 +113,8 @@ pub enum SimError {
         time: f64,
         steps: usize,
         max_steps: usize,
+        /// What to try, for the method that stalled.
+        hint: &'static str,
     },
 }
 

@@ -132,9 +132,10 @@ pub fn dare_with_cross(
     stabilising_solution(Domain::Discrete, a, b, x, k, orig.relative, steps)
 }
 
-/// `K = (R + BᵀXB)⁻¹(BᵀXA + Nᵀ)`, multiplied as `((R + BᵀXB)⁻¹Bᵀ)(XA)`: the first factor is of the size of `1/B`
-/// and the second of `K/A`-ish, so neither underflows where `K` is representable. `BᵀXA` first would: with weights
-/// of 1e-150 it is `(R + BᵀXB)·K`, below the range of f64 for a gain of 1e-301.
+/// `K = (R + BᵀXB)⁻¹(BᵀXA + Nᵀ)`, multiplied as `(((R + BᵀXB)⁻¹Bᵀ)X)A`: the solve first, then two products of
+/// `O(m n²)` as for `BᵀXA`. `BᵀXA` first underflowed: with weights of 1e-150 it is `(R + BᵀXB)·K`, below the range
+/// of f64 for a gain of 1e-301, while the solve gives a result of order 0.1 there and the products after it are of
+/// the order of `K A⁻¹` and `K`.
 fn gain(
     b: &DMatrix<f64>,
     r: &DMatrix<f64>,
@@ -144,7 +145,7 @@ fn gain(
 ) -> Option<DMatrix<f64>> {
     let lu = (r + b.transpose() * x * b).lu();
     let left = lu.solve(&b.transpose())?;
-    let mut k = left * (x * a);
+    let mut k = (left * x) * a;
     if let Some(n_t) = n_t {
         k += lu.solve(n_t)?;
     }

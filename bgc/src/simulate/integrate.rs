@@ -346,8 +346,9 @@ fn segment(
         } => {
             notes.push(format!(
                 "BDF stalled at t = {t:e} ({steps} steps from t = {a:e}, too short to reach t = {b:e} in the step \
-                 budget): a lightly damped fast mode makes its orders above 2, which are not A-stable, unstable once \
-                 the tolerances resolve that mode; the run went on with --solver tr_bdf2 (A- and L-stable) from there"
+                 budget), as when a lightly damped fast mode makes its orders above 2, which are not A-stable, \
+                 unstable once the tolerances resolve that mode (a law with a near-discontinuity holds the step short \
+                 too); the run went on with --solver tr_bdf2 (A- and L-stable) from there"
             ));
             let rest = RunOptions {
                 method: Method::TrBdf2,

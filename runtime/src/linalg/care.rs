@@ -22,7 +22,8 @@ const MAX_NEWTON_STEPS: usize = 30;
 /// `K = R⁻¹(BᵀX + Nᵀ)`.
 ///
 /// Method: validate the inputs and the PBH conditions ((A, B) stabilisable, (Q̃, Ã) detectable), reduce the cross
-/// term and balance (see [`crate::linalg::riccati`]); compute `W = sign(H)` of the Hamiltonian
+/// term and balance (see [`crate::linalg::riccati`]), in a unit of time (a power of two) that brings the Hamiltonian
+/// to unit size; compute `W = sign(H)` of the Hamiltonian
 /// `H = [Ã, −G; −Q̃, −Ãᵀ]` ([`crate::linalg::sign`]), whose stable invariant subspace `[I; X]` is the null space of
 /// `W + I`, giving `X` as the least-squares solution of `[W₁₂; W₂₂ + I] X = −[W₁₁ + I; W₂₁]`; then Newton–Kleinman
 /// refinement in correction form: `(Ã − GX)ᵀ Δ + Δ (Ã − GX) + Res(X) = 0`, `X ← X + Δ`, until the residual stops

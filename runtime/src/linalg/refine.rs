@@ -5,7 +5,8 @@
 //! for a correction `Δ` and proposes `X + Δ` (symmetrised). A proposal is accepted only while the relative
 //! residual decreases, so the result is never worse than the base solver's: rounding stalls the iteration
 //! instead of undoing the solution. The iteration stops at `max_steps` accepted steps, once the relative
-//! residual is at rounding level (`1e-15`), or when a correction or an evaluation fails.
+//! residual is at rounding level (`1e-15`), after a step that did not halve it (Newton's steps do until rounding
+//! holds them), or when a correction or an evaluation fails.
 
 use nalgebra::DMatrix;
 
@@ -43,9 +44,15 @@ pub(crate) fn refine<E: Evaluated>(
         if next.relative().is_nan() || next.relative() >= eval.relative() {
             break;
         }
+        // Newton at least halves the residual until rounding holds it; a smaller gain means rounding does, and
+        // further steps (each an O(n³) Lyapunov solve) would only trade its last digits.
+        let at_rounding = next.relative() > 0.5 * eval.relative();
         steps += 1;
         x = candidate;
         eval = next;
+        if at_rounding {
+            break;
+        }
     }
     (x, steps)
 }

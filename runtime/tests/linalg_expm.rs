@@ -259,3 +259,22 @@ fn a_sample_time_too_long_for_the_rates_is_named() {
         other => panic!("expected Overflow, got {other:?}"),
     }
 }
+
+/// A stable plant far faster than the sample time: `A dt = −1e301` is finite and so is its exponential (zero),
+/// and `B_d = (1 − e^{A dt}) (−A)⁻¹ B = 1`. The exponential used to square the unscaled `A` first, which overflows
+/// above about 1e154, and refused the plant as an overflow.
+#[test]
+fn a_stable_plant_far_faster_than_the_sample_time_discretises() {
+    let a = DMatrix::from_element(1, 1, -1e300);
+    assert_eq!(expm(&(&a * 10.0)).expect("e^(-1e301)")[(0, 0)], 0.0);
+    let sys = StateSpace::new(
+        a,
+        DMatrix::from_element(1, 1, 1e300),
+        DMatrix::from_element(1, 1, 1.0),
+        DMatrix::zeros(1, 1),
+    )
+    .expect("finite model");
+    let d = c2d_zoh(&sys, 10.0).expect("finite discretisation");
+    assert_eq!(d.a()[(0, 0)], 0.0);
+    assert!((d.b()[(0, 0)] - 1.0).abs() < 1e-12, "B_d = {}", d.b());
+}

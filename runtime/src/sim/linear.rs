@@ -170,6 +170,14 @@ impl<const NX: usize, const NU: usize> ZohStep<NX, NU> {
             }
             big[(i, NX + NU + i)] = t;
         }
+        if big.iter().any(|v| !v.is_finite()) {
+            // Finite matrices whose product with T left f64: not a non-finite entry of the caller's A.
+            return Err(SimError::Discretisation {
+                message: format!(
+                    "the sample time of {t:?} s is too long for the plant's rates: A T or B T overflows f64"
+                ),
+            });
+        }
         let e = expm(&big).map_err(|e| SimError::Discretisation {
             message: e.to_string(),
         })?;
@@ -194,5 +202,33 @@ impl<const NX: usize, const NU: usize> ZohStep<NX, NU> {
     ) -> SVector<f64, NX> {
         let (ad, bd, ed) = (&*self.ad, &*self.bd, &*self.ed);
         ad * x + bd * u + ed * w
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::SMatrix;
+
+    /// A plant whose rates times the sample time overflow is refused for its sample time (it was reported as a
+    /// non-finite entry of `A`, which the caller's `A` does not have).
+    #[test]
+    fn a_sample_time_too_long_for_the_rates_is_named() {
+        let plant = LinearPlant::new(
+            SMatrix::<f64, 1, 1>::new(-1e300),
+            SMatrix::<f64, 1, 1>::new(1.0),
+            SMatrix::<f64, 1, 1>::new(1.0),
+            SMatrix::<f64, 1, 1>::zeros(),
+        );
+        match ZohStep::new(&plant, 1e10) {
+            Err(SimError::Discretisation { message }) => {
+                assert!(
+                    message.contains("is too long for the plant's rates"),
+                    "{message}"
+                )
+            }
+            Err(other) => panic!("expected a discretisation error, got {other:?}"),
+            Ok(_) => panic!("expected a discretisation error"),
+        }
     }
 }

@@ -138,3 +138,16 @@ fn errors() {
         }))
     ));
 }
+
+/// `(sA) X + X (sA)ᵀ + sQ = 0` has the `X` of `s = 1` (a change of the unit of time). From about 1e154 on, the
+/// norm of `A` overflowed and every pair of eigenvalues passed for `λᵢ + λⱼ = 0`.
+#[test]
+fn a_change_of_the_unit_of_time_keeps_the_lyapunov_solution() {
+    let a = DMatrix::from_row_slice(3, 3, &[-1.0, 0.1, 0.0, 0.0, -1.0, 0.2, -0.3, 0.0, -0.5]);
+    let q = DMatrix::<f64>::identity(3, 3);
+    let x_ref = lyap(&a, &q).expect("unit scale");
+    for s in [1e-300, 1e-150, 1e160, 1e200, 1e300] {
+        let x = lyap(&(&a * s), &(&q * s)).unwrap_or_else(|e| panic!("{s:e}: {e}"));
+        assert!((&x - &x_ref).amax() <= 1e-12 * x_ref.amax(), "{s:e}: {x}");
+    }
+}

@@ -11,6 +11,7 @@
 
 use nalgebra::DMatrix;
 
+use super::balance::{frobenius, unit_scale};
 use super::check::{self, MatrixError};
 use super::schur::{SchurError, real_schur};
 use super::sylvester::{Kind, check_unique, reversed, reversed_columns, solve_quasi_triangular};
@@ -40,10 +41,15 @@ pub(crate) const RESIDUAL_TOLERANCE: f64 = 1e-8;
 /// Solves `A X + X Aᵀ + Q = 0` for symmetric `Q`; the solution is symmetric.
 pub fn lyap(a: &DMatrix<f64>, q: &DMatrix<f64>) -> Result<DMatrix<f64>, LyapunovError> {
     validate(a, q)?;
-    let scale = a.norm().max(f64::MIN_POSITIVE);
+    // A change of the unit of time (a power of two, exact) divides A and Q alike and keeps X: A of unit size, so
+    // that the uniqueness test and the residual do not overflow for rates of 1e160 (which were refused as
+    // λᵢ + λⱼ = 0).
+    let unit = unit_scale(a.amax());
+    let (a, q) = (&(a / unit), &(q / unit));
+    let scale = frobenius(a).max(f64::MIN_POSITIVE);
     let x = solve_symmetric(a, q, Kind::Continuous, scale, "λᵢ + λⱼ = 0")?;
-    let residual = (a * &x + &x * a.transpose() + q).norm()
-        / (2.0 * a.norm() * x.norm() + q.norm()).max(f64::MIN_POSITIVE);
+    let residual = frobenius(&(a * &x + &x * a.transpose() + q))
+        / (2.0 * frobenius(a) * frobenius(&x) + frobenius(q)).max(f64::MIN_POSITIVE);
     accept(x, residual)
 }
 

@@ -117,6 +117,9 @@ fn errors() {
         lyap(&a, &q),
         Err(LyapunovError::NoUniqueSolution { .. })
     ));
+    // The eigenvalues in the message are in scientific notation (1e160 was printed with 161 digits).
+    let err = lyap(&(&a * 1e160), &q).expect_err("λ₁ + λ₂ = 0 at any scale");
+    assert!(err.to_string().contains("1.0000e160"), "{err}");
     // λ = 2, 0.5: λ₁λ₂ = 1.
     let a = DMatrix::from_row_slice(2, 2, &[2.0, 0.0, 0.0, 0.5]);
     assert!(matches!(

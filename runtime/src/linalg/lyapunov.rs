@@ -24,7 +24,7 @@ pub enum LyapunovError {
     #[error(transparent)]
     Schur(#[from] SchurError),
     #[error(
-        "the equation has no unique solution: eigenvalues {first} and {second} violate the uniqueness condition ({kind})"
+        "the equation has no unique solution: eigenvalues {first:.4e} and {second:.4e} violate the uniqueness condition ({kind})"
     )]
     NoUniqueSolution {
         first: nalgebra::Complex<f64>,
@@ -47,7 +47,19 @@ pub fn lyap(a: &DMatrix<f64>, q: &DMatrix<f64>) -> Result<DMatrix<f64>, Lyapunov
     let unit = unit_scale(a.amax());
     let (a, q) = (&(a / unit), &(q / unit));
     let scale = frobenius(a).max(f64::MIN_POSITIVE);
-    let x = solve_symmetric(a, q, Kind::Continuous, scale, "λᵢ + λⱼ = 0")?;
+    let x = solve_symmetric(a, q, Kind::Continuous, scale, "λᵢ + λⱼ = 0").map_err(|e| match e {
+        // The eigenvalues of the caller's A.
+        LyapunovError::NoUniqueSolution {
+            first,
+            second,
+            kind,
+        } => LyapunovError::NoUniqueSolution {
+            first: first * unit,
+            second: second * unit,
+            kind,
+        },
+        e => e,
+    })?;
     let residual = frobenius(&(a * &x + &x * a.transpose() + q))
         / (2.0 * frobenius(a) * frobenius(&x) + frobenius(q)).max(f64::MIN_POSITIVE);
     accept(x, residual)

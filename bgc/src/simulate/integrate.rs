@@ -630,6 +630,7 @@ impl Drive<'_> {
         let mut window_start = self.from;
         let mut long_window_start = self.from;
         let long_window = (self.max_steps / ONE_STEP_STALL_SHARE).max(1);
+        let one_step = matches!(self.method, Method::TrBdf2 | Method::Esdirk34);
         for step in 0..self.max_steps {
             let reason = solver
                 .step()
@@ -669,7 +670,6 @@ impl Drive<'_> {
             if reached {
                 return Ok(Outcome::Reached(y));
             }
-            let one_step = matches!(self.method, Method::TrBdf2 | Method::Esdirk34);
             if one_step && (step + 1) % long_window == 0 {
                 // A law that is nearly discontinuous (a friction regularised over 1e-9 rad/s) holds every method's
                 // step short for good: minutes of work before the budget runs out.

@@ -78,7 +78,7 @@ pub fn frobenius<C: nalgebra::ComplexField<RealField = f64>>(m: &DMatrix<C>) -> 
     if largest == 0.0 || !largest.is_finite() {
         return m.norm();
     }
-    let scale = power_of_two(largest);
+    let scale = unit_scale(largest);
     let sum: f64 = m.iter().map(|v| (v.clone().abs() / scale).powi(2)).sum();
     scale * sum.sqrt()
 }

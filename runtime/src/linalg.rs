@@ -29,7 +29,7 @@ pub mod sylvester;
 pub use care::{care, care_with_cross};
 pub use check::MatrixError;
 pub use dare::{dare, dare_with_cross};
-pub use discretize::{DiscretizeError, c2d_zoh, van_loan};
+pub use discretize::{DiscretizeError, c2d_zoh, van_loan, zoh_blocks};
 pub use expm::{ExpmError, expm};
 pub use lyapunov::{LyapunovError, dlyap, lyap};
 pub use pbh::{

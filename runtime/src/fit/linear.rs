@@ -19,7 +19,7 @@ use nalgebra::{DMatrix, DVector};
 use super::record::Record;
 use super::sensitivity::{FitModel, Fitted, SensitivityError, Simulated, sample_outputs};
 use crate::fit::Interp;
-use crate::linalg::expm;
+use crate::linalg::{DiscretizeError, zoh_blocks};
 
 /// The augmented continuous system `Ẋ = A_aug X + B_aug [u; 1]` of the states and the scaled sensitivities.
 struct Augmented {
@@ -95,22 +95,12 @@ pub fn simulate(
 
 /// `(Φ, Γ)` of the augmented system over `dt`.
 fn discretise(sys: &Augmented, dt: f64) -> Result<(DMatrix<f64>, DMatrix<f64>), String> {
-    let (n, p) = (sys.a.nrows(), sys.b.ncols());
-    let mut big = DMatrix::zeros(n + p, n + p);
-    big.view_mut((0, 0), (n, n)).copy_from(&(&sys.a * dt));
-    big.view_mut((0, n), (n, p)).copy_from(&(&sys.b * dt));
-    if big.iter().any(|v| !v.is_finite()) {
-        return Err(format!(
+    zoh_blocks(&sys.a, &sys.b, dt).map_err(|e| match e {
+        DiscretizeError::Overflow { .. } => format!(
             "the sample interval of {dt:?} s is too long for the exact discretisation: A dt or B dt overflows"
-        ));
-    }
-    let e = expm(&big).map_err(|e| {
-        format!("the exact discretisation over the sample interval of {dt:?} s failed: {e}")
-    })?;
-    Ok((
-        e.view((0, 0), (n, n)).clone_owned(),
-        e.view((0, n), (n, p)).clone_owned(),
-    ))
+        ),
+        other => format!("the exact discretisation over the sample interval of {dt:?} s failed: {other}"),
+    })
 }
 
 /// The rate `f`, `∂f/∂x` and the free columns of `∂f/∂p` at a point.

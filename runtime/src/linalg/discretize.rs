@@ -51,13 +51,7 @@ pub fn c2d_zoh(sys: &StateSpace, dt: f64) -> Result<StateSpace, DiscretizeError>
     let n = check::square("A", sys.a())?;
     let m = sys.b().ncols();
     check::shape("B", sys.b(), n, m)?;
-    let mut big = DMatrix::<f64>::zeros(n + m, n + m);
-    big.view_mut((0, 0), (n, n)).copy_from(&(sys.a() * dt));
-    big.view_mut((0, n), (n, m)).copy_from(&(sys.b() * dt));
-    finite_product("[A B]·dt", &big, dt)?;
-    let e = expm(&big)?;
-    let ad = e.view((0, 0), (n, n)).clone_owned();
-    let bd = e.view((0, n), (n, m)).clone_owned();
+    let (ad, bd) = zoh_blocks(sys.a(), sys.b(), dt)?;
     Ok(StateSpace::new_discrete(
         ad,
         bd,
@@ -65,6 +59,26 @@ pub fn c2d_zoh(sys: &StateSpace, dt: f64) -> Result<StateSpace, DiscretizeError>
         sys.d().clone(),
         dt,
     )?)
+}
+
+/// `(A_d, B_d)` of `ẋ = A x + B u` with `u` held over `dt`: the blocks of `exp([A B; 0 0]·dt)`. The caller has
+/// checked that `A` and `B` are finite and of matching rows; a product with `dt` that leaves f64 is an
+/// [`DiscretizeError::Overflow`].
+pub fn zoh_blocks(
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+    dt: f64,
+) -> Result<(DMatrix<f64>, DMatrix<f64>), DiscretizeError> {
+    let (n, m) = (a.nrows(), b.ncols());
+    let mut big = DMatrix::<f64>::zeros(n + m, n + m);
+    big.view_mut((0, 0), (n, n)).copy_from(&(a * dt));
+    big.view_mut((0, n), (n, m)).copy_from(&(b * dt));
+    finite_product("[A B]·dt", &big, dt)?;
+    let e = expm(&big)?;
+    Ok((
+        e.view((0, 0), (n, n)).clone_owned(),
+        e.view((0, n), (n, m)).clone_owned(),
+    ))
 }
 
 /// `(A_d, Q_d)` for `ẋ = A x + w`, `E[w(t) w(s)ᵀ] = (G Q_c Gᵀ) δ(t − s)`, sampled every `dt` (Van Loan).

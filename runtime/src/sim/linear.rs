@@ -15,7 +15,7 @@
 use nalgebra::{DMatrix, SMatrix, SVector};
 
 use super::error::SimError;
-use crate::linalg::expm;
+use crate::linalg::{DiscretizeError, zoh_blocks};
 use crate::linearize::BoxedJacobians;
 use crate::matrix::{boxed_copy, boxed_fixed, product_sum, zeroed_box};
 use crate::model::ContinuousModel;
@@ -159,37 +159,34 @@ impl<const NX: usize, const NU: usize> ZohStep<NX, NU> {
                 reason: "the matrices A, B, C, D of a linear plant must be finite",
             });
         }
-        let size = 2 * NX + NU;
-        let mut big = DMatrix::<f64>::zeros(size, size);
-        for i in 0..NX {
-            for j in 0..NX {
-                big[(i, j)] = plant.a[(i, j)] * t;
+        // The disturbance enters as a second input of identity gain: `E_d` is the last block of `B_d`.
+        let a = DMatrix::from_fn(NX, NX, |i, j| plant.a[(i, j)]);
+        let b = DMatrix::from_fn(NX, NU + NX, |i, j| {
+            if j < NU {
+                plant.b[(i, j)]
+            } else if j - NU == i {
+                1.0
+            } else {
+                0.0
             }
-            for j in 0..NU {
-                big[(i, NX + j)] = plant.b[(i, j)] * t;
-            }
-            big[(i, NX + NU + i)] = t;
-        }
-        if big.iter().any(|v| !v.is_finite()) {
-            // Finite matrices whose product with T left f64: not a non-finite entry of the caller's A.
-            return Err(SimError::Discretisation {
-                message: format!(
+        });
+        let (ad, bd) = zoh_blocks(&a, &b, t).map_err(|e| SimError::Discretisation {
+            message: match e {
+                // Finite matrices whose product with T left f64: not a non-finite entry of the caller's A.
+                DiscretizeError::Overflow { .. } => format!(
                     "the sample time of {t:?} s is too long for the plant's rates: A T or B T overflows f64"
                 ),
-            });
-        }
-        let e = expm(&big).map_err(|e| SimError::Discretisation {
-            message: e.to_string(),
+                other => other.to_string(),
+            },
         })?;
-        let block = |column: usize| e.view((0, column), (NX, NX));
         let mut step = ZohStep {
             ad: zeroed_box::<NX, NX>(),
             bd: zeroed_box::<NX, NU>(),
             ed: zeroed_box::<NX, NX>(),
         };
-        step.ad.copy_from(&block(0));
-        step.bd.copy_from(&e.view((0, NX), (NX, NU)));
-        step.ed.copy_from(&block(NX + NU));
+        step.ad.copy_from(&ad);
+        step.bd.copy_from(&bd.columns(0, NU));
+        step.ed.copy_from(&bd.columns(NU, NX));
         Ok(step)
     }
 

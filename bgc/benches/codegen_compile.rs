@@ -6,6 +6,8 @@
 
 #[path = "../tests/codegen_support/mod.rs"]
 mod codegen_support;
+#[path = "../tests/scratch.rs"]
+mod scratch;
 
 use bgc::codegen::{self, rust};
 use bgc::lower::MemoryLoader;

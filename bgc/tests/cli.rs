@@ -149,7 +149,7 @@ fn usage_and_io_errors_exit_2() {
 
 /// A scratch directory of this test binary's own.
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bgc-cli-{}-{name}", std::process::id()));
+    let dir = crate::scratch::path(&format!("cli-{name}"));
     std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
     dir
 }

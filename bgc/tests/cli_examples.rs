@@ -71,7 +71,7 @@ fn cannot_run(args: &[String]) -> Option<&'static str> {
 
 #[test]
 fn documented_commands_succeed() {
-    let scratch = std::env::temp_dir().join(format!("bgc-cli-examples-{}", std::process::id()));
+    let scratch = crate::scratch::path("cli-examples");
     std::fs::create_dir_all(&scratch).unwrap_or_else(|e| panic!("{}: {e}", scratch.display()));
     let all = commands();
     let mut ran = 0;

@@ -81,7 +81,7 @@ fn bgc(dir: &Path, args: &[&str]) -> Run {
 
 /// A scratch directory of this test's own.
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bgc-hostile-{}-{name}", std::process::id()));
+    let dir = crate::scratch::path(&format!("hostile-{name}"));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
     dir

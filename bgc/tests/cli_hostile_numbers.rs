@@ -6,9 +6,9 @@ use crate::cli_support;
 
 use cli_support::{bgc, corpus};
 
-/// Writes `text` to a fresh file of the temporary directory and returns its path.
+/// Writes `text` to a file of the tests' scratch directory and returns its path.
 fn temp_file(name: &str, text: &str) -> String {
-    let path = std::env::temp_dir().join(format!("bgc-numbers-{}-{name}", std::process::id()));
+    let path = crate::scratch::path(&format!("numbers-{name}"));
     std::fs::write(&path, text).expect("temporary file written");
     path.display().to_string()
 }

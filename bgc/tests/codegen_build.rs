@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 /// A fresh directory for one test.
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bgc-codegen-{}-{name}", std::process::id()));
+    let dir = crate::scratch::path(&format!("codegen-build-{name}"));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
     dir

@@ -5,6 +5,7 @@ mod codegen_support;
 mod equations_support;
 mod fmu_support;
 mod lsp_support;
+mod scratch;
 
 mod causality_allow;
 mod causality_models;

@@ -125,9 +125,9 @@ pub fn simulate(args: &[&str]) -> Csv {
     Csv::parse(&out)
 }
 
-/// Writes a model to a fresh file of the system's temporary directory and returns its path.
+/// Writes a model to a file of the tests' scratch directory and returns its path.
 pub fn temp_model(name: &str, text: &str) -> String {
-    let path = std::env::temp_dir().join(format!("bgc-{}-{name}.bg", std::process::id()));
+    let path = crate::scratch::path(&format!("{name}.bg"));
     std::fs::write(&path, text).expect("temporary model written");
     path.display().to_string()
 }

@@ -162,7 +162,7 @@ pub fn generate_text(name: &str, text: &str, options: rust::Options) -> String {
 
 /// A fresh directory for one test.
 pub fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bgc-codegen-{}-{name}", std::process::id()));
+    let dir = crate::scratch::path(&format!("codegen-{name}"));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
     dir

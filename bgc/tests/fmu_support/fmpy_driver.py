@@ -17,13 +17,22 @@ jacobian FMU SCENARIO.json
     lists for each row (null where it lists none, meaning every state and input).
 """
 import ctypes
+import atexit
 import json
+import shutil
 import sys
 
 import numpy as np
 from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi2 import FMU2Model
 from fmpy.fmi3 import FMU3Model
+
+
+def unzipped(fmu):
+    """The FMU extracted to a directory of its own, removed when the driver exits."""
+    directory = extract(fmu)
+    atexit.register(shutil.rmtree, directory, ignore_errors=True)
+    return directory
 
 
 def scenario(path):
@@ -64,7 +73,7 @@ def jacobian(fmu, path):
     input_vrs = [v.valueReference for v in md.modelVariables if v.causality == "input"]
     fmi3 = md.fmiVersion.startswith("3")
     model = FMU3Model if fmi3 else FMU2Model
-    m = model(guid=md.guid, unzipDirectory=extract(fmu),
+    m = model(guid=md.guid, unzipDirectory=unzipped(fmu),
               modelIdentifier=md.modelExchange.modelIdentifier, instanceName="jacobian")
     m.instantiate()
     if fmi3:
@@ -127,7 +136,7 @@ def interface(fmu):
     """Calls the C interface directly, against the standard's rules too, and prints JSON of what it answered."""
     md = read_model_description(fmu)
     ident = md.coSimulation.modelIdentifier
-    lib = ctypes.CDLL(f"{extract(fmu)}/binaries/linux64/{ident}.so")
+    lib = ctypes.CDLL(f"{unzipped(fmu)}/binaries/linux64/{ident}.so")
     messages = []
     LOGGER = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p,
                               ctypes.c_char_p, ctypes.c_char_p)
@@ -212,7 +221,7 @@ def interface(fmu):
 def interface3(fmu):
     """The FMI 3.0 interface called directly, against the standard's rules too; prints JSON of its answers."""
     md = read_model_description(fmu)
-    lib = ctypes.CDLL(f"{extract(fmu)}/binaries/x86_64-linux/{md.coSimulation.modelIdentifier}.so")
+    lib = ctypes.CDLL(f"{unzipped(fmu)}/binaries/x86_64-linux/{md.coSimulation.modelIdentifier}.so")
     messages = []
     LOG = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_char_p)
     log = LOG(lambda env, status, category, message: messages.append((status, message.decode())))

@@ -101,5 +101,31 @@ fn rhs(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, clock::clock, rhs);
+/// How many rhs evaluations a UKF step of the back-support model makes: its 2n + 1 = 21 sigma points (n = 10).
+const SIGMA_POINTS: usize = 21;
+
+/// The rhs at the 21 sigma points of a UKF step, one after the other, as the filter propagates them: the
+/// evaluations are independent, so the core overlaps them and the time per evaluation is a throughput, the
+/// quantity a flop bound (flops at 4 per cycle) bounds. The time printed is for all 21; divide by 21.
+fn rhs_at_sigma_points(c: &mut Criterion) {
+    let model = m::Model::default();
+    let u = m::Inputs::new(0.5, 0.1);
+    let points: [m::State; SIGMA_POINTS] =
+        std::array::from_fn(|k| m::State::from_fn(|i, _| 1e-3 * (i + k + 1) as f64));
+    let mut rates = [m::State::zeros(); SIGMA_POINTS];
+    let mut group = c.benchmark_group("back_support_rhs_sigma_points");
+    group.throughput(criterion::Throughput::Elements(SIGMA_POINTS as u64));
+    group.bench_function("model_rhs_x21", |b| {
+        b.iter(|| {
+            let model = black_box(&model);
+            for (x, dx) in black_box(&points).iter().zip(rates.iter_mut()) {
+                model.rhs(0.0, x, black_box(&u), dx);
+            }
+            black_box(&rates);
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, clock::clock, rhs, rhs_at_sigma_points);
 criterion_main!(benches);

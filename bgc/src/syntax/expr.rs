@@ -358,6 +358,10 @@ impl<'a> Parser<'a> {
                 "an empty unit: write `[1]` for a dimensionless quantity",
             ));
         }
+        if let Some(help) = unit_operator_help(self.peek().kind, !denominator.is_empty()) {
+            let t = self.peek();
+            return Err(self.bad_unit(self.tok_span(t), help));
+        }
         self.close(Tok::RBracket, open, "the unit")?;
         Ok(UnitExpr {
             numerator,
@@ -406,6 +410,20 @@ impl<'a> Parser<'a> {
                 .with_help(help.to_string()),
         );
         Fail
+    }
+}
+
+/// What to write instead of an operator that other tools put in units (`[N*m]`, `[N.m]`, `[m/s/s]`), which the
+/// unit grammar does not have.
+fn unit_operator_help(tok: Tok, after_slash: bool) -> Option<&'static str> {
+    match tok {
+        Tok::Star | Tok::Dot => {
+            Some("unit factors multiply by a space, as in `[N m]` or `[kg m^2]`")
+        }
+        Tok::Slash if after_slash => Some(
+            "a unit has one `/`, and every factor after it is in the denominator: `[m/s^2]` or `[kg/m s]`",
+        ),
+        _ => None,
     }
 }
 

@@ -532,6 +532,26 @@ fn unclosed_unit_bracket_at_a_line_end() {
 }
 
 #[test]
+fn operators_of_other_tools_in_a_unit_say_how_to_write_it() {
+    for (unit, at, help) in [
+        ("[N*m]", "*", "multiply by a space"),
+        ("[N.m]", ".", "multiply by a space"),
+        ("[kg*m^2/s]", "*", "multiply by a space"),
+        ("[m/s/s]", "/", "one `/`"),
+    ] {
+        let src = format!("model m {{ param a = 1 {unit}; }}");
+        let (_, diags) = parse(FileId(0), &src);
+        assert_eq!(diags.len(), 1, "{unit}: {diags:#?}");
+        assert_eq!(diags[0].code.0, "BG0116", "{unit}");
+        let start = src.find(unit).unwrap_or(0) + unit.rfind(at).unwrap_or(0);
+        let span = diags[0].primary_span().map(|s| s.range());
+        assert_eq!(span, Some(start..start + 1), "{unit}");
+        let said = diags[0].help.as_deref().unwrap_or("");
+        assert!(said.contains(help), "{unit}: {said}");
+    }
+}
+
+#[test]
 fn a_bad_model_name_is_one_error_and_the_body_is_read() {
     let (file, diags) = parse(FileId(0), "model 3 { param a = 1 [1]; }");
     assert_eq!(diags.len(), 1, "{diags:#?}");

@@ -79,7 +79,7 @@ pub use compiled::Compiled;
 pub use cse::{cse, to_rust_cse, to_text_cse};
 pub use error::SymbolicError;
 pub use eval::{max, min, sign};
-pub use expr::{Expr, Node, Symbol, SymbolKind};
+pub use expr::{Expr, ExprMap, ExprSet, Node, Symbol, SymbolKind};
 pub use from_ir::from_ir;
 pub use linear::{LinearForm, MAX_EXPANDED_POWER, MAX_EXPANDED_TERMS};
 pub use print::latex::{latex_symbol, to_latex, to_latex_with};

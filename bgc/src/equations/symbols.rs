@@ -12,9 +12,8 @@
 //! an expression can grow with the model.
 
 use crate::ir::Func;
-use crate::symbolic::{Expr, Node, Symbol, SymbolKind};
+use crate::symbolic::{Expr, ExprMap, ExprSet, Node, Symbol, SymbolKind};
 use std::cell::RefCell;
-use std::collections::{HashMap, HashSet};
 
 /// A leaf of the stage's expressions. The variants are declared in the order of their [`SymbolKind`]s, so that
 /// `Sym`'s order is that of its symbols.
@@ -152,7 +151,7 @@ impl SymExt for Expr {
 
 /// The distinct nodes reachable from `roots`, each after its children, found on an explicit stack.
 pub fn post_order(roots: &[Expr]) -> Vec<Expr> {
-    let mut seen: HashSet<Expr> = HashSet::new();
+    let mut seen = ExprSet::default();
     let mut order = Vec::new();
     let mut stack: Vec<(Expr, usize)> = Vec::new();
     for root in roots {
@@ -336,7 +335,7 @@ pub fn affine_in(e: &Expr, s: Sym) -> Option<(Expr, Expr)> {
 /// True when `s` appears in `e` only under sums, products and integer powers.
 fn algebraic_in(e: &Expr, s: Sym) -> bool {
     let x = s.symbol();
-    let mut holds: HashMap<Expr, bool> = HashMap::new();
+    let mut holds: ExprMap<bool> = ExprMap::default();
     for n in post_order(std::slice::from_ref(e)) {
         let has = |c: &Expr| holds.get(c).copied().unwrap_or(false);
         let (contains, ok) = match n.node() {
@@ -396,7 +395,7 @@ const MEMO_MAX: usize = 1 << 20;
 /// scratch: the expansion of a node does not depend on where it sits.
 #[derive(Default)]
 pub struct Expander {
-    memo: HashMap<Expr, Expr>,
+    memo: ExprMap<Expr>,
 }
 
 impl Expander {

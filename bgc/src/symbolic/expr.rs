@@ -366,6 +366,13 @@ impl Hash for Expr {
     }
 }
 
+/// A map keyed by expressions that hashes each key by its structural hash as it is (already well mixed), not
+/// again through `std`'s SipHash: the codegen and equation passes look up millions of nodes.
+pub type ExprMap<V> = std::collections::HashMap<Expr, V, super::intern::PassThroughState>;
+
+/// A set of expressions, hashed as [`ExprMap`] hashes its keys.
+pub type ExprSet = std::collections::HashSet<Expr, super::intern::PassThroughState>;
+
 impl Node {
     /// Calls `f` on each child, in order.
     pub(super) fn for_each_child<'a>(&'a self, mut f: impl FnMut(&'a Expr)) {

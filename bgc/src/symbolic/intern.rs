@@ -26,7 +26,7 @@ const MIN_SWEEP: usize = 1024;
 
 /// A hasher for keys that are already well-mixed 64-bit hashes: it passes them through.
 #[derive(Default)]
-pub(super) struct PassThrough(u64);
+pub struct PassThrough(u64);
 
 impl Hasher for PassThrough {
     fn finish(&self) -> u64 {
@@ -50,7 +50,7 @@ impl Hasher for PassThrough {
     }
 }
 
-pub(super) type PassThroughState = BuildHasherDefault<PassThrough>;
+pub type PassThroughState = BuildHasherDefault<PassThrough>;
 
 /// A node of the table, with its structural hash: the table grows and sweeps without reading the nodes, and a
 /// lookup upgrades only the entries whose whole hash matches.

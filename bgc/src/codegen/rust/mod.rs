@@ -71,7 +71,9 @@ use super::format::{self, Wrap};
 use super::layout::MAX_WIDTH;
 use super::names::{Namer, comment, string_literal};
 use super::{CompiledFile, CompiledModel};
-use crate::symbolic::{Expr, RUST_HELPER_FNS, RustCode, Symbol, rust_helpers_used, to_rust_code};
+use crate::symbolic::{
+    Expr, ExprMap, RUST_HELPER_FNS, RustCode, Symbol, rust_helpers_used, to_rust_code,
+};
 use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 use std::fmt::Write;
@@ -317,14 +319,14 @@ pub(in crate::codegen) struct Writer<'a> {
 /// identity). Both are pure functions of the expression for one writer. Cleared when full, to bound its memory.
 #[derive(Default)]
 struct Printed {
-    code: HashMap<Expr, RustCode>,
-    text: HashMap<Expr, String>,
+    code: ExprMap<RustCode>,
+    text: ExprMap<String>,
 }
 
 impl Printed {
     const CAPACITY: usize = 4096;
 
-    fn get_or<T: Clone>(map: &mut HashMap<Expr, T>, e: &Expr, make: impl FnOnce() -> T) -> T {
+    fn get_or<T: Clone>(map: &mut ExprMap<T>, e: &Expr, make: impl FnOnce() -> T) -> T {
         if let Some(v) = map.get(e) {
             return v.clone();
         }

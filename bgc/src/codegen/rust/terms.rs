@@ -18,8 +18,8 @@ use super::super::format;
 use super::super::layout::Body;
 use super::super::names::Namer;
 use super::Writer;
-use crate::symbolic::{Expr, Node, Symbol, SymbolKind};
-use std::collections::{HashMap, HashSet};
+use crate::symbolic::{Expr, ExprMap, Node, Symbol, SymbolKind};
+use std::collections::HashSet;
 use std::fmt::Write;
 
 /// The first character of a term's symbol name (not one a `.bg` name can start with); the rest is its field.
@@ -38,27 +38,27 @@ pub(in crate::codegen) struct ParamTerms {
     /// Each term's field and expression, in the order found.
     terms: Vec<(String, Expr)>,
     /// The symbol of each term, by its expression.
-    by_expr: HashMap<Expr, Symbol>,
+    by_expr: ExprMap<Symbol>,
     /// The field names taken (with the generated code's own names reserved, so that `ParamTerms::at` can bind
     /// each term to a local of the same name).
     fields: Namer,
     /// The parameters whose value is a method (a derived parameter): worth a term of their own.
     derived: HashSet<Symbol>,
     /// Whether a node reads parameters and literals only.
-    pure: HashMap<Expr, bool>,
+    pure: ExprMap<bool>,
     /// Rewritten nodes.
-    memo: HashMap<Expr, Expr>,
+    memo: ExprMap<Expr>,
 }
 
 impl ParamTerms {
     pub(in crate::codegen) fn new(derived: HashSet<Symbol>) -> ParamTerms {
         ParamTerms {
             terms: Vec::new(),
-            by_expr: HashMap::new(),
+            by_expr: ExprMap::default(),
             fields: Namer::with_reserved(),
             derived,
-            pure: HashMap::new(),
-            memo: HashMap::new(),
+            pure: ExprMap::default(),
+            memo: ExprMap::default(),
         }
     }
 

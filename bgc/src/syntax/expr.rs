@@ -35,13 +35,33 @@ impl<'a> Parser<'a> {
     }
 
     fn enter(&mut self) -> PResult<()> {
+        self.enter_level(
+            "nesting limit reached here",
+            "split the expression using parameters or outputs, or remove redundant parentheses",
+        )
+    }
+
+    /// One more operator of a `+ -` or `* /` chain: a long flat sum reaches the limit too, and needs other advice
+    /// than nesting does.
+    fn enter_chain(&mut self) -> PResult<()> {
+        self.enter_level(
+            "the limit is reached at this operator: each operator of a chain counts one level",
+            "group the terms in parentheses, as in `(a + b + c) + (d + e + f)`: the depth is then about the number \
+             of groups plus the length of the longest group, not the number of terms",
+        )
+    }
+
+    fn enter_level(&mut self, label: &str, help: &str) -> PResult<()> {
         self.depth += 1;
         if self.depth > MAX_DEPTH {
             let t = self.peek();
             self.diags.push(
-                Diagnostic::error("BG0105", format!("expression nested too deeply (more than {MAX_DEPTH} levels)"))
-                    .with_primary(self.tok_span(t), "nesting limit reached here")
-                    .with_help("split the expression using parameters or outputs, or remove redundant parentheses"),
+                Diagnostic::error(
+                    "BG0105",
+                    format!("expression nested too deeply (more than {MAX_DEPTH} levels)"),
+                )
+                .with_primary(self.tok_span(t), label.to_string())
+                .with_help(help.to_string()),
             );
             self.depth -= 1;
             return Err(Fail);
@@ -88,7 +108,7 @@ impl<'a> Parser<'a> {
         let result = (|| {
             let mut lhs = operand(self, index)?;
             while let Some(op) = operator(self.peek().kind) {
-                self.enter()?;
+                self.enter_chain()?;
                 levels += 1;
                 self.bump();
                 let rhs = operand(self, index)?;

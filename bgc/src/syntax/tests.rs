@@ -296,6 +296,23 @@ fn deep_nesting_is_an_error_not_a_crash() {
     assert_eq!(codes(&src), vec!["BG0105"]);
     let src = format!("model m {{ output y [1] = {}1; }}", "x * ".repeat(10_000));
     assert_eq!(codes(&src), vec!["BG0105"]);
+    // The advice for a long chain is to group its terms, and 400 terms in 20 groups of 20 are within the limit.
+    let src = format!("model m {{ output y [1] = {}1; }}", "x + ".repeat(400));
+    let (_, diags) = parse(FileId(0), &src);
+    assert!(
+        diags[0]
+            .help
+            .as_deref()
+            .unwrap_or("")
+            .contains("group the terms"),
+        "{diags:#?}"
+    );
+    let group = format!("({}x)", "x + ".repeat(19));
+    let src = format!(
+        "model m {{ output y [1] = {}; }}",
+        vec![group; 20].join(" + ")
+    );
+    assert!(codes(&src).is_empty());
     // Within the limit, all is well: 150 terms, 150 parentheses.
     let src = format!("model m {{ output y [1] = {}1; }}", "x + ".repeat(150));
     assert!(codes(&src).is_empty());

@@ -129,15 +129,16 @@ pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
 }
 
 /// The candidate nearest to `name`, if it is near enough to be a likely typo: at most one edit for short names,
-/// a third of the length for longer ones.
+/// a third of the length for longer ones. Among equally near candidates, one that differs from `name` in case
+/// only comes first (`Kg` is `kg`, not `g`), then the first in the order given (callers give declaration order).
 pub(crate) fn closest<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<String> {
     let limit = (name.chars().count() / 3).max(1);
     candidates
         .filter(|c| *c != name)
-        .map(|c| (edit_distance(name, c), c))
-        .filter(|(d, _)| *d <= limit)
-        .min_by_key(|(d, _)| *d)
-        .map(|(_, c)| c.to_string())
+        .map(|c| (edit_distance(name, c), !c.eq_ignore_ascii_case(name), c))
+        .filter(|(d, _, _)| *d <= limit)
+        .min_by_key(|(d, case_differs, _)| (*d, *case_differs))
+        .map(|(_, _, c)| c.to_string())
 }
 
 #[cfg(test)]
@@ -158,5 +159,9 @@ mod tests {
         assert_eq!(closest("sprin", names.into_iter()), Some("spring".into()));
         assert_eq!(closest("rotr", names.into_iter()), Some("rotor".into()));
         assert_eq!(closest("xyz", names.into_iter()), None);
+        // A case slip beats another single edit, whatever the order; otherwise the first given.
+        assert_eq!(closest("Kg", ["g", "kg"].into_iter()), Some("kg".into()));
+        assert_eq!(closest("Kg", ["kg", "g"].into_iter()), Some("kg".into()));
+        assert_eq!(closest("ab", ["ac", "aa"].into_iter()), Some("ac".into()));
     }
 }

@@ -373,6 +373,14 @@ impl<'a> Parser<'a> {
         }
         if numerator.is_empty() && one.is_none() && self.at(Tok::RBracket) {
             let t = self.peek();
+            let inside = self
+                .text
+                .get(open.end as usize..t.start as usize)
+                .unwrap_or("");
+            if !inside.trim().is_empty() {
+                // Not empty: characters the lexer refused (`[°]`), reported there with what to write instead.
+                return Err(Fail);
+            }
             return Err(self.bad_unit(
                 self.tok_span(open).to(self.tok_span(t)),
                 "an empty unit: write `[1]` for a dimensionless quantity",

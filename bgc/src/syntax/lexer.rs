@@ -255,12 +255,17 @@ impl<'a> Lexer<'a> {
             } else {
                 "invalid characters".to_string()
             };
+            let help = shown
+                .chars()
+                .next()
+                .and_then(typographic_help)
+                .unwrap_or(
+                    "names are ASCII letters, digits and `_`; text belongs in a \"string\"; comments start with `//`",
+                );
             self.out.diagnostics.push(
                 Diagnostic::error("BG0104", msg)
                     .with_primary(self.span(start, end), "not part of the language")
-                    .with_help(
-                        "names are ASCII letters, digits and `_`; text belongs in a \"string\"; comments start with `//`",
-                    ),
+                    .with_help(help),
             );
         }
     }
@@ -510,4 +515,18 @@ impl<'a> Lexer<'a> {
             }
         }
     }
+}
+
+/// What to write for a character that word processors, papers and other tools use in formulas and units.
+fn typographic_help(c: char) -> Option<&'static str> {
+    Some(match c {
+        '°' => "write degrees as `deg`, as in `[deg]` or `[deg/s]`",
+        '·' | '×' | '⋅' => {
+            "multiply by `*` in an expression, and by a space in a unit, as in `[N m]`"
+        }
+        '²' | '³' => "write a power with `^`, as in `x^2` or `[m^2]`",
+        '−' | '–' => "write the minus sign as the ASCII `-`",
+        '÷' => "divide by `/`",
+        _ => return None,
+    })
 }

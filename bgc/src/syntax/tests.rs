@@ -396,6 +396,25 @@ fn body_of(f: &File) -> &[Stmt] {
 }
 
 #[test]
+fn characters_of_typeset_formulas_say_what_to_write() {
+    for (text, help) in [
+        ("param a = 90 [°];", "`deg`"),
+        ("output y [1] = 2 · x;", "`*`"),
+        ("output y [1] = x²;", "`^`"),
+        ("output y [1] = 2 − x;", "`-`"),
+    ] {
+        let (_, diags) = parse(FileId(0), &format!("model m {{ {text} }}"));
+        if text.contains('°') {
+            // One error, at the character: `[°]` is not reported as an empty unit besides.
+            assert_eq!(diags.len(), 1, "{text}: {diags:#?}");
+        }
+        let junk = diags.iter().find(|d| d.code.0 == "BG0104");
+        let said = junk.and_then(|d| d.help.as_deref()).unwrap_or("");
+        assert!(said.contains(help), "{text}: {diags:#?}");
+    }
+}
+
+#[test]
 fn binary_junk_is_one_diagnostic_per_run() {
     let junk: String = (0..100_000)
         .map(|i| char::from(b"#$%&?@`|~\x01"[i % 10]))

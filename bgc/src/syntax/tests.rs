@@ -402,6 +402,8 @@ fn characters_of_typeset_formulas_say_what_to_write() {
         ("output y [1] = 2 · x;", "`*`"),
         ("output y [1] = x²;", "`^`"),
         ("output y [1] = 2 − x;", "`-`"),
+        ("bond a <- b;", "`bond a -> b;`"),
+        ("output y [1] = x > 0;", "`sign(x)`"),
     ] {
         let (_, diags) = parse(FileId(0), &format!("model m {{ {text} }}"));
         if text.contains('°') {

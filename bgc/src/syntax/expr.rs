@@ -179,6 +179,15 @@ impl<'a> Parser<'a> {
                 }
                 if index && self.at(Tok::LBracket) {
                     let open = self.bump();
+                    if self.at(Tok::Ident) {
+                        // `C spring = 1/k [m/N];`: a unit after a value, not an index of a field's port.
+                        return Err(self.expected(
+                            "an index",
+                            "units are not written in an expression: an element's value takes its unit from its \
+                             kind and domain, and a parameter's, input's or output's unit follows its name, as in \
+                             `param k = 800 [N/m];`",
+                        ));
+                    }
                     let (i, _) = self.positive_int("an index")?;
                     self.close(Tok::RBracket, open, "the index")?;
                     return Ok(Expr {

@@ -527,6 +527,7 @@ fn typographic_help(c: char) -> Option<&'static str> {
         '²' | '³' => "write a power with `^`, as in `x^2` or `[m^2]`",
         '−' | '–' => "write the minus sign as the ASCII `-`",
         '÷' => "divide by `/`",
+        'π' => "write pi as `pi`",
         '<' | '>' => {
             "a bond is written `bond a -> b;` (power from `a` to `b`); expressions have no comparisons, but \
              `min(a, b)`, `max(a, b)` and `sign(x)`"

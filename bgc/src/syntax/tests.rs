@@ -396,6 +396,24 @@ fn body_of(f: &File) -> &[Stmt] {
 }
 
 #[test]
+fn a_unit_after_a_value_is_not_taken_for_an_index() {
+    let (_, diags) = parse(FileId(0), "model m { C spring = 1/k [m/N]; }");
+    assert_eq!(diags.len(), 1, "{diags:#?}");
+    assert_eq!(diags[0].code.0, "BG0101");
+    let said = diags[0].help.as_deref().unwrap_or("");
+    assert!(
+        said.contains("units are not written in an expression"),
+        "{said}"
+    );
+    // An index is still an index.
+    let (_, diags) = parse(
+        FileId(0),
+        "model m { CF s(2) { e[1] = k * q[2]; e[2] = k * q[1]; } }",
+    );
+    assert!(diags.is_empty(), "{diags:#?}");
+}
+
+#[test]
 fn characters_of_typeset_formulas_say_what_to_write() {
     for (text, help) in [
         ("param a = 90 [°];", "`deg`"),
@@ -403,6 +421,7 @@ fn characters_of_typeset_formulas_say_what_to_write() {
         ("output y [1] = x²;", "`^`"),
         ("output y [1] = 2 − x;", "`-`"),
         ("bond a <- b;", "`bond a -> b;`"),
+        ("output y [1] = 2 * π;", "`pi`"),
         ("output y [1] = x > 0;", "`sign(x)`"),
     ] {
         let (_, diags) = parse(FileId(0), &format!("model m {{ {text} }}"));

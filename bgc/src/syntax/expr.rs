@@ -382,11 +382,13 @@ impl<'a> Parser<'a> {
         }
         if numerator.is_empty() && one.is_none() && self.at(Tok::RBracket) {
             let t = self.peek();
-            let inside = self
-                .text
-                .get(open.end as usize..t.start as usize)
-                .unwrap_or("");
-            if !inside.trim().is_empty() {
+            let (from, to) = (open.end, t.start);
+            let refused_inside = self.diags.iter().any(|d| {
+                d.code.0 == "BG0104"
+                    && d.primary_span()
+                        .is_some_and(|s| s.start >= from && s.end <= to)
+            });
+            if refused_inside {
                 // Not empty: characters the lexer refused (`[°]`), reported there with what to write instead.
                 return Err(Fail);
             }

@@ -396,6 +396,13 @@ fn body_of(f: &File) -> &[Stmt] {
 }
 
 #[test]
+fn a_unit_with_only_a_comment_inside_is_reported_empty() {
+    let (_, diags) = parse(FileId(0), "model m { param a = 1 [ // none\n ]; }");
+    assert_eq!(diags.len(), 1, "{diags:#?}");
+    assert_eq!(diags[0].code.0, "BG0116");
+}
+
+#[test]
 fn a_unit_after_a_value_is_not_taken_for_an_index() {
     let (_, diags) = parse(FileId(0), "model m { C spring = 1/k [m/N]; }");
     assert_eq!(diags.len(), 1, "{diags:#?}");

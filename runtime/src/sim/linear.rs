@@ -17,7 +17,7 @@ use nalgebra::{DMatrix, SMatrix, SVector};
 use super::error::SimError;
 use crate::linalg::{DiscretizeError, zoh_blocks};
 use crate::linearize::BoxedJacobians;
-use crate::matrix::{boxed_copy, boxed_fixed, product_sum, zeroed_box};
+use crate::matrix::{boxed_copy, boxed_fixed, dynamic, product_sum, zeroed_box};
 use crate::model::ContinuousModel;
 use crate::statespace::StateSpace;
 
@@ -160,17 +160,10 @@ impl<const NX: usize, const NU: usize> ZohStep<NX, NU> {
             });
         }
         // The disturbance enters as a second input of identity gain: `E_d` is the last block of `B_d`.
-        let a = DMatrix::from_fn(NX, NX, |i, j| plant.a[(i, j)]);
-        let b = DMatrix::from_fn(NX, NU + NX, |i, j| {
-            if j < NU {
-                plant.b[(i, j)]
-            } else if j - NU == i {
-                1.0
-            } else {
-                0.0
-            }
-        });
-        let (ad, bd) = zoh_blocks(&a, &b, t).map_err(|e| SimError::Discretisation {
+        let mut b = DMatrix::<f64>::zeros(NX, NU + NX);
+        b.columns_mut(0, NU).copy_from(&*plant.b);
+        b.columns_mut(NU, NX).fill_with_identity();
+        let (ad, bd) = zoh_blocks(&dynamic(&plant.a), &b, t).map_err(|e| SimError::Discretisation {
             message: match e {
                 // Finite matrices whose product with T left f64: not a non-finite entry of the caller's A.
                 DiscretizeError::Overflow { .. } => format!(

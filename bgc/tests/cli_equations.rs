@@ -243,6 +243,36 @@ fn nonlinear_model_needs_an_operating_point() {
 }
 
 #[test]
+fn an_operating_point_names_what_a_wrong_name_is() {
+    let model = repo("models/back_support.bg");
+    // A typo gets the nearest name.
+    let (code, _, err) = bgc(&["statespace", &model, "--at", "p_rotr=1"]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains(
+            "unknown state or input `p_rotr` (did you mean `p_rotor`?); the model has p_rotor,"
+        ),
+        "{err}"
+    );
+    // An integrated flow that no rate or output reads is a state of the model, not of its state space.
+    let (code, _, err) = bgc(&["statespace", &model, "--at", "theta_m=0.1"]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains(
+            "`theta_m` is an integrated flow (`var`) that neither the rates nor the outputs read"
+        ),
+        "{err}"
+    );
+    // A parameter's typo, through the same path as every `NAME=VALUE` option.
+    let (code, _, err) = bgc(&["statespace", &model, "--param", "J_mm=1"]);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("unknown parameter `J_mm` (did you mean `J_m`?)"),
+        "{err}"
+    );
+}
+
+#[test]
 fn parameter_errors_are_reported() {
     let (code, _, err) = bgc(&["statespace", &corpus("oscillator.bg"), "--param", "q=1"]);
     assert_eq!(code, 1);

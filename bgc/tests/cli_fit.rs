@@ -266,7 +266,10 @@ fn bad_records_are_refused_with_the_row_or_column_named() {
     assert!(err.contains("measured values"), "{err}");
     let (code, err) = refused(&pend, "t,theta_pend\n0,0\n0.1,0\n0.2,0\n", "J_q");
     assert_eq!(code, 1);
-    assert!(err.contains("--free `J_q`"), "{err}");
+    assert!(
+        err.contains("--free: unknown parameter `J_q` (did you mean `J_p`?)"),
+        "{err}"
+    );
 }
 
 #[test]

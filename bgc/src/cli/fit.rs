@@ -3,7 +3,9 @@
 use super::fit_model::Interpreted;
 use super::io::stderrln;
 use super::model::derive_one;
-use super::params::{Assignment, assign, check_physical, reject_repeats, values_or_zero};
+use super::params::{
+    Assignment, assign, check_physical, reject_repeats, unknown_name, values_or_zero,
+};
 use super::quantities::{self, Declared};
 use super::{ReportFormat, Status};
 use bgc::equations::Equations;
@@ -140,10 +142,10 @@ fn free_params(
     let mut out = Vec::with_capacity(args.free.len());
     for name in args.free {
         let Some(index) = declared.iter().position(|d| &d.name == name) else {
-            let known: Vec<&str> = declared.iter().map(|d| d.name.as_str()).collect();
+            let known = super::params::names(declared);
             return Err(format!(
-                "--free `{name}` is no parameter of the model; it has {}",
-                known.join(", ")
+                "--free: {}",
+                unknown_name("parameter", name, &known)
             ));
         };
         let log = start[index] > 0.0 && positive_by_unit(model, declared[index].unit);
@@ -221,9 +223,8 @@ fn weights(record: &Record, outputs: &[&str], given: &[Assignment]) -> Result<Ve
     for a in given {
         let Some(o) = outputs.iter().position(|n| *n == a.name) else {
             return Err(format!(
-                "--weight `{}` is no output of the model; it has {}",
-                a.name,
-                outputs.join(", ")
+                "--weight: {}",
+                unknown_name("output", &a.name, outputs)
             ));
         };
         let Some(c) = record.outputs.iter().position(|&m| m == o) else {

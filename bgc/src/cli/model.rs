@@ -296,6 +296,16 @@ fn operating_point(
         })
         .collect();
     declared.extend(quantities::inputs(model));
+    if let Some(a) = at
+        .iter()
+        .find(|a| by_name.contains_key(a.name.as_str()) && !state_names.contains(&a.name))
+    {
+        return Err(format!(
+            "`{}` is an integrated flow (`var`) that neither the rates nor the outputs read, so it is no state \
+             of this state space and the linearisation does not depend on it: leave it out of --at",
+            a.name
+        ));
+    }
     let values = values_or_zero("state or input", "--at", &declared, at)?;
     if verbose {
         stderr(&quantities::describe_values(

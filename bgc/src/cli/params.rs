@@ -49,20 +49,39 @@ pub fn assign(
     let mut out = Vec::with_capacity(given.len());
     for a in given {
         let Some(i) = declared.iter().position(|d| d.name == a.name) else {
-            let names: Vec<&str> = declared.iter().map(|d| d.name.as_str()).collect();
-            return Err(format!(
-                "unknown {what} `{}`; the model has {}",
-                a.name,
-                if names.is_empty() {
-                    "none".to_string()
-                } else {
-                    names.join(", ")
-                }
-            ));
+            return Err(unknown_name(what, &a.name, &names(declared)));
         };
         out.push((i, quantities::value_in_declared(what, &declared[i], a)?));
     }
     Ok(out)
+}
+
+/// The names listed in full when a given name is unknown; a model of thousands of states lists the first ones.
+const LISTED_NAMES: usize = 24;
+
+/// The error for a name that is none of `names` (what the model has of a kind): the nearest name when it is likely a
+/// typo, and the names.
+pub fn unknown_name(what: &str, name: &str, names: &[&str]) -> String {
+    let suggestion = bgc::lower::closest(name, names.iter().copied())
+        .map(|c| format!(" (did you mean `{c}`?)"))
+        .unwrap_or_default();
+    let listed = if names.is_empty() {
+        "none".to_string()
+    } else if names.len() <= LISTED_NAMES {
+        names.join(", ")
+    } else {
+        format!(
+            "{}, ... ({} in all)",
+            names[..LISTED_NAMES].join(", "),
+            names.len()
+        )
+    };
+    format!("unknown {what} `{name}`{suggestion}; the model has {listed}")
+}
+
+/// The names of `declared`.
+pub fn names(declared: &[Declared]) -> Vec<&str> {
+    declared.iter().map(|d| d.name.as_str()).collect()
 }
 
 /// The values of `declared` in their declared units: 0 where not given.
@@ -151,16 +170,7 @@ pub fn input_signals(
     let mut signals: Vec<Option<Signal>> = vec![None; declared.len()];
     for a in given {
         let Some(i) = declared.iter().position(|d| d.name == a.name) else {
-            let names: Vec<&str> = declared.iter().map(|d| d.name.as_str()).collect();
-            return Err(format!(
-                "unknown input `{}`; the model has {}",
-                a.name,
-                if names.is_empty() {
-                    "no inputs".to_string()
-                } else {
-                    names.join(", ")
-                }
-            ));
+            return Err(unknown_name("input", &a.name, &names(&declared)));
         };
         let (text, unit) =
             quantities::split_unit(&a.value).map_err(|e| format!("input `{}` = {e}", a.name))?;
@@ -198,5 +208,29 @@ pub fn zero_inputs_warning(zero: &[String]) -> Option<String> {
             "warning: inputs {} are not given and are held at 0 (set them with --input NAME=EXPR)",
             list.join(", ")
         )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_unknown_name_lists_the_first_names_of_a_large_model_and_the_nearest() {
+        let many: Vec<String> = (1..=1000).map(|i| format!("p_mass{i}")).collect();
+        let names: Vec<&str> = many.iter().map(String::as_str).collect();
+        let err = unknown_name("state", "p_mas7", &names);
+        assert!(err.starts_with(
+            "unknown state `p_mas7` (did you mean `p_mass7`?); the model has p_mass1, p_mass2,"
+        ));
+        assert!(err.ends_with("p_mass24, ... (1000 in all)"), "{err}");
+        assert_eq!(
+            unknown_name("input", "u", &[]),
+            "unknown input `u`; the model has none"
+        );
+        assert_eq!(
+            unknown_name("parameter", "q", &["m", "k", "d"]),
+            "unknown parameter `q`; the model has m, k, d"
+        );
     }
 }

@@ -43,6 +43,7 @@ use std::path::{Path, PathBuf};
 
 pub use imports::{STD_DISPLAY_NAME, STD_NAME, STD_SOURCE, normalize};
 pub use instances::add_instance_context;
+pub use scope::closest;
 
 /// Where lowering gets the text of imported files. The loader decides which file an import names and what
 /// identifies it (its key: two imports with one key are one file, so a diamond of imports loads it once and a file

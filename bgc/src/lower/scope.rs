@@ -129,14 +129,16 @@ pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
 }
 
 /// The candidate nearest to `name`, if it is near enough to be a likely typo: at most one edit for short names,
-/// a third of the length for longer ones. Among equally near candidates, one that differs from `name` in case
-/// only comes first (`Kg` is `kg`, not `g`), then the first in the order given (callers give declaration order).
-pub(crate) fn closest<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<String> {
-    let limit = (name.chars().count() / 3).max(1);
+/// a third of the length for longer ones, and never one that rewrites every character (`q` is not a typo of `m`)
+/// unless it differs in case only. Among equally near candidates, one that differs from `name` in case only comes
+/// first (`Kg` is `kg`, not `g`), then the first in the order given (callers give declaration order).
+pub fn closest<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<String> {
+    let length = name.chars().count();
+    let limit = (length / 3).max(1);
     candidates
         .filter(|c| *c != name)
         .map(|c| (edit_distance(name, c), !c.eq_ignore_ascii_case(name), c))
-        .filter(|(d, _, _)| *d <= limit)
+        .filter(|(d, case_differs, _)| *d <= limit && (*d < length || !*case_differs))
         .min_by_key(|(d, case_differs, _)| (*d, *case_differs))
         .map(|(_, _, c)| c.to_string())
 }
@@ -163,5 +165,8 @@ mod tests {
         assert_eq!(closest("Kg", ["g", "kg"].into_iter()), Some("kg".into()));
         assert_eq!(closest("Kg", ["kg", "g"].into_iter()), Some("kg".into()));
         assert_eq!(closest("ab", ["ac", "aa"].into_iter()), Some("ac".into()));
+        // A one-letter name is no typo of another letter, but is of the same letter in the other case.
+        assert_eq!(closest("q", ["m", "k", "d"].into_iter()), None);
+        assert_eq!(closest("G", ["F", "g"].into_iter()), Some("g".into()));
     }
 }

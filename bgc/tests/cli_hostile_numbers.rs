@@ -253,6 +253,44 @@ fn a_coefficient_whose_reciprocal_overflows_is_refused_at_the_element() {
     assert!(err.lines().all(|l| l.len() < 200), "{err}");
 }
 
+/// A finite initial state whose stored energy overflows said "the initial energy is not finite", which named no
+/// element; it now names the storage whose energy overflows, and says so when each term is finite and their sum
+/// is not.
+#[test]
+fn an_initial_stored_energy_that_overflows_names_its_element() {
+    let model = corpus("oscillator.bg");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["simulate", &model, "--t-end", "0.01"];
+        args.extend(extra);
+        bgc(&args)
+    };
+    // q²/(2·(1/k)) = 1e320·800/2 overflows; the rates (k·q = 8e162) do not.
+    let (code, _, err) = run(&["--x0", "q_spring=1e160"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("error: the initial stored energy of `spring` is not finite"),
+        "{err}"
+    );
+    // With m = 0.5 and k = 1, p²/(2m) = 1.69e308 and k·q²/2 = 8.45e307 are finite, and their sum is not.
+    let (code, _, err) = run(&[
+        "--param",
+        "m=0.5",
+        "--param",
+        "k=1",
+        "--x0",
+        "p_mass=1.3e154",
+        "--x0",
+        "q_spring=1.3e154",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains(
+            "the initial energy (its terms are finite; their sum overflows) is not finite"
+        ),
+        "{err}"
+    );
+}
+
 /// A record with times 0 and 1e308 said "the exact discretisation failed: matrix A has a non-finite entry -inf at
 /// (0, 0)", a matrix the user never wrote; the error now names the sample interval.
 #[test]

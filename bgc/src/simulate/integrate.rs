@@ -217,8 +217,14 @@ pub fn run_streaming_noted(
     let first = system.row(&y, 0.0, &mut u, &mut stack)?;
     if let Some(i) = first.iter().position(|v| !v.is_finite()) {
         let columns = system.columns();
+        // The stored energy is the third column from the end (see `System::columns`).
+        let what = if i + 3 == columns.len() {
+            system.stored_energy_fault(&y, 0.0, &u, &mut stack)
+        } else {
+            None
+        };
         return Err(SimError::NonFiniteStart {
-            what: columns.get(i).cloned().unwrap_or_default(),
+            what: what.unwrap_or_else(|| columns.get(i).cloned().unwrap_or_default()),
         });
     }
     if sink(0.0, &first).is_break() {

@@ -136,6 +136,8 @@ pub struct System {
     jacobian: Option<Vec<(usize, usize, Program)>>,
     outputs_h: Vec<Program>,
     stored: Program,
+    /// The terms of `stored`, by element.
+    stored_terms: Vec<(String, Program)>,
     /// The I-fields' mass blocks: the states whose rates solve `M ẋ_B = F` (their `rates` give `F`), and `M`
     /// row-major.
     mass: Vec<(Vec<usize>, Vec<Program>)>,
@@ -202,12 +204,19 @@ impl System {
             rate_exprs.push((e, format!("the rate of `{state}`")));
         }
         let mut warnings = Vec::new();
+        // Each stored energy's program is kept, to name the term when the sum is not finite.
+        let mut stored_terms = Vec::new();
         let mut sum =
             |kind: EnergyKind| {
                 let mut terms = Vec::new();
                 for term in eqs.energy.iter().filter(|t| t.kind == kind) {
-                    match &term.value {
-                    Some(v) if compile(v, "").is_ok() => terms.push(v.clone()),
+                    match term.value.as_ref().map(|v| (v, compile(v, ""))) {
+                    Some((v, Ok(program))) => {
+                        terms.push(v.clone());
+                        if kind == EnergyKind::Stored {
+                            stored_terms.push((term.element.clone(), program));
+                        }
+                    }
                     _ => warnings.push(format!(
                         "the {} {} of `{}` has no expression and is left out of the `{}` column",
                         kind.name(),
@@ -279,6 +288,7 @@ impl System {
             jacobian,
             outputs_h,
             stored: compile(&stored, "the stored energy")?,
+            stored_terms,
             mass,
             loops,
             ext_len,
@@ -487,6 +497,27 @@ impl System {
         row.push(self.stored.eval(&v, stack));
         row.extend(y.iter().skip(n).take(2));
         Ok(row)
+    }
+
+    /// What makes the stored energy at `y` not finite, when it is not: the first element whose stored energy is
+    /// not finite, or the sum of finite terms. Reads the inputs (and the loops' solution) [`System::row`] left in
+    /// `u`.
+    pub fn stored_energy_fault(
+        &self,
+        y: &[f64],
+        t: f64,
+        u: &[f64],
+        stack: &mut Vec<f64>,
+    ) -> Option<String> {
+        let v = self.values(y, u, t);
+        if self.stored.eval(&v, stack).is_finite() {
+            return None;
+        }
+        let culprit = self.stored_terms.iter().find_map(|(element, p)| {
+            let e = p.eval(&v, stack);
+            (!e.is_finite()).then(|| format!("stored energy of `{element}`"))
+        });
+        Some(culprit.unwrap_or_else(|| "energy (its terms are finite; their sum overflows)".into()))
     }
 
     /// The CSV header matching [`System::row`], after `t`.

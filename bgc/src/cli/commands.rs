@@ -1,6 +1,6 @@
 //! The subcommands. Each returns the process status; all printing happens here.
 
-use super::io::{loader, read_source, stderr, stderrln, stdout, stdoutln};
+use super::io::{keep_until_exit, loader, read_source, stderr, stderrln, stdout, stdoutln};
 use super::{DiagFormat, DrawFormat, ReportFormat, Status};
 use bgc::diagnostic::{Diagnostic, Severity, has_errors, render};
 use bgc::span::SourceMap;
@@ -310,9 +310,9 @@ pub fn rust(path: &Path, runtime: bool, color: bool) -> Status {
             let cwd = std::env::current_dir().ok();
             let name = bgc::build::header_name(path, cwd.as_deref());
             let options = bgc::codegen::rust::Options { runtime };
-            stdout(&bgc::codegen::rust::generate_with(
-                &compiled, &name, options,
-            ));
+            let code = bgc::codegen::rust::generate_with(&compiled, &name, options);
+            stdout(&code);
+            keep_until_exit(compiled);
             Status::Ok
         }
         Err(diags) => {

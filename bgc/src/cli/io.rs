@@ -90,6 +90,14 @@ pub fn stdout(text: &str) {
     }
 }
 
+/// Leaves `value` to the end of the process instead of dropping it: a command's derived model lives until the
+/// command ends, and freeing its millions of expression nodes one by one took 0.43 s of the 5.9 s of
+/// `bgc equations` (0.9 s of `bgc rust`) on a 100,000-mass chain, where the exit returns the memory at once. For
+/// plain data only: nothing whose drop writes or releases anything but memory.
+pub fn keep_until_exit<T>(value: T) {
+    std::mem::forget(value);
+}
+
 /// Ends the process after a failed write to standard output: quietly (0) for a closed pipe, else with status 2.
 pub fn output_failed(e: &std::io::Error) -> ! {
     if e.kind() == std::io::ErrorKind::BrokenPipe {

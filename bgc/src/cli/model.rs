@@ -1,7 +1,7 @@
 //! `bgc equations` and `bgc statespace`: the equations stage and the linear state space of one model.
 
 use super::commands::{Loaded, count_line, load_one};
-use super::io::{stderr, stderrln, stdout, stdoutln};
+use super::io::{keep_until_exit, stderr, stderrln, stdout, stdoutln};
 use super::matrix_text;
 use super::params::{Assignment, param_values, values_or_zero};
 use super::quantities::{self, Declared};
@@ -66,6 +66,7 @@ pub fn equations(
                 .unwrap_or_else(|_| "{}".into()),
         ),
     }
+    keep_until_exit(d);
     if failed {
         Status::InputErrors
     } else {
@@ -97,7 +98,9 @@ pub fn statespace(
         Ok(x) => x,
         Err(s) => return s,
     };
-    match state_space(&d, args) {
+    let result = state_space(&d, args);
+    keep_until_exit(d);
+    match result {
         Ok(v) => {
             match (args.format, args.sparse) {
                 (ReportFormat::Json, false) => stdout(&json_rows(&v)),

@@ -205,7 +205,7 @@ pub(super) fn load_one(path: &Path, wanted: Option<&str>, color: bool) -> Result
             stderrln(&format!(
                 "error: {} declares several models ({}); choose one with --model",
                 path.display(),
-                names.join(", ")
+                super::params::name_list(&names)
             ));
             return Err(Status::UsageOrIo);
         }
@@ -215,7 +215,7 @@ pub(super) fn load_one(path: &Path, wanted: Option<&str>, color: bool) -> Result
                 stderrln(&format!(
                     "error: {} has no model `{w}`; it declares {}",
                     path.display(),
-                    names.join(", ")
+                    super::params::name_list(&names)
                 ));
                 return Err(Status::UsageOrIo);
             }

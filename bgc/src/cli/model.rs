@@ -3,7 +3,7 @@
 use super::commands::{Loaded, count_line, load_one};
 use super::io::{keep_until_exit, stderr, stderrln, stdout, stdoutln};
 use super::matrix_text;
-use super::params::{Assignment, param_values, values_or_zero};
+use super::params::{Assignment, name_list, param_values, values_or_zero};
 use super::quantities::{self, Declared};
 use super::sparse;
 use super::{Coords, EquationsFormat, ReportFormat, Status};
@@ -198,8 +198,8 @@ fn energy_coords(
         return Err(format!(
             "the model is not linear ({why}): give an operating point with --at NAME=VALUE,... (states: {}; inputs: \
              {}; those not given are 0)",
-            list(&state_names),
-            list(&eqs.inputs)
+            name_list(&state_names),
+            name_list(&eqs.inputs)
         ));
     }
     let fixed = fixed_params(eqs, args.params, params);
@@ -262,14 +262,6 @@ fn dense_fits(states: usize, symbolic: bool) -> Result<(), String> {
              {MAX_DENSE_STATES}² printed densely; use --sparse for the non-zero entries as coordinate triplets"
         )
     })
-}
-
-fn list(names: &[String]) -> String {
-    if names.is_empty() {
-        "none".into()
-    } else {
-        names.join(", ")
-    }
 }
 
 /// The operating point from `--at`: state values and input values by name (each in its unit: see

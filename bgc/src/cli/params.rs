@@ -56,7 +56,7 @@ pub fn assign(
     Ok(out)
 }
 
-/// The names listed in full when a given name is unknown; a model of thousands of states lists the first ones.
+/// The names a message lists in full; a model of thousands of states lists the first ones and the count.
 const LISTED_NAMES: usize = 24;
 
 /// The error for a name that is none of `names` (what the model has of a kind): the nearest name when it is likely a
@@ -65,18 +65,20 @@ pub fn unknown_name(what: &str, name: &str, names: &[&str]) -> String {
     let suggestion = bgc::lower::closest(name, names.iter().copied())
         .map(|c| format!(" (did you mean `{c}`?)"))
         .unwrap_or_default();
-    let listed = if names.is_empty() {
-        "none".to_string()
-    } else if names.len() <= LISTED_NAMES {
-        names.join(", ")
-    } else {
-        format!(
-            "{}, ... ({} in all)",
-            names[..LISTED_NAMES].join(", "),
-            names.len()
-        )
-    };
-    format!("unknown {what} `{name}`{suggestion}; the model has {listed}")
+    format!(
+        "unknown {what} `{name}`{suggestion}; the model has {}",
+        name_list(names)
+    )
+}
+
+/// `names` for a message, comma-separated: "none" when empty, the first [`LISTED_NAMES`] and the count when more.
+pub fn name_list<S: AsRef<str>>(names: &[S]) -> String {
+    let first: Vec<&str> = names.iter().take(LISTED_NAMES).map(AsRef::as_ref).collect();
+    match names.len() {
+        0 => "none".to_string(),
+        n if n <= LISTED_NAMES => first.join(", "),
+        n => format!("{}, ... ({n} in all)", first.join(", ")),
+    }
 }
 
 /// The names of `declared`.
@@ -228,6 +230,9 @@ mod tests {
             unknown_name("input", "u", &[]),
             "unknown input `u`; the model has none"
         );
+        // Every list of a model's names in a message is bounded the same way.
+        assert_eq!(name_list(&many[..24]).matches(", ").count(), 23);
+        assert!(name_list(&many[..25]).ends_with("p_mass24, ... (25 in all)"));
         assert_eq!(
             unknown_name("parameter", "q", &["m", "k", "d"]),
             "unknown parameter `q`; the model has m, k, d"

@@ -20,6 +20,11 @@ use super::parser::{Fail, MAX_DEPTH, PResult, Parser};
 use crate::diagnostic::Diagnostic;
 use crate::span::Span;
 
+/// The help for a unit written inside an expression (`1/k [m/N]`, `(1 [m^2])`).
+pub(super) const UNITS_IN_EXPRESSIONS: &str = "units are not written in an expression: an element's value takes its \
+     unit from its kind and domain, and a parameter's, input's or output's unit follows its name, as in \
+     `param k = 800 [N/m];`";
+
 const EXPR_HELP: &str = "an expression is built from numbers, names, calls such as `f(x)` or `sin(x)`, parentheses \
                          and the operators `+ - * / ^`";
 
@@ -181,12 +186,7 @@ impl<'a> Parser<'a> {
                     let open = self.bump();
                     if self.at(Tok::Ident) {
                         // `C spring = 1/k [m/N];`: a unit after a value, not an index of a field's port.
-                        return Err(self.expected(
-                            "an index",
-                            "units are not written in an expression: an element's value takes its unit from its \
-                             kind and domain, and a parameter's, input's or output's unit follows its name, as in \
-                             `param k = 800 [N/m];`",
-                        ));
+                        return Err(self.expected("an index", UNITS_IN_EXPRESSIONS));
                     }
                     let (i, _) = self.positive_int("an index")?;
                     self.close(Tok::RBracket, open, "the index")?;
@@ -296,6 +296,17 @@ impl<'a> Parser<'a> {
         })
     }
 
+    /// A `[` right after a number, a name or a `)`, where the expression could not go on: a unit written after a
+    /// value, as other tools and papers write them (`0.5 [m/N]`).
+    pub(super) fn unit_after_value(&self) -> bool {
+        self.at(Tok::LBracket)
+            && self.pos > 0
+            && self
+                .toks
+                .get(self.pos - 1)
+                .is_some_and(|p| matches!(p.kind, Tok::Number | Tok::Ident | Tok::RParen))
+    }
+
     /// A closing bracket matching `open`; when missing, the error shows where the bracket was opened. When the
     /// next token is on a later line, the bracket is missing at the end of the line, and the error points there.
     pub(super) fn close(&mut self, kind: Tok, open: Token, what: &str) -> PResult<Token> {
@@ -318,7 +329,11 @@ impl<'a> Parser<'a> {
             )
             .with_primary(at, format!("expected {want}"))
             .with_secondary(self.tok_span(open), "opened here")
-            .with_help(format!("add the missing {want}")),
+            .with_help(if kind == Tok::RParen && self.unit_after_value() {
+                UNITS_IN_EXPRESSIONS.to_string()
+            } else {
+                format!("add the missing {want}")
+            }),
         );
         Err(Fail)
     }

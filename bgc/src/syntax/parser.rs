@@ -322,7 +322,12 @@ impl<'a> Parser<'a> {
             self.diags.push(d.with_help("end every statement with `;`"));
             return Ok(());
         }
-        Err(self.expected(&format!("`;` after {what}"), "end every statement with `;`"))
+        let help = if self.unit_after_value() {
+            super::expr::UNITS_IN_EXPRESSIONS
+        } else {
+            "end every statement with `;`"
+        };
+        Err(self.expected(&format!("`;` after {what}"), help))
     }
 
     /// Reads a name being declared or referred to. A keyword or a name with non-ASCII letters is reported but

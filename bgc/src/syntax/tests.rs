@@ -412,6 +412,28 @@ fn a_unit_after_a_value_is_not_taken_for_an_index() {
         said.contains("units are not written in an expression"),
         "{said}"
     );
+    // After a number or a `)`, wherever the expression stops at the `[`: the end of the statement, a parenthesis, a
+    // call's arguments.
+    for text in [
+        "C spring = 0.5 [m/N];",
+        "C s { e = k*q^3/(1 [m^2]); }",
+        "output y [m] = (a) [m];",
+        "output y [m] = max(a, 2 [m]);",
+    ] {
+        let (_, diags) = parse(FileId(0), &format!("model m {{ {text} }}"));
+        assert_eq!(diags.len(), 1, "{text}: {diags:#?}");
+        let said = diags[0].help.as_deref().unwrap_or("");
+        assert!(
+            said.contains("units are not written in an expression"),
+            "{text}: {said}"
+        );
+    }
+    // A missing `;` or `)` elsewhere keeps its own help.
+    let (_, diags) = parse(FileId(0), "model m { C spring = 0.5 R; }");
+    assert_eq!(
+        diags[0].help.as_deref(),
+        Some("end every statement with `;`")
+    );
     // An index is still an index.
     let (_, diags) = parse(
         FileId(0),

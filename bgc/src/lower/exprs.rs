@@ -473,12 +473,38 @@ impl Builder<'_> {
         }
         let Some(func) = Func::from_name(&f.name) else {
             let names = Func::ALL.map(Func::name);
-            let help = match closest(
-                &f.name,
-                names.iter().copied().chain(["e", "f", "p", "q", "int"]),
-            ) {
-                Some(c) => format!("did you mean `{c}`?"),
-                None => format!("the functions are {}", names.join(", ")),
+            let declared = self.scopes.get(cx.scope).and_then(|s| s.get(&f.name));
+            let help = match (declared, other_tool_function(&f.name)) {
+                // `F(t)`: an input, parameter, output or var is a value, not a function of time.
+                (
+                    Some(
+                        entity @ (Entity::Param(_)
+                        | Entity::Input(_)
+                        | Entity::Output(_)
+                        | Entity::Var(_)),
+                    ),
+                    _,
+                ) => {
+                    let now = if matches!(entity, Entity::Input(_)) {
+                        ", its value at the current time"
+                    } else {
+                        ""
+                    };
+                    format!(
+                        "`{}` is {}, a value and not a function: write `{}`{now}",
+                        f.name,
+                        entity.describe(),
+                        f.name
+                    )
+                }
+                (_, Some(help)) => help.to_string(),
+                _ => match closest(
+                    &f.name,
+                    names.iter().copied().chain(["e", "f", "p", "q", "int"]),
+                ) {
+                    Some(c) => format!("did you mean `{c}`?"),
+                    None => format!("the functions are {}", names.join(", ")),
+                },
             };
             self.diags.push(
                 Diagnostic::error("BG0208", format!("unknown function `{}`", f.name))
@@ -630,4 +656,28 @@ pub(crate) fn var_letter(v: PortVar) -> &'static str {
         PortVar::Momentum => "p",
         PortVar::Displacement => "q",
     }
+}
+
+/// What bgc writes for a function name of other modelling tools and languages, or `None`.
+fn other_tool_function(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "flow" => "the flow of element or port `x` is `f(x)`",
+        "effort" => "the effort of element or port `x` is `e(x)`",
+        "momentum" => "the momentum of an inertia `x` is `p(x)`",
+        "displacement" | "charge" => "the displacement of a compliance `x` is `q(x)`",
+        "log" => "write `ln` for the natural logarithm, `log10` for the decimal one",
+        "pow" | "power" => "write a power with `^`, as in `x^2`",
+        "sgn" | "signum" => "did you mean `sign`?",
+        "fabs" => "did you mean `abs`?",
+        "arcsin" => "did you mean `asin`?",
+        "arccos" => "did you mean `acos`?",
+        "arctan" => "did you mean `atan`?",
+        "integ" | "integral" | "integrate" => {
+            "an integral is a `var`: declare `var theta [rad] = int(f(x));` and use `theta`"
+        }
+        "der" | "diff" | "ddt" | "derivative" => {
+            "expressions have no time derivatives: a storage element (`C`, `I`) holds a state and its rate"
+        }
+        _ => return None,
+    })
 }

@@ -380,6 +380,42 @@ fn unknown_name_suggests_the_closest_declared_name() {
 }
 
 #[test]
+fn a_function_name_of_another_tool_or_a_value_called_says_what_to_write() {
+    let model = |expr: &str| {
+        format!(
+            "model m {{ domain translational; param k = 2 [N/m]; input F [N]; Se drive = F; I mass = 1; 1 v; \
+             bond drive -> v -> mass; output y [N] = {expr}; }}"
+        )
+    };
+    for (expr, called, help) in [
+        (
+            "F(t)",
+            "F",
+            "`F` is an input, a value and not a function: write `F`, its value at the current time",
+        ),
+        (
+            "k(2) * 1",
+            "k",
+            "`k` is a parameter, a value and not a function: write `k`",
+        ),
+        (
+            "effort(mass)",
+            "effort",
+            "the effort of element or port `x` is `e(x)`",
+        ),
+        (
+            "F * log(2)",
+            "log",
+            "write `ln` for the natural logarithm, `log10` for the decimal one",
+        ),
+        ("F * sgn(F)", "sgn", "did you mean `sign`?"),
+    ] {
+        let d = expect_one(&model(expr), "BG0208", called);
+        assert_eq!(d.help.as_deref(), Some(help), "{expr}");
+    }
+}
+
+#[test]
 fn non_physical_values_are_errors_and_zero_resistance_is_not() {
     // A zero stiffness makes an infinite compliance; the secondary label shows the parameter's value.
     let d = expect_one(

@@ -200,8 +200,17 @@ impl<'a> Parser<'a> {
                     span: name.span,
                 })
             }
+            Tok::Star if self.after(Tok::Star) => Err(self.expected(
+                "an expression",
+                "a power is written with `^`, as in `x^2` (not `x**2`)",
+            )),
             _ => Err(self.expected("an expression", EXPR_HELP)),
         }
+    }
+
+    /// The token before the current one is of `kind`.
+    fn after(&self, kind: Tok) -> bool {
+        self.pos > 0 && self.toks.get(self.pos - 1).is_some_and(|p| p.kind == kind)
     }
 
     /// The arguments of a call, after its `(`. The single argument of `e`, `f`, `p` or `q` that is written as a node

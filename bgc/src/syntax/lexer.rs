@@ -314,6 +314,21 @@ impl<'a> Lexer<'a> {
                 rest = r;
                 continue;
             }
+            if self.foreign_comment(rest) {
+                self.flush_junk();
+                let len = rest.find(['\n', '\r']).unwrap_or(rest.len());
+                let marker = rest.get(..1).unwrap_or("#");
+                self.out.diagnostics.push(
+                    Diagnostic::error("BG0104", format!("invalid character {marker:?}"))
+                        .with_primary(
+                            self.span(start, start + len),
+                            "a comment as other languages write it",
+                        )
+                        .with_help("comments start with `//`; the rest of this line is skipped"),
+                );
+                rest = rest.get(len..).unwrap_or("");
+                continue;
+            }
             // Nothing starts here: extend the current run of invalid characters by one character.
             let width = rest.chars().next().map(char::len_utf8).unwrap_or(1);
             let end = start + width;
@@ -517,6 +532,21 @@ impl<'a> Lexer<'a> {
     }
 }
 
+impl Lexer<'_> {
+    /// A `#` (Python, shell) or `%` (MATLAB) that starts a line or follows the end of a statement: a comment in
+    /// another language's syntax, whose words would otherwise each be an error. Inside a statement (`800 # [N/m]`,
+    /// `[%]`) it is an invalid character like any other.
+    fn foreign_comment(&self, rest: &str) -> bool {
+        matches!(rest.chars().next(), Some('#' | '%'))
+            && (self.at_line_start
+                || self
+                    .out
+                    .tokens
+                    .last()
+                    .is_some_and(|t| matches!(t.kind, Tok::Semi | Tok::LBrace | Tok::RBrace)))
+    }
+}
+
 /// What to write for a character that word processors, papers and other tools use in formulas and units.
 fn typographic_help(c: char) -> Option<&'static str> {
     Some(match c {
@@ -528,6 +558,9 @@ fn typographic_help(c: char) -> Option<&'static str> {
         '−' | '–' => "write the minus sign as the ASCII `-`",
         '÷' => "divide by `/`",
         'π' => "write pi as `pi`",
+        '%' => {
+            "there is no percent sign: write a fraction, dimensionless (`[1]`), as in `0.5` for 50 %"
+        }
         '<' | '>' => {
             "a bond is written `bond a -> b;` (power from `a` to `b`); expressions have no comparisons, but \
              `min(a, b)`, `max(a, b)` and `sign(x)`"

@@ -465,6 +465,45 @@ fn characters_of_typeset_formulas_say_what_to_write() {
 }
 
 #[test]
+fn comments_and_powers_as_other_languages_write_them_say_what_to_write() {
+    // A `#` or `%` comment is one error and the rest of its line is skipped, not an error per word.
+    for text in [
+        "# the plant\n    param k = 1 [N/m];",
+        "% the plant\n    param k = 1 [N/m];",
+        "param k = 1 [N/m]; # stiffness",
+        "param k = 1 [N/m]; % stiffness",
+    ] {
+        let (file, diags) = parse(FileId(0), &format!("model m {{\n    {text}\n}}"));
+        assert_eq!(diags.len(), 1, "{text}: {diags:#?}");
+        assert_eq!(diags[0].code.0, "BG0104");
+        assert!(
+            diags[0]
+                .help
+                .as_deref()
+                .unwrap_or("")
+                .contains("comments start with `//`")
+        );
+        assert_eq!(file.items.len(), 1, "{text}");
+    }
+    // A `%` as a unit is no comment.
+    let (_, diags) = parse(FileId(0), "model m { param eff = 90 [%]; }");
+    let said = diags
+        .iter()
+        .find(|d| d.code.0 == "BG0104")
+        .and_then(|d| d.help.as_deref());
+    assert!(
+        said.unwrap_or("").contains("write a fraction"),
+        "{diags:#?}"
+    );
+    let (_, diags) = parse(FileId(0), "model m { output y [1] = x**2; }");
+    assert_eq!(diags.len(), 1, "{diags:#?}");
+    assert!(
+        diags[0].help.as_deref().unwrap_or("").contains("`x^2`"),
+        "{diags:#?}"
+    );
+}
+
+#[test]
 fn binary_junk_is_one_diagnostic_per_run() {
     let junk: String = (0..100_000)
         .map(|i| char::from(b"#$%&?@`|~\x01"[i % 10]))

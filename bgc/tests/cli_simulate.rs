@@ -304,7 +304,7 @@ fn a_flow_source_supplies_the_kinetic_energy_of_the_inertia_it_drives() {
 #[test]
 fn simulate_errors_are_reported() {
     let osc = corpus("oscillator.bg");
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 7] = [
         (&["--param", "mass=3"], "unknown parameter `mass`"),
         (
             &["--input", "F=sin(2*t"],
@@ -315,6 +315,15 @@ fn simulate_errors_are_reported() {
         (
             &["--x0", "q=1"],
             "unknown state `q`; the model has p_mass, q_spring",
+        ),
+        // A unit stuck to the number, and two states in one option, as other tools take them.
+        (
+            &["--param", "k=800N/m"],
+            "not a number; a unit goes in brackets after the number: '800 [N/m]'",
+        ),
+        (
+            &["--x0", "q_spring=1,p_mass=2"],
+            "not a number; give each NAME=VALUE its own option",
         ),
     ];
     for (extra, message) in cases {

@@ -153,9 +153,35 @@ pub fn value_in_declared(what: &str, d: &Declared, a: &Assignment) -> Result<f64
                 a.name, a.value
             ));
         }
-        Err(_) => return Err(format!("{what} `{}` = `{}`: not a number", a.name, a.value)),
+        Err(_) => {
+            return Err(format!(
+                "{what} `{}` = `{}`: not a number{}",
+                a.name,
+                a.value,
+                not_a_number_hint(number)
+            ));
+        }
     };
     Ok(v * factor_to_declared(what, d, unit)?)
+}
+
+/// What a value that is not a number probably meant, as a clause to append.
+fn not_a_number_hint(text: &str) -> String {
+    let number_end = text
+        .find(|c: char| !(c.is_ascii_digit() || matches!(c, '.' | 'e' | 'E' | '+' | '-')))
+        .unwrap_or(text.len());
+    let (number, rest) = text.split_at(number_end);
+    if text.contains(',') && text.contains('=') {
+        "; give each NAME=VALUE its own option, as in `--x0 a=1 --x0 b=2`".to_string()
+    } else if !number.is_empty() && number.parse::<f64>().is_ok() {
+        // `800N/m`, `3000rpm`: a number with its unit stuck to it.
+        format!(
+            "; a unit goes in brackets after the number: '{number} [{}]'",
+            rest.trim()
+        )
+    } else {
+        String::new()
+    }
 }
 
 /// The CSV header of `bgc simulate`: each column with its unit, `speed [rpm]`, `q_spring [m]`, `energy [J]`.

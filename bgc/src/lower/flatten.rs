@@ -228,9 +228,18 @@ impl<'a> Builder<'a> {
                         "J", "W", "C", "V", "F", "Ohm", "S", "Wb", "T", "H", "min", "h", "deg",
                         "rpm", "L",
                     ];
-                    d = d.with_help(match closest(symbol, known.into_iter()) {
-                        Some(c) => format!("did you mean `{c}`?"),
-                        None => "units are SI symbols with optional prefixes p n u µ m c d k M G (docs/language.md, Units)".to_string(),
+                    let near = closest(symbol, known.into_iter());
+                    let case_slip = near
+                        .as_ref()
+                        .is_some_and(|c| c.eq_ignore_ascii_case(symbol));
+                    d = d.with_help(match (near, joined_factors(symbol)) {
+                        (Some(c), _) if case_slip => format!("did you mean `{c}`?"),
+                        // `[Ns/m]`, `[kgm^2]`: two units written together.
+                        (_, Some((a, b))) => format!(
+                            "unit factors are separated by a space: `{a} {b}`, as in `[N m]`"
+                        ),
+                        (Some(c), None) => format!("did you mean `{c}`?"),
+                        (None, None) => "units are SI symbols with optional prefixes p n u µ m c d k M G (docs/language.md, Units)".to_string(),
                     });
                 }
                 self.diags.push(d);
@@ -566,4 +575,14 @@ fn declares_name(stmt: &Stmt) -> bool {
             | Stmt::Element(_)
             | Stmt::Instance(_)
     )
+}
+
+/// `symbol` as two unit symbols written without the space between them (`Ns` is `N s`), when it splits so.
+fn joined_factors(symbol: &str) -> Option<(&str, &str)> {
+    (1..symbol.len())
+        .filter(|&i| symbol.is_char_boundary(i))
+        .map(|i| symbol.split_at(i))
+        .find(|(a, b)| {
+            crate::units::parse_symbol(a).is_some() && crate::units::parse_symbol(b).is_some()
+        })
 }

@@ -416,6 +416,35 @@ fn a_function_name_of_another_tool_or_a_value_called_says_what_to_write() {
 }
 
 #[test]
+fn two_unit_symbols_written_together_are_told_apart_from_a_case_slip() {
+    for (unit, help) in [
+        ("N s/m", None),
+        (
+            "Ns/m",
+            Some("unit factors are separated by a space: `N s`, as in `[N m]`"),
+        ),
+        (
+            "kgm^2",
+            Some("unit factors are separated by a space: `kg m`, as in `[N m]`"),
+        ),
+        // `K g` would split too, but a case slip of a known unit comes first.
+        ("Kg", Some("did you mean `kg`?")),
+    ] {
+        let text = format!(
+            "model m {{ domain translational; param d = 4 [{unit}]; input F [N]; Se s = F; I i = 1; R r = d; \
+             1 v; bond s -> v -> i, r; }}"
+        );
+        let (_, diags, _) = lower_text(&text);
+        let found = diags.iter().find(|d| d.code.0 == "BG0312");
+        assert_eq!(
+            found.and_then(|d| d.help.as_deref()),
+            help,
+            "[{unit}]: {diags:#?}"
+        );
+    }
+}
+
+#[test]
 fn non_physical_values_are_errors_and_zero_resistance_is_not() {
     // A zero stiffness makes an infinite compliance; the secondary label shows the parameter's value.
     let d = expect_one(

@@ -305,15 +305,16 @@ impl<'a> Parser<'a> {
         })
     }
 
-    /// A `[` right after a number, a name or a `)`, where the expression could not go on: a unit written after a
-    /// value, as other tools and papers write them (`0.5 [m/N]`).
+    /// A `[` right after a number, a name or a `)`, or a name right after a number, where the expression could not
+    /// go on: a unit written after a value, as other tools and papers write them (`0.5 [m/N]`, `2 kg`).
     pub(super) fn unit_after_value(&self) -> bool {
-        self.at(Tok::LBracket)
-            && self.pos > 0
-            && self
-                .toks
-                .get(self.pos - 1)
-                .is_some_and(|p| matches!(p.kind, Tok::Number | Tok::Ident | Tok::RParen))
+        let previous = self.pos.checked_sub(1).and_then(|i| self.toks.get(i));
+        match previous.map(|p| p.kind) {
+            Some(Tok::Number | Tok::Ident | Tok::RParen) if self.at(Tok::LBracket) => true,
+            // `I mass = 2 kg;`: a unit without brackets, on the number's line.
+            Some(Tok::Number) => self.at(Tok::Ident) && !self.starts_line(self.peek()),
+            _ => false,
+        }
     }
 
     /// A closing bracket matching `open`; when missing, the error shows where the bracket was opened. When the

@@ -74,6 +74,15 @@ impl<'a> Parser<'a> {
                 let name = self.expect_name("the name of the input")?;
                 let unit = self.unit()?;
                 let description = self.description();
+                if self.at(Tok::Eq) {
+                    // `input u [N] = 0;`: an input's value comes from outside the model.
+                    return Err(self.expected(
+                        "`;` after the input",
+                        "an input has no value in the file: it is given when the model runs (`bgc simulate \
+                         --input NAME=EXPR`, or by the program that uses the generated code); a constant is a \
+                         `param`",
+                    ));
+                }
                 self.expect_semi("the input")?;
                 Stmt::Input(Box::new(InputDecl {
                     doc: doc_text(docs),
@@ -221,6 +230,18 @@ impl<'a> Parser<'a> {
     fn element(&mut self, docs: Docs, kind: ElementKind) -> PResult<ElementDecl> {
         let kw = self.bump();
         let kind_span = self.tok_span(kw);
+        if self.at(Tok::Colon) {
+            // `Se:source`, as 20-sim names elements.
+            return Err(self.expected(
+                &format!("the name of the `{}` element", kind.keyword()),
+                &format!(
+                    "write the kind, a space and the name: `{} source = ...;` (a domain follows the name: \
+                     `{} source: electrical = ...;`)",
+                    kind.keyword(),
+                    kind.keyword()
+                ),
+            ));
+        }
         let name =
             self.expect_name_for(|| format!("the name of the `{}` element", kind.keyword()))?;
         let mut ports = None;

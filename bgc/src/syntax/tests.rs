@@ -428,6 +428,16 @@ fn a_unit_after_a_value_is_not_taken_for_an_index() {
             "{text}: {said}"
         );
     }
+    // A unit without brackets after a number.
+    let (_, diags) = parse(FileId(0), "model m { I mass = 2 kg; }");
+    assert_eq!(diags.len(), 1, "{diags:#?}");
+    assert!(
+        diags[0]
+            .help
+            .as_deref()
+            .unwrap_or("")
+            .contains("units are not written in an expression")
+    );
     // A missing `;` or `)` elsewhere keeps its own help.
     let (_, diags) = parse(FileId(0), "model m { C spring = 0.5 R; }");
     assert_eq!(
@@ -501,6 +511,24 @@ fn comments_and_powers_as_other_languages_write_them_say_what_to_write() {
         diags[0].help.as_deref().unwrap_or("").contains("`x^2`"),
         "{diags:#?}"
     );
+}
+
+#[test]
+fn declarations_as_other_tools_write_them_say_what_to_write() {
+    for (text, help) in [
+        ("input u [N] = 0;", "an input has no value in the file"),
+        (
+            "Se:source = u;",
+            "write the kind, a space and the name: `Se source = ...;`",
+        ),
+    ] {
+        let (_, diags) = parse(FileId(0), &format!("model m {{ {text} }}"));
+        assert_eq!(diags.len(), 1, "{text}: {diags:#?}");
+        assert!(
+            diags[0].help.as_deref().unwrap_or("").contains(help),
+            "{text}: {diags:#?}"
+        );
+    }
 }
 
 #[test]

@@ -206,6 +206,19 @@ impl Parser {
         }
     }
 
+    /// "expected X", with what the character found probably meant.
+    fn expected(&self, what: &str) -> SignalError {
+        let hint = match self.peek() {
+            Some('<' | '>') => {
+                "; there are no comparisons: `step(t0)` is 0 before `t0` and 1 from `t0` on, as in \
+                 `10*step(0.1)`"
+            }
+            Some('[') => "; a unit goes after the whole expression, as in `30*sin(t) [deg]`",
+            _ => "",
+        };
+        self.error(format!("expected {what}{hint}"))
+    }
+
     fn peek(&self) -> Option<char> {
         self.chars.get(self.pos).copied()
     }
@@ -289,7 +302,7 @@ impl Parser {
                 self.pos += 1;
                 let e = self.expr()?;
                 if !self.eat(')') {
-                    return Err(self.error("expected `)`".into()));
+                    return Err(self.expected("`)`"));
                 }
                 Ok(e)
             }
@@ -350,11 +363,17 @@ impl Parser {
             _ => {}
         }
         let Some(&(_, func, arity)) = SignalFunc::ALL.iter().find(|(n, _, _)| *n == name) else {
-            return Err(SignalError {
-                column: start + 1,
-                message: format!(
+            let message = match name.as_str() {
+                "heaviside" | "Heaviside" | "unitstep" | "H" => format!(
+                    "unknown name `{name}`: the unit step is `step(t0)`, 0 before `t0` and 1 from `t0` on"
+                ),
+                _ => format!(
                     "unknown name `{name}` (an input may use `t`, `pi`, numbers and step, ramp, sin, cos, tan, exp, ln, sqrt, abs, sign, min, max)"
                 ),
+            };
+            return Err(SignalError {
+                column: start + 1,
+                message,
             });
         };
         if !self.eat('(') {
@@ -365,7 +384,7 @@ impl Parser {
             args.push(self.expr()?);
         }
         if !self.eat(')') {
-            return Err(self.error("expected `)` or `,`".into()));
+            return Err(self.expected("`)` or `,`"));
         }
         if args.len() != arity {
             return Err(SignalError {
@@ -412,6 +431,19 @@ mod tests {
             .unwrap()
             .breakpoints(&mut b);
         assert_eq!(b, vec![0.5, 1.5, 2.0]);
+    }
+
+    #[test]
+    fn comparisons_steps_and_units_of_other_tools_say_what_to_write() {
+        let said = |text: &str| Signal::parse(text).unwrap_err().message;
+        assert!(
+            said("10*(t>0.1)").contains("`step(t0)` is 0 before `t0`"),
+            "{}",
+            said("10*(t>0.1)")
+        );
+        assert!(said("heaviside(t-0.1)").contains("the unit step is `step(t0)`"));
+        assert!(said("sin(2 [rad])").contains("a unit goes after the whole expression"));
+        assert_eq!(said("(1"), "expected `)`");
     }
 
     #[test]

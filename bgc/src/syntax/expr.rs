@@ -20,6 +20,10 @@ use super::parser::{Fail, MAX_DEPTH, PResult, Parser};
 use crate::diagnostic::Diagnostic;
 use crate::span::Span;
 
+/// The help for a name right after a number (`2 kg`, `2 k`).
+const NAME_AFTER_NUMBER: &str = "to multiply, write `*`, as in `2*k`; a unit is not written in an expression: a \
+     quantity with a unit is a parameter, as in `param m = 2 [kg];`";
+
 /// The help for a unit written inside an expression (`1/k [m/N]`, `(1 [m^2])`).
 pub(super) const UNITS_IN_EXPRESSIONS: &str = "units are not written in an expression: an element's value takes its \
      unit from its kind and domain, and a parameter's, input's or output's unit follows its name, as in \
@@ -305,15 +309,19 @@ impl<'a> Parser<'a> {
         })
     }
 
-    /// A `[` right after a number, a name or a `)`, or a name right after a number, where the expression could not
-    /// go on: a unit written after a value, as other tools and papers write them (`0.5 [m/N]`, `2 kg`).
-    pub(super) fn unit_after_value(&self) -> bool {
+    /// The help for a `[` right after a number, a name or a `)`, or a name right after a number, where the
+    /// expression could not go on: a unit written after a value, as other tools and papers write them
+    /// (`0.5 [m/N]`, `2 kg`), or, for a name, perhaps a product without its `*`.
+    pub(super) fn unit_after_value(&self) -> Option<&'static str> {
         let previous = self.pos.checked_sub(1).and_then(|i| self.toks.get(i));
         match previous.map(|p| p.kind) {
-            Some(Tok::Number | Tok::Ident | Tok::RParen) if self.at(Tok::LBracket) => true,
-            // `I mass = 2 kg;`: a unit without brackets, on the number's line.
-            Some(Tok::Number) => self.at(Tok::Ident) && !self.starts_line(self.peek()),
-            _ => false,
+            Some(Tok::Number | Tok::Ident | Tok::RParen) if self.at(Tok::LBracket) => {
+                Some(UNITS_IN_EXPRESSIONS)
+            }
+            Some(Tok::Number) if self.at(Tok::Ident) && !self.starts_line(self.peek()) => {
+                Some(NAME_AFTER_NUMBER)
+            }
+            _ => None,
         }
     }
 
@@ -339,11 +347,12 @@ impl<'a> Parser<'a> {
             )
             .with_primary(at, format!("expected {want}"))
             .with_secondary(self.tok_span(open), "opened here")
-            .with_help(if kind == Tok::RParen && self.unit_after_value() {
-                UNITS_IN_EXPRESSIONS.to_string()
-            } else {
-                format!("add the missing {want}")
-            }),
+            .with_help(
+                match self.unit_after_value().filter(|_| kind == Tok::RParen) {
+                    Some(help) => help.to_string(),
+                    None => format!("add the missing {want}"),
+                },
+            ),
         );
         Err(Fail)
     }

@@ -322,11 +322,9 @@ impl<'a> Parser<'a> {
             self.diags.push(d.with_help("end every statement with `;`"));
             return Ok(());
         }
-        let help = if self.unit_after_value() {
-            super::expr::UNITS_IN_EXPRESSIONS
-        } else {
-            "end every statement with `;`"
-        };
+        let help = self
+            .unit_after_value()
+            .unwrap_or("end every statement with `;`");
         Err(self.expected(&format!("`;` after {what}"), help))
     }
 

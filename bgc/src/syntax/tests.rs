@@ -428,16 +428,16 @@ fn a_unit_after_a_value_is_not_taken_for_an_index() {
             "{text}: {said}"
         );
     }
-    // A unit without brackets after a number.
-    let (_, diags) = parse(FileId(0), "model m { I mass = 2 kg; }");
-    assert_eq!(diags.len(), 1, "{diags:#?}");
-    assert!(
-        diags[0]
-            .help
-            .as_deref()
-            .unwrap_or("")
-            .contains("units are not written in an expression")
-    );
+    // A unit without brackets after a number, or a product without its `*`.
+    for text in ["I mass = 2 kg;", "C spring = 2 k;"] {
+        let (_, diags) = parse(FileId(0), &format!("model m {{ {text} }}"));
+        assert_eq!(diags.len(), 1, "{diags:#?}");
+        let said = diags[0].help.as_deref().unwrap_or("");
+        assert!(
+            said.contains("to multiply, write `*`") && said.contains("a unit is not written"),
+            "{said}"
+        );
+    }
     // A missing `;` or `)` elsewhere keeps its own help.
     let (_, diags) = parse(FileId(0), "model m { C spring = 0.5 R; }");
     assert_eq!(

@@ -530,9 +530,7 @@ impl<'a> Lexer<'a> {
             }
         }
     }
-}
 
-impl Lexer<'_> {
     /// A `#` (Python, shell) or `%` (MATLAB) that starts a line or follows the end of a statement: a comment in
     /// another language's syntax, whose words would otherwise each be an error. Inside a statement (`800 # [N/m]`,
     /// `[%]`) it is an invalid character like any other.

@@ -270,6 +270,26 @@ fn bad_records_are_refused_with_the_row_or_column_named() {
         err.contains("--free: unknown parameter `J_q` (did you mean `J_p`?)"),
         "{err}"
     );
+    // A state, an output or a repeated name in --free says what it is.
+    let record = "t,theta_pend\n0,0\n0.1,0\n0.2,0\n";
+    for (free, said) in [
+        (
+            "theta",
+            "`theta` is a state, not a parameter; its initial value is fitted with --free-x0",
+        ),
+        (
+            "theta_pend",
+            "`theta_pend` is an output of the model, not a parameter",
+        ),
+        (
+            "J_p,d_s,J_p",
+            "--free names parameter `J_p` twice (at places 1 and 3)",
+        ),
+    ] {
+        let (code, err) = refused(&pend, record, free);
+        assert_eq!(code, 1, "{free}");
+        assert!(err.contains(said), "{free}: {err}");
+    }
 }
 
 #[test]

@@ -68,7 +68,7 @@ fn fit_record(
     let outputs: Vec<&str> = eqs.outputs.iter().map(|o| o.name.as_str()).collect();
     let record = Record::from_csv(text, &inputs, &outputs)
         .map_err(|e| format!("{}: {e}", args.data.display()))?;
-    let free = free_params(model, &declared, &start, args)?;
+    let free = free_params(model, eqs, &declared, &start, args)?;
     let states = quantities::states(model, eqs);
     let x0 = values_or_zero("state", "--x0", &states, args.x0)?;
     let mut spec = FitSpec::new(free, record.outputs.len());
@@ -126,22 +126,48 @@ impl Units {
 /// The `--free` parameters with their log-space flag and `--bound`s (in the declared unit, converted to SI).
 fn free_params(
     model: &Model,
+    eqs: &Equations,
     declared: &[Declared],
     start: &[f64],
     args: &FitArgs<'_>,
 ) -> Result<Vec<FreeParam>, String> {
-    let as_assignments: Vec<Assignment> = args
+    if let Some((k, name)) = args
         .free
         .iter()
-        .map(|n| Assignment {
-            name: n.clone(),
-            value: "free".into(),
-        })
-        .collect();
-    reject_repeats("parameter", "--free", &as_assignments)?;
+        .enumerate()
+        .find(|(k, n)| args.free[..*k].contains(n))
+    {
+        return Err(format!(
+            "--free names parameter `{name}` twice (at places {} and {}); give each name once",
+            args.free[..k]
+                .iter()
+                .position(|n| n == name)
+                .map_or(1, |i| i + 1),
+            k + 1
+        ));
+    }
     let mut out = Vec::with_capacity(args.free.len());
     for name in args.free {
         let Some(index) = declared.iter().position(|d| &d.name == name) else {
+            let is_state = quantities::states(model, eqs)
+                .iter()
+                .any(|d| &d.name == name);
+            if is_state {
+                return Err(format!(
+                    "--free: `{name}` is a state, not a parameter; its initial value is fitted with --free-x0 \
+                     (with `--x0 {name}=START`, only the states given there)"
+                ));
+            }
+            if eqs.outputs.iter().any(|o| &o.name == name) || eqs.inputs.contains(name) {
+                return Err(format!(
+                    "--free: `{name}` is {} of the model, not a parameter; --free takes parameters",
+                    if eqs.inputs.contains(name) {
+                        "an input"
+                    } else {
+                        "an output"
+                    }
+                ));
+            }
             let known = super::params::names(declared);
             return Err(format!(
                 "--free: {}",

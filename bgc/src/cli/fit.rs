@@ -131,41 +131,34 @@ fn free_params(
     start: &[f64],
     args: &FitArgs<'_>,
 ) -> Result<Vec<FreeParam>, String> {
-    if let Some((k, name)) = args
-        .free
-        .iter()
-        .enumerate()
-        .find(|(k, n)| args.free[..*k].contains(n))
-    {
-        return Err(format!(
-            "--free names parameter `{name}` twice (at places {} and {}); give each name once",
-            args.free[..k]
-                .iter()
-                .position(|n| n == name)
-                .map_or(1, |i| i + 1),
-            k + 1
-        ));
+    for (k, name) in args.free.iter().enumerate() {
+        if let Some(first) = args.free[..k].iter().position(|n| n == name) {
+            return Err(format!(
+                "--free names parameter `{name}` twice (at places {} and {}); give each name once",
+                first + 1,
+                k + 1
+            ));
+        }
     }
     let mut out = Vec::with_capacity(args.free.len());
     for name in args.free {
         let Some(index) = declared.iter().position(|d| &d.name == name) else {
-            let is_state = quantities::states(model, eqs)
-                .iter()
-                .any(|d| &d.name == name);
-            if is_state {
+            if eqs.states.iter().any(|s| &s.name == name) {
                 return Err(format!(
                     "--free: `{name}` is a state, not a parameter; its initial value is fitted with --free-x0 \
                      (with `--x0 {name}=START`, only the states given there)"
                 ));
             }
-            if eqs.outputs.iter().any(|o| &o.name == name) || eqs.inputs.contains(name) {
+            let other = if eqs.inputs.contains(name) {
+                Some("an input")
+            } else if eqs.outputs.iter().any(|o| &o.name == name) {
+                Some("an output")
+            } else {
+                None
+            };
+            if let Some(kind) = other {
                 return Err(format!(
-                    "--free: `{name}` is {} of the model, not a parameter; --free takes parameters",
-                    if eqs.inputs.contains(name) {
-                        "an input"
-                    } else {
-                        "an output"
-                    }
+                    "--free: `{name}` is {kind} of the model, not a parameter; --free takes parameters"
                 ));
             }
             let known = super::params::names(declared);

@@ -204,17 +204,13 @@ impl<'a> Parser<'a> {
                     span: name.span,
                 })
             }
-            Tok::Star if self.after(Tok::Star) => Err(self.expected(
-                "an expression",
-                "a power is written with `^`, as in `x^2` (not `x**2`)",
-            )),
+            Tok::Star if self.previous().is_some_and(|p| p.kind == Tok::Star) => Err(self
+                .expected(
+                    "an expression",
+                    "a power is written with `^`, as in `x^2` (not `x**2`)",
+                )),
             _ => Err(self.expected("an expression", EXPR_HELP)),
         }
-    }
-
-    /// The token before the current one is of `kind`.
-    fn after(&self, kind: Tok) -> bool {
-        self.pos > 0 && self.toks.get(self.pos - 1).is_some_and(|p| p.kind == kind)
     }
 
     /// The arguments of a call, after its `(`. The single argument of `e`, `f`, `p` or `q` that is written as a node
@@ -313,8 +309,7 @@ impl<'a> Parser<'a> {
     /// expression could not go on: a unit written after a value, as other tools and papers write them
     /// (`0.5 [m/N]`, `2 kg`), or, for a name, perhaps a product without its `*`.
     pub(super) fn unit_after_value(&self) -> Option<&'static str> {
-        let previous = self.pos.checked_sub(1).and_then(|i| self.toks.get(i));
-        match previous.map(|p| p.kind) {
+        match self.previous().map(|p| p.kind) {
             Some(Tok::Number | Tok::Ident | Tok::RParen) if self.at(Tok::LBracket) => {
                 Some(UNITS_IN_EXPRESSIONS)
             }

@@ -216,13 +216,17 @@ impl<'a> Parser<'a> {
         self.span(t.start, t.end)
     }
 
+    /// The last consumed token.
+    pub(super) fn previous(&self) -> Option<Token> {
+        self.pos
+            .checked_sub(1)
+            .and_then(|i| self.toks.get(i))
+            .copied()
+    }
+
     /// End of the last consumed token.
     pub(super) fn prev_end(&self) -> u32 {
-        if self.pos == 0 {
-            0
-        } else {
-            self.toks.get(self.pos - 1).map(|t| t.end).unwrap_or(0)
-        }
+        self.previous().map_or(0, |t| t.end)
     }
 
     /// From `start` to the end of the last consumed token.
@@ -297,10 +301,9 @@ impl<'a> Parser<'a> {
             return Ok(());
         }
         let t = self.peek();
-        let after_unterminated = self.pos > 0
-            && self.toks.get(self.pos - 1).is_some_and(|p| {
-                p.kind == Tok::Str && self.unterminated.binary_search(&p.start).is_ok()
-            });
+        let after_unterminated = self.previous().is_some_and(|p| {
+            p.kind == Tok::Str && self.unterminated.binary_search(&p.start).is_ok()
+        });
         if after_unterminated && (self.starts_line(t) || matches!(t.kind, Tok::RBrace | Tok::Eof)) {
             // The unterminated string swallowed the rest of its line, `;` included; it is reported already.
             return Ok(());

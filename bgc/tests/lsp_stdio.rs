@@ -120,3 +120,105 @@ fn a_protocol_error_is_named_not_the_reader_thread_that_fails_after_it() {
     );
     assert!(!err.contains("disconnected channel"), "{err}");
 }
+
+/// Runs `bgc lsp` on raw bytes (framing included) and returns its output.
+fn serve_raw(input: &[u8]) -> std::process::Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bgc"))
+        .arg("lsp")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("bgc lsp starts");
+    let mut stdin = child.stdin.take().expect("stdin");
+    let _ = stdin.write_all(input);
+    drop(stdin);
+    child.wait_with_output().expect("bgc lsp ends")
+}
+
+/// A body that is not JSON ended the session ("malformed LSP payload", status 2), losing every open document. It
+/// is now skipped and reported, a request whose id can be read is answered with `InvalidRequest`, and the session
+/// goes on.
+#[test]
+fn a_malformed_message_is_skipped_and_the_session_goes_on() {
+    let doc = uri(&back_support_path());
+    let mut input = [
+        serde_json::json!({"jsonrpc": "2.0", "id": 1, "method": "initialize",
+            "params": {"processId": null, "rootUri": null, "capabilities": {}}}),
+        serde_json::json!({"jsonrpc": "2.0", "method": "initialized", "params": {}}),
+        serde_json::json!({"jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {"textDocument":
+            {"uri": doc, "languageId": "bg", "version": 1, "text": back_support_unacknowledged()}}}),
+    ]
+    .iter()
+    .flat_map(frame)
+    .collect::<Vec<u8>>();
+    input.extend_from_slice(b"Content-Length: 9\r\n\r\n{not json");
+    input.extend(frame(
+        &serde_json::json!({"jsonrpc": "2.0", "id": 2, "method": 3}),
+    ));
+    for m in [
+        serde_json::json!({"jsonrpc": "2.0", "id": 3, "method": "textDocument/hover", "params":
+            {"textDocument": {"uri": doc}, "position": {"line": 21, "character": 11}}}),
+        serde_json::json!({"jsonrpc": "2.0", "id": 4, "method": "shutdown", "params": null}),
+        serde_json::json!({"jsonrpc": "2.0", "method": "exit", "params": null}),
+    ] {
+        input.extend(frame(&m));
+    }
+    let out = serve_raw(&input);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert_eq!(
+        err.matches("bgc lsp: skipped a message").count(),
+        2,
+        "{err}"
+    );
+    let received = messages(&out.stdout);
+    let logged = received
+        .iter()
+        .find(|m| m["method"] == "window/logMessage")
+        .map(|m| m["params"]["message"].to_string())
+        .unwrap_or_default();
+    assert!(logged.contains("key must be a string"), "{received:#?}");
+    let refused = received.iter().find(|m| m["id"] == 2);
+    assert_eq!(
+        refused.map(|m| m["error"]["code"].clone()),
+        Some((-32600).into())
+    );
+    let hover = received
+        .iter()
+        .find(|m| m["id"] == 3)
+        .map(|m| m["result"]["contents"]["value"].to_string());
+    assert!(
+        hover.is_some_and(|h| h.contains("gearbox stiffness")),
+        "{received:#?}"
+    );
+}
+
+/// lsp-server allocated the body from its declared length first: a corrupt `Content-Length` of 100 GB had the
+/// process killed for memory. The body is now read as it arrives, and the session ends with the cause.
+#[test]
+fn a_corrupt_content_length_ends_the_session_with_the_cause() {
+    let cases: [(&[u8], &str); 3] = [
+        (
+            b"Content-Length: 100000000000\r\n\r\n{}",
+            "the input ended after 2 of the 100000000000 bytes",
+        ),
+        (
+            b"Content-Type: text\r\n\r\n{}",
+            "a message header without `Content-Length`",
+        ),
+        (
+            b"Content-Length: twelve\r\n\r\n{}",
+            "the length is not a whole number of bytes",
+        ),
+    ];
+    for (input, cause) in cases {
+        let out = serve_raw(input);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(
+            err.starts_with("error: bgc lsp: the connection failed: ") && err.contains(cause),
+            "{err}"
+        );
+    }
+}

@@ -23,6 +23,7 @@ pub mod index;
 pub mod lines;
 pub mod navigation;
 pub mod server;
+pub mod transport;
 
 use lsp_server::Connection;
 use lsp_types::{
@@ -104,12 +105,8 @@ pub fn serve(connection: &Connection, options: Options) -> Result<(), String> {
 
 /// Serves on standard input and output.
 pub fn run_stdio(options: Options) -> Result<(), String> {
-    let (connection, io) = Connection::stdio();
+    let (connection, transport) = transport::stdio();
     let served = serve(&connection, options);
     drop(connection);
-    let joined = io.join();
-    // When the server stops on a protocol error, the reader thread fails next ("sending on a disconnected
-    // channel", for the messages the client had already sent): the server's error is the one that names the cause.
-    served?;
-    joined.map_err(|e| format!("the connection failed: {e}"))
+    transport.finish(served)
 }

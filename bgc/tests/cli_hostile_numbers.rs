@@ -407,3 +407,45 @@ fn a_relative_tolerance_of_one_or_more_is_refused() {
     let (code, _, err) = bgc(&["simulate", &model, "--t-end", "0.1", "--rtol", "0.5"]);
     assert_eq!(code, 0, "{err}");
 }
+
+/// An input signal that is not finite (`1/0`, `sqrt(t - 1)` before t = 1, `ln(t)` at 0) gave "the derivative of
+/// `p_rotor` became non-finite at t = 0.0", which blamed a state for the user's signal; the error now names the
+/// input, its value and the time.
+#[test]
+fn a_non_finite_input_signal_is_named_not_the_state_it_reaches() {
+    let model = cli_support::repo("models/back_support.bg");
+    for (signal, value) in [("1/0", "inf"), ("sqrt(t-1)", "NaN"), ("-ln(t)", "inf")] {
+        let input = format!("tau_m={signal}");
+        let (code, _, err) = bgc(&[
+            "simulate",
+            &model,
+            "--t-end",
+            "0.1",
+            "--input",
+            &input,
+            "--input",
+            "omega_h=0",
+        ]);
+        assert_eq!(code, 1, "{signal}: {err}");
+        assert!(
+            err.contains(&format!("error: the input `tau_m` is {value} at t = 0.0")),
+            "{signal}: {err}"
+        );
+    }
+    // A finite signal whose power overflows later is still the model's: the supplied power is named.
+    let (code, _, err) = bgc(&[
+        "simulate",
+        &model,
+        "--t-end",
+        "1",
+        "--input",
+        "tau_m=exp(1000*t)",
+        "--input",
+        "omega_h=0",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("error: the derivative of `supplied` became non-finite"),
+        "{err}"
+    );
+}

@@ -216,6 +216,9 @@ pub fn run_streaming_noted(
     let mut stack = Vec::new();
     let first = system.row(&y, 0.0, &mut u, &mut stack)?;
     if let Some(i) = first.iter().position(|v| !v.is_finite()) {
+        if let Some(input) = system.non_finite_input(0.0) {
+            return Err(input);
+        }
         let columns = system.columns();
         // The stored energy is the third column from the end (see `System::columns`).
         let what = if i + 3 == columns.len() {
@@ -609,6 +612,16 @@ impl Drive<'_> {
         }
     }
 
+    /// The derivative of state `i` was not finite at `time`: because an input signal was not, when one was.
+    fn non_finite_derivative(&self, time: f64, i: usize) -> SimError {
+        self.system
+            .non_finite_input(time)
+            .unwrap_or_else(|| SimError::NonFiniteDerivative {
+                time,
+                state: self.name(i),
+            })
+    }
+
     /// A solver error, attributed to the model when its algebraic loops could not be solved or it had returned a
     /// non-finite derivative.
     fn failure(&self, time: f64, e: DiffsolError) -> SimError {
@@ -616,10 +629,7 @@ impl Drive<'_> {
             return loop_error;
         }
         match self.bad.get() {
-            Some((time, i)) => SimError::NonFiniteDerivative {
-                time,
-                state: self.name(i),
-            },
+            Some((time, i)) => self.non_finite_derivative(time, i),
             None => solver_error(time, e),
         }
     }
@@ -648,10 +658,7 @@ impl Drive<'_> {
                     return Err(loop_error);
                 }
                 return Err(match self.bad.get() {
-                    Some((time, i)) => SimError::NonFiniteDerivative {
-                        time,
-                        state: self.name(i),
-                    },
+                    Some((time, i)) => self.non_finite_derivative(time, i),
                     None => SimError::NonFiniteState {
                         time: t_now,
                         state: self.name(i),

@@ -77,6 +77,9 @@ pub enum SimError {
     NonFiniteStart { what: String },
     #[error("the derivative of `{state}` became non-finite at t = {time:?}")]
     NonFiniteDerivative { time: f64, state: String },
+    /// The model's values became non-finite because an input signal is (`1/0`, `sqrt(t - 1)` before t = 1).
+    #[error("the {what} is {value:?} at t = {time:?}")]
+    NonFiniteInput { time: f64, what: String, value: f64 },
     #[error("`{state}` became non-finite at t = {time:?}")]
     NonFiniteState { time: f64, state: String },
     #[error(
@@ -127,6 +130,7 @@ pub struct System {
     pub outputs: Vec<String>,
     params: Vec<f64>,
     inputs: Vec<Signal>,
+    input_names: Vec<String>,
     /// `d/dt` of each input signal.
     input_rates: Vec<Signal>,
     /// `f_i` for the model states, then the dissipated and the supplied power.
@@ -284,6 +288,7 @@ impl System {
             params,
             input_rates: inputs.iter().map(Signal::derivative).collect(),
             inputs,
+            input_names: eqs.inputs.clone(),
             rates,
             jacobian,
             outputs_h,
@@ -313,6 +318,25 @@ impl System {
         for (slot, v) in out.iter_mut().zip(values) {
             *slot = v;
         }
+    }
+
+    /// The first input signal, or time derivative of one, that is not finite at `t`: the cause to name when the
+    /// model's values become non-finite there.
+    pub fn non_finite_input(&self, t: f64) -> Option<SimError> {
+        let named = |signals: &[Signal], rate: bool| {
+            signals.iter().zip(&self.input_names).find_map(|(s, name)| {
+                let value = s.eval(t);
+                (!value.is_finite()).then(|| SimError::NonFiniteInput {
+                    time: t,
+                    what: match rate {
+                        false => format!("input `{name}`"),
+                        true => format!("time derivative of the input `{name}`"),
+                    },
+                    value,
+                })
+            })
+        };
+        named(&self.inputs, false).or_else(|| named(&self.input_rates, true))
     }
 
     /// Solves the nonlinear algebraic loops at the extended state `y` and time `t`, with the inputs already in

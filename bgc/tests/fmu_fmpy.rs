@@ -47,6 +47,18 @@ const DIODE: Scenario = Scenario {
     jumps: &[0.25],
 };
 
+/// A model without states: Co-Simulation's step took the LU decomposition of the 0×0 Jacobian and panicked in
+/// nalgebra (`fmi2DoStep: internal error`); Model Exchange worked.
+const NO_STATES: Scenario = Scenario {
+    model: "bgc/tests/fmu_support/no_states.bg",
+    t_end: 1.0,
+    dt: 1e-2,
+    inputs: &[("v", "4*step(0.5)")],
+    rows: &[&[0.0, 0.0], &[0.5, 0.0], &[0.5, 4.0], &[1.0, 4.0]],
+    x0: &[],
+    jumps: &[0.5],
+};
+
 /// The required agreement with `bgc simulate`, relative to each output's range.
 const AGREEMENT: f64 = 1e-6;
 
@@ -144,6 +156,12 @@ fn walking_leg_fmu_follows_bgc_simulate() {
 fn diode_loop_fmu_follows_bgc_simulate() {
     agrees(&DIODE, 2);
     agrees(&DIODE, 3);
+}
+
+#[test]
+fn a_model_without_states_follows_bgc_simulate() {
+    agrees(&NO_STATES, 2);
+    agrees(&NO_STATES, 3);
 }
 
 #[test]

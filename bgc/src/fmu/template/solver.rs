@@ -46,7 +46,9 @@ impl Integrator {
         u: &[f64],
     ) -> Result<(), Failure> {
         let span = t1 - t0;
-        if span <= 0.0 {
+        // A model without states (outputs that are functions of the inputs) has nothing to integrate; its 0×0
+        // Jacobian has no LU decomposition to take.
+        if span <= 0.0 || NX == 0 {
             return Ok(());
         }
         let mut t = t0;

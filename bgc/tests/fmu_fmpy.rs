@@ -1,7 +1,7 @@
 //! FMUs of `bgc fmu` (FMI 2.0 and 3.0) in FMPy, a real importer, and FMI 2.0 Co-Simulation also in the Open
 //! Simulation Platform's libcosim, a second one: `fmpy validate` accepts the FMU of every model in `models/`, and
-//! the simulations of the back-support plant, the walking leg (mass matrix) and the diode loop (nonlinear
-//! algebraic loop), through Model Exchange (FMPy's CVode) and Co-Simulation (the FMU's own integrator), give the
+//! the simulations of the back-support plant, the walking leg (mass matrix), the diode loop (nonlinear
+//! algebraic loop) and a voltage divider (no states), through Model Exchange (FMPy's CVode) and Co-Simulation (the FMU's own integrator), give the
 //! outputs of `bgc simulate` to 1e-6 of each output's range; the directional derivatives equal central
 //! differences of the derivatives and outputs, and every dependency they show is listed in `ModelStructure`.
 

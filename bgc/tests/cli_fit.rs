@@ -325,6 +325,28 @@ fn a_fit_that_stalls_is_reported_and_exits_with_3() {
     assert_eq!(estimate(&v, "J_p")["determined"], false);
 }
 
+/// A record that the model reproduces exactly (a divider's current `v/40`, computed as `v * 0.025`, which rounds
+/// differently from the model) reached r1 = 10 (r2 = 30) and was reported "stalled (not a minimum)", exit 3: there
+/// the residuals are rounding errors, and the Gauss–Newton step in their standard error (3.5) measures nothing.
+/// It is an exact fit, converged.
+#[test]
+fn a_record_the_model_reproduces_exactly_is_a_converged_fit() {
+    let mut record = String::from("t,v,i\n");
+    for k in 0..50 {
+        let v = 1.0 + k as f64 * 0.1;
+        record.push_str(&format!("{},{v},{}\n", 0.01 * k as f64, v * 0.025));
+    }
+    let data = temp_file("divider_exact.csv", &record);
+    let model = repo("bgc/tests/fmu_support/no_states.bg");
+    for start in ["r1=10", "r1=3"] {
+        let v = fit_json(&[&model, "--data", &data, "--free", "r1", "--param", start]);
+        assert_eq!(v["status"], "converged", "{start}: {v}");
+        assert_eq!(v["optimality"], 0.0, "{start}: {v}");
+        let r1 = estimate(&v, "r1")["value"].as_f64().unwrap_or(f64::NAN);
+        assert!((r1 - 10.0).abs() <= 1e-12, "{start}: {v}");
+    }
+}
+
 #[test]
 fn a_linear_model_with_held_inputs_is_fitted_on_the_exact_path() {
     // The back-support drive (linear) answering a held torque step, simulated by `bgc simulate` at the defaults

@@ -22,7 +22,10 @@
 //!   Gauss–Newton step in the metric of the estimate's covariance `s² (JᵀJ)⁻¹`. Below
 //!   [`LmOptions::optimality`] (a tenth of a standard error by default) the remaining distance to the minimum is
 //!   statistically nothing. With no more residuals than unknowns there is no standard error to measure by: there
-//!   the undamped Gauss–Newton step must be below `√xtol (‖z‖ + √xtol)` instead. Otherwise the fit **stalled** (e.g. a parameter running off towards infinity, where
+//!   the undamped Gauss–Newton step must be below `√xtol (‖z‖ + √xtol)` instead. Residuals within the problem's
+//!   rounding floor ([`Residuals::rounding_floor`]: a record the model reproduces to rounding) are an exact fit,
+//!   whose distance is 0: there `‖P r‖` and `s` are both rounding errors, and their ratio is of order one
+//!   whatever the iterate. Otherwise the fit **stalled** (e.g. a parameter running off towards infinity, where
 //!   the cost keeps falling ever more slowly and the gradient is parallel to the residuals) and is reported as
 //!   not converged.
 
@@ -37,6 +40,13 @@ pub trait Residuals {
     /// tried; the damping grows instead, as a trust region's radius shrinks.
     fn step_limits(&self) -> Vec<f64> {
         Vec::new()
+    }
+
+    /// The length of `r` below which the residuals are rounding errors of the values they compare: a fit that
+    /// reaches it is exact, and its Gauss–Newton step measures rounding, not a distance to the minimum
+    /// (0: the problem does not say).
+    fn rounding_floor(&self) -> f64 {
+        0.0
     }
 }
 
@@ -166,7 +176,8 @@ pub struct Minimum {
     pub stop: StopReason,
     pub convergence: Convergence,
     /// The Gauss–Newton step from `z` in standard errors, `‖P r‖ / s` (see the module docs); 0 at an exact
-    /// minimum.
+    /// minimum, and at an exact fit (residuals within [`Residuals::rounding_floor`]), where the ratio of two
+    /// rounding errors would measure nothing.
     pub optimality: f64,
 }
 
@@ -288,7 +299,13 @@ pub fn minimise(
             }
         }
     }
-    let optimality = gauss_newton_distance(&z, &j, &r, lower, upper);
+    // Residuals at the rounding level of the values they compare (a record the model reproduces exactly) have
+    // a standard error of the same order, so the Gauss–Newton step in standard errors is noise of order one.
+    let exact = r.norm() <= problem.rounding_floor();
+    let optimality = match exact {
+        true => 0.0,
+        false => gauss_newton_distance(&z, &j, &r, lower, upper),
+    };
     // Without degrees of freedom there is no standard error to measure by: the step's length decides.
     let near = opts.xtol.sqrt();
     let gn_negligible = j.nrows() <= j.ncols()
@@ -608,6 +625,56 @@ mod tests {
         // There s² is that of the displaced residuals: ‖r‖² = 0.2 + 5 se² = 0.3, s = √(0.3/2).
         let want = (5.0f64).sqrt() * se / (0.3f64 / 2.0).sqrt();
         assert!((d - want).abs() < 1e-12, "{d} vs {want}");
+    }
+
+    /// A current `v/R` through a resistor measured exactly (`v/10`, each value rounded once): near `R = 10` the
+    /// residuals are rounding errors, and the Gauss–Newton step measured in their standard error was 6.7, a stall
+    /// ("the fit stalled (not a minimum)" for a record the model reproduces exactly). With the rounding floor
+    /// of the measured values the fit is exact and converged.
+    struct Divider {
+        floor: bool,
+    }
+
+    impl Residuals for Divider {
+        fn evaluate(&mut self, z: &[f64]) -> Result<(DVector<f64>, DMatrix<f64>), String> {
+            let v = |k: usize| 1.0 + k as f64 * 0.1;
+            // The model multiplies by the conductance, the record divides: they differ in the last place.
+            let r = DVector::from_fn(50, |k, _| v(k) * z[0].recip() - v(k) / 10.0);
+            let j = DMatrix::from_fn(50, 1, |k, _| -v(k) / (z[0] * z[0]));
+            Ok((r, j))
+        }
+
+        fn rounding_floor(&self) -> f64 {
+            let measured = (0..50).map(|k| (1.0 + k as f64 * 0.1) / 10.0);
+            match self.floor {
+                true => 1e3 * f64::EPSILON * measured.map(|y| y * y).sum::<f64>().sqrt(),
+                false => 0.0,
+            }
+        }
+    }
+
+    #[test]
+    fn a_record_reproduced_to_rounding_is_an_exact_fit_not_a_stall() {
+        let inf = f64::INFINITY;
+        let run = |floor| {
+            minimise(
+                &mut Divider { floor },
+                &[3.0],
+                &[0.0],
+                &[inf],
+                &LmOptions::default(),
+            )
+            .unwrap()
+        };
+        let exact = run(true);
+        assert!((exact.z[0] - 10.0).abs() <= 1e-13, "{exact:?}");
+        assert_eq!(exact.convergence, Convergence::Converged);
+        assert_eq!(exact.optimality, 0.0);
+        // Without the floor, the same iterate reads as a stall: the ratio of two rounding errors.
+        let blind = run(false);
+        assert!((blind.z[0] - 10.0).abs() <= 1e-13, "{blind:?}");
+        assert_eq!(blind.convergence, Convergence::Stalled, "{blind:?}");
+        assert!(blind.optimality > 0.1, "{blind:?}");
     }
 
     /// `r = scale (z − 1, z − 2)`: with `scale` 1e200 the squared norm overflows, with 1e-170 it underflows to 0.

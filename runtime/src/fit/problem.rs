@@ -579,6 +579,20 @@ impl Residuals for Objective<'_> {
             .collect()
     }
 
+    /// A thousand units in the last place of the weighted measured values (their root sum of squares): the
+    /// model's predictions are computed to about that.
+    fn rounding_floor(&self) -> f64 {
+        let mut sum = 0.0;
+        for meas in &self.record.measured {
+            for (c, v) in meas.iter().enumerate() {
+                if !v.is_nan() {
+                    sum += self.spec.weights[c] * v * v;
+                }
+            }
+        }
+        ROUNDING_ULPS * f64::EPSILON * sum.sqrt()
+    }
+
     fn evaluate(&mut self, z: &[f64]) -> Result<(DVector<f64>, DMatrix<f64>), String> {
         self.set(z);
         let sim = self.simulate().map_err(|e| e.to_string())?;
@@ -608,6 +622,10 @@ impl Residuals for Objective<'_> {
         Ok((r, j))
     }
 }
+
+/// The rounding error of a prediction, in units in the last place of the measured values, below which a fit is
+/// exact ([`Residuals::rounding_floor`]).
+const ROUNDING_ULPS: f64 = 1e3;
 
 /// The position of the first index that an earlier one repeats.
 fn first_repeat(indices: impl Iterator<Item = usize>) -> Option<usize> {

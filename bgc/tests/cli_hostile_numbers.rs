@@ -449,3 +449,40 @@ fn a_non_finite_input_signal_is_named_not_the_state_it_reaches() {
         "{err}"
     );
 }
+
+/// A resistance of 0 is physical (a short) and passes the coefficient checks, but a resistor in conductance
+/// causality divides by it: `--param r2=0` on a divider said "the initial i is not finite" (`simulate`), "D[0][0]
+/// evaluates to a non-finite number" (`statespace`) or "output `i` evaluates to a non-finite number" (`fit`). Each
+/// now names the parameter and the element. Zero where the equations only multiply by it is still accepted.
+#[test]
+fn a_zero_parameter_the_equations_divide_by_is_named() {
+    let model = cli_support::repo("bgc/tests/fmu_support/no_states.bg");
+    let record = temp_file("divider.csv", "t,v,i\n0,1,0.025\n0.1,2,0.05\n0.2,3,0.075\n");
+    let runs: [&[&str]; 3] = [
+        &[
+            "simulate", &model, "--t-end", "1", "--input", "v=1", "--param", "r2=0",
+        ],
+        &["statespace", &model, "--param", "r2=0"],
+        &[
+            "fit", &model, "--data", &record, "--free", "r1", "--param", "r2=0",
+        ],
+    ];
+    for args in runs {
+        let (code, _, err) = bgc(args);
+        assert_eq!(code, 1, "{args:?}: {err}");
+        assert!(
+            err.contains(
+                "error: parameter `r2` = 0 with these parameter values: the derived equations divide by it \
+                 (the coefficient of R `lower`)"
+            ),
+            "{args:?}: {err}"
+        );
+    }
+    // `upper` sets the effort, e = r1·f: a short there leaves the current v/r2.
+    let (code, out, err) = bgc(&[
+        "simulate", &model, "--t-end", "1", "--input", "v=3", "--param", "r1=0",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let last = out.lines().last().unwrap_or_default();
+    assert!(last.starts_with("1,1e-1,3e0,"), "{last}");
+}

@@ -4,7 +4,8 @@ use super::fit_model::Interpreted;
 use super::io::stderrln;
 use super::model::derive_one;
 use super::params::{
-    Assignment, assign, check_physical, reject_repeats, unknown_name, values_or_zero,
+    Assignment, assign, check_divisors, check_physical, reject_repeats, unknown_name,
+    values_or_zero,
 };
 use super::quantities::{self, Declared};
 use super::{ReportFormat, Status};
@@ -64,6 +65,7 @@ fn fit_record(
     }
     let start = eqs.param_values(&given);
     check_physical(model, &start)?;
+    check_divisors(model, eqs, &start)?;
     let inputs: Vec<&str> = eqs.inputs.iter().map(String::as_str).collect();
     let outputs: Vec<&str> = eqs.outputs.iter().map(|o| o.name.as_str()).collect();
     let record = Record::from_csv(text, &inputs, &outputs)

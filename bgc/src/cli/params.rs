@@ -2,8 +2,11 @@
 //! parameter values.
 
 use super::quantities::{self, Declared};
+use bgc::equations::Equations;
+use bgc::equations::symbols::{Sym, SymExt, post_order};
 use bgc::ir::{CoefficientFault, Expr, Model, Relation, coefficient_fault};
 use bgc::simulate::input::Signal;
+use bgc::symbolic::{Expr as SymExpr, Node};
 use bgc::syntax::ast::ElementKind;
 
 /// A `NAME=VALUE` pair as given (the value is checked by the command, so that a bad number is an input error).
@@ -115,7 +118,63 @@ pub fn param_values(
     }
     let values = eqs.param_values(&given_values);
     check_physical(model, &values)?;
+    check_divisors(model, eqs, &values)?;
     Ok(values)
+}
+
+/// Refuses a parameter value without a finite reciprocal (0) that the derived equations divide by. A resistance
+/// of 0 is physical, a short, but in the causality the graph gives the resistor (conductance: `f = e/R`) the
+/// equations divide by it; before, the run said only that the first value was not finite.
+pub fn check_divisors(model: &Model, eqs: &Equations, values: &[f64]) -> Result<(), String> {
+    let mut roots: Vec<SymExpr> = eqs.rates.clone();
+    roots.extend(eqs.intermediates.iter().map(|i| i.value.clone()));
+    roots.extend(eqs.outputs.iter().map(|o| o.value.clone()));
+    for node in post_order(&roots) {
+        let Node::Pow(base, exponent) = node.node() else {
+            continue;
+        };
+        if !exponent.as_const().is_some_and(|x| x < 0.0) {
+            continue;
+        }
+        let Some(Sym::Param(i)) = base.as_sym() else {
+            continue;
+        };
+        let Some(&v) = values.get(i) else {
+            continue;
+        };
+        if (1.0 / v).is_finite() {
+            continue;
+        }
+        let name = eqs.params.get(i).map_or("?", |(n, _)| n.as_str());
+        let users = elements_using(model, i, values);
+        let used = match users.is_empty() {
+            true => String::new(),
+            false => format!(" (the coefficient of {})", users.join(", ")),
+        };
+        return Err(format!(
+            "parameter `{name}` = {} with these parameter values: the derived equations divide by it{used}; \
+             give it a value whose reciprocal is finite",
+            bgc::diagnostic::number(v)
+        ));
+    }
+    Ok(())
+}
+
+/// The elements (`R lower`) whose coefficient depends on parameter `i`.
+fn elements_using(model: &Model, i: usize, values: &[f64]) -> Vec<String> {
+    let all = |j: usize| values.get(j).copied();
+    let without = |j: usize| if j == i { None } else { values.get(j).copied() };
+    model
+        .graph
+        .node_weights()
+        .filter(|n| match &n.relation {
+            Relation::Linear(e) | Relation::Modulus(e) => {
+                e.eval_const(&all).is_some() && e.eval_const(&without).is_none()
+            }
+            _ => false,
+        })
+        .map(|n| format!("{} `{}`", n.kind.keyword(), n.name))
+        .collect()
 }
 
 /// Checks the coefficients of the linear storages and resistors: an inertia or a compliance must be positive

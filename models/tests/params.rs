@@ -90,3 +90,39 @@ fn parametric_access_refuses_and_keeps_the_old_value() {
     );
     assert_eq!(model.param(99), None);
 }
+
+/// A parameter the equations divide by, with no element check to keep it from zero: the walking leg's Coulomb
+/// regularisation `eps` (`tanh(ω/eps)`), the rehabilitation leg's gait period. Before, `validate` accepted 0 and
+/// every evaluation gave NaN; now it is refused with its name and the reason.
+#[test]
+fn a_zero_the_equations_divide_by_is_refused() {
+    use bgc_models::{rehab_leg, walking_leg};
+    let leg = walking_leg::Params::default();
+    assert_eq!(leg.validate(), Ok(()));
+    match (walking_leg::Params { eps: 0.0, ..leg }).validate() {
+        Err(ParamError::NonPhysical {
+            name,
+            value,
+            reason,
+        }) => {
+            assert_eq!((name, value), ("eps", 0.0));
+            assert_eq!(
+                reason,
+                "the equations divide by it, and its reciprocal is not finite"
+            );
+        }
+        other => panic!("expected a refusal, got {other:?}"),
+    }
+    // A subnormal value has no finite reciprocal either.
+    let tiny = walking_leg::Params { eps: 1e-310, ..leg };
+    assert!(tiny.validate().is_err());
+    let rehab = rehab_leg::Params::default();
+    assert!(matches!(
+        (rehab_leg::Params {
+            T_gait: 0.0,
+            ..rehab
+        })
+        .validate(),
+        Err(ParamError::NonPhysical { name: "T_gait", .. })
+    ));
+}

@@ -3,10 +3,8 @@
 
 use super::quantities::{self, Declared};
 use bgc::equations::Equations;
-use bgc::equations::symbols::{Sym, SymExt, post_order};
 use bgc::ir::{CoefficientFault, Expr, Model, Relation, coefficient_fault};
 use bgc::simulate::input::Signal;
-use bgc::symbolic::{Expr as SymExpr, Node};
 use bgc::syntax::ast::ElementKind;
 
 /// A `NAME=VALUE` pair as given (the value is checked by the command, so that a bad number is an input error).
@@ -126,19 +124,7 @@ pub fn param_values(
 /// of 0 is physical, a short, but in the causality the graph gives the resistor (conductance: `f = e/R`) the
 /// equations divide by it; before, the run said only that the first value was not finite.
 pub fn check_divisors(model: &Model, eqs: &Equations, values: &[f64]) -> Result<(), String> {
-    let mut roots: Vec<SymExpr> = eqs.rates.clone();
-    roots.extend(eqs.intermediates.iter().map(|i| i.value.clone()));
-    roots.extend(eqs.outputs.iter().map(|o| o.value.clone()));
-    for node in post_order(&roots) {
-        let Node::Pow(base, exponent) = node.node() else {
-            continue;
-        };
-        if !exponent.as_const().is_some_and(|x| x < 0.0) {
-            continue;
-        }
-        let Some(Sym::Param(i)) = base.as_sym() else {
-            continue;
-        };
+    for i in eqs.divisor_params() {
         let Some(&v) = values.get(i) else {
             continue;
         };

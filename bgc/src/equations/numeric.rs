@@ -8,7 +8,7 @@ use super::dense::{self, Mat};
 use super::linear::{LinearError, NumericStateSpace, check_len as check};
 use super::symbols::{self, Sym, SymExt};
 use super::{Equations, MassBlock};
-use crate::symbolic::Expr;
+use crate::symbolic::{Expr, Node};
 
 /// Evaluates `e`, naming `what` in errors.
 fn value_of(
@@ -86,6 +86,37 @@ impl Equations {
             values.push(v);
         }
         values
+    }
+
+    /// The parameters the equations divide by (raised to a negative power in a rate, an intermediate, an output,
+    /// a loop residual or a mass matrix), in index order: a value without a finite reciprocal (0) makes them
+    /// non-finite, although the coefficient checks may allow it (a resistance of 0 in conductance causality).
+    pub fn divisor_params(&self) -> Vec<usize> {
+        let mut roots: Vec<Expr> = self.rates.clone();
+        roots.extend(self.f.iter().flatten().cloned());
+        roots.extend(self.intermediates.iter().map(|i| i.value.clone()));
+        roots.extend(self.outputs.iter().map(|o| o.value.clone()));
+        for block in &self.tear_blocks {
+            roots.extend(block.residuals.iter().cloned());
+        }
+        for block in &self.mass {
+            roots.extend(block.matrix.iter().flatten().cloned());
+        }
+        let mut found: Vec<usize> = symbols::post_order(&roots)
+            .iter()
+            .filter_map(|e| match e.node() {
+                Node::Pow(base, exponent) if exponent.as_const().is_some_and(|x| x < 0.0) => {
+                    match base.as_sym() {
+                        Some(Sym::Param(i)) => Some(i),
+                        _ => None,
+                    }
+                }
+                _ => None,
+            })
+            .collect();
+        found.sort_unstable();
+        found.dedup();
+        found
     }
 
     /// The rates `ẋ` of all states at parameter values, state, input and time, with the mass-matrix rows solved.

@@ -356,7 +356,9 @@ pub type OutJacU = SMatrix<f64, N_OUTPUTS, N_INPUTS>;
             .iter()
             .map(|p| (p.name.clone(), self.param_access(&p.name)))
             .collect();
-        for check in self.element_checks(&field_of) {
+        let checks = self.element_checks(&field_of);
+        let divisors = self.divisor_checks(&checks);
+        for check in checks {
             let (cond, what) = match check.rule {
                 Rule::Positive(what) => ("!v.is_finite() || v <= 0.0", (what, "positive")),
                 Rule::NonNegative => ("!v.is_finite() || v < 0.0", ("resistance", "non-negative")),
@@ -404,12 +406,32 @@ pub type OutJacU = SMatrix<f64, N_OUTPUTS, N_INPUTS>;
                 .map(str::to_string),
             );
         }
+        for (name, access) in divisors {
+            let reason = "the equations divide by it, and its reciprocal is not finite";
+            body.lines(
+                format!(
+                    "        // The equations divide by {name}.
+        if !(1.0 / {access}).is_finite() {{
+            return Err(ParamError::NonPhysical {{
+                name: {},
+                value: {access},
+                reason: {},
+            }});
+        }}",
+                    string_literal(&name),
+                    string_literal(reason),
+                )
+                .lines()
+                .map(str::to_string),
+            );
+        }
         body.line("Ok(())");
         let text = body.finish();
         self.doc(
             4,
             "Checks that the parameters are physical: all finite, inertias and compliances positive, resistances \
-             non-negative, transformer and gyrator moduli non-zero.",
+             non-negative, transformer and gyrator moduli non-zero, and each parameter the equations divide by \
+             with a finite reciprocal.",
         );
         if format::may_look_like_a_constant(&text) {
             self.out.push_str("    #[allow(clippy::approx_constant)]\n");
@@ -478,6 +500,30 @@ impl Writer<'_> {
             });
         }
         checks
+    }
+}
+
+impl Writer<'_> {
+    /// The parameters the equations divide by that no element check already keeps away from zero (an inertia
+    /// `m` or a compliance `1/k` must be positive, a modulus non-zero; a resistance may be 0), with how
+    /// `validate` reads each.
+    fn divisor_checks(&self, checks: &[ElementCheck]) -> Vec<(String, String)> {
+        let eqs = &self.m.equations;
+        let covered = |name: &str| {
+            checks.iter().any(|c| {
+                !matches!(c.rule, Rule::NonNegative)
+                    && (c.text == name || c.text == format!("1/{name}"))
+            })
+        };
+        eqs.divisor_params()
+            .into_iter()
+            .filter_map(|i| eqs.params.get(i).map(|(name, _)| name.clone()))
+            .filter(|name| !covered(name))
+            .map(|name| {
+                let access = self.param_access(&name);
+                (name, access)
+            })
+            .collect()
     }
 }
 

@@ -4,6 +4,7 @@ mod commands;
 mod fit;
 mod fit_model;
 mod fit_plot;
+mod fit_record;
 mod fit_report;
 mod fmu;
 mod io;

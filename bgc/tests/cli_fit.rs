@@ -194,6 +194,58 @@ fn pendulum_estimate_agrees_with_scipy_least_squares() {
     assert_eq!(v["converged"], true);
 }
 
+/// `bgc simulate` writes its header with units (`t [s],x [m]`); a record with such a header said "the record
+/// has no `t` column". A header cell may now carry a unit in brackets, and the column is converted to the model's
+/// unit: the pendulum record in milliseconds and degrees gives the estimate of the record in seconds and radians.
+#[test]
+fn a_record_with_units_in_its_header_is_converted_to_the_model_units() {
+    let mut converted = String::from("t [ms],theta_pend [deg],omega_pend [rad/s]\n");
+    for line in PENDULUM_RECORD.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').filter_map(|c| c.parse().ok()).collect();
+        if let [t, theta, omega] = v[..] {
+            let deg = theta.to_degrees();
+            converted.push_str(&format!("{},{deg},{omega}\n", t * 1e3));
+        }
+    }
+    let data = temp_file("pendulum_units.csv", &converted);
+    let v = fit_json(&[
+        &repo("models/pendulum_rig.bg"),
+        "--data",
+        &data,
+        "--free",
+        "J_p,d_s",
+        "--param",
+        "J_p=0.0156",
+        "--param",
+        "d_s=0.14",
+        "--weight",
+        "theta_pend=250000",
+        "--weight",
+        "omega_pend=2500",
+    ]);
+    let j = estimate(&v, "J_p")["value"].as_f64().unwrap_or(f64::NAN);
+    let d = estimate(&v, "d_s")["value"].as_f64().unwrap_or(f64::NAN);
+    assert!((j - 0.01210337751724493).abs() <= 1e-6 * 0.0121, "{v}");
+    assert!((d - 0.20583616074856637).abs() <= 1e-5 * 0.206, "{v}");
+    // A unit of another dimension, and a column `bgc simulate` writes that a fit does not read.
+    let model = repo("models/pendulum_rig.bg");
+    let wrong = "t [s],theta_pend [s]\n0,0\n1,0\n";
+    let (code, err) = refused(&model, wrong, "J_p");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("the record's column `theta_pend` is in [rad]")
+            && err.contains("but [s] is in"),
+        "{err}"
+    );
+    let simulated = "t [s],theta_pend [rad],energy [J]\n0,0,0\n1,0,0\n";
+    let (code, err) = refused(&model, simulated, "J_p");
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("`energy` is a column of `bgc simulate`"),
+        "{err}"
+    );
+}
+
 #[test]
 fn a_product_the_record_cannot_split_is_named_and_held() {
     // Gravity enters only as m_p g l_p: the record determines m_p l_p, not m_p / l_p.

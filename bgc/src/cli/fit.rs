@@ -66,9 +66,8 @@ fn fit_record(
     let start = eqs.param_values(&given);
     check_physical(model, &start)?;
     check_divisors(model, eqs, &start)?;
-    let inputs: Vec<&str> = eqs.inputs.iter().map(String::as_str).collect();
     let outputs: Vec<&str> = eqs.outputs.iter().map(|o| o.name.as_str()).collect();
-    let record = Record::from_csv(text, &inputs, &outputs)
+    let record = super::fit_record::read(model, eqs, text)
         .map_err(|e| format!("{}: {e}", args.data.display()))?;
     let free = free_params(model, eqs, &declared, &start, args)?;
     let states = quantities::states(model, eqs);

@@ -1,0 +1,109 @@
+//! The record of `bgc fit`: a CSV file whose header may carry units, as `bgc simulate` writes it.
+//!
+//! A header cell is a name (`x`) or a name and a unit in brackets (`x [mm]`, `t [s]`). A column in a unit is
+//! converted to the unit the model declares for that input or output (to seconds for `t`), as `--param` converts
+//! a value in brackets; a unit of another dimension is an error naming both. The runtime's reader then sees bare
+//! names, and says what is wrong with the columns themselves. A column that `bgc simulate` writes but a fit does
+//! not read (a state, an energy column) gets an error that says so.
+
+use super::quantities::{self, Declared, factor_to_declared, split_unit};
+use bgc::equations::Equations;
+use bgc::ir::Model;
+use bgc::units::parse_unit_text;
+use bgc_runtime::fit::Record;
+
+/// The columns `bgc simulate` writes after the states and outputs.
+const ENERGY_COLUMNS: [&str; 3] = ["energy", "dissipated", "supplied"];
+
+/// Reads the record `text`, with each column in a unit converted to the model's unit.
+pub fn read(model: &Model, eqs: &Equations, text: &str) -> Result<Record, String> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    // Blank lines before the header are kept, so that the reader's line numbers stay those of the file.
+    let header_start = text
+        .split_inclusive('\n')
+        .take_while(|l| l.trim().is_empty())
+        .map(str::len)
+        .sum::<usize>();
+    let (blank, rest) = text.split_at(header_start);
+    let (header, body) = rest.split_once('\n').unwrap_or((rest, ""));
+    let mut names = Vec::new();
+    let mut factors = Vec::new();
+    for cell in header.trim_end_matches('\r').split(',') {
+        let (name, unit) = split_unit(cell).map_err(|e| format!("the record's header: {e}"))?;
+        factors.push(match declared(model, name) {
+            Some(d) => factor_to_declared("the record's column", &d, unit)?,
+            None => 1.0,
+        });
+        names.push(name.to_string());
+    }
+    let inputs: Vec<&str> = eqs.inputs.iter().map(String::as_str).collect();
+    let outputs: Vec<&str> = eqs.outputs.iter().map(|o| o.name.as_str()).collect();
+    let bare = format!("{blank}{}\n{body}", names.join(","));
+    let mut record = Record::from_csv(&bare, &inputs, &outputs)
+        .map_err(|e| e.to_string() + &not_read(model, eqs, &names))?;
+    convert(&mut record, &names, &factors, &inputs, &outputs);
+    Ok(record)
+}
+
+/// The declared quantity of a column name: the time, an input or an output.
+fn declared(model: &Model, name: &str) -> Option<Declared> {
+    if name == "t" {
+        let unit = parse_unit_text("s").ok()?;
+        return Some(Declared {
+            name: "t".into(),
+            unit,
+            text: "s".into(),
+        });
+    }
+    let mut all = quantities::inputs(model);
+    all.extend(quantities::outputs(model));
+    all.into_iter().find(|d| d.name == name)
+}
+
+/// Multiplies each column by its factor to the model's unit.
+fn convert(
+    record: &mut Record,
+    names: &[String],
+    factors: &[f64],
+    inputs: &[&str],
+    outputs: &[&str],
+) {
+    let factor = |name: &str| {
+        names
+            .iter()
+            .position(|n| n == name)
+            .and_then(|c| factors.get(c))
+            .copied()
+            .unwrap_or(1.0)
+    };
+    let t = factor("t");
+    record.times.iter_mut().for_each(|v| *v *= t);
+    let per_input: Vec<f64> = inputs.iter().map(|n| factor(n)).collect();
+    for row in &mut record.inputs {
+        row.iter_mut().zip(&per_input).for_each(|(v, f)| *v *= f);
+    }
+    let per_column: Vec<f64> = record
+        .outputs
+        .iter()
+        .map(|&o| outputs.get(o).map_or(1.0, |n| factor(n)))
+        .collect();
+    for row in &mut record.measured {
+        row.iter_mut().zip(&per_column).for_each(|(v, f)| *v *= f);
+    }
+}
+
+/// A sentence for a column that `bgc simulate` writes and a fit does not read, or nothing.
+fn not_read(model: &Model, eqs: &Equations, names: &[String]) -> String {
+    let states = quantities::states(model, eqs);
+    let is_output = |n: &str| eqs.outputs.iter().any(|o| o.name == n);
+    names
+        .iter()
+        .find(|n| !is_output(n) && (ENERGY_COLUMNS.contains(&n.as_str()) || states.iter().any(|s| &s.name == *n)))
+        .map(|n| {
+            format!(
+                "; `{n}` is a column of `bgc simulate` (a state or an energy) that a fit does not read: a record \
+                 holds `t`, the inputs and measured outputs (declare an `output` for what was measured)"
+            )
+        })
+        .unwrap_or_default()
+}

@@ -105,7 +105,8 @@ pub fn serve(connection: &Connection, options: Options) -> Result<(), String> {
 
 /// Serves on standard input and output.
 pub fn run_stdio(options: Options) -> Result<(), String> {
-    let (connection, transport) = transport::stdio();
+    let (connection, transport) =
+        transport::stdio().map_err(|e| format!("the connection's threads could not start: {e}"))?;
     let served = serve(&connection, options);
     drop(connection);
     transport.finish(served)

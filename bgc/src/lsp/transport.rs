@@ -23,28 +23,32 @@ pub struct Transport {
     broken: Arc<Mutex<Option<String>>>,
 }
 
-/// A connection on standard input and output, and its threads.
-pub fn stdio() -> (Connection, Transport) {
+/// A connection on standard input and output, and its threads; an error when a thread cannot be started.
+pub fn stdio() -> io::Result<(Connection, Transport)> {
     let (to_writer, from_server) = crossbeam_channel::bounded::<Message>(0);
     let (to_server, incoming) = crossbeam_channel::bounded::<Message>(0);
     // The reader's own answers (to skipped bodies) reach the writer on a channel of their own, so that the writer
     // ends with the server's side and does not wait for a reader still blocked on the client's input.
     let (replies, from_reader) = crossbeam_channel::unbounded::<Message>();
-    let writer = thread::spawn(move || {
-        let stdout = io::stdout();
-        write_messages(&from_server, from_reader, &mut stdout.lock())
-    });
+    let writer = thread::Builder::new()
+        .name("bgc-lsp-writer".into())
+        .spawn(move || {
+            let stdout = io::stdout();
+            write_messages(&from_server, from_reader, &mut stdout.lock())
+        })?;
     let broken = Arc::new(Mutex::new(None));
     let cause = Arc::clone(&broken);
-    let reader = thread::spawn(move || {
-        let stdin = io::stdin();
-        let read = read_messages(&mut stdin.lock(), &to_server, &replies, &mut io::stderr());
-        // Recorded before the server's channel closes, so that the server, which stops when it does, finds it.
-        if let Err(why) = read {
-            *cause.lock().unwrap_or_else(PoisonError::into_inner) = Some(why);
-        }
-        drop(to_server);
-    });
+    let reader = thread::Builder::new()
+        .name("bgc-lsp-reader".into())
+        .spawn(move || {
+            let stdin = io::stdin();
+            let read = read_messages(&mut stdin.lock(), &to_server, &replies, &mut io::stderr());
+            // Recorded before the server's channel closes, so that the server, which stops when it does, finds it.
+            if let Err(why) = read {
+                *cause.lock().unwrap_or_else(PoisonError::into_inner) = Some(why);
+            }
+            drop(to_server);
+        })?;
     let connection = Connection {
         sender: to_writer,
         receiver: incoming,
@@ -54,7 +58,7 @@ pub fn stdio() -> (Connection, Transport) {
         writer,
         broken,
     };
-    (connection, transport)
+    Ok((connection, transport))
 }
 
 impl Transport {

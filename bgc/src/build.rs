@@ -354,6 +354,18 @@ fn write_if_changed(path: &Path, text: &str) -> Result<bool, Error> {
 /// elements takes 24 MB); anything larger is a mistake or an attack, and is refused before it fills the memory.
 pub const MAX_SOURCE_BYTES: u64 = 64 << 20;
 
+/// The first of `inputs` that `output` names too (the same existing file, links resolved): writing the output
+/// there would destroy an input (`bgc fmu model.bg -o model.bg`).
+pub fn overwritten_input<'a>(
+    output: &Path,
+    inputs: impl IntoIterator<Item = &'a Path>,
+) -> Option<&'a Path> {
+    let target = std::fs::canonicalize(output).ok()?;
+    inputs
+        .into_iter()
+        .find(|p| std::fs::canonicalize(p).is_ok_and(|q| q == target))
+}
+
 /// Reads a source file: a `.bg` file (by the name it resolves to, so a link named `x.bg` to another file is
 /// refused too) that is a regular file (not a FIFO, a device or a directory, which could block or never end) of at
 /// most [`MAX_SOURCE_BYTES`]. Refusing other files keeps their contents out of diagnostics, which quote the source.

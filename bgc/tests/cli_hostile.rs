@@ -649,3 +649,57 @@ fn a_dense_state_space_too_large_to_print_is_refused_and_sparse_is_offered() {
         "{nonzero} non-zero entries"
     );
 }
+
+/// An output named like an input was written over it: `bgc fmu lib.bg -o lib.bg` replaced the model (or a file it
+/// imports) with the FMU's zip, `bgc draw m.bg -o m.bg` with the SVG, and `bgc fit --plot rig.csv --data rig.csv`
+/// the measured record with the plot. Each is now refused (exit 2) with the input named, the file untouched, also
+/// through a link or another spelling of the path.
+#[test]
+fn an_output_over_an_input_is_refused_and_the_input_kept() {
+    let dir = scratch("overwrite");
+    let lib = "component load {\n    domain electrical;\n    param r = 10 [Ohm];\n    1 j;\n    R res = r;\n    \
+               bond j -> res;\n    port a = j;\n}\n";
+    let model = "import \"lib.bg\";\nmodel m {\n    domain electrical;\n    input v [V];\n    Se s = v;\n    \
+                 load h;\n    bond s -> h.a;\n    output i [A] = f(h.res);\n}\n";
+    write(&dir.join("lib.bg"), lib);
+    write(&dir.join("m.bg"), model);
+    write(
+        &dir.join("rig.csv"),
+        "t,v,i\n0,1,0.1\n0.1,2,0.2\n0.2,3,0.3\n",
+    );
+    #[cfg(unix)]
+    let _ = std::os::unix::fs::symlink("m.bg", dir.join("link.bg"));
+    let cases: [(&[&str], &str); 5] = [
+        (
+            &["fmu", "m.bg", "-o", "m.bg"],
+            "m.bg is the model's source file m.bg",
+        ),
+        (
+            &["fmu", "m.bg", "-o", "lib.bg"],
+            "lib.bg is the model's source file",
+        ),
+        (
+            &["draw", "m.bg", "-o", "./m.bg"],
+            "./m.bg (the same file as m.bg) is an input",
+        ),
+        (
+            &["draw", "m.bg", "-o", "link.bg"],
+            "link.bg (the same file as m.bg) is an input",
+        ),
+        (
+            &[
+                "fit", "m.bg", "--data", "rig.csv", "--free", "r", "--plot", "rig.csv",
+            ],
+            "rig.csv is an input of this command",
+        ),
+    ];
+    for (args, said) in cases {
+        let run = bgc(&dir, args);
+        assert_eq!(run.status, 2, "{args:?}\n{}", run.transcript());
+        assert!(run.stderr.contains(said), "{args:?}\n{}", run.transcript());
+    }
+    let read = |name: &str| std::fs::read_to_string(dir.join(name)).unwrap_or_default();
+    assert_eq!(read("m.bg"), model);
+    assert_eq!(read("lib.bg"), lib);
+    assert!(read("rig.csv").starts_with("t,v,i\n"));
+}

@@ -269,6 +269,11 @@ pub fn draw(
         Ok(l) => l,
         Err(s) => return s,
     };
+    if let Some(out) = output
+        && super::io::refuse_overwrite(out, &loaded.sources, &[]).is_err()
+    {
+        return Status::UsageOrIo;
+    }
     // A drawing is most useful exactly when causality has problems, so they are drawn (highlighted), not refused.
     let (result, mut causal_diags) = bgc::causality::analyse(&loaded.model);
     bgc::lower::add_instance_context(&loaded.model, &mut causal_diags);

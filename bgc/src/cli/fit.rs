@@ -36,6 +36,11 @@ pub fn run(path: &Path, wanted: Option<&str>, args: &FitArgs<'_>, color: bool) -
         Ok(x) => x,
         Err(s) => return s,
     };
+    if let Some(plot) = args.plot
+        && super::io::refuse_overwrite(plot, &d.loaded.sources, &[args.data]).is_err()
+    {
+        return Status::UsageOrIo;
+    }
     let text = match super::io::read_record(args.data) {
         Ok(t) => t,
         Err(e) => {

@@ -41,6 +41,34 @@ pub fn read_source(
     }
 }
 
+/// Refuses to write `output` over an input of the command: a source file of the model, or another file it reads
+/// (`bgc draw m.bg -o m.bg`, `bgc fit ... --data rig.csv --plot rig.csv`). Prints the error; the caller ends with
+/// [`crate::cli::Status::UsageOrIo`].
+pub fn refuse_overwrite(output: &Path, sources: &SourceMap, others: &[&Path]) -> Result<(), ()> {
+    let names: Vec<PathBuf> = sources
+        .files()
+        .map(|(_, f)| PathBuf::from(&f.name))
+        .collect();
+    let inputs = names
+        .iter()
+        .map(PathBuf::as_path)
+        .chain(others.iter().copied());
+    match bgc::build::overwritten_input(output, inputs) {
+        Some(input) => {
+            let same = match input == output {
+                true => String::new(),
+                false => format!(" (the same file as {})", input.display()),
+            };
+            stderrln(&format!(
+                "error: {}{same} is an input of this command: choose another file for the output",
+                output.display(),
+            ));
+            Err(())
+        }
+        None => Ok(()),
+    }
+}
+
 /// The largest measured record `bgc fit --data` reads.
 pub const MAX_RECORD_BYTES: u64 = 256 << 20;
 

@@ -60,6 +60,9 @@ pub enum Error {
     Build { dir: PathBuf, stderr: String },
     #[error("{0}")]
     Zip(#[from] zip::ZipError),
+    /// The FMU would be written over a source file of the model.
+    #[error("{fmu} is the model's source file {source_file}: choose another name for the FMU")]
+    OverwritesSource { fmu: PathBuf, source_file: PathBuf },
 }
 
 /// How to make an FMU.
@@ -114,8 +117,15 @@ impl Config {
     /// Compiles `source`, builds the library with Cargo (the `CARGO` environment variable names it, else
     /// `cargo` on the path) and writes the FMU to `fmu`.
     pub fn build(&self, source: impl AsRef<Path>, fmu: impl AsRef<Path>) -> Result<Built, Error> {
-        let source = source.as_ref();
-        let (compiled, warnings) = self.compile(source)?;
+        let (source, fmu) = (source.as_ref(), fmu.as_ref());
+        let (compiled, warnings, files) = self.compile(source)?;
+        if let Some(file) = crate::build::overwritten_input(fmu, files.iter().map(PathBuf::as_path))
+        {
+            return Err(Error::OverwritesSource {
+                fmu: fmu.to_path_buf(),
+                source_file: file.to_path_buf(),
+            });
+        }
         let sources = package_sources(
             &compiled,
             self.model.as_deref(),
@@ -142,7 +152,6 @@ impl Config {
             &format!("binaries/{platform}/{}.so", sources.identifier),
             &bytes,
         )?;
-        let fmu = fmu.as_ref();
         std::fs::write(fmu, archive.finish()?).map_err(|e| io(fmu, e))?;
         Ok(Built {
             fmu: fmu.to_path_buf(),
@@ -152,7 +161,8 @@ impl Config {
         })
     }
 
-    fn compile(&self, source: &Path) -> Result<(CompiledFile, String), Error> {
+    /// The compiled file, its warnings rendered, and the paths of the files it was read from.
+    fn compile(&self, source: &Path) -> Result<(CompiledFile, String, Vec<PathBuf>), Error> {
         let bytes = crate::build::read_source_file(source).map_err(|e| io(source, e))?;
         let mut loader = FsLoader::new(&self.include)
             .map_err(|e| io(self.include.first().map_or(source, |p| p), e))?;
@@ -172,7 +182,8 @@ impl Config {
         match codegen::compile(&mut map, root, &mut loader) {
             Ok(c) => {
                 let warnings = render::to_text(&map, &c.warnings, false);
-                Ok((c, warnings))
+                let files = map.files().map(|(_, f)| PathBuf::from(&f.name)).collect();
+                Ok((c, warnings, files))
             }
             Err(diags) => Err(Error::Diagnostics {
                 file: source.to_path_buf(),

@@ -703,3 +703,24 @@ fn an_output_over_an_input_is_refused_and_the_input_kept() {
     assert_eq!(read("lib.bg"), lib);
     assert!(read("rig.csv").starts_with("t,v,i\n"));
 }
+
+/// `bgc fmt` rewrote a CRLF file (a Windows checkout) with `\n` line breaks, and `bgc fmt --check` failed on every
+/// formatted CRLF file with a diff of all its lines; the file's line breaks are now kept.
+#[test]
+fn fmt_keeps_a_files_crlf_line_breaks() {
+    let dir = scratch("crlf");
+    let canonical = "model a {\r\n    domain electrical;\r\n    param r = 1 [Ohm];\r\n}\r\n";
+    write(&dir.join("ok.bg"), canonical);
+    let run = bgc(&dir, &["fmt", "--check", "ok.bg"]);
+    assert_eq!(run.status, 0, "{}", run.transcript());
+    write(
+        &dir.join("messy.bg"),
+        "model a {\r\n  domain electrical;\r\n  param r=1 [Ohm];}\r\n",
+    );
+    let run = bgc(&dir, &["fmt", "messy.bg"]);
+    assert_eq!(run.status, 0, "{}", run.transcript());
+    assert_eq!(
+        std::fs::read_to_string(dir.join("messy.bg")).unwrap_or_default(),
+        canonical
+    );
+}

@@ -100,7 +100,7 @@ fn fmt_one(path: &Path, check_only: bool, color: bool) -> std::io::Result<bool> 
         ));
         return Ok(false);
     }
-    let formatted = bgc::syntax::format(&ast);
+    let formatted = bgc::syntax::in_style_of(&text, bgc::syntax::format(&ast));
     if formatted == text {
         return Ok(true);
     }

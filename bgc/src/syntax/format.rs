@@ -29,13 +29,33 @@ pub fn format(file: &File) -> String {
     p.out
 }
 
-/// Parses `text` and formats it; refuses (returning the diagnostics) when the text has syntax errors.
+/// Parses `text` and formats it in its own line endings and byte-order mark (see [`in_style_of`]); refuses
+/// (returning the diagnostics) when the text has syntax errors.
 pub fn format_source(file: FileId, text: &str) -> Result<String, Vec<Diagnostic>> {
     let (tree, diags) = super::parse(file, text);
     if has_errors(&diags) {
         return Err(diags);
     }
-    Ok(format(&tree))
+    Ok(in_style_of(text, format(&tree)))
+}
+
+/// `formatted` (from [`format`]: `\n` line breaks, no byte-order mark) with the conventions of the file it came
+/// from: CRLF line breaks when the original's first line break is CRLF (a Windows checkout), and the byte-order
+/// mark when the original starts with one. The layout is canonical; the encoding of line breaks is the file's,
+/// as rustfmt's and ruff's default (`auto`) keeps it, so that formatting never rewrites every line of such a file.
+pub fn in_style_of(original: &str, formatted: String) -> String {
+    const BOM: char = '\u{feff}';
+    let crlf = original
+        .find('\n')
+        .is_some_and(|i| original[..i].ends_with('\r'));
+    let mut out = match crlf {
+        true => formatted.replace("\r\n", "\n").replace('\n', "\r\n"),
+        false => formatted,
+    };
+    if original.starts_with(BOM) && !out.starts_with(BOM) {
+        out.insert(0, BOM);
+    }
+    out
 }
 
 struct Printer<'f> {

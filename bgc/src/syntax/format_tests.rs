@@ -329,3 +329,37 @@ mod generated_trees {
         }
     }
 }
+
+/// A file with CRLF line breaks (a Windows checkout) or a byte-order mark was rewritten with `\n` and without the
+/// mark: `bgc fmt` changed every line, and `bgc fmt --check` and the editor's formatting reported a formatted
+/// file as unformatted. The layout is canonical; the line breaks and the mark are the file's.
+#[test]
+fn line_endings_and_byte_order_mark_are_the_files_own() {
+    let lf = "model a {\n    domain electrical; // note\n    param r = 1 [Ohm];\n}\n";
+    let crlf = lf.replace('\n', "\r\n");
+    assert_eq!(
+        format_source(FileId(0), &crlf).ok().as_deref(),
+        Some(crlf.as_str())
+    );
+    let messy = "model a {\r\n  domain electrical; // note\r\n  param r=1 [Ohm];}\r\n";
+    assert_eq!(
+        format_source(FileId(0), messy).ok().as_deref(),
+        Some(crlf.as_str())
+    );
+    let bom = format!("\u{feff}{lf}");
+    assert_eq!(
+        format_source(FileId(0), &bom).ok().as_deref(),
+        Some(bom.as_str())
+    );
+    let bom_crlf = format!("\u{feff}{crlf}");
+    assert_eq!(
+        format_source(FileId(0), &bom_crlf).ok().as_deref(),
+        Some(bom_crlf.as_str())
+    );
+    // The first line break decides: a file in LF with one stray CR line is made LF throughout.
+    let mixed = "model a {\n    domain electrical;\r\n}\n";
+    assert_eq!(
+        format_source(FileId(0), mixed).ok().as_deref(),
+        Some("model a {\n    domain electrical;\n}\n")
+    );
+}

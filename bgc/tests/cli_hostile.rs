@@ -724,3 +724,38 @@ fn fmt_keeps_a_files_crlf_line_breaks() {
         canonical
     );
 }
+
+/// `bgc fmt` wrote the file in place, which truncates it first: a full disk or a stop halfway left a cut model.
+/// It now writes a file beside it and renames it over the original, keeping its permissions and any link to
+/// it, and leaves no file of its own behind.
+#[cfg(unix)]
+#[test]
+fn fmt_replaces_a_file_whole_through_its_link_with_its_permissions() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = scratch("fmt-replace");
+    write(&dir.join("real.bg"), "model a {\n  domain electrical;\n}\n");
+    let mode = |p: &Path| {
+        std::fs::metadata(p)
+            .map(|m| m.permissions().mode() & 0o777)
+            .unwrap_or(0)
+    };
+    let _ = std::fs::set_permissions(dir.join("real.bg"), std::fs::Permissions::from_mode(0o640));
+    let _ = std::os::unix::fs::symlink("real.bg", dir.join("link.bg"));
+    let run = bgc(&dir, &["fmt", "link.bg"]);
+    assert_eq!(run.status, 0, "{}", run.transcript());
+    let link = std::fs::symlink_metadata(dir.join("link.bg")).map(|m| m.file_type().is_symlink());
+    assert!(matches!(link, Ok(true)), "the link is kept");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("real.bg")).unwrap_or_default(),
+        "model a {\n    domain electrical;\n}\n"
+    );
+    assert_eq!(mode(&dir.join("real.bg")), 0o640);
+    let names: Vec<String> = std::fs::read_dir(&dir)
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .collect()
+        })
+        .unwrap_or_default();
+    assert_eq!(names.len(), 2, "{names:?}");
+}

@@ -115,7 +115,7 @@ fn fmt_one(path: &Path, check_only: bool, color: bool) -> std::io::Result<bool> 
         stderrln(&format!("{name}: not in the canonical layout"));
         return Ok(false);
     }
-    std::fs::write(path, formatted)?;
+    super::io::replace_file(path, formatted.as_bytes())?;
     Ok(true)
 }
 

@@ -17,6 +17,7 @@ pub mod ast;
 mod bond;
 mod decode;
 mod expr;
+pub mod foreign;
 mod format;
 mod items;
 mod lexer;

@@ -208,6 +208,9 @@ impl Builder<'_> {
                 );
                 None
             }
+            // A name with letters outside ASCII (`π`) is already an error of its own (BG0104, with its ASCII
+            // spelling); "unknown name" would only repeat it.
+            None if crate::syntax::foreign::reported_by_lexer(name) => None,
             None => {
                 let mut d = Diagnostic::error("BG0201", format!("unknown name `{name}`"))
                     .with_primary(e.span, "not declared in this scope");

@@ -219,6 +219,14 @@ impl<'a> Builder<'a> {
                 self.last_unit_ok = true;
                 (unit, text)
             }
+            // A symbol with letters outside ASCII (`[kΩ]`) is already an error of its own (BG0104, with the ASCII
+            // spelling).
+            Err(crate::units::UnitError::UnknownSymbol { symbol })
+                if crate::syntax::foreign::reported_by_lexer(&symbol) =>
+            {
+                self.last_unit_ok = false;
+                (Unit::ONE, text)
+            }
             Err(err) => {
                 let mut d = Diagnostic::error("BG0312", format!("{err} in `[{text}]`"))
                     .with_primary(u.span, err.to_string());

@@ -962,3 +962,53 @@ mod random_models {
         }
     }
 }
+
+/// Names and units written with letters outside ASCII (`τ_m`, `π`, `[kΩ]`), as papers write them: each letter was
+/// an invalid character, and each statement went on to a cascade ("expected the name of the parameter, found `=`",
+/// "unknown name", "unknown unit `k`"). Each is now one BG0104 per occurrence, with the ASCII spelling.
+#[test]
+fn names_and_units_outside_ascii_are_one_error_each_with_the_ascii_spelling() {
+    let text = "model a {\n    domain electrical;\n    param r = 1 [kΩ];\n    input τ_m [V];\n    \
+                Se s = τ_m;\n    R res = r * π;\n    bond s -> res;\n}\n";
+    let (_, diags, _) = lower_text(text);
+    let found: Vec<(&str, String, Option<String>)> = diags
+        .iter()
+        .map(|d| (d.code.0, d.message.clone(), d.help.clone()))
+        .collect();
+    let spelled = |name: &str, what: &str, help: &str| {
+        (
+            "BG0104",
+            format!("the {what} `{name}` has letters outside ASCII"),
+            Some(help.to_string()),
+        )
+    };
+    assert_eq!(
+        found,
+        vec![
+            spelled("kΩ", "unit", "the ohm is written `Ohm`: `kOhm`"),
+            spelled(
+                "τ_m",
+                "name",
+                "names are ASCII letters, digits and `_`: write `tau_m`"
+            ),
+            spelled(
+                "τ_m",
+                "name",
+                "names are ASCII letters, digits and `_`: write `tau_m`"
+            ),
+            spelled(
+                "π",
+                "name",
+                "names are ASCII letters, digits and `_`: write `pi`"
+            ),
+        ]
+    );
+    // An ASCII name joined to a letter outside it is one name.
+    let (_, diags, _) = lower_text("model a { domain electrical; param masse_é = 1 [1]; }");
+    let messages: Vec<&str> = diags.iter().map(|d| d.message.as_str()).collect();
+    assert_eq!(messages[0], "the name `masse_é` has letters outside ASCII");
+    assert!(
+        !messages.iter().any(|m| m.contains("expected")),
+        "{messages:?}"
+    );
+}

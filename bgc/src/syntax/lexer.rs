@@ -194,6 +194,8 @@ struct Lexer<'a> {
     junk: Option<(usize, usize)>,
     /// Whether only whitespace has been seen since the last newline.
     at_line_start: bool,
+    /// Whether the last bracket was a `[` not closed yet: a unit is being written.
+    in_unit: bool,
 }
 
 /// Splits `text` into tokens. See the module documentation.
@@ -208,6 +210,7 @@ pub fn lex(file: FileId, text: &str) -> Lexed {
         out,
         junk: None,
         at_line_start: true,
+        in_unit: false,
     };
     lx.run();
     lx.out
@@ -219,6 +222,11 @@ impl<'a> Lexer<'a> {
     }
 
     fn push(&mut self, kind: Tok, start: usize, end: usize) {
+        match kind {
+            Tok::LBracket => self.in_unit = true,
+            Tok::RBracket | Tok::Semi => self.in_unit = false,
+            _ => {}
+        }
         self.out.tokens.push(Token {
             kind,
             start: start as u32,
@@ -329,6 +337,12 @@ impl<'a> Lexer<'a> {
                 rest = rest.get(len..).unwrap_or("");
                 continue;
             }
+            if let Some(len) = super::foreign::name_len(rest) {
+                self.flush_junk();
+                self.foreign_name(start, start + len);
+                rest = rest.get(len..).unwrap_or("");
+                continue;
+            }
             // Nothing starts here: extend the current run of invalid characters by one character.
             let width = rest.chars().next().map(char::len_utf8).unwrap_or(1);
             let end = start + width;
@@ -346,6 +360,37 @@ impl<'a> Lexer<'a> {
             start: end as u32,
             end: end as u32,
         });
+    }
+
+    /// A name with letters outside ASCII from `start` to `end` (joined to an ASCII name just before it, as in
+    /// `masse_é`): one error with the ASCII spelling when there is one, and one name token, so that the statement
+    /// parses on.
+    fn foreign_name(&mut self, start: usize, end: usize) {
+        let start = match self.out.tokens.last() {
+            Some(t) if t.kind == Tok::Ident && t.end as usize == start => {
+                let joined = t.start as usize;
+                self.out.tokens.pop();
+                joined
+            }
+            _ => start,
+        };
+        let name = self.text.get(start..end).unwrap_or("");
+        let (what, help) = match self.in_unit {
+            true => ("unit", super::foreign::unit_help(name)),
+            false => ("name", super::foreign::name_help(name)),
+        };
+        self.out.diagnostics.push(
+            Diagnostic::error(
+                "BG0104",
+                format!("the {what} `{name}` has letters outside ASCII"),
+            )
+            .with_primary(
+                self.span(start, end),
+                format!("not a {what} of the language"),
+            )
+            .with_help(help),
+        );
+        self.push(Tok::Ident, start, end);
     }
 
     /// The common tokens, recognised from their first byte without trying each parser in turn: whitespace, ASCII

@@ -361,7 +361,7 @@ impl<'a> Parser<'a> {
                     "choose another name, such as `{text}_1` or `my_{text}`"
                 )),
             );
-        } else if !text.is_ascii() {
+        } else if !text.is_ascii() && !super::foreign::reported_by_lexer(text) {
             self.diags.push(
                 Diagnostic::error("BG0104", format!("name `{text}` has a non-ASCII character"))
                     .with_primary(span, "names are ASCII")

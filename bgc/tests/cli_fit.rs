@@ -147,13 +147,12 @@ t,theta_pend,omega_pend
 //     print("# J_p", repr(J), "d_s", repr(d))
 //     print("# se", repr(np.sqrt(cov[0, 0])), repr(np.sqrt(cov[1, 1])), "s2", repr(s2), "corr", repr(cov[0, 1] / np.sqrt(cov[0, 0] * cov[1, 1])))
 
-#[test]
-fn pendulum_estimate_agrees_with_scipy_least_squares() {
-    let data = temp_file("pendulum.csv", PENDULUM_RECORD);
-    let v = fit_json(&[
+/// The fit of the SciPy reference below: `J_p` and `d_s` from the record at `data`, weighted by its noise.
+fn pendulum_fit(data: &str) -> Value {
+    fit_json(&[
         &repo("models/pendulum_rig.bg"),
         "--data",
-        &data,
+        data,
         "--free",
         "J_p,d_s",
         "--param",
@@ -164,7 +163,13 @@ fn pendulum_estimate_agrees_with_scipy_least_squares() {
         "theta_pend=250000",
         "--weight",
         "omega_pend=2500",
-    ]);
+    ])
+}
+
+#[test]
+fn pendulum_estimate_agrees_with_scipy_least_squares() {
+    let data = temp_file("pendulum.csv", PENDULUM_RECORD);
+    let v = pendulum_fit(&data);
     let close = |got: f64, want: f64, rel: f64| {
         assert!(
             (got - want).abs() <= rel * want.abs(),
@@ -208,21 +213,7 @@ fn a_record_with_units_in_its_header_is_converted_to_the_model_units() {
         }
     }
     let data = temp_file("pendulum_units.csv", &converted);
-    let v = fit_json(&[
-        &repo("models/pendulum_rig.bg"),
-        "--data",
-        &data,
-        "--free",
-        "J_p,d_s",
-        "--param",
-        "J_p=0.0156",
-        "--param",
-        "d_s=0.14",
-        "--weight",
-        "theta_pend=250000",
-        "--weight",
-        "omega_pend=2500",
-    ]);
+    let v = pendulum_fit(&data);
     let j = estimate(&v, "J_p")["value"].as_f64().unwrap_or(f64::NAN);
     let d = estimate(&v, "d_s")["value"].as_f64().unwrap_or(f64::NAN);
     assert!((j - 0.01210337751724493).abs() <= 1e-6 * 0.0121, "{v}");

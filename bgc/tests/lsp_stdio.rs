@@ -13,6 +13,12 @@ fn frame(message: &serde_json::Value) -> Vec<u8> {
 /// Runs `bgc ARGS` with the framed `session` on its standard input and returns what it wrote and its status. A
 /// server may stop reading at a protocol violation: a closed pipe is part of the outcome, which the caller checks.
 fn serve(args: &[&str], session: &[serde_json::Value]) -> std::process::Output {
+    let input: Vec<u8> = session.iter().flat_map(frame).collect();
+    serve_bytes(args, &input)
+}
+
+/// Runs `bgc ARGS` with `input` (framing included) on its standard input.
+fn serve_bytes(args: &[&str], input: &[u8]) -> std::process::Output {
     let mut child = Command::new(env!("CARGO_BIN_EXE_bgc"))
         .args(args)
         .stdin(Stdio::piped())
@@ -21,9 +27,7 @@ fn serve(args: &[&str], session: &[serde_json::Value]) -> std::process::Output {
         .spawn()
         .expect("bgc lsp starts");
     let mut stdin = child.stdin.take().expect("stdin");
-    for m in session {
-        let _ = stdin.write_all(&frame(m));
-    }
+    let _ = stdin.write_all(input);
     drop(stdin);
     child.wait_with_output().expect("bgc lsp ends")
 }
@@ -121,21 +125,6 @@ fn a_protocol_error_is_named_not_the_reader_thread_that_fails_after_it() {
     assert!(!err.contains("disconnected channel"), "{err}");
 }
 
-/// Runs `bgc lsp` on raw bytes (framing included) and returns its output.
-fn serve_raw(input: &[u8]) -> std::process::Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_bgc"))
-        .arg("lsp")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("bgc lsp starts");
-    let mut stdin = child.stdin.take().expect("stdin");
-    let _ = stdin.write_all(input);
-    drop(stdin);
-    child.wait_with_output().expect("bgc lsp ends")
-}
-
 /// A body that is not JSON ended the session ("malformed LSP payload", status 2), losing every open document. It
 /// is now skipped and reported, a request whose id can be read is answered with `InvalidRequest`, and the session
 /// goes on.
@@ -164,7 +153,7 @@ fn a_malformed_message_is_skipped_and_the_session_goes_on() {
     ] {
         input.extend(frame(&m));
     }
-    let out = serve_raw(&input);
+    let out = serve_bytes(&["lsp"], &input);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "{err}");
     assert_eq!(
@@ -213,7 +202,7 @@ fn a_corrupt_content_length_ends_the_session_with_the_cause() {
         ),
     ];
     for (input, cause) in cases {
-        let out = serve_raw(input);
+        let out = serve_bytes(&["lsp"], input);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{err}");
         assert!(

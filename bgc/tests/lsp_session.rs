@@ -547,6 +547,11 @@ fn importers_see_unsaved_text_and_rename_reaches_them() {
     for (name, why) in [
         ("bond", "reserved"),
         ("2k", "is not a name"),
+        // A Greek letter, as papers write stiffness: the ASCII spelling is proposed.
+        (
+            "κ",
+            "is not a name: a name is an ASCII letter or `_` followed by ASCII letters, digits and `_` (write `kappa`)",
+        ),
         ("spring", "already declared"),
     ] {
         let refused = client.request::<Rename>(lsp_types::RenameParams {

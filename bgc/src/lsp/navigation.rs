@@ -134,8 +134,13 @@ pub fn check_new_name(name: &str) -> Result<(), String> {
         .next()
         .is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
     if !starts || !chars.all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        // `τ_m`: the spelling the compiler proposes for it.
+        let ascii = crate::syntax::foreign::ascii_spelling(name)
+            .filter(|a| a != name && check_new_name(a).is_ok())
+            .map(|a| format!(" (write `{a}`)"))
+            .unwrap_or_default();
         return Err(format!(
-            "`{name}` is not a name: a name is a letter or `_` followed by letters, digits and `_`"
+            "`{name}` is not a name: a name is an ASCII letter or `_` followed by ASCII letters, digits and `_`{ascii}"
         ));
     }
     if crate::syntax::KEYWORDS.contains(&name) || matches!(name, "t" | "pi") {

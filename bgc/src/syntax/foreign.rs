@@ -48,7 +48,7 @@ pub(super) fn unit_help(symbol: &str) -> String {
 
 /// `name` with each Greek letter spelled out (`τ_m` → `tau_m`, `Δx` → `Deltax`); `None` when some other letter
 /// outside ASCII has no spelling here.
-pub(super) fn ascii_spelling(name: &str) -> Option<String> {
+pub fn ascii_spelling(name: &str) -> Option<String> {
     let mut out = String::with_capacity(name.len() + 8);
     for c in name.chars() {
         match c {

@@ -228,6 +228,7 @@ pub fn minimise(
     while iterations < opts.max_iterations {
         let jtj = j.transpose() * &j;
         let g = j.transpose() * &r;
+        check_products(&jtj, &g, iterations)?;
         let diag = jtj.diagonal().map(|d| d.max(1e-30));
         if largest_cosine(&z, &j, &r, &g, lower, upper) <= opts.gtol {
             stop = StopReason::Gradient;
@@ -348,6 +349,21 @@ fn check_start(r: &DVector<f64>, j: &DMatrix<f64>, cost: f64) -> Result<(), Stri
         ));
     }
     Ok(())
+}
+
+/// Refuses products of the Jacobian that overflow (`JᵀJ`, `Jᵀr`): a residual of 1e151 and a Jacobian of 1e153 each
+/// fit in f64, their squares summed over the samples do not, and an infinite `JᵀJ` scales every step to zero and
+/// every cosine of the gradient test to zero: the start came back as a converged minimum with standard errors of
+/// 0. Checked at each iteration, since `J` changes as the parameters move.
+fn check_products(jtj: &DMatrix<f64>, g: &DVector<f64>, iteration: usize) -> Result<(), String> {
+    let finite = jtj.iter().all(|v| v.is_finite()) && g.iter().all(|v| v.is_finite());
+    match finite {
+        true => Ok(()),
+        false => Err(format!(
+            "the products of the Jacobian of the weighted residuals (JᵀJ, Jᵀr) are out of the range of f64 at \
+             iteration {iteration}: scale the record, the weights or the parameters"
+        )),
+    }
 }
 
 /// MINPACK's first-order optimality: the largest `|J_kᵀ r| / (‖J_k‖ ‖r‖)` over the columns free to move
@@ -675,6 +691,31 @@ mod tests {
         assert!((blind.z[0] - 10.0).abs() <= 1e-13, "{blind:?}");
         assert_eq!(blind.convergence, Convergence::Stalled, "{blind:?}");
         assert!(blind.optimality > 0.1, "{blind:?}");
+    }
+
+    /// `r = 1e154 (z − 1)` three times from `z = 1.001`: each residual (1e151) and its cost fit in f64, but `JᵀJ`
+    /// (3e308) does not. The infinite products made every step and every gradient cosine zero, and the start came
+    /// back as a converged minimum; it is now an error.
+    struct Steep;
+
+    impl Residuals for Steep {
+        fn evaluate(&mut self, z: &[f64]) -> Result<(DVector<f64>, DMatrix<f64>), String> {
+            Ok((
+                DVector::from_element(3, 1e154 * (z[0] - 1.0)),
+                DMatrix::from_element(3, 1, 1e154),
+            ))
+        }
+    }
+
+    #[test]
+    fn a_jacobian_whose_products_overflow_is_an_error_not_a_minimum() {
+        let inf = f64::INFINITY;
+        let m = minimise(&mut Steep, &[1.001], &[-inf], &[inf], &LmOptions::default());
+        let err = m.expect_err("out of range");
+        assert!(
+            err.contains("(JᵀJ, Jᵀr) are out of the range of f64 at iteration 0"),
+            "{err}"
+        );
     }
 
     /// `r = scale (z − 1, z − 2)`: with `scale` 1e200 the squared norm overflows, with 1e-170 it underflows to 0.

@@ -582,15 +582,22 @@ impl Residuals for Objective<'_> {
     /// A thousand units in the last place of the weighted measured values (their root sum of squares): the
     /// model's predictions are computed to about that.
     fn rounding_floor(&self) -> f64 {
-        let mut sum = 0.0;
-        for meas in &self.record.measured {
-            for (c, v) in meas.iter().enumerate() {
-                if !v.is_nan() {
-                    sum += self.spec.weights[c] * v * v;
-                }
-            }
+        let weighted = || {
+            self.record.measured.iter().flat_map(|meas| {
+                meas.iter()
+                    .enumerate()
+                    .filter(|(_, v)| !v.is_nan())
+                    .map(|(c, v)| self.spec.weights[c].sqrt() * v.abs())
+            })
+        };
+        // Scaled by the largest value, so that the sum of squares of values near the limits of f64 neither
+        // overflows (an infinite floor would call any fit exact) nor underflows.
+        let largest = weighted().fold(0.0, f64::max);
+        if !(largest > 0.0 && largest.is_finite()) {
+            return 0.0;
         }
-        ROUNDING_ULPS * f64::EPSILON * sum.sqrt()
+        let sum: f64 = weighted().map(|v| (v / largest).powi(2)).sum();
+        ROUNDING_ULPS * f64::EPSILON * largest * sum.sqrt()
     }
 
     fn evaluate(&mut self, z: &[f64]) -> Result<(DVector<f64>, DMatrix<f64>), String> {

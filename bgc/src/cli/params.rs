@@ -135,7 +135,7 @@ pub fn check_divisors(model: &Model, eqs: &Equations, values: &[f64]) -> Result<
         let users = elements_using(model, i, values);
         let used = match users.is_empty() {
             true => String::new(),
-            false => format!(" (the coefficient of {})", users.join(", ")),
+            false => format!(" (the coefficient of {})", name_list(&users)),
         };
         return Err(format!(
             "parameter `{name}` = {} with these parameter values: the derived equations divide by it{used}; \

@@ -39,7 +39,7 @@ pub fn format_source(file: FileId, text: &str) -> Result<String, Vec<Diagnostic>
     Ok(in_style_of(text, format(&tree)))
 }
 
-/// `formatted` (from [`format`]: `\n` line breaks, no byte-order mark) with the conventions of the file it came
+/// `formatted` (from [`format()`]: `\n` line breaks, no byte-order mark) with the conventions of the file it came
 /// from: CRLF line breaks when the original's first line break is CRLF (a Windows checkout), and the byte-order
 /// mark when the original starts with one. The layout is canonical; the encoding of line breaks is the file's,
 /// as rustfmt's and ruff's default (`auto`) keeps it, so that formatting never rewrites every line of such a file.

@@ -300,6 +300,8 @@ pub fn minimise(
             }
         }
     }
+    // The final point's products too: the iteration may have ended right after the evaluation that reached it.
+    check_products(&(j.transpose() * &j), &(j.transpose() * &r), iterations)?;
     // Residuals at the rounding level of the values they compare (a record the model reproduces exactly) have
     // a standard error of the same order, so the Gauss–Newton step in standard errors is noise of order one.
     let exact = r.norm() <= problem.rounding_floor();
@@ -354,7 +356,7 @@ fn check_start(r: &DVector<f64>, j: &DMatrix<f64>, cost: f64) -> Result<(), Stri
 /// Refuses products of the Jacobian that overflow (`JᵀJ`, `Jᵀr`): a residual of 1e151 and a Jacobian of 1e153 each
 /// fit in f64, their squares summed over the samples do not, and an infinite `JᵀJ` scales every step to zero and
 /// every cosine of the gradient test to zero: the start came back as a converged minimum with standard errors of
-/// 0. Checked at each iteration, since `J` changes as the parameters move.
+/// 0. Checked at each iteration and at the final point, since `J` changes as the parameters move.
 fn check_products(jtj: &DMatrix<f64>, g: &DVector<f64>, iteration: usize) -> Result<(), String> {
     let finite = jtj.iter().all(|v| v.is_finite()) && g.iter().all(|v| v.is_finite());
     match finite {

@@ -530,3 +530,39 @@ fn a_loop_without_a_solution_stops_the_run_with_its_residual() {
     let (code, _, err) = bgc(&["simulate", &path, "--t-end", "1", "--input", "u=0.5"]);
     assert_eq!(code, 0, "{err}");
 }
+
+/// Breakpoints that differ by rounding (`step(0.3)` and `step(0.1 + 0.2)`, 0.3 and 0.30000000000000004) made a
+/// segment shorter than the solver resolves at its start, and the run failed: "the solver failed at t = 0.3: ODE
+/// solver error: Stop time is at the current state time". The state now goes on unchanged over such a segment,
+/// and the run equals the one with a single step of twice the height. A whole run that short gets a warning.
+#[test]
+fn breakpoints_that_differ_by_rounding_are_one_time() {
+    let model = corpus("oscillator.bg");
+    let run = |signal: &str| {
+        let input = format!("F={signal}");
+        simulate(&[
+            &model, "--t-end", "1", "--dt-out", "0.01", "--input", &input,
+        ])
+    };
+    let reference = run("2*step(0.3)");
+    for signal in ["step(0.3)+step(0.1+0.2)", "step(0.3)+step(0.3+1e-15)"] {
+        let got = run(signal);
+        assert_eq!(got.rows.len(), reference.rows.len(), "{signal}");
+        for (a, b) in got.rows.iter().zip(&reference.rows) {
+            for (x, y) in a.iter().zip(b) {
+                assert!(
+                    (x - y).abs() <= 1e-9 * (1e-3 + y.abs()),
+                    "{signal}: {a:?} vs {b:?}"
+                );
+            }
+        }
+    }
+    let (code, _, err) = bgc(&["simulate", &model, "--t-end", "1e-30", "--input", "F=1"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains(
+            "warning: the interval from t = 0e0 to 1e-30 s is shorter than the solver resolves"
+        ),
+        "{err}"
+    );
+}

@@ -18,7 +18,7 @@
 use std::cell::{Cell, RefCell};
 use std::ops::ControlFlow;
 
-use diffsol::error::DiffsolError;
+use diffsol::error::{DiffsolError, OdeSolverError};
 use diffsol::{
     FaerSparseLU, FaerSparseMat, NalgebraLU, NalgebraMat, OdeBuilder, OdeEquations,
     OdeSolverMethod, OdeSolverStopReason, Vector,
@@ -346,6 +346,17 @@ fn segment(
 ) -> Result<Option<Vec<f64>>, SimError> {
     match segment_once(system, y0, a, b, last, wanted, opts, out, warm)? {
         Outcome::Reached(y) => Ok(Some(y)),
+        Outcome::Unresolved(y) => {
+            // Breakpoints a few units in the last place apart are the same time written two ways; a whole run of
+            // 1e-30 s is not, and its flat result deserves a word.
+            if b - a > UNRESOLVED_ULPS * f64::EPSILON * a.abs() {
+                notes.push(format!(
+                    "the interval from t = {a:e} to {b:e} s is shorter than the solver resolves at its start, and the \
+                     state was carried over it unchanged: its rows show no change (lengthen --t-end)"
+                ));
+            }
+            Ok(Some(y))
+        }
         Outcome::Stopped => Ok(None),
         Outcome::Stalled {
             t,
@@ -366,7 +377,7 @@ fn segment(
             };
             let rest_of = wanted.after(delivered);
             match segment_once(system, &y, t, b, last, &rest_of, &rest, out, warm)? {
-                Outcome::Reached(y) => Ok(Some(y)),
+                Outcome::Reached(y) | Outcome::Unresolved(y) => Ok(Some(y)),
                 Outcome::Stopped => Ok(None),
                 Outcome::Stalled { .. } => Err(SimError::TooManySteps {
                     from: a,
@@ -379,10 +390,17 @@ fn segment(
     }
 }
 
+/// How far apart, in units in the last place of their time, two ends of an unresolved segment may be without a
+/// note: breakpoints that differ by rounding (`0.3` and `0.1 + 0.2`).
+const UNRESOLVED_ULPS: f64 = 1e3;
+
 /// How one solver's integration of a segment ended.
 enum Outcome {
     /// At the segment's end, with the extended state there.
     Reached(Vec<f64>),
+    /// The segment is shorter than the solver resolves at its start: the state at its end is the state at its
+    /// start.
+    Unresolved(Vec<f64>),
     /// The receiver stopped the run.
     Stopped,
     /// BDF advanced too slowly to finish within its step budget ([`Drive::stalled`]): at `t` with the state `y`,
@@ -639,9 +657,24 @@ impl Drive<'_> {
         Eqn: OdeEquations<T = f64> + 'a,
         S: OdeSolverMethod<'a, Eqn>,
     {
-        solver
-            .set_stop_time(self.to)
-            .map_err(|e| self.failure(self.from, e))?;
+        match solver.set_stop_time(self.to) {
+            Ok(()) => {}
+            // The segment is shorter than the solver's resolution of time at its start: two breakpoints that differ
+            // by rounding (`step(0.3) + step(0.1 + 0.2)`) or a run of 1e-20 s. Integrating over it changes nothing
+            // to rounding, so the state goes on unchanged (this failed the run before).
+            Err(DiffsolError::OdeSolverError(OdeSolverError::StopTimeAtCurrentTime)) => {
+                let y = solver.state().y.clone_as_vec();
+                let mut next = 0;
+                while let Some(t) = self.wanted.get(next) {
+                    if out(t, &y)?.is_break() {
+                        return Ok(Outcome::Stopped);
+                    }
+                    next += 1;
+                }
+                return Ok(Outcome::Unresolved(y));
+            }
+            Err(e) => return Err(self.failure(self.from, e)),
+        }
         let mut next = 0;
         let mut window_start = self.from;
         let mut long_window_start = self.from;

@@ -396,6 +396,17 @@ impl Parser {
                 ),
             });
         }
+        // A switching time that is not a number would switch never, silently (`t >= NaN` is false).
+        if matches!(func, SignalFunc::Step | SignalFunc::Ramp)
+            && let Some(a) = args.first()
+            && !a.uses_time()
+            && a.eval(0.0).is_nan()
+        {
+            return Err(SignalError {
+                column: start + 1,
+                message: format!("the time of `{name}` is not a number (NaN)"),
+            });
+        }
         Ok(Signal::Call(func, args))
     }
 }
@@ -406,6 +417,19 @@ mod tests {
 
     fn at(text: &str, t: f64) -> f64 {
         Signal::parse(text).unwrap().eval(t)
+    }
+
+    #[test]
+    fn a_switching_time_that_is_not_a_number_is_refused() {
+        let err = Signal::parse("2*step(0/0)").err();
+        assert_eq!(
+            err.map(|e| e.to_string()),
+            Some("the time of `step` is not a number (NaN) at column 3".to_string())
+        );
+        assert!(Signal::parse("ramp(ln(-1))").is_err());
+        // An infinite time is a switch that never comes (or always was): a number, accepted.
+        assert_eq!(at("step(1/0)", 1e300), 0.0);
+        assert_eq!(at("step(-1/0)", 0.0), 1.0);
     }
 
     #[test]

@@ -194,8 +194,6 @@ struct Lexer<'a> {
     junk: Option<(usize, usize)>,
     /// Whether only whitespace has been seen since the last newline.
     at_line_start: bool,
-    /// Whether the last bracket was a `[` not closed yet: a unit is being written.
-    in_unit: bool,
 }
 
 /// Splits `text` into tokens. See the module documentation.
@@ -210,7 +208,6 @@ pub fn lex(file: FileId, text: &str) -> Lexed {
         out,
         junk: None,
         at_line_start: true,
-        in_unit: false,
     };
     lx.run();
     lx.out
@@ -222,11 +219,6 @@ impl<'a> Lexer<'a> {
     }
 
     fn push(&mut self, kind: Tok, start: usize, end: usize) {
-        match kind {
-            Tok::LBracket => self.in_unit = true,
-            Tok::RBracket | Tok::Semi => self.in_unit = false,
-            _ => {}
-        }
         self.out.tokens.push(Token {
             kind,
             start: start as u32,
@@ -375,7 +367,7 @@ impl<'a> Lexer<'a> {
             _ => start,
         };
         let name = self.text.get(start..end).unwrap_or("");
-        let (what, help) = match self.in_unit {
+        let (what, help) = match self.in_unit() {
             true => ("unit", super::foreign::unit_help(name)),
             false => ("name", super::foreign::name_help(name)),
         };
@@ -391,6 +383,19 @@ impl<'a> Lexer<'a> {
             .with_help(help),
         );
         self.push(Tok::Ident, start, end);
+    }
+
+    /// Whether the tokens so far leave a `[` open: a unit is being written. Asked only for a name with letters
+    /// outside ASCII, so the common tokens pay nothing for it; a unit is a few tokens long.
+    fn in_unit(&self) -> bool {
+        for t in self.out.tokens.iter().rev().take(64) {
+            match t.kind {
+                Tok::LBracket => return true,
+                Tok::RBracket | Tok::Semi | Tok::LBrace | Tok::RBrace => return false,
+                _ => {}
+            }
+        }
+        false
     }
 
     /// The common tokens, recognised from their first byte without trying each parser in turn: whitespace, ASCII

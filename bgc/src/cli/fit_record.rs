@@ -11,6 +11,7 @@ use bgc::equations::Equations;
 use bgc::ir::Model;
 use bgc::units::parse_unit_text;
 use bgc_runtime::fit::Record;
+use std::collections::HashMap;
 
 /// The columns `bgc simulate` writes after the states and outputs.
 const ENERGY_COLUMNS: [&str; 3] = ["energy", "dissipated", "supplied"];
@@ -26,12 +27,13 @@ pub fn read(model: &Model, eqs: &Equations, text: &str) -> Result<Record, String
         .sum::<usize>();
     let (blank, rest) = text.split_at(header_start);
     let (header, body) = rest.split_once('\n').unwrap_or((rest, ""));
+    let declared = declared(model);
     let mut names = Vec::new();
     let mut factors = Vec::new();
     for cell in header.trim_end_matches('\r').split(',') {
         let (name, unit) = split_unit(cell).map_err(|e| format!("the record's header: {e}"))?;
-        factors.push(match declared(model, name) {
-            Some(d) => factor_to_declared("the record's column", &d, unit)?,
+        factors.push(match declared.get(name) {
+            Some(d) => factor_to_declared("the record's column", d, unit)?,
             None => 1.0,
         });
         names.push(name.to_string());
@@ -45,19 +47,18 @@ pub fn read(model: &Model, eqs: &Equations, text: &str) -> Result<Record, String
     Ok(record)
 }
 
-/// The declared quantity of a column name: the time, an input or an output.
-fn declared(model: &Model, name: &str) -> Option<Declared> {
-    if name == "t" {
-        let unit = parse_unit_text("s").ok()?;
-        return Some(Declared {
+/// The quantities a column may hold, by name: the time, the inputs and the outputs.
+fn declared(model: &Model) -> HashMap<String, Declared> {
+    let mut all = quantities::inputs(model);
+    all.extend(quantities::outputs(model));
+    if let Ok(unit) = parse_unit_text("s") {
+        all.push(Declared {
             name: "t".into(),
             unit,
             text: "s".into(),
         });
     }
-    let mut all = quantities::inputs(model);
-    all.extend(quantities::outputs(model));
-    all.into_iter().find(|d| d.name == name)
+    all.into_iter().map(|d| (d.name.clone(), d)).collect()
 }
 
 /// Multiplies each column by its factor to the model's unit.

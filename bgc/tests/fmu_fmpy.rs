@@ -192,6 +192,11 @@ fn the_c_interface_refuses_misuse_and_keeps_instances_apart() {
         assert_eq!(v[key], error, "{key}: {v}");
     }
     assert_eq!(v["step_before_init_logged"], true, "{v}");
+    // `fmi2GetDerivatives` answered a Co-Simulation instance and a Model Exchange one before initialisation
+    // (fmi2OK, with the start values' derivatives); the standard allows neither. From initialisation on it answers.
+    assert_eq!(v["derivatives_of_co_simulation"], error, "{v}");
+    assert_eq!(v["derivatives_before_init"], error, "{v}");
+    assert_eq!(v["derivatives_in_init"], serde_json::json!(0), "{v}");
     // Instance a is driven by a motor torque, b is not: b stays at rest.
     let a: Vec<f64> = serde_json::from_value(v["a"].clone()).unwrap_or_default();
     let b: Vec<f64> = serde_json::from_value(v["b"].clone()).unwrap_or_default();

@@ -156,7 +156,7 @@ def interface(fmu):
                                     ctypes.POINTER(Callbacks), ctypes.c_int, ctypes.c_int]
     for f in ["fmi2SetupExperiment", "fmi2EnterInitializationMode", "fmi2ExitInitializationMode",
               "fmi2DoStep", "fmi2GetReal", "fmi2SetReal", "fmi2Reset", "fmi2FreeInstance", "fmi2GetFMUstate",
-              "fmi2SetFMUstate", "fmi2FreeFMUstate", "fmi2Terminate"]:
+              "fmi2SetFMUstate", "fmi2FreeFMUstate", "fmi2Terminate", "fmi2GetDerivatives"]:
         getattr(lib, f).argtypes = None
     vp = ctypes.c_void_p
     out = {}
@@ -181,6 +181,15 @@ def interface(fmu):
     out["step_before_init"] = lib.fmi2DoStep(a, ctypes.c_double(0.0), ctypes.c_double(0.01), 1)
     out["step_before_init_logged"] = any(s == 3 and "fmi2DoStep" in m for s, m in messages)
     out["null_values"] = lib.fmi2GetReal(a, refs, ctypes.c_size_t(n), None)
+    # Derivatives are a Model Exchange call, and readable only once initialisation has begun.
+    nx = md.numberOfContinuousStates
+    dx = (ctypes.c_double * max(nx, 1))()
+    out["derivatives_of_co_simulation"] = lib.fmi2GetDerivatives(a, dx, ctypes.c_size_t(nx))
+    me = vp(lib.fmi2Instantiate(b"me", 0, guid, b"", ctypes.byref(callbacks), 0, 0))
+    out["derivatives_before_init"] = lib.fmi2GetDerivatives(me, dx, ctypes.c_size_t(nx))
+    lib.fmi2EnterInitializationMode(me)
+    out["derivatives_in_init"] = lib.fmi2GetDerivatives(me, dx, ctypes.c_size_t(nx))
+    lib.fmi2FreeInstance(me)
     for c in (a, b):
         lib.fmi2SetupExperiment(c, 1, ctypes.c_double(1e-8), ctypes.c_double(0.0), 0, ctypes.c_double(0.0))
         lib.fmi2EnterInitializationMode(c)

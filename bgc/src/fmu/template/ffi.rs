@@ -52,6 +52,18 @@ pub const RUNNING: &[Phase] = &[
 /// Model Exchange between initialisation and termination.
 pub const ME_SOLVING: &[Phase] = &[Phase::Event, Phase::ContinuousTime];
 
+/// The phases in which the states and their derivatives may be read: any after `EnterInitializationMode`. Before
+/// it the parameters and start values may still change, and the standard's state machine allows no such read.
+pub const STATES_READABLE: &[Phase] = &[
+    Phase::Initialization,
+    Phase::Event,
+    Phase::ContinuousTime,
+    Phase::StepComplete,
+    Phase::StepFailed,
+    Phase::Terminated,
+    Phase::Error,
+];
+
 /// The count of continuous states the importer passes.
 pub fn check_count(n: usize) -> Outcome<()> {
     if n == NX {

@@ -1,7 +1,7 @@
 //! The Model Exchange and Co-Simulation functions of the FMI 2.0 interface (the common ones are in
 //! `fmi2.rs`), with the same checks.
 
-use crate::ffi::{ME_SOLVING, check_count, slice, slice_mut, write};
+use crate::ffi::{ME_SOLVING, STATES_READABLE, check_count, slice, slice_mut, write};
 use crate::fmi2::*;
 use crate::instance::{Kind, Outcome, Phase};
 use core::ffi::{c_char, c_int, c_void};
@@ -122,6 +122,7 @@ pub unsafe extern "C" fn fmi2SetContinuousStates(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2GetContinuousStates(c: *mut c_void, x: *mut f64, n: usize) -> Status {
     guarded(c, "fmi2GetContinuousStates", |comp| {
+        comp.inst.expect("fmi2GetContinuousStates", STATES_READABLE)?;
         check_count(n)?;
         slice_mut(x, n, "x")?.copy_from_slice(comp.inst.states());
         Ok(())
@@ -133,6 +134,8 @@ pub unsafe extern "C" fn fmi2GetContinuousStates(c: *mut c_void, x: *mut f64, n:
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2GetDerivatives(c: *mut c_void, dx: *mut f64, n: usize) -> Status {
     guarded(c, "fmi2GetDerivatives", |comp| {
+        expect_kind(comp, "fmi2GetDerivatives", Kind::ModelExchange)?;
+        comp.inst.expect("fmi2GetDerivatives", STATES_READABLE)?;
         check_count(n)?;
         let out = slice_mut(dx, n, "derivatives")?;
         out.copy_from_slice(&comp.inst.derivatives()?);

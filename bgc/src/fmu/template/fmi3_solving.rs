@@ -1,7 +1,7 @@
 //! The Model Exchange and Co-Simulation functions of the FMI 3.0 interface (the common ones are in
 //! `fmi3.rs`), with the same checks.
 
-use crate::ffi::{ME_SOLVING, check_count, slice, slice_mut, write};
+use crate::ffi::{ME_SOLVING, STATES_READABLE, check_count, slice, slice_mut, write};
 use crate::fmi3::*;
 use crate::instance::{Kind, Outcome, Phase};
 use crate::plant::NX;
@@ -114,6 +114,8 @@ pub unsafe extern "C" fn fmi3GetContinuousStateDerivatives(
     n: usize,
 ) -> Status {
     guarded(c, "fmi3GetContinuousStateDerivatives", |comp| {
+        comp.inst
+            .expect("fmi3GetContinuousStateDerivatives", STATES_READABLE)?;
         check_count(n)?;
         let out = slice_mut(dx, n, "derivatives")?;
         out.copy_from_slice(&comp.inst.derivatives()?);
@@ -139,6 +141,7 @@ pub unsafe extern "C" fn fmi3GetEventIndicators(c: *mut c_void, _z: *mut f64, n:
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3GetContinuousStates(c: *mut c_void, x: *mut f64, n: usize) -> Status {
     guarded(c, "fmi3GetContinuousStates", |comp| {
+        comp.inst.expect("fmi3GetContinuousStates", STATES_READABLE)?;
         check_count(n)?;
         slice_mut(x, n, "continuousStates")?.copy_from_slice(comp.inst.states());
         Ok(())

@@ -35,8 +35,8 @@ mod tests;
 
 pub use decode::decode;
 pub use format::{
-    expr as format_expr, format, format_source, in_style_of, node as format_node,
-    number as format_number, unit as format_unit,
+    expr as format_expr, format, format_source, node as format_node, number as format_number,
+    unit as format_unit,
 };
 pub use parser::{KEYWORDS, MAX_DEPTH};
 

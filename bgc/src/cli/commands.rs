@@ -91,16 +91,17 @@ fn fmt_one(path: &Path, check_only: bool, color: bool) -> std::io::Result<bool> 
         return Ok(false);
     }
     let text = sources.get(id).map(|f| f.text.clone()).unwrap_or_default();
-    let (ast, diags) = bgc::syntax::parse(id, &text);
-    if has_errors(&diags) {
-        stderr(&render::to_text(&sources, &diags, color));
-        stderrln(&format!(
-            "{}: not formatted: the file has syntax errors",
-            path.display()
-        ));
-        return Ok(false);
-    }
-    let formatted = bgc::syntax::in_style_of(&text, bgc::syntax::format(&ast));
+    let formatted = match bgc::syntax::format_source(id, &text) {
+        Ok(formatted) => formatted,
+        Err(diags) => {
+            stderr(&render::to_text(&sources, &diags, color));
+            stderrln(&format!(
+                "{}: not formatted: the file has syntax errors",
+                path.display()
+            ));
+            return Ok(false);
+        }
+    };
     if formatted == text {
         return Ok(true);
     }

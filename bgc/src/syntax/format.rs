@@ -29,8 +29,8 @@ pub fn format(file: &File) -> String {
     p.out
 }
 
-/// Parses `text` and formats it in its own line endings and byte-order mark (see [`in_style_of`]); refuses
-/// (returning the diagnostics) when the text has syntax errors.
+/// Parses `text` and formats it in its own line endings (CRLF when its first line break is CRLF) and with its
+/// byte-order mark, if it has one; refuses (returning the diagnostics) when the text has syntax errors.
 pub fn format_source(file: FileId, text: &str) -> Result<String, Vec<Diagnostic>> {
     let (tree, diags) = super::parse(file, text);
     if has_errors(&diags) {
@@ -43,7 +43,7 @@ pub fn format_source(file: FileId, text: &str) -> Result<String, Vec<Diagnostic>
 /// from: CRLF line breaks when the original's first line break is CRLF (a Windows checkout), and the byte-order
 /// mark when the original starts with one. The layout is canonical; the encoding of line breaks is the file's,
 /// as rustfmt's and ruff's default (`auto`) keeps it, so that formatting never rewrites every line of such a file.
-pub fn in_style_of(original: &str, formatted: String) -> String {
+fn in_style_of(original: &str, formatted: String) -> String {
     const BOM: char = '\u{feff}';
     let crlf = original
         .find('\n')

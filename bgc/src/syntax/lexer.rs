@@ -605,7 +605,6 @@ fn typographic_help(c: char) -> Option<&'static str> {
         '²' | '³' => "write a power with `^`, as in `x^2` or `[m^2]`",
         '−' | '–' => "write the minus sign as the ASCII `-`",
         '÷' => "divide by `/`",
-        'π' => "write pi as `pi`",
         '%' => {
             "there is no percent sign: write a fraction, dimensionless (`[1]`), as in `0.5` for 50 %"
         }

@@ -92,6 +92,7 @@ impl<'a> Builder<'a> {
         for step in walk {
             match self.scopes.get(cur).and_then(|s| s.get(&step.name)) {
                 Some(Entity::Instance(child)) => cur = child,
+                None if self.scopes[cur].unparsed(&step.name) => return None,
                 other => {
                     let msg = match other {
                         Some(e) => format!(
@@ -156,6 +157,7 @@ impl<'a> Builder<'a> {
                 );
                 None
             }
+            None if self.scopes[sid].unparsed(&last.name) => None,
             None => {
                 let suggestion = self.scopes[sid].suggest(&last.name, |e| {
                     matches!(e, Entity::Node(_) | Entity::Instance(_))
@@ -239,9 +241,9 @@ impl<'a> Builder<'a> {
                     Diagnostic::error(
                         "BG0205",
                         format!(
-                            "`{}` is a `{}`, not a multiport field",
+                            "`{}` is {}, not a multiport field",
                             name.name,
-                            kind.keyword()
+                            kind.with_article()
                         ),
                     )
                     .with_primary(span, "only fields have numbered ports")

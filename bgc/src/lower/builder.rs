@@ -59,6 +59,9 @@ pub(crate) struct Builder<'a> {
     /// An unknown name without a close match was reported: any unused parameter may be the one it meant, so
     /// BG0402 is left out until that error is fixed.
     pub unmatched_name: bool,
+    /// An unknown domain or a `domain` statement that did not parse was reported: bonds without a domain follow
+    /// from it, so BG0311 is left out.
+    pub domain_reported: bool,
     /// The domains a BG0303 hint has already suggested: later hints for the same domain stay short.
     pub suggested_domains: Vec<Domain>,
     /// The components being instantiated, to catch a component that contains itself.
@@ -110,6 +113,7 @@ impl<'a> Builder<'a> {
             bad_units: Vec::new(),
             last_unit_ok: true,
             unmatched_name: false,
+            domain_reported: false,
             suggested_domains: Vec::new(),
             suspect_nodes: std::collections::HashSet::new(),
         }

@@ -112,6 +112,7 @@ impl Builder<'_> {
                     self.agree(&defaults[g], first, "default")
                 }
                 (None, Some(&first)) => self.agree(&weak[g], first, "default"),
+                (None, None) if self.domain_reported => None,
                 (None, None) => {
                     let span = self.bond_span(EdgeIndex::new(e));
                     self.diags.push(

@@ -186,7 +186,7 @@ impl Builder<'_> {
         self.diags.push(
             Diagnostic::error(
                 "BG0313",
-                format!("`{name}`, a `{}`, {what}", decl.kind.keyword()),
+                format!("`{name}`, {}, {what}", decl.kind.with_article()),
             )
             .with_primary(span, what.to_string())
             .with_help(help),
@@ -362,8 +362,8 @@ impl Builder<'_> {
                     Diagnostic::error(
                         "BG0207",
                         format!(
-                            "a law of a `{}` gives `{}` or `{}`",
-                            kind.keyword(),
+                            "a law of {} gives `{}` or `{}`",
+                            kind.with_article(),
                             forms[0],
                             forms[1]
                         ),
@@ -459,7 +459,7 @@ impl Builder<'_> {
                 self.diags.push(
                     Diagnostic::error(
                         "BG0207",
-                        format!("a law of a `{}` is written {form}", kind.keyword()),
+                        format!("a law of {} is written {form}", kind.with_article()),
                     )
                     .with_primary(law.lhs.span, "not a variable this field can define")
                     .with_help(format!("write the laws of `{}` as {form}", decl.name.name)),

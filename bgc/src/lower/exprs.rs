@@ -211,6 +211,8 @@ impl Builder<'_> {
             // A name with letters outside ASCII (`π`) is already an error of its own (BG0104, with its ASCII
             // spelling); "unknown name" would only repeat it.
             None if crate::syntax::foreign::reported_by_lexer(name) => None,
+            // Declared by a statement that did not parse: its syntax error is the one to fix.
+            None if self.scopes.get(cx.scope).is_some_and(|s| s.unparsed(name)) => None,
             None => {
                 let mut d = Diagnostic::error("BG0201", format!("unknown name `{name}`"))
                     .with_primary(e.span, "not declared in this scope");

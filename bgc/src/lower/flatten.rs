@@ -59,6 +59,13 @@ impl<'a> Builder<'a> {
             ..Default::default()
         });
         let sid = self.scopes.len() - 1;
+        let scope = &mut self.scopes[sid];
+        scope
+            .unparsed
+            .extend(decl.unparsed.names.iter().map(|n| (n.name.as_str(), ())));
+        self.domain_reported |= decl.unparsed.domain;
+        // A parameter used only by a statement that did not parse is not "unused".
+        self.unmatched_name |= !decl.unparsed.names.is_empty();
         // One table of the right size rather than one that rehashes its way up to a hundred thousand names.
         let declared = decl.body.iter().filter(|s| declares_name(s)).count();
         self.scopes[sid].names.reserve(declared);
@@ -285,6 +292,7 @@ impl<'a> Builder<'a> {
                 Some(c) => format!("did you mean `{c}`?"),
                 None => format!("the domains are {}", names.join(", ")),
             };
+            self.domain_reported = true;
             self.diags.push(
                 Diagnostic::error("BG0201", format!("unknown domain `{}`", name.name))
                     .with_primary(name.span, "not a domain")

@@ -29,6 +29,8 @@ mod unit_hints;
 #[cfg(test)]
 mod fixture_tests;
 #[cfg(test)]
+mod recovery_tests;
+#[cfg(test)]
 mod tests;
 
 use crate::diagnostic::Diagnostic;

@@ -74,7 +74,7 @@ impl Builder<'_> {
             self.diags.push(
                 Diagnostic::error(
                     "BG0207",
-                    format!("`{letter}` of a `{}` has no index", kind.keyword()),
+                    format!("`{letter}` of {} has no index", kind.with_article()),
                 )
                 .with_primary(e.span, "only fields have indexed port variables")
                 .with_help(format!("write `{letter}`")),
@@ -289,6 +289,7 @@ impl Builder<'_> {
         for step in walk {
             match self.scopes.get(cur).and_then(|s| s.get(&step.name)) {
                 Some(Entity::Instance(child)) => cur = child,
+                None if self.scopes[cur].unparsed(&step.name) => return None,
                 _ => {
                     self.diags.push(
                         Diagnostic::error(
@@ -337,6 +338,7 @@ impl Builder<'_> {
                 let end = self.scopes[cur].ports[&last.name].0;
                 Some((Target::Node(end.node), ()))
             }
+            None if self.scopes[cur].unparsed(&last.name) => None,
             other => {
                 let msg = match other {
                     Some(x) => format!(

@@ -66,6 +66,9 @@ pub(crate) struct Scope<'a> {
     /// The scope of an instance whose component could not be instantiated (already reported): references into it
     /// are not reported again.
     pub broken: bool,
+    /// Names declared by statements that did not parse (already reported): references to them are not reported
+    /// again.
+    pub unparsed: NameMap<&'a str, ()>,
     /// This scope's own instance declaration (None for the model).
     pub own_instance: Option<Span>,
     /// Whether a bond outside the instance goes to one of its ports.
@@ -87,6 +90,11 @@ impl<'a> Scope<'a> {
 
     pub fn get(&self, name: &str) -> Option<Entity> {
         self.names.get(name).map(|(e, _, _)| *e)
+    }
+
+    /// Whether `name` was declared by a statement that did not parse (its error is reported).
+    pub fn unparsed(&self, name: &str) -> bool {
+        self.unparsed.contains_key(name)
     }
 
     /// The closest declared name accepted by `filter`, for "did you mean" help.

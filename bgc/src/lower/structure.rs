@@ -146,7 +146,8 @@ impl Builder<'_> {
                     )
                     .with_primary(self.bond_span(all[1]), "a second bond");
                     d = d.with_secondary(self.bond_span(all[0]), "first bond");
-                    d = d.with_secondary(decl_span, format!("a `{}` has one port", kind.keyword()));
+                    d = d
+                        .with_secondary(decl_span, format!("{} has one port", kind.with_article()));
                     self.diags.push(d.with_help(format!(
                         "bond `{name}` to a junction and bond the other elements to that junction"
                     )));
@@ -237,10 +238,7 @@ impl Builder<'_> {
         let name = self.model.graph[n].name.clone();
         let from = self.model.graph[from].name.clone();
         let to = self.model.graph[to].name.clone();
-        let kw = match kind {
-            K::I | K::R => format!("an `{}`", kind.keyword()),
-            _ => format!("a `{}`", kind.keyword()),
-        };
+        let kw = kind.with_article();
         let (message, label, note) = if source {
             (
                 format!("the bond of source `{name}` points into it"),

@@ -61,8 +61,26 @@ pub struct ModelDecl {
     pub doc: Vec<String>,
     pub name: Ident,
     pub body: Vec<Stmt>,
+    /// What the statements that failed to parse declared (their errors are reported): later stages leave
+    /// references to these alone rather than call them unknown.
+    #[serde(skip_serializing_if = "Unparsed::is_empty")]
+    pub unparsed: Unparsed,
     /// From the keyword to the closing brace.
     pub span: Span,
+}
+
+/// The declarations of a body whose statements did not parse: the names they declared and whether one was a
+/// `domain` statement.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Unparsed {
+    pub names: Vec<Ident>,
+    pub domain: bool,
+}
+
+impl Unparsed {
+    pub fn is_empty(&self) -> bool {
+        self.names.is_empty() && !self.domain
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -204,6 +222,25 @@ impl ElementKind {
             ElementKind::RF => "RF",
             ElementKind::IF => "IF",
         }
+    }
+
+    /// The keyword with its indefinite article, as it is read aloud: "an `R`", "a `C`", "an `MTF`".
+    pub fn with_article(self) -> String {
+        let vowel_sound = matches!(
+            self,
+            ElementKind::Se
+                | ElementKind::Sf
+                | ElementKind::MSe
+                | ElementKind::MSf
+                | ElementKind::I
+                | ElementKind::R
+                | ElementKind::MTF
+                | ElementKind::MGY
+                | ElementKind::RF
+                | ElementKind::IF
+        );
+        let article = if vowel_sound { "an" } else { "a" };
+        format!("{article} `{}`", self.keyword())
     }
 
     /// Parses a kind keyword.

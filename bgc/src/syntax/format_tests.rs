@@ -321,6 +321,7 @@ mod generated_trees {
                     doc: vec![],
                     name: ident("m"),
                     body: vec![Stmt::Coords(Box::new(CoordsDecl { coords: vec![x.clone()], span: Span::default() }))],
+                    unparsed: Unparsed::default(),
                     span: Span::default(),
                 })],
                 ..File::default()

@@ -150,6 +150,7 @@ impl Parser<'_> {
             doc: docs.into_iter().map(|(t, _, _)| t).collect(),
             name,
             body,
+            unparsed: std::mem::take(&mut self.unparsed),
             span: self.span_from(kw.start),
         }
     }

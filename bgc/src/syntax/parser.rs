@@ -85,6 +85,8 @@ pub struct Parser<'a> {
     docs: Vec<RawComment>,
     next_doc: usize,
     comments: Vec<Comment>,
+    /// What the failed statements of the body being read declared; taken when the body ends.
+    pub(super) unparsed: ast::Unparsed,
 }
 
 /// Parses a whole file. See [`crate::syntax::parse`].
@@ -113,6 +115,7 @@ pub fn parse_file(file: FileId, text: &str) -> (ast::File, Vec<Diagnostic>) {
         docs,
         next_doc: 0,
         comments,
+        unparsed: ast::Unparsed::default(),
     };
     let items = p.items();
     p.stray_docs_before(u32::MAX);

@@ -13,15 +13,46 @@ impl<'a> Parser<'a> {
     pub(super) fn statement(&mut self) -> Option<Stmt> {
         let start_pos = self.pos;
         let docs = self.take_docs();
+        let first = self.pos;
         match self.statement_inner(docs) {
             Ok(s) => Some(s),
             Err(Fail) => {
+                self.note_unparsed(first);
                 self.recover();
                 if self.pos == start_pos {
                     self.bump();
                 }
                 None
             }
+        }
+    }
+
+    /// Records what the failed statement starting at token `first` declared: the name after its keyword or element
+    /// kind (`param m`, `I mass`, `0 j`), or the instance name after a component's name (`Leg left`).
+    fn note_unparsed(&mut self, first: usize) {
+        let (Some(&lead), Some(&next)) = (self.toks.get(first), self.toks.get(first + 1)) else {
+            return;
+        };
+        let word = self.tok_text(lead);
+        if lead.kind == Tok::Ident && word == "domain" {
+            self.unparsed.domain = true;
+            return;
+        }
+        let declares = match lead.kind {
+            Tok::Number => ElementKind::from_keyword(word).is_some(),
+            Tok::Ident => {
+                matches!(word, "param" | "input" | "output" | "var")
+                    || ElementKind::from_keyword(word).is_some()
+                    || !super::parser::is_keyword(word)
+            }
+            _ => false,
+        };
+        let name = self.tok_text(next);
+        if declares && next.kind == Tok::Ident && !super::parser::is_keyword(name) {
+            self.unparsed.names.push(Ident {
+                name: name.to_string(),
+                span: self.tok_span(next),
+            });
         }
     }
 
@@ -252,7 +283,7 @@ impl<'a> Parser<'a> {
                 self.diags.push(
                     Diagnostic::error(
                         "BG0117",
-                        format!("a `{}` element has no port count", kind.keyword()),
+                        format!("{} element has no port count", kind.with_article()),
                     )
                     .with_primary(n.1, "only fields take a port count")
                     .with_help(

@@ -1,0 +1,63 @@
+//! Recovery from statements that do not parse: each syntax error is reported once, and what the failed statement
+//! declared is not then reported as unknown wherever it is used.
+
+use super::tests::lower_text;
+
+fn codes_and_messages(text: &str) -> Vec<(&'static str, String)> {
+    lower_text(text)
+        .1
+        .iter()
+        .map(|d| (d.code.0, d.message.clone()))
+        .collect()
+}
+
+/// Five statements with one syntax error each; every name they declare is used further on. Each name used to be
+/// reported again as unknown where it was used ("unknown name `u`", "bond to `mass1`, which does not exist").
+#[test]
+fn names_of_statements_that_do_not_parse_are_not_reported_again() {
+    let text = "model c1 {\n    domain translational;\n    param m = 2 [kg;\n    input u [N*m];\n    \
+                Se src = u;\n    I mass1 = m +;\n    C spring = 1/3;\n    1 j;\n    \
+                bond src -> j -> mass1, spring;\n    output v [m/s] = f(mass1);\n    output w [m/s] = u/m;\n    \
+                output z [m/s] = v + w + zz;\n}\n";
+    assert_eq!(
+        codes_and_messages(text),
+        vec![
+            (
+                "BG0101",
+                "expected `]` to close the unit, found `;`".to_string()
+            ),
+            ("BG0116", "malformed unit".to_string()),
+            ("BG0101", "expected an expression, found `;`".to_string()),
+            // A name no statement declares is still unknown.
+            ("BG0201", "unknown name `zz`".to_string()),
+        ]
+    );
+}
+
+/// An instance whose statement does not parse: its ports and elements are not reported as missing.
+#[test]
+fn an_instance_that_does_not_parse_is_not_reported_again() {
+    let text = "component Spring {\n    domain translational;\n    param k = 1 [N/m];\n    C c = 1/k;\n    \
+                0 a;\n    port p = a;\n    bond a -> c;\n}\nmodel m {\n    domain translational;\n    \
+                Sf push = 1;\n    Spring s(k = );\n    bond push -> s.p;\n    output x [m] = q(s.c);\n}\n";
+    let found = codes_and_messages(text);
+    assert_eq!(
+        found,
+        vec![("BG0101", "expected an expression, found `)`".to_string())],
+        "{found:?}"
+    );
+}
+
+/// A domain that is misspelt or does not parse leaves the bonds without one: that follows from its error and is
+/// not a second one (BG0311, whose help proposed `domain rotational;` whatever the elements were).
+#[test]
+fn an_unknown_domain_is_not_followed_by_bonds_without_a_domain() {
+    for (domain, code) in [("domain mechanical;", "BG0201"), ("domain;", "BG0101")] {
+        let text = format!(
+            "model m {{\n    {domain}\n    param k = 1 [N/m];\n    Sf push = 1;\n    C c = 1/k;\n    \
+             bond push -> c;\n}}\n"
+        );
+        let found: Vec<&str> = codes_and_messages(&text).iter().map(|d| d.0).collect();
+        assert_eq!(found, vec![code], "{domain}");
+    }
+}

@@ -4,8 +4,6 @@
 //! ```toml
 //! [dependencies]
 //! bgc-runtime = { path = "../runtime" }
-//! libm = "0.2"
-//! nalgebra = "0.34"
 //!
 //! [build-dependencies]
 //! bgc = { path = "../bgc", default-features = false }
@@ -27,12 +25,15 @@
 //! ```
 //!
 //! The generated functions call `libm` for the elementary functions (`sin`, `exp`, ...), so that they need only
-//! `core`. For a `#![no_std]` crate, leave out the runtime's trait implementations with [`Config::runtime`]:
+//! `core`. They reach `nalgebra` and `libm` through the runtime's re-exports (`bgc_runtime::nalgebra`), so the
+//! crate needs no dependency on either, and a `nalgebra` of its own may be another version. For a `#![no_std]`
+//! crate, leave out the runtime's trait implementations with [`Config::runtime`]; the module then uses the crate's
+//! own `nalgebra` and `libm`:
 //!
 //! ```toml
 //! [dependencies]
 //! libm = "0.2"
-//! nalgebra = { version = "0.34", default-features = false }
+//! nalgebra = { version = "0.35", default-features = false }
 //! ```
 //!
 //! ```no_run

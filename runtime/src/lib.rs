@@ -15,6 +15,14 @@
 //!   behind `fit`'s fits. Without it the crate keeps everything else, including the exact linear-plant loop
 //!   (`sim::simulate_sampled_linear_loop`), and a first build skips diffsol and its dense linear algebra.
 
+//! # Re-exports
+//! Generated modules reach [`nalgebra`] and [`libm`] through this crate (`bgc_runtime::nalgebra`), so a crate that
+//! uses them depends on `bgc-runtime` alone, and its own `nalgebra`, if any, may be another version. Values passed
+//! to a generated model are built with `bgc_runtime::nalgebra` (or the same version of nalgebra).
+
+pub use libm;
+pub use nalgebra;
+
 pub mod analysis;
 pub mod control;
 pub mod design;

@@ -18,7 +18,7 @@ use bgc_runtime::matrix::{self, dynamic};
 use bgc_runtime::sim::{
     LinearPlant, SampledController, SampledLoopConfig, simulate_sampled_linear_loop,
 };
-use nalgebra::{DMatrix, SMatrix, SVector};
+use bgc_runtime::nalgebra::{self, DMatrix, SMatrix, SVector};
 
 /// States `p_inductance, p_rotor, q_shaft_spring, p_load, theta_L`; input `V`; outputs `angle, current`.
 const NX: usize = drive::N_STATES;

@@ -533,19 +533,31 @@ impl<'a> Writer<'a> {
         self.functions();
         self.param_terms_struct();
         self.model();
-        let mut prelude = String::from("use nalgebra::{SMatrix, SVector};\n");
+        let mut solvers = String::new();
         let helpers = rust_helpers_used(&self.helper_calls());
         if !helpers.is_empty() {
-            prelude.push('\n');
-            prelude.push_str(helpers.trim_end());
-            prelude.push('\n');
+            solvers.push('\n');
+            solvers.push_str(helpers.trim_end());
+            solvers.push('\n');
         }
         if !self.plan.mass.is_empty() || self.plan.loops.is_some() {
-            prelude.push_str(super::mass::SOLVE_FN);
+            solvers.push_str(super::mass::SOLVE_FN);
         }
         if self.plan.loops.is_some() {
-            prelude.push_str(super::loops::NEWTON_FN);
+            solvers.push_str(super::loops::NEWTON_FN);
         }
+        // With the runtime, its re-exports: the user's crate then needs neither nalgebra nor libm, nor to match
+        // their versions (a second nalgebra makes every signature "a different `Matrix`").
+        let mut prelude = String::new();
+        if self.options.runtime {
+            if calls_libm(&solvers) || calls_libm(&self.out) {
+                prelude.push_str("use bgc_runtime::libm;\n");
+            }
+            prelude.push_str("use bgc_runtime::nalgebra::{SMatrix, SVector};\n");
+        } else {
+            prelude.push_str("use nalgebra::{SMatrix, SVector};\n");
+        }
+        prelude.push_str(&solvers);
         // Every piece of the prelude ends its last line, so its lines and the items' lines are those of the two
         // texts joined.
         out.reserve(prelude.len() + self.out.len() + self.out.len() / 8);
@@ -572,4 +584,10 @@ impl<'a> Writer<'a> {
 /// The outputs' names, in output order.
 fn output_names(eqs: &crate::equations::Equations) -> Vec<String> {
     eqs.outputs.iter().map(|o| o.name.clone()).collect()
+}
+
+/// Whether a line of code (not a comment, which may quote anything) in `text` calls `libm`.
+fn calls_libm(text: &str) -> bool {
+    text.lines()
+        .any(|l| l.contains("libm::") && !l.trim_start().starts_with("//"))
 }

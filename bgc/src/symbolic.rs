@@ -82,7 +82,9 @@ pub use eval::{max, min, sign};
 pub use expr::{Expr, ExprMap, ExprSet, Node, Symbol, SymbolKind};
 pub use from_ir::from_ir;
 pub use linear::{LinearForm, MAX_EXPANDED_POWER, MAX_EXPANDED_TERMS};
-pub use print::latex::{latex_symbol, to_latex, to_latex_with};
+pub use print::latex::{
+    latex_subscript, latex_symbol, latex_symbol_parts, to_latex, to_latex_with,
+};
 pub use print::rust::{
     RUST_HELPER_FNS, RUST_HELPERS, RUST_MAX_FN, RUST_MIN_FN, RUST_POWI_FN, RUST_SIGN_FN, RustCode,
     RustOp, rust_helpers_used, to_rust, to_rust_code,

@@ -178,39 +178,30 @@ enum Style {
     Latex,
 }
 
-const GREEK: [&str; 24] = [
-    "alpha", "beta", "gamma", "delta", "epsilon", "zeta", "eta", "theta", "iota", "kappa",
-    "lambda", "mu", "nu", "xi", "pi", "rho", "sigma", "tau", "upsilon", "phi", "chi", "psi",
-    "omega", "Omega",
-];
-
-/// A name in LaTeX: `J_sint` → `J_{sint}`, `tau_m` → `\tau_{m}`, `e_hd_spring` → `e_{hd\_spring}`.
+/// A symbol name in LaTeX (`J_sint` → `J_{sint}`, `tau_m` → `\\tau_{m}`, `e_hd_spring` → `e_{hd\\_spring}`):
+/// the engine's typesetting, so that a name reads the same in every equation.
 fn latex_name(name: &str) -> String {
-    let (base, sub) = match name.split_once('_') {
-        Some((b, s)) if !b.is_empty() && !s.is_empty() => (b, Some(s)),
-        _ => (name, None),
-    };
-    let base = if GREEK.contains(&base) {
-        format!("\\{base}")
-    } else if base.chars().count() > 1 {
-        format!("\\mathrm{{{}}}", base.replace('_', "\\_"))
-    } else {
-        base.to_string()
-    };
-    match sub {
-        Some(s) => format!("{base}_{{{}}}", s.replace('_', "\\_")),
-        None => base,
+    crate::symbolic::latex_symbol(name)
+}
+
+/// The time derivative of a symbol in LaTeX, the dot on the main symbol alone: `\\dot{p}_{leg\\_1}`.
+fn latex_dot(name: &str) -> String {
+    match crate::symbolic::latex_symbol_parts(name) {
+        (head, None) => format!("\\dot{{{head}}}"),
+        (head, Some(sub)) => format!("\\dot{{{head}}}_{{{sub}}}"),
     }
+}
+
+/// An element's name as the subscript of a quantity of it (`E_{leg\\_1}`, `M_{leg}`): as written, like the
+/// subscripts of its state names.
+fn latex_element(name: &str) -> String {
+    crate::symbolic::latex_subscript(name)
 }
 
 fn name_of(eqs: &Equations, s: Sym, style: Style) -> String {
     match (style, s) {
-        (Style::Latex, Sym::StateDot(i)) => {
-            format!("\\dot{{{}}}", name_of(eqs, Sym::State(i), style))
-        }
-        (Style::Latex, Sym::InputDot(i)) => {
-            format!("\\dot{{{}}}", name_of(eqs, Sym::Input(i), style))
-        }
+        (Style::Latex, Sym::StateDot(i)) => latex_dot(&eqs.sym_name(Sym::State(i))),
+        (Style::Latex, Sym::InputDot(i)) => latex_dot(&eqs.sym_name(Sym::Input(i))),
         (Style::Latex, _) => latex_name(&eqs.sym_name(s)),
         (Style::Text, _) => eqs.sym_name(s),
     }
@@ -331,7 +322,7 @@ const NOT_COMPUTED: &str = "not computed (see warning BG0607)";
 
 /// The left-hand side of an energy term in LaTeX: `E_{x}` stored, `P^{diss}_{x}`, `P^{sup}_{x}`.
 fn energy_latex(t: &super::EnergyTerm) -> String {
-    let name = latex_name(&t.element);
+    let name = latex_element(&t.element);
     match t.kind {
         super::EnergyKind::Stored => format!("E_{{{name}}}"),
         super::EnergyKind::Dissipated => format!("P^{{\\mathrm{{diss}}}}_{{{name}}}"),
@@ -359,11 +350,11 @@ pub fn to_latex(eqs: &Equations) -> String {
                 let lhs = match mass_row(eqs, i) {
                     Some((b, k)) => format!(
                         "\\left[M_{{{}}} \\dot{{f}}_{{{}}}\\right]_{{{}}}",
-                        latex_name(&b.element),
-                        latex_name(&b.element),
+                        latex_element(&b.element),
+                        latex_element(&b.element),
                         k + 1
                     ),
-                    None => format!("\\dot{{{}}}", latex_name(&s.name)),
+                    None => latex_dot(&s.name),
                 };
                 (lhs, expr_latex(eqs, r))
             })
@@ -374,7 +365,7 @@ pub fn to_latex(eqs: &Equations) -> String {
         for (i, row) in b.matrix.iter().enumerate() {
             for (j, m) in row.iter().enumerate().skip(i) {
                 lines.push((
-                    format!("M_{{{},{}{}}}", latex_name(&b.element), i + 1, j + 1),
+                    format!("M_{{{},{}{}}}", latex_element(&b.element), i + 1, j + 1),
                     expr_latex(eqs, m),
                 ));
             }

@@ -59,6 +59,15 @@ fn is_greek(s: &str) -> bool {
 
 /// The LaTeX form of a symbol name (see the module docs).
 pub fn latex_symbol(name: &str) -> String {
+    match latex_symbol_parts(name) {
+        (head, None) => head,
+        (head, Some(sub)) => format!("{head}_{{{sub}}}"),
+    }
+}
+
+/// The LaTeX form of a symbol name as its main symbol and its subscript, for a decoration that belongs on the main
+/// symbol alone: `\dot{p}_{leg\_1}`, not `\dot{p_{leg\_1}}` (the dot over the middle of both).
+pub fn latex_symbol_parts(name: &str) -> (String, Option<String>) {
     let (head, sub) = match name.split_once('_') {
         Some((h, s)) if !h.is_empty() && !s.is_empty() => (h, Some(s)),
         _ => (name, None),
@@ -70,11 +79,19 @@ pub fn latex_symbol(name: &str) -> String {
     } else {
         format!("\\mathrm{{{}}}", escape(head))
     };
-    match sub {
-        None => head,
-        Some(s) if is_greek(s) => format!("{head}_{{\\{s}}}"),
-        Some(s) => format!("{head}_{{{}}}", escape(s)),
-    }
+    let sub = sub.map(|s| {
+        if is_greek(s) {
+            format!("\\{s}")
+        } else {
+            escape(s)
+        }
+    });
+    (head, sub)
+}
+
+/// A name as a LaTeX subscript: kept as written, with `_` and the other special characters escaped.
+pub fn latex_subscript(name: &str) -> String {
+    escape(name)
 }
 
 /// Escapes the characters that are special in LaTeX math.

@@ -1,8 +1,8 @@
 //! Printer snapshots for text, LaTeX and Rust, and the exact forms the code generators rely on.
 
 use super::super::{
-    Expr, RUST_HELPERS, RustCode, RustOp, Symbol, SymbolKind, latex_symbol, rust_helpers_used,
-    to_latex, to_rust, to_rust_code, to_text,
+    Expr, RUST_HELPERS, RustCode, RustOp, Symbol, SymbolKind, latex_subscript, latex_symbol,
+    latex_symbol_parts, rust_helpers_used, to_latex, to_rust, to_rust_code, to_text,
 };
 use super::{c, p, s};
 
@@ -105,6 +105,14 @@ fn latex_symbol_names() {
     assert_eq!(latex_symbol("Kt"), "\\mathrm{Kt}");
     assert_eq!(latex_symbol("x"), "x");
     assert_eq!(latex_symbol("_x"), "\\mathrm{\\_x}");
+    // The main symbol apart, for a dot over it alone (`\dot{p}_{leg\_1}`).
+    assert_eq!(
+        latex_symbol_parts("p_leg_1"),
+        ("p".to_string(), Some("leg\\_1".to_string()))
+    );
+    assert_eq!(latex_symbol_parts("omega"), ("\\omega".to_string(), None));
+    // An element's name as a subscript reads as in its states' names: `E_{leg\_1}` beside `p_{leg\_1}`.
+    assert_eq!(latex_subscript("leg_1"), "leg\\_1");
 }
 
 #[test]

@@ -304,7 +304,7 @@ fn a_flow_source_supplies_the_kinetic_energy_of_the_inertia_it_drives() {
 #[test]
 fn simulate_errors_are_reported() {
     let osc = corpus("oscillator.bg");
-    let cases: [(&[&str], &str); 7] = [
+    let cases: [(&[&str], &str); 9] = [
         (&["--param", "mass=3"], "unknown parameter `mass`"),
         (
             &["--input", "F=sin(2*t"],
@@ -324,6 +324,16 @@ fn simulate_errors_are_reported() {
         (
             &["--x0", "q_spring=1,p_mass=2"],
             "not a number; give each NAME=VALUE its own option",
+        ),
+        // An expression is not a number with a unit stuck to it (the hint had proposed the unit `[*10]`).
+        (
+            &["--param", "k=1e3*10"],
+            "`1e3*10`: not a number; a value is a number (with an optional unit in brackets, `0.5 [deg]`), not an \
+             expression",
+        ),
+        (
+            &["--x0", "q_spring=1/3"],
+            "not a number; a value is a number",
         ),
     ];
     for (extra, message) in cases {

@@ -173,12 +173,21 @@ fn not_a_number_hint(text: &str) -> String {
     let (number, rest) = text.split_at(number_end);
     if text.contains(',') && text.contains('=') {
         "; give each NAME=VALUE its own option, as in `--x0 a=1 --x0 b=2`".to_string()
-    } else if !number.is_empty() && number.parse::<f64>().is_ok() {
+    } else if !number.is_empty()
+        && number.parse::<f64>().is_ok()
+        && rest
+            .trim_start()
+            .starts_with(|c: char| c.is_alphabetic() || c == '°')
+    {
         // `800N/m`, `3000rpm`: a number with its unit stuck to it.
         format!(
             "; a unit goes in brackets after the number: '{number} [{}]'",
             rest.trim()
         )
+    } else if text.contains(['*', '/', '+', '(', '^']) {
+        // `2*pi`, `1/3`: the value of an option is a number; only `--input` signals are expressions.
+        "; a value is a number (with an optional unit in brackets, `0.5 [deg]`), not an expression: write          its value"
+            .to_string()
     } else {
         String::new()
     }

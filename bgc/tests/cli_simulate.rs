@@ -576,3 +576,36 @@ fn breakpoints_that_differ_by_rounding_are_one_time() {
         "{err}"
     );
 }
+
+/// The time column is decimal where that is short and has an exponent at the ends of the range: `--t-end 1e-300`
+/// printed each time as three hundred digits (`0.000…0001`), `--t-end 1e20` as twenty-one.
+#[test]
+fn times_at_the_ends_of_the_range_are_written_with_an_exponent() {
+    let osc = corpus("oscillator.bg");
+    for (t_end, dt, last) in [
+        ("1e-300", "2.5e-301", "1e-300"),
+        ("1e20", "2.5e19", "1e20"),
+        ("1", "0.25", "1"),
+        ("1e-3", "5e-5", "0.001"),
+    ] {
+        let (code, out, err) = bgc(&[
+            "simulate", &osc, "--t-end", t_end, "--dt-out", dt, "--input", "F=1",
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let times: Vec<&str> = out
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').next().unwrap_or(""))
+            .collect();
+        assert_eq!(times.last(), Some(&last), "{out}");
+        assert!(times.iter().all(|t| t.len() <= 24), "{times:?}");
+        // Each reads back as a number no larger than the end.
+        let end: f64 = t_end.parse().unwrap_or(f64::NAN);
+        assert!(
+            times
+                .iter()
+                .all(|t| t.parse::<f64>().is_ok_and(|v| (0.0..=end).contains(&v))),
+            "{times:?}"
+        );
+    }
+}

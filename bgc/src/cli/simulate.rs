@@ -138,7 +138,7 @@ fn csv(
         &opts,
         &mut |t, row| {
             balance.see(t, row);
-            let _ = write!(line, "{t}");
+            write_time(&mut line, t);
             for v in row {
                 // Shortest round-trip form: the printed numbers read back exactly.
                 let _ = write!(line, ",{v:e}");
@@ -175,6 +175,16 @@ fn csv(
         n => format!("{e} (the {n} rows before it were printed)"),
     })?;
     flushed.map_err(Failure::Output)
+}
+
+/// The time column: decimal (`0.25`, `12.5`) where that is short, else with an exponent (`1e-300`, `1e20`), which
+/// Display would write out in hundreds of digits; both are the shortest form that reads back exactly.
+fn write_time(line: &mut String, t: f64) {
+    let _ = if t == 0.0 || (1e-4..1e16).contains(&t.abs()) {
+        write!(line, "{t}")
+    } else {
+        write!(line, "{t:e}")
+    };
 }
 
 /// The energy balance of a run: `energy + dissipated − supplied` stays at its initial value in the exact solution,

@@ -5,7 +5,7 @@
 use crate::codegen_support;
 
 use bgc::codegen::rust::Options;
-use codegen_support::rustc::{compile_no_std, stand_ins};
+use codegen_support::rustc::{compile_no_std, document_no_std, stand_ins};
 use codegen_support::{generate_text, scratch};
 
 /// Derived parameters named as the methods of `Params` (before: E0592 "duplicate definitions"), descriptions with
@@ -91,6 +91,57 @@ fn hostile_names_and_descriptions_give_code_rustc_and_rustdoc_accept() {
     let compiled = compile_no_std(&dir, "hostile", &code);
     let _ = std::fs::remove_dir_all(&dir);
     assert!(compiled.is_ok(), "{}", compiled.err().unwrap_or_default());
+}
+
+/// Documentation of the model file as engineers write it: units in brackets, symbols in angle brackets, a code
+/// fence. rustdoc read `[kg]` as an unresolved intra-doc link and `<m>` as an unclosed HTML tag (errors under
+/// `RUSTDOCFLAGS=-D warnings`), and compiled and ran the fenced example as a doctest of the user's crate.
+const MARKDOWN_DOCS: &str =
+    "/// A rig <b>after</b> [1], [the paper](https://example.org/p) and <https://example.org>.
+///
+/// `[kg]` and `<T>` as code stay as they are.
+///
+/// An unclosed ` backtick, then [kg] again.
+///
+/// ```
+/// fn main() { panic!(\"a doctest\") }
+/// ```
+///
+/// ```bg
+/// param m = 1 [kg];
+/// ```
+model m {
+    domain translational;
+    /// The mass <m> [kg], after [Smith 2020]
+    param m0 = 2 [kg] \"mass <m> [kg] of [`Params`]\";
+    input F [N];
+    Se push = F;
+    I mass = m0;
+    bond push -> mass;
+}
+";
+
+#[test]
+fn markdown_of_the_model_file_is_literal_for_rustdoc_and_no_doctest() {
+    let code = generate_text("docs.bg", MARKDOWN_DOCS, Options { runtime: false });
+    for expected in [
+        "/// A rig \\<b>after\\</b> \\[1\\], [the paper](https://example.org/p) and <https://example.org>.",
+        "/// `[kg]` and `<T>` as code stay as they are.\n",
+        "/// An unclosed ` backtick, then \\[kg\\] again.\n",
+        "/// ```text\n/// fn main()",
+        "/// ```bg\n/// param m = 1 [kg];\n/// ```",
+        "/// The mass \\<m> \\[kg\\], after \\[Smith 2020\\]",
+        "mass \\<m> \\[kg\\] of \\[`Params`\\]",
+    ] {
+        assert!(code.contains(expected), "{expected}\n{code}");
+    }
+    let dir = scratch("markdown-docs");
+    stand_ins(&dir);
+    let documented = document_no_std(&dir, "docs", &code);
+    let _ = std::fs::remove_dir_all(&dir);
+    let (doc, tests) = documented.unwrap_or_else(|e| panic!("{e}"));
+    assert!(!doc.contains("warning"), "{doc}");
+    assert!(tests.contains("running 0 tests"), "{tests}");
 }
 
 /// The `@generated` header names the source relative to the crate, with `/`, so two checkouts in different

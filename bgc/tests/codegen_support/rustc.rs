@@ -178,3 +178,42 @@ pub fn compile_no_std_with(
     std::fs::write(dir.join(format!("{file}.rs")), root).map_err(|e| e.to_string())?;
     compile_against_stand_ins(dir, "rlib", file, &format!("{file}.rs"), extra)
 }
+
+/// Runs `rustdoc` on `module` as a `#![no_std]` library against the stand-ins (built by [`stand_ins`]): once to
+/// document it with `-D warnings`, once with `--test` for its doctests. rustdoc's output of each on success, its
+/// errors on failure.
+pub fn document_no_std(dir: &Path, file: &str, module: &str) -> Result<(String, String), String> {
+    let root = format!(
+        "#![no_std]\n//! One generated module.\n\npub mod model {{\n    include!(\"{file}.module\");\n}}\n"
+    );
+    std::fs::write(dir.join(format!("{file}.module")), module).map_err(|e| e.to_string())?;
+    std::fs::write(dir.join(format!("{file}.rs")), root).map_err(|e| e.to_string())?;
+    let rustdoc = std::env::var("RUSTDOC").unwrap_or_else(|_| "rustdoc".into());
+    let run = |extra: &[&str]| {
+        let out = Command::new(&rustdoc)
+            .current_dir(dir)
+            .args(["--edition", "2024", "-D", "warnings", "--crate-name", file])
+            .args([
+                "--extern",
+                "nalgebra=libnalgebra.rlib",
+                "--extern",
+                "libm=liblibm.rlib",
+            ])
+            .args(["-L", ".", "-o", "doc"])
+            .args(extra)
+            .arg(format!("{file}.rs"))
+            .output()
+            .map_err(|e| format!("cannot run {rustdoc}: {e}"))?;
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        if out.status.success() {
+            Ok(text)
+        } else {
+            Err(text)
+        }
+    };
+    Ok((run(&[])?, run(&["--test"])?))
+}

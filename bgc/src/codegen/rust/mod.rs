@@ -438,9 +438,9 @@ impl<'a> Writer<'a> {
     }
 
     /// Wrapped documentation lines `{indent}/// text`; the text is made inert for rustdoc and rustc
-    /// ([`params::doc_safe`]).
+    /// ([`params::doc_safe`], [`params::rustdoc_literal`]).
     pub(in crate::codegen) fn doc(&mut self, indent: usize, text: &str) {
-        let text = params::doc_safe(text);
+        let text = params::rustdoc_literal(&params::doc_safe(text));
         for line in format::comment(indent, "///", &text, Wrap::Prose, self.width) {
             self.out.push_str(&line);
             self.out.push('\n');
@@ -449,8 +449,15 @@ impl<'a> Writer<'a> {
 
     /// Documentation lines of the model file (of the model or of a parameter), as wrapped paragraphs.
     fn doc_lines(&mut self, indent: usize, lines: &[String]) {
+        let mut in_code = false;
         for (text, verbatim) in format::paragraphs(lines) {
             if verbatim {
+                let text = if text.trim_start().starts_with("```") {
+                    in_code = !in_code;
+                    params::rustdoc_fence(&text, in_code)
+                } else {
+                    params::visible(&text)
+                };
                 let pad = " ".repeat(indent);
                 let space = if text.is_empty() { "" } else { " " };
                 let _ = writeln!(self.out, "{pad}///{space}{text}");

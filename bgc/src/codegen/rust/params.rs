@@ -588,14 +588,7 @@ pub(super) fn field_name(namer: &mut Namer, name: &str, derived: bool) -> String
 /// are written as `\u{…}`; a run of three backticks or tildes (which rustdoc would read as a code fence, and then
 /// as a doctest) and a leading indent (an indented code block) are escaped.
 pub(in crate::codegen) fn doc_safe(text: &str) -> String {
-    let mut visible = String::with_capacity(text.len());
-    for c in text.trim_start().chars() {
-        if invisible(c) {
-            visible.push_str(&format!("\\u{{{:x}}}", c as u32));
-        } else {
-            visible.push(c);
-        }
-    }
+    let visible = visible(text.trim_start());
     let chars: Vec<char> = visible.chars().collect();
     let mut out = String::with_capacity(visible.len());
     let mut i = 0;
@@ -615,6 +608,123 @@ pub(in crate::codegen) fn doc_safe(text: &str) -> String {
         i = j;
     }
     out
+}
+
+/// `text` with the code points rustc refuses in comments, and other invisible controls, written as `\\u{…}`.
+pub(in crate::codegen) fn visible(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        if invisible(c) {
+            out.push_str(&format!("\\u{{{:x}}}", c as u32));
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// A code fence of a model file's documentation as rustdoc should read it: an opening fence that rustdoc would take
+/// for Rust (no language, `rust`, or only rustdoc's attributes such as `no_run`) becomes ```` ```text ````, so that
+/// no example of the model file becomes a doctest of the user's crate; other languages (`bg`, `python`) stay.
+pub(in crate::codegen) fn rustdoc_fence(line: &str, opening: bool) -> String {
+    let (indent, fence) = line.split_at(line.len() - line.trim_start().len());
+    let marks = fence.chars().take_while(|&c| c == '`').count();
+    let info = fence[marks..].trim();
+    const RUSTDOC: [&str; 8] = [
+        "rust",
+        "ignore",
+        "no_run",
+        "should_panic",
+        "compile_fail",
+        "test_harness",
+        "standalone_crate",
+        "allow_fail",
+    ];
+    let rust_like = info
+        .split([',', ' '])
+        .filter(|t| !t.is_empty())
+        .all(|t| RUSTDOC.contains(&t) || t.starts_with("edition"));
+    if opening && rust_like {
+        format!("{indent}{}text", &fence[..marks])
+    } else {
+        visible(line)
+    }
+}
+
+/// Prose from the model file made literal for rustdoc (after [`doc_safe`]): outside inline code, a `[`…`]` that is
+/// not an inline link `[text](url)` and a `<` that does not open an autolink (`<https://…>`) are escaped, so that
+/// `Mass [kg]` is not an unresolved intra-doc link and `<m>` not an unclosed HTML tag (both warnings, errors under
+/// `RUSTDOCFLAGS=-D warnings`).
+pub(in crate::codegen) fn rustdoc_literal(text: &str) -> String {
+    let chars: Vec<char> = text.chars().collect();
+    let mut out = String::with_capacity(text.len() + 8);
+    let mut code_run = 0usize;
+    let mut link_close = None;
+    let mut i = 0;
+    while let Some(&c) = chars.get(i) {
+        match c {
+            '\\' => {
+                out.push(c);
+                if let Some(&next) = chars.get(i + 1) {
+                    out.push(next);
+                    i += 1;
+                }
+            }
+            '`' => {
+                let run = chars[i..].iter().take_while(|&&b| b == '`').count();
+                code_run = match code_run {
+                    // A run that nothing closes is literal backticks, as in Markdown.
+                    0 if closes_later(&chars[i + run..], run) => run,
+                    0 => 0,
+                    open if open == run => 0,
+                    open => open,
+                };
+                out.extend(std::iter::repeat_n('`', run));
+                i += run;
+                continue;
+            }
+            _ if code_run > 0 => out.push(c),
+            '[' => match inline_link_close(&chars, i) {
+                Some(close) => {
+                    link_close = Some(close);
+                    out.push(c);
+                }
+                None => out.push_str("\\["),
+            },
+            ']' if link_close == Some(i) => {
+                link_close = None;
+                out.push(c);
+            }
+            ']' => out.push_str("\\]"),
+            '<' if !opens_autolink(&chars[i + 1..]) => out.push_str("\\<"),
+            _ => out.push(c),
+        }
+        i += 1;
+    }
+    out
+}
+
+/// Whether `rest` holds a run of exactly `run` backticks, which closes a code span opened by one.
+fn closes_later(rest: &[char], run: usize) -> bool {
+    rest.split(|&c| c != '`').any(|r| r.len() == run)
+}
+
+/// The index of the `]` that closes the `[` at `open` when the two make an inline link `[text](url)`.
+fn inline_link_close(chars: &[char], open: usize) -> Option<usize> {
+    let close = open
+        + 1
+        + chars[open + 1..]
+            .iter()
+            .position(|&c| c == ']' || c == '[')?;
+    (chars[close] == ']' && chars.get(close + 1) == Some(&'(')).then_some(close)
+}
+
+/// Whether the text after a `<` is an autolink's scheme (`https://`, `mailto:`), which rustdoc renders as a link.
+fn opens_autolink(rest: &[char]) -> bool {
+    let head: String = rest.iter().take(8).collect();
+    ["http://", "https://", "mailto:"]
+        .iter()
+        .any(|s| head.starts_with(s))
 }
 
 /// A code point that changes how text around it reads without showing itself.

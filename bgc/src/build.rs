@@ -470,6 +470,13 @@ impl FsLoader {
         Ok(loader)
     }
 
+    /// Lets imports resolve into `dir` (which must exist), as into the importing file's directory: for a root that
+    /// is not a file (a model read from standard input), whose imports are looked up in the current directory.
+    pub fn allow_directory(&mut self, dir: &Path) -> std::io::Result<()> {
+        self.allowed.push(std::fs::canonicalize(dir)?);
+        Ok(())
+    }
+
     /// Every path read or asked for (the root file and its imports, also those that could not be read).
     pub fn requested(&self) -> impl Iterator<Item = &Path> {
         self.requested.iter().map(PathBuf::as_path)

@@ -22,7 +22,13 @@ use std::process::ExitCode;
 
 /// bgc: the bond-graph compiler.
 #[derive(Parser, Debug)]
-#[command(name = "bgc", version, about, long_about = None)]
+#[command(
+    name = "bgc",
+    version,
+    about,
+    long_about = None,
+    after_help = "A FILE given as `-` is read from standard input (its imports from the current directory)."
+)]
 pub struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -288,6 +294,7 @@ enum Command {
     },
     /// Print .bg files in the canonical layout (in place), or with --check report the files that differ.
     Fmt {
+        /// The files to format; `-` formats standard input and prints the result.
         #[arg(required = true)]
         files: Vec<PathBuf>,
         /// Change nothing; exit 1 when a file is not in the canonical layout.

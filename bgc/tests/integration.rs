@@ -21,6 +21,7 @@ mod cli_root_files;
 mod cli_simulate;
 mod cli_simulate_large;
 mod cli_solver_long;
+mod cli_stdin;
 mod cli_units;
 mod codegen_build;
 mod codegen_generate;

@@ -1,6 +1,8 @@
 //! The subcommands. Each returns the process status; all printing happens here.
 
-use super::io::{keep_until_exit, loader, read_source, stderr, stderrln, stdout, stdoutln};
+use super::io::{
+    is_stdin, keep_until_exit, loader_for, read_source, stderr, stderrln, stdout, stdoutln,
+};
 use super::{DiagFormat, DrawFormat, ReportFormat, Status};
 use bgc::diagnostic::{Diagnostic, Severity, has_errors, render};
 use bgc::span::SourceMap;
@@ -25,7 +27,15 @@ pub fn check(files: &[PathBuf], format: DiagFormat, color: bool) -> Status {
             all_diags.push(d);
             continue;
         }
-        let (models, mut diags) = bgc::lower::lower(&mut sources, id, &mut loader());
+        let mut loader = match loader_for(path) {
+            Ok(l) => l,
+            Err(e) => {
+                stderrln(&format!("error: cannot read {}: {e}", path.display()));
+                status = Status::UsageOrIo;
+                continue;
+            }
+        };
+        let (models, mut diags) = bgc::lower::lower(&mut sources, id, &mut loader);
         if !has_errors(&diags) {
             for m in &models {
                 let mut found = bgc::causality::analyse(m).1;
@@ -37,7 +47,7 @@ pub fn check(files: &[PathBuf], format: DiagFormat, color: bool) -> Status {
             for m in &models {
                 summaries.push(format!(
                     "{}: model `{}`: {} elements and junctions, {} bonds, {} parameters",
-                    path.display(),
+                    sources.get(id).map(|f| f.name.as_str()).unwrap_or_default(),
                     m.name,
                     m.graph.node_count(),
                     m.graph.edge_count(),
@@ -97,16 +107,24 @@ fn fmt_one(path: &Path, check_only: bool, color: bool) -> std::io::Result<bool> 
             stderr(&render::to_text(&sources, &diags, color));
             stderrln(&format!(
                 "{}: not formatted: the file has syntax errors",
-                path.display()
+                sources.get(id).map(|f| f.name.as_str()).unwrap_or_default()
             ));
             return Ok(false);
         }
     };
+    if is_stdin(path) && !check_only {
+        // A filter, as editors and hooks use formatters: the text in the canonical layout goes to standard output.
+        stdout(&formatted);
+        return Ok(true);
+    }
     if formatted == text {
         return Ok(true);
     }
     if check_only {
-        let name = path.display().to_string();
+        let name = match is_stdin(path) {
+            true => super::io::STDIN_NAME.to_string(),
+            false => path.display().to_string(),
+        };
         let diff = similar::TextDiff::from_lines(&text, &formatted)
             .unified_diff()
             .context_radius(3)
@@ -189,7 +207,11 @@ pub(super) fn load_one(path: &Path, wanted: Option<&str>, color: bool) -> Result
         stderr(&render::to_text(&sources, &[d], color));
         return Err(Status::InputErrors);
     }
-    let (models, diags) = bgc::lower::lower(&mut sources, id, &mut loader());
+    let mut loader = loader_for(path).map_err(|e| {
+        stderrln(&format!("error: cannot read {}: {e}", path.display()));
+        Status::UsageOrIo
+    })?;
+    let (models, diags) = bgc::lower::lower(&mut sources, id, &mut loader);
     if has_errors(&diags) {
         stderr(&render::to_text(&sources, &diags, color));
         stderrln(&count_line(&diags));
@@ -310,11 +332,21 @@ pub fn rust(path: &Path, runtime: bool, color: bool) -> Status {
         stderr(&render::to_text(&sources, &[d], color));
         return Status::InputErrors;
     }
-    match bgc::codegen::compile(&mut sources, id, &mut loader()) {
+    let mut loader = match loader_for(path) {
+        Ok(l) => l,
+        Err(e) => {
+            stderrln(&format!("error: cannot read {}: {e}", path.display()));
+            return Status::UsageOrIo;
+        }
+    };
+    match bgc::codegen::compile(&mut sources, id, &mut loader) {
         Ok(compiled) => {
             // Named as `bgc::build` names it, so that both print the same text.
             let cwd = std::env::current_dir().ok();
-            let name = bgc::build::header_name(path, cwd.as_deref());
+            let name = match is_stdin(path) {
+                true => super::io::STDIN_NAME.to_string(),
+                false => bgc::build::header_name(path, cwd.as_deref()),
+            };
             let options = bgc::codegen::rust::Options { runtime };
             let code = bgc::codegen::rust::generate_with(&compiled, &name, options);
             stdout(&code);

@@ -22,14 +22,59 @@ pub fn loader() -> FsLoader {
     LOADER.get().cloned().unwrap_or_default()
 }
 
-/// Reads a file into the source map. Invalid UTF-8 is not an I/O error: the file is added with the bad bytes
+/// The name of a model read from standard input (`-`), as diagnostics show it.
+pub const STDIN_NAME: &str = "<stdin>";
+
+/// Whether `path` is `-`: the model comes from standard input, as formatters and checkers take `-`.
+pub fn is_stdin(path: &Path) -> bool {
+    path == Path::new("-")
+}
+
+/// The loader for the file `path`: [`loader`], and for standard input the current directory, which is where its
+/// imports are looked up (as beside a file).
+pub fn loader_for(path: &Path) -> std::io::Result<FsLoader> {
+    let mut loader = loader();
+    if is_stdin(path) {
+        loader.allow_directory(&std::env::current_dir()?)?;
+    }
+    Ok(loader)
+}
+
+/// Reads standard input as a source file: at most `MAX_SOURCE_BYTES`, like a file.
+fn read_stdin() -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let limit = bgc::build::MAX_SOURCE_BYTES;
+    let mut bytes = Vec::new();
+    std::io::stdin()
+        .lock()
+        .take(limit + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!(
+                "standard input is larger than the {} MiB a source file may have",
+                limit >> 20
+            ),
+        ));
+    }
+    Ok(bytes)
+}
+
+/// Reads a file (standard input for `-`) into the source map. Invalid UTF-8 is not an I/O error: the file is added with the bad bytes
 /// replaced, so that the diagnostic returned can show where they are.
 pub fn read_source(
     sources: &mut SourceMap,
     path: &Path,
 ) -> std::io::Result<(FileId, Option<Diagnostic>)> {
-    let bytes = bgc::build::read_source_file(path)?;
-    let name = path.display().to_string();
+    let (bytes, name) = if is_stdin(path) {
+        (read_stdin()?, STDIN_NAME.to_string())
+    } else {
+        (
+            bgc::build::read_source_file(path)?,
+            path.display().to_string(),
+        )
+    };
     // The id the file will get, so that the decode diagnostic points into it.
     let next = FileId(sources.files().count() as u32);
     match bgc::syntax::decode(next, &bytes) {

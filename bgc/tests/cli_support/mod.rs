@@ -29,6 +29,31 @@ pub fn bgc(args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// Runs `bgc` in `dir` with `input` on its standard input; the exit code, standard output and standard error.
+pub fn bgc_stdin(args: &[&str], input: &str, dir: &std::path::Path) -> (i32, String, String) {
+    use std::io::Write;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bgc"))
+        .args(args)
+        .arg("--color=never")
+        .current_dir(dir)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("bgc runs");
+    if let Some(mut stdin) = child.stdin.take() {
+        stdin
+            .write_all(input.as_bytes())
+            .expect("bgc reads its input");
+    }
+    let out = child.wait_with_output().expect("bgc runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
 pub fn ok_json(args: &[&str]) -> Value {
     let (code, out, err) = bgc(args);
     assert_eq!(code, 0, "stderr: {err}");

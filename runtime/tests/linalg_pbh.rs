@@ -220,3 +220,22 @@ fn eigenvalues_beyond_f64_are_an_error() {
     assert_eq!(eigenvalues(&a), Err(SchurError::OutOfRange { n: 2 }));
     assert_eq!(real_schur(&a).err(), Some(SchurError::OutOfRange { n: 2 }));
 }
+
+/// A model without states (a static gain, `StateSpace` of a divider) has a 0×0 `A`: its eigenvalues are none, and
+/// its Schur factors are empty (the PBH tests refuse it by name). `eigenvalues` panicked inside nalgebra ("Matrix index
+/// out of bounds").
+#[test]
+fn a_matrix_without_states_has_no_eigenvalues() {
+    use bgc_runtime::linalg::eigenvalues;
+    use bgc_runtime::linalg::schur::real_schur;
+    let empty = DMatrix::<f64>::zeros(0, 0);
+    assert_eq!(eigenvalues(&empty), Ok(Vec::new()));
+    let (u, t) = real_schur(&empty).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!((u.shape(), t.shape()), ((0, 0), (0, 0)));
+    let b = DMatrix::<f64>::zeros(0, 2);
+    let refused = uncontrollable_modes(&empty, &b).map(|m| m.len());
+    assert!(
+        refused.as_ref().is_err_and(|e| e.to_string().contains("A")),
+        "{refused:?}"
+    );
+}

@@ -63,6 +63,10 @@ pub fn real_schur(a: &DMatrix<f64>) -> Result<(DMatrix<f64>, DMatrix<f64>), Schu
 /// The eigenvalues of a square matrix, in the order of the diagonal of its real Schur form.
 pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, SchurError> {
     let n = checked(a)?;
+    if n == 0 {
+        // A model without states (a static gain) has none; nalgebra's eigenvalues of a 0×0 matrix index out of it.
+        return Ok(Vec::new());
+    }
     let scale = matrix_scale(a);
     let values: Vec<Complex<f64>> = Schur::try_new(a / scale, f64::EPSILON, 1000 * n.max(10))
         .ok_or(SchurError::NoConvergence { n })?

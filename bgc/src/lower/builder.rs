@@ -35,6 +35,9 @@ pub(crate) struct ParamInfo {
     pub value_span: Span,
     /// Its declared unit.
     pub unit_span: Span,
+    /// Its value could not be computed (an error says why, and 0 stands in): the checks of values computed from
+    /// it are left out, since they would report the stand-in ("an inertia of 0").
+    pub value_reported: bool,
 }
 
 pub(crate) struct Builder<'a> {

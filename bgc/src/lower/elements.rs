@@ -273,6 +273,11 @@ impl Builder<'_> {
 
     /// BG0401: the value with the parameters at their defaults must be physical.
     fn check_value(&mut self, kind: K, name: &str, expr: &ir::Expr, span: Span) {
+        let mut used = Vec::new();
+        params_of(expr, &mut used);
+        if self.values_reported(&used) {
+            return;
+        }
         let Some(v) = eval(expr, &self.model.params) else {
             return;
         };
@@ -314,8 +319,6 @@ impl Builder<'_> {
             span,
             format!("this is {shown} with the default parameter values"),
         );
-        let mut used = Vec::new();
-        params_of(expr, &mut used);
         for id in used {
             if let (Some(p), Some(info)) = (self.model.params.get(id), self.params.get(id)) {
                 d = d.with_secondary(

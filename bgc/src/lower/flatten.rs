@@ -374,6 +374,7 @@ impl<'a> Builder<'a> {
         };
         let mut value = 0.0;
         let mut derived = None;
+        let mut value_reported = true;
         if let Some((ir_expr, q)) = self.expr(expr, cx) {
             match q {
                 Q::Dim(d) if unit_ok && d != unit.dim => {
@@ -389,13 +390,17 @@ impl<'a> Builder<'a> {
                 }
                 _ => {}
             }
+            let mut refs = Vec::new();
+            super::consteval::params_of(&ir_expr, &mut refs);
             match eval(&ir_expr, &self.model.params) {
                 // A bare number is written in the declared unit; an expression of parameters is already in SI.
                 Some(v) if q == Q::Free => value = v * unit.scale,
                 Some(v) => value = v,
                 None => {}
             }
+            value_reported = self.values_reported(&refs);
             if !value.is_finite() {
+                value_reported = true;
                 self.diags.push(
                     Diagnostic::error(
                         "BG0403",
@@ -406,8 +411,6 @@ impl<'a> Builder<'a> {
                 );
                 value = 0.0;
             }
-            let mut refs = Vec::new();
-            super::consteval::params_of(&ir_expr, &mut refs);
             if !refs.is_empty() {
                 derived = Some(ir_expr);
             }
@@ -430,7 +433,14 @@ impl<'a> Builder<'a> {
             name_span: p.name.span,
             value_span: expr.span,
             unit_span: p.unit.span,
+            value_reported,
         });
+    }
+
+    /// Whether one of the parameters `ids` has a value that could not be computed (already reported).
+    pub fn values_reported(&self, ids: &[usize]) -> bool {
+        ids.iter()
+            .any(|&id| self.params.get(id).is_some_and(|p| p.value_reported))
     }
 
     fn element(&mut self, sid: usize, e: &'a ast::ElementDecl) {

@@ -61,3 +61,44 @@ fn an_unknown_domain_is_not_followed_by_bonds_without_a_domain() {
         assert_eq!(found, vec![code], "{domain}");
     }
 }
+
+/// A parameter whose value cannot be computed is one error: 0 stands in for it, and the elements computed from it
+/// were then reported with that stand-in ("`i` has an inertia of 0"), also through a derived parameter and an
+/// instance's override.
+#[test]
+fn an_element_of_a_parameter_without_a_value_is_not_checked_with_the_stand_in() {
+    let cases = [
+        (
+            "model a { domain translational; param m = 1/0 [kg]; Se s = 1; I i = m; bond s -> i; }",
+            "the value of `m` is not finite",
+        ),
+        (
+            "model a { domain translational; param m = n [kg]; param n = 1 [kg]; Se s = 1; I i = m; bond s -> i; }",
+            "unknown name `n`",
+        ),
+        (
+            "model a { domain translational; param m = 1e300*1e300 [kg]; param k = 2*m [kg]; Se s = 1; I i = k; \
+             bond s -> i; }",
+            "the value of `m` is not finite",
+        ),
+        (
+            "component S { domain translational; param k = 1 [N/m]; C c = 1/k; port p = c; }\n\
+             model a { domain translational; Se s = 1; S x(k = 1/0); bond s -> x.p; }",
+            "the value of `k` is not finite",
+        ),
+    ];
+    for (text, message) in cases {
+        let found = codes_and_messages(text);
+        assert_eq!(found.len(), 1, "{text}\n{found:?}");
+        assert_eq!(found[0].1, message, "{text}");
+    }
+    // A value that is computed and unphysical is still reported.
+    let found = codes_and_messages(
+        "model a { domain translational; param m = 1 [kg]; Se s = 1; I i = m - 1; bond s -> i; }",
+    );
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert_eq!(
+        found[0].1,
+        "`i` has an inertia of 0 (an inertia must be positive)"
+    );
+}

@@ -10,6 +10,16 @@ use crate::syntax::ast::{BondStmt, Ident, NodeRef};
 
 impl<'a> Builder<'a> {
     pub(super) fn bond_stmt(&mut self, sid: usize, b: &'a BondStmt) {
+        if b.malformed {
+            // Which bonds a fan-out inside the chain meant is unknown (BG0110 says so): none is made, and the
+            // counts of its nodes follow from that error.
+            for node in b.chain.iter().flatten() {
+                if let Some(end) = self.resolve_end(sid, node) {
+                    self.suspect_nodes.insert(end.node);
+                }
+            }
+            return;
+        }
         // The label and the hint apply only when the statement made exactly one bond: count, keep the first.
         let mut created = 0usize;
         let mut first = None;

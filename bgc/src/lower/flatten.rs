@@ -142,6 +142,16 @@ impl<'a> Builder<'a> {
                 self.bond_stmt(sid, b);
             }
         }
+        // The nodes of bond statements that did not parse lack those bonds: their counts follow from that error.
+        for name in &decl.unparsed.bonded {
+            match self.scopes[sid].get(&name.name) {
+                Some(Entity::Node(n)) => {
+                    self.suspect_nodes.insert(n);
+                }
+                Some(Entity::Instance(child)) => self.scopes[child].connected = true,
+                _ => {}
+            }
+        }
         // Pass 4: ports and coordinates.
         for stmt in &decl.body {
             match stmt {

@@ -102,3 +102,41 @@ fn an_element_of_a_parameter_without_a_value_is_not_checked_with_the_stand_in() 
         "`i` has an inertia of 0 (an inertia must be positive)"
     );
 }
+
+/// A bond statement that does not parse, or whose chain has a fan-out before its end, is one error: its nodes
+/// were then reported as "not connected" or as 1-ports with two bonds, and the fan-out's guessed bonds as "a bond
+/// cannot join a node to itself".
+#[test]
+fn the_nodes_of_a_bond_statement_in_error_are_not_reported_again() {
+    let head = "model a { domain translational; param m = 1 [kg]; Se s = 1; Se t = 2; I i = m; R r = 1; 1 j; ";
+    for (bond, message) in [
+        (
+            "bond s -> j -> i,; bond t -> r; }",
+            "expected a node, found `;`",
+        ),
+        (
+            "bond s -> j -> i r; bond t -> r; }",
+            "expected `;` after the bond, found `r`",
+        ),
+        (
+            "bond s -> j, t -> j -> i, r; }",
+            "a fan-out must end the chain",
+        ),
+    ] {
+        let text = format!("{head}{bond}");
+        let found = codes_and_messages(&text);
+        assert_eq!(found.len(), 1, "{text}\n{found:?}");
+        assert_eq!(found[0].1, message, "{text}");
+    }
+    // A node that no statement bonds is still reported, with a junction to bond it from that is not itself.
+    let (_, diags, _) = super::tests::lower_text(
+        "model a { domain translational; Se s = 1; R r = 1; 1 j; bond s -> r; }",
+    );
+    let helps: Vec<Option<&str>> = diags.iter().map(|d| d.help.as_deref()).collect();
+    assert_eq!(
+        helps,
+        vec![Some(
+            "bond it (`bond j1 -> j;`, from a junction) or remove it"
+        )]
+    );
+}

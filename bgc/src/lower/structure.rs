@@ -88,7 +88,10 @@ impl Builder<'_> {
             self.diags.push(
                 Diagnostic::error("BG0306", format!("`{name}` is not connected"))
                     .with_primary(decl_span, format!("this {} has no bond", kind_name(kind)))
-                    .with_help(format!("bond it (`bond j -> {name};`) or remove it")),
+                    .with_help(format!(
+                        "bond it (`bond {junction} -> {name};`, from a junction) or remove it",
+                        junction = if name == "j" { "j1" } else { "j" }
+                    )),
             );
             return;
         }

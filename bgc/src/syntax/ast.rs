@@ -75,11 +75,13 @@ pub struct ModelDecl {
 pub struct Unparsed {
     pub names: Vec<Ident>,
     pub domain: bool,
+    /// The names in `bond` statements that did not parse: the bonds of those nodes are not all known.
+    pub bonded: Vec<Ident>,
 }
 
 impl Unparsed {
     pub fn is_empty(&self) -> bool {
-        self.names.is_empty() && !self.domain
+        self.names.is_empty() && !self.domain && self.bonded.is_empty()
     }
 }
 
@@ -365,6 +367,9 @@ pub struct BondStmt {
     /// The chain: each entry is joined to the next by an arrow. All but the last have exactly one node.
     pub chain: Vec<ShortList<NodeRef>>,
     pub hint: Option<CausalHint>,
+    /// The chain has a fan-out before its end (BG0110, reported): which bonds it meant is unknown, so it makes none.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub malformed: bool,
     pub span: Span,
 }
 

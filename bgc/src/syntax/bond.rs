@@ -38,13 +38,14 @@ impl Parser<'_> {
             });
         }
         self.expect_semi("the bond")?;
-        let bond = BondStmt {
+        let mut bond = BondStmt {
             label,
             chain,
             hint,
+            malformed: false,
             span: self.span_from(start),
         };
-        self.check_bond_shape(&bond);
+        bond.malformed = self.check_bond_shape(&bond);
         Ok(bond)
     }
 
@@ -57,13 +58,16 @@ impl Parser<'_> {
         Ok(group)
     }
 
-    /// Fan-outs only at the end; labels and hints only on single bonds; a hint at one of the bond's ends.
-    fn check_bond_shape(&mut self, bond: &BondStmt) {
+    /// Fan-outs only at the end; labels and hints only on single bonds; a hint at one of the bond's ends. Whether
+    /// a fan-out comes before the end (the statement is then malformed).
+    fn check_bond_shape(&mut self, bond: &BondStmt) -> bool {
         let last = bond.chain.len().saturating_sub(1);
+        let mut malformed = false;
         for group in bond.chain.iter().take(last) {
             if let (Some(first), Some(end)) = (group.first(), group.last())
                 && group.len() > 1
             {
+                malformed = true;
                 self.diags.push(
                     Diagnostic::error("BG0110", "a fan-out must end the chain")
                         .with_primary(first.span.to(end.span), "this fan-out is followed by `->`")
@@ -89,7 +93,7 @@ impl Parser<'_> {
                     );
                 }
             }
-            return;
+            return malformed;
         }
         let what = if bond.chain.len() > 2 {
             "a chain"
@@ -124,6 +128,7 @@ impl Parser<'_> {
             self.diags
                 .push(d.with_help("give the hint on a single bond: `bond a -> b stroke b;`"));
         }
+        malformed
     }
 }
 

@@ -17,8 +17,8 @@ impl<'a> Parser<'a> {
         match self.statement_inner(docs) {
             Ok(s) => Some(s),
             Err(Fail) => {
-                self.note_unparsed(first);
                 self.recover();
+                self.note_unparsed(first);
                 if self.pos == start_pos {
                     self.bump();
                 }
@@ -27,8 +27,9 @@ impl<'a> Parser<'a> {
         }
     }
 
-    /// Records what the failed statement starting at token `first` declared: the name after its keyword or element
-    /// kind (`param m`, `I mass`, `0 j`), or the instance name after a component's name (`Leg left`).
+    /// Records what the failed statement from token `first` to the cursor declared: the name after its keyword or
+    /// element kind (`param m`, `I mass`, `0 j`), or the instance name after a component's name (`Leg left`); for a
+    /// `bond` statement, the names it bonds.
     fn note_unparsed(&mut self, first: usize) {
         let (Some(&lead), Some(&next)) = (self.toks.get(first), self.toks.get(first + 1)) else {
             return;
@@ -36,6 +37,19 @@ impl<'a> Parser<'a> {
         let word = self.tok_text(lead);
         if lead.kind == Tok::Ident && word == "domain" {
             self.unparsed.domain = true;
+            return;
+        }
+        if lead.kind == Tok::Ident && word == "bond" {
+            for k in first + 1..self.pos.min(self.toks.len()) {
+                let t = self.toks[k];
+                let name = self.tok_text(t);
+                if t.kind == Tok::Ident && !super::parser::is_keyword(name) {
+                    self.unparsed.bonded.push(Ident {
+                        name: name.to_string(),
+                        span: self.tok_span(t),
+                    });
+                }
+            }
             return;
         }
         let declares = match lead.kind {

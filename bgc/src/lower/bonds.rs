@@ -286,6 +286,12 @@ impl<'a> Builder<'a> {
             }
             return Some(end);
         }
+        // The bond was meant for one of this instance's ports: "not connected", of the instance or of the node of
+        // a port, would only repeat this error.
+        scope.connected = true;
+        let port_nodes: Vec<_> = scope.ports.values().map(|(end, _)| end.node).collect();
+        self.suspect_nodes.extend(port_nodes);
+        let scope = self.scopes.get(child)?;
         let inst = walk.last().map(|i| i.name.as_str()).unwrap_or("");
         let (comp, comp_span) = scope.component.clone().unwrap_or_default();
         let names: Vec<&str> = scope.port_order.iter().map(String::as_str).collect();

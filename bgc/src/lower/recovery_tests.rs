@@ -140,3 +140,18 @@ fn the_nodes_of_a_bond_statement_in_error_are_not_reported_again() {
         )]
     );
 }
+
+/// A bond to a port an instance does not have is one error: the instance was then also "not connected".
+#[test]
+fn a_bond_to_an_unknown_port_does_not_leave_its_instance_unconnected() {
+    let text = "component S { domain translational; param k = 1 [N/m]; C c = 1/k; port p = c; }\n\
+                model a { domain translational; Se s = 1; S sp; bond s -> sp.q; }";
+    let found = codes_and_messages(text);
+    assert_eq!(
+        found,
+        vec![(
+            "BG0205",
+            "instance `sp` (component `S`) has no port `q`".to_string()
+        )]
+    );
+}

@@ -25,6 +25,7 @@ mod parser;
 mod short_list;
 mod stmt;
 mod suggest;
+mod typographic;
 
 #[cfg(test)]
 mod format_tests;

@@ -155,3 +155,32 @@ fn a_bond_to_an_unknown_port_does_not_leave_its_instance_unconnected() {
         )]
     );
 }
+
+/// A model pasted from a paper or a word processor: `×`, `·`, `²`, `⁻¹`, `−`, `→`, typographic quotes and a
+/// no-break space. Each is one BG0104 with the ASCII form, and is read as that form: `m·k` went on to "expected
+/// `;`, found `k`", `[kg·m²]` to a unit mismatch against `[kg m]`, `“inertia”` to "expected `;`, found `inertia`".
+#[test]
+fn typographic_characters_are_one_error_each_and_read_as_their_ascii_form() {
+    let text = "model a {\n    domain rotational;\n    param J = 2 × 1 [kg·m²] “inertia”;\n    \
+                param k = 3 [N·m·rad⁻¹];\n    Se s = −1;\n    I i = J·k/k;\n    C c = 1/k;\n    1\u{a0}j;\n    \
+                bond s → j -> i, c;\n}\n";
+    let found = codes_and_messages(text);
+    let shown: Vec<&str> = found.iter().map(|(_, m)| m.as_str()).collect();
+    assert_eq!(
+        shown,
+        vec![
+            "invalid character \"×\"",
+            "invalid character \"·\"",
+            "invalid character \"²\"",
+            "a string between typographic quotes",
+            "invalid character \"·\"",
+            "invalid character \"·\"",
+            "invalid characters \"⁻¹\"",
+            "invalid character \"−\"",
+            "invalid character \"·\"",
+            "invalid character \"\\u{a0}\"",
+            "invalid character \"→\"",
+        ]
+    );
+    assert!(found.iter().all(|(code, _)| *code == "BG0104"));
+}

@@ -448,8 +448,12 @@ impl<'a> Parser<'a> {
                 let negative = self.eat(Tok::Minus).is_some();
                 let p = self.peek();
                 let text = self.tok_text(p);
-                let parsed = if p.kind == Tok::Number && text.bytes().all(|b| b.is_ascii_digit()) {
-                    text.parse::<i32>().ok().filter(|v| *v != 0)
+                // Digits, or superscripts (`m²`, reported by the lexer and read as `m^2`).
+                let whole = text.bytes().all(|b| b.is_ascii_digit()) || !text.is_ascii();
+                let parsed = if p.kind == Tok::Number && whole {
+                    let v = self.number_value(p);
+                    (v != 0.0 && v.fract() == 0.0 && v.abs() <= f64::from(i32::MAX))
+                        .then_some(v as i32)
                 } else {
                     None
                 };

@@ -6,6 +6,7 @@
 //! the token stream; they are returned separately so that the parser can attach doc comments and the formatter can
 //! print ordinary ones back. Lexing is a single left-to-right pass, so it takes time linear in the input.
 
+use super::typographic::StandIn;
 use crate::diagnostic::Diagnostic;
 use crate::span::{FileId, Span};
 use nom::branch::alt;
@@ -329,6 +330,18 @@ impl<'a> Lexer<'a> {
                 rest = rest.get(len..).unwrap_or("");
                 continue;
             }
+            if let Some((len, text)) = super::typographic::quoted(rest) {
+                self.flush_junk();
+                self.typographic_string(start, len, text);
+                rest = rest.get(len..).unwrap_or("");
+                continue;
+            }
+            if let Some((len, stand_in, help)) = super::typographic::stand_in(rest) {
+                self.flush_junk();
+                self.typographic(start, start + len, stand_in, help);
+                rest = rest.get(len..).unwrap_or("");
+                continue;
+            }
             if let Some(len) = super::foreign::name_len(rest) {
                 self.flush_junk();
                 self.foreign_name(start, start + len);
@@ -581,6 +594,62 @@ impl<'a> Lexer<'a> {
         }
     }
 
+    /// A typographic character (`·`, `²`, `→`, ...; see [`super::typographic`]): one error, and the tokens of what it
+    /// stands for.
+    fn typographic(&mut self, start: usize, end: usize, stand_in: StandIn, help: &'static str) {
+        let shown = self.text.get(start..end).unwrap_or("");
+        let msg = match shown.chars().count() {
+            1 => format!("invalid character {shown:?}"),
+            _ => format!("invalid characters {shown:?}"),
+        };
+        self.out.diagnostics.push(
+            Diagnostic::error("BG0104", msg)
+                .with_primary(self.span(start, end), "not part of the language")
+                .with_help(help),
+        );
+        let at_line_start = self.at_line_start;
+        match stand_in {
+            StandIn::Token(kind) => self.push(kind, start, end),
+            // Factors of a unit are separated by a space.
+            StandIn::Product if self.inside_brackets() => {}
+            StandIn::Product => self.push(Tok::Star, start, end),
+            StandIn::Power(p) => {
+                self.push(Tok::Caret, start, start);
+                if p < 0 {
+                    self.push(Tok::Minus, start, start);
+                }
+                self.push_number(start, end, f64::from(p.unsigned_abs()));
+            }
+            StandIn::Space => self.at_line_start = at_line_start,
+        }
+    }
+
+    /// A string between typographic quotes (`“moving mass”`): one error, and the string.
+    fn typographic_string(&mut self, start: usize, len: usize, text: &str) {
+        self.out.diagnostics.push(
+            Diagnostic::error("BG0104", "a string between typographic quotes")
+                .with_primary(self.span(start, start + len), "not part of the language")
+                .with_help(format!("write it between ASCII quotes: \"{text}\"")),
+        );
+        self.out.strings.push((start as u32, text.to_string()));
+        self.push(Tok::Str, start, start + len);
+    }
+
+    /// Whether the last `[` or `(` not yet closed in this statement is a `[` (a unit, a port index).
+    fn inside_brackets(&self) -> bool {
+        let mut depth = 0usize;
+        for t in self.out.tokens.iter().rev() {
+            match t.kind {
+                Tok::RBracket | Tok::RParen => depth += 1,
+                Tok::LBracket | Tok::LParen if depth > 0 => depth -= 1,
+                Tok::LBracket => return true,
+                Tok::LParen | Tok::Semi | Tok::LBrace | Tok::RBrace => return false,
+                _ => {}
+            }
+        }
+        false
+    }
+
     /// A `#` (Python, shell) or `%` (MATLAB) that starts a line or follows the end of a statement: a comment in
     /// another language's syntax, whose words would otherwise each be an error. Inside a statement (`800 # [N/m]`,
     /// `[%]`) it is an invalid character like any other.
@@ -599,12 +668,6 @@ impl<'a> Lexer<'a> {
 fn typographic_help(c: char) -> Option<&'static str> {
     Some(match c {
         '°' => "write degrees as `deg`, as in `[deg]` or `[deg/s]`",
-        '·' | '×' | '⋅' => {
-            "multiply by `*` in an expression, and by a space in a unit, as in `[N m]`"
-        }
-        '²' | '³' => "write a power with `^`, as in `x^2` or `[m^2]`",
-        '−' | '–' => "write the minus sign as the ASCII `-`",
-        '÷' => "divide by `/`",
         '%' => {
             "there is no percent sign: write a fraction, dimensionless (`[1]`), as in `0.5` for 50 %"
         }

@@ -615,10 +615,14 @@ fn declares_name(stmt: &Stmt) -> bool {
 
 /// `symbol` as two unit symbols written without the space between them (`Ns` is `N s`), when it splits so.
 fn joined_factors(symbol: &str) -> Option<(&str, &str)> {
+    use crate::units::parse_symbol;
     (1..symbol.len())
         .filter(|&i| symbol.is_char_boundary(i))
         .map(|i| symbol.split_at(i))
+        // Two factors of one quantity (`kg g`, `N N`) are a typo of one unit (`kgg`, `NN`), not a product.
         .find(|(a, b)| {
-            crate::units::parse_symbol(a).is_some() && crate::units::parse_symbol(b).is_some()
+            parse_symbol(a)
+                .zip(parse_symbol(b))
+                .is_some_and(|(x, y)| x.dim != y.dim)
         })
 }

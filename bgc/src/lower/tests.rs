@@ -429,6 +429,9 @@ fn two_unit_symbols_written_together_are_told_apart_from_a_case_slip() {
         ),
         // `K g` would split too, but a case slip of a known unit comes first.
         ("Kg", Some("did you mean `kg`?")),
+        // Two factors of one quantity are a typo of one unit, not a product (the help was `kg g`, `N N`).
+        ("kgg", Some("did you mean `kg`?")),
+        ("NN", Some("did you mean `N`?")),
     ] {
         let text = format!(
             "model m {{ domain translational; param d = 4 [{unit}]; input F [N]; Se s = F; I i = 1; R r = d; \

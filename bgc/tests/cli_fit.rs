@@ -199,6 +199,39 @@ fn pendulum_estimate_agrees_with_scipy_least_squares() {
     assert_eq!(v["converged"], true);
 }
 
+/// The pendulum record as spreadsheets and data tools export it: every cell in quotes (`csv.QUOTE_ALL`, MATLAB's
+/// `writetable` of text), and with `;` between cells and decimal commas (a spreadsheet where the decimal separator
+/// is a comma). Both said "the record's header: `\"t\"`: write the unit once, in brackets at the end"; both now
+/// give the estimates of the plain record.
+#[test]
+fn a_record_in_quotes_or_with_decimal_commas_is_read_as_the_plain_one() {
+    let quoted: String = PENDULUM_RECORD
+        .lines()
+        .map(|l| {
+            let cells: Vec<String> = l.split(',').map(|c| format!("\"{c}\"")).collect();
+            cells.join(",") + "\n"
+        })
+        .collect();
+    let semicolons: String = PENDULUM_RECORD
+        .lines()
+        .map(|l| l.replace(',', ";").replace('.', ",") + "\n")
+        .collect();
+    for (name, text) in [("quoted", quoted), ("semicolons", semicolons)] {
+        let data = temp_file(&format!("pendulum_{name}.csv"), &text);
+        let v = pendulum_fit(&data);
+        let j = estimate(&v, "J_p")["value"].as_f64().unwrap_or(f64::NAN);
+        let d = estimate(&v, "d_s")["value"].as_f64().unwrap_or(f64::NAN);
+        assert!(
+            (j - 0.01210337751724493).abs() <= 1e-6 * 0.0121,
+            "{name}: {v}"
+        );
+        assert!(
+            (d - 0.20583616074856637).abs() <= 1e-5 * 0.206,
+            "{name}: {v}"
+        );
+    }
+}
+
 /// `bgc simulate` writes its header with units (`t [s],x [m]`); a record with such a header said "the record
 /// has no `t` column". A header cell may now carry a unit in brackets, and the column is converted to the model's
 /// unit: the pendulum record in milliseconds and degrees gives the estimate of the record in seconds and radians.

@@ -14,6 +14,7 @@
 //! - [`generated`]: [`Generated`], a generated model (or any [`crate::model::ContinuousModel`] with
 //!   [`crate::model::Parametric`]) as a [`FitModel`].
 
+pub mod csv;
 pub mod generated;
 #[cfg(feature = "ode")]
 pub mod linear;

@@ -1,6 +1,7 @@
 //! The record of `bgc fit`: a CSV file whose header may carry units, as `bgc simulate` writes it.
 //!
-//! A header cell is a name (`x`) or a name and a unit in brackets (`x [mm]`, `t [s]`). A column in a unit is
+//! A header cell is a name (`x`) or a name and a unit in brackets (`x [mm]`, `t [s]`), in quotes or not, and the
+//! cells are separated as the runtime's reader separates them ([`Dialect`]). A column in a unit is
 //! converted to the unit the model declares for that input or output (to seconds for `t`), as `--param` converts
 //! a value in brackets; a unit of another dimension is an error naming both. The runtime's reader then sees bare
 //! names, and says what is wrong with the columns themselves. A column that `bgc simulate` writes but a fit does
@@ -11,6 +12,7 @@ use bgc::equations::Equations;
 use bgc::ir::Model;
 use bgc::units::parse_unit_text;
 use bgc_runtime::fit::Record;
+use bgc_runtime::fit::csv::Dialect;
 use std::collections::HashMap;
 
 /// The columns `bgc simulate` writes after the states and outputs.
@@ -30,8 +32,9 @@ pub fn read(model: &Model, eqs: &Equations, text: &str) -> Result<Record, String
     let declared = declared(model);
     let mut names = Vec::new();
     let mut factors = Vec::new();
-    for cell in header.trim_end_matches('\r').split(',') {
-        let (name, unit) = split_unit(cell).map_err(|e| format!("the record's header: {e}"))?;
+    let dialect = Dialect::of_header(header);
+    for cell in dialect.cells(header.trim_end_matches('\r')) {
+        let (name, unit) = split_unit(&cell).map_err(|e| format!("the record's header: {e}"))?;
         factors.push(match declared.get(name) {
             Some(d) => factor_to_declared("the record's column", d, unit)?,
             None => 1.0,
@@ -40,7 +43,10 @@ pub fn read(model: &Model, eqs: &Equations, text: &str) -> Result<Record, String
     }
     let inputs: Vec<&str> = eqs.inputs.iter().map(String::as_str).collect();
     let outputs: Vec<&str> = eqs.outputs.iter().map(|o| o.name.as_str()).collect();
-    let bare = format!("{blank}{}\n{body}", names.join(","));
+    let bare = format!(
+        "{blank}{}\n{body}",
+        names.join(&dialect.delimiter.to_string())
+    );
     let mut record = Record::from_csv(&bare, &inputs, &outputs)
         .map_err(|e| e.to_string() + &not_read(model, eqs, &names))?;
     convert(&mut record, &names, &factors, &inputs, &outputs);

@@ -131,7 +131,8 @@ impl Record {
         Ok(r)
     }
 
-    /// Reads a CSV record for a model with the given input and output names.
+    /// Reads a CSV record for a model with the given input and output names. Cells may be in quotes; a header with
+    /// `;` between its cells makes `;` the separator and a comma the decimal separator ([`super::csv::Dialect`]).
     pub fn from_csv(
         text: &str,
         input_names: &[&str],
@@ -146,13 +147,15 @@ impl Record {
         let Some((_, header)) = lines.next() else {
             return Err(RecordError::TooShort);
         };
-        let names: Vec<&str> = header.split(',').map(str::trim).collect();
+        let dialect = super::csv::Dialect::of_header(header);
+        let header_cells = dialect.cells(header);
+        let names: Vec<&str> = header_cells.iter().map(|c| c.as_ref()).collect();
         let columns = Columns::map(&names, input_names, output_names)?;
         let mut times = Vec::new();
         let mut inputs = Vec::new();
         let mut measured = Vec::new();
         for (index, row) in lines {
-            let cells: Vec<&str> = row.split(',').map(str::trim).collect();
+            let cells = dialect.cells(row);
             let line = index + 1;
             if cells.len() != names.len() {
                 return Err(RecordError::Ragged {
@@ -162,15 +165,19 @@ impl Record {
                 });
             }
             let cell = |c: usize, may_be_missing: bool| -> Result<f64, RecordError> {
-                let text = cells[c];
+                let text = cells[c].as_ref();
                 if text.is_empty() && may_be_missing {
                     return Ok(f64::NAN);
                 }
-                let v: f64 = text.parse().map_err(|_| RecordError::NotANumber {
-                    line,
-                    column: names[c].to_string(),
-                    text: text.to_string(),
-                })?;
+                let v: f64 =
+                    dialect
+                        .number_text(text)
+                        .parse()
+                        .map_err(|_| RecordError::NotANumber {
+                            line,
+                            column: names[c].to_string(),
+                            text: text.to_string(),
+                        })?;
                 if v.is_finite() {
                     Ok(v)
                 } else {

@@ -329,7 +329,7 @@ fn simulate_errors_are_reported() {
         (
             &["--param", "k=1e3*10"],
             "`1e3*10`: not a number; a value is a number (with an optional unit in brackets, `0.5 [deg]`), not an \
-             expression",
+             expression: write its value",
         ),
         (
             &["--x0", "q_spring=1/3"],

@@ -186,7 +186,8 @@ fn not_a_number_hint(text: &str) -> String {
         )
     } else if text.contains(['*', '/', '+', '(', '^']) {
         // `2*pi`, `1/3`: the value of an option is a number; only `--input` signals are expressions.
-        "; a value is a number (with an optional unit in brackets, `0.5 [deg]`), not an expression: write          its value"
+        "; a value is a number (with an optional unit in brackets, `0.5 [deg]`), not an expression: \
+         write its value"
             .to_string()
     } else {
         String::new()

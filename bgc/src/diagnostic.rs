@@ -38,6 +38,9 @@ pub struct Label {
     pub message: String,
     /// The primary label marks the offending place; secondary labels explain it.
     pub primary: bool,
+    /// The text that replaces the label's span to fix the diagnostic, when the fix is certain (a character pasted
+    /// from a document and its ASCII form): editors offer it as a quick fix.
+    pub replacement: Option<String>,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
@@ -82,6 +85,7 @@ impl Diagnostic {
             span,
             message: message.into(),
             primary: true,
+            replacement: None,
         });
         self
     }
@@ -92,6 +96,7 @@ impl Diagnostic {
             span,
             message: message.into(),
             primary: false,
+            replacement: None,
         });
         self
     }
@@ -104,6 +109,22 @@ impl Diagnostic {
     pub fn with_help(mut self, help: impl Into<String>) -> Self {
         self.help = Some(help.into());
         self
+    }
+
+    /// The certain fix: `replacement` for the text of the primary label (added before).
+    pub fn with_fix(mut self, replacement: impl Into<String>) -> Self {
+        if let Some(label) = self.labels.iter_mut().find(|l| l.primary) {
+            label.replacement = Some(replacement.into());
+        }
+        self
+    }
+
+    /// The certain fix of [`Diagnostic::with_fix`], if any.
+    pub fn fix(&self) -> Option<&str> {
+        self.labels
+            .iter()
+            .find(|l| l.primary)
+            .and_then(|l| l.replacement.as_deref())
     }
 
     pub fn is_error(&self) -> bool {

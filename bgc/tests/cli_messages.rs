@@ -183,3 +183,33 @@ model drive {
     assert!(err.contains(" 6 │     gearbox gb(ratio = 50);"), "{err}");
     assert!(code == 0 || code == 1, "{err}");
 }
+
+/// `bgc check --format json` gives the certain fix of a diagnostic (the ASCII form of a pasted character) in
+/// `fix`, for tools that apply it; other diagnostics have none.
+#[test]
+fn json_diagnostics_carry_their_certain_fix() {
+    let path = temp_model(
+        "pasted_units",
+        "model a { domain rotational; param J = 2 [kg·m²]; param b = 1 [N m s/rad]; Se s = 1; I i = J; \
+         R r = bb; 1 j; bond s -> j -> i, r; }\n",
+    );
+    let (code, out, err) = bgc(&["check", "--format", "json", &path]);
+    assert_eq!(code, 1, "{err}");
+    let diags: serde_json::Value = serde_json::from_str(&out).unwrap_or_default();
+    let fixes: Vec<(&str, Option<&str>)> = diags
+        .as_array()
+        .map(|a| {
+            a.iter()
+                .map(|d| (d["code"].as_str().unwrap_or(""), d["fix"].as_str()))
+                .collect()
+        })
+        .unwrap_or_default();
+    assert_eq!(
+        fixes,
+        vec![
+            ("BG0104", Some(" ")),
+            ("BG0104", Some("^2")),
+            ("BG0201", None)
+        ]
+    );
+}

@@ -57,6 +57,7 @@ mod hostile_props;
 mod language_examples;
 mod loops_globalised;
 mod loops_warm_start;
+mod lsp_fixes;
 mod lsp_props;
 mod lsp_session;
 mod lsp_stdio;

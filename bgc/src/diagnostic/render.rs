@@ -134,6 +134,9 @@ struct JsonDiagnostic<'a> {
     labels: Vec<JsonLabel<'a>>,
     notes: &'a [String],
     help: Option<&'a str>,
+    /// The replacement of the primary label's text that fixes it, when certain.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    fix: Option<&'a str>,
 }
 
 /// Diagnostics as a JSON array, with line and column (1-based) for every label.
@@ -167,6 +170,7 @@ pub fn to_json_value(sources: &SourceMap, diags: &[Diagnostic]) -> serde_json::V
                 .collect(),
             notes: &d.notes,
             help: d.help.as_deref(),
+            fix: d.fix(),
         })
         .collect();
     serde_json::to_value(items).unwrap_or(serde_json::Value::Null)

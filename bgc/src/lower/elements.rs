@@ -266,6 +266,7 @@ impl Builder<'_> {
                     span,
                     message: msg,
                     primary: false,
+                    replacement: None,
                 });
             }
         }

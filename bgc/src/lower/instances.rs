@@ -46,6 +46,7 @@ pub fn add_instance_context(model: &Model, diags: &mut [Diagnostic]) {
             span: instance,
             message: format!("in instance `{prefix}` (the element `{name}`), declared here"),
             primary: false,
+            replacement: None,
         });
     }
 }

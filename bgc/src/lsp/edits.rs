@@ -113,13 +113,13 @@ pub fn code_actions(analysis: &Analysis, uri: &Uri, range: Range) -> Vec<CodeAct
         if place.end < range.start || range.end < place.start {
             continue;
         }
-        let Some(replacement) = d.help.as_deref().and_then(suggestion) else {
-            continue;
-        };
         let written = text.get(span.range()).unwrap_or("");
-        if !plausible(written, replacement) {
-            continue;
-        }
+        // A certain fix (a character pasted from a document), else the name a "did you mean" help proposes.
+        let replacement = match (d.fix(), d.help.as_deref().and_then(suggestion)) {
+            (Some(fix), _) => fix,
+            (None, Some(name)) if plausible(written, name) => name,
+            _ => continue,
+        };
         let edit = TextEdit::new(place, replacement.to_string());
         let diagnostic = lsp_types::Diagnostic {
             range: place,
@@ -130,7 +130,10 @@ pub fn code_actions(analysis: &Analysis, uri: &Uri, range: Range) -> Vec<CodeAct
             ..lsp_types::Diagnostic::default()
         };
         out.push(CodeActionOrCommand::CodeAction(CodeAction {
-            title: format!("Replace `{written}` with `{replacement}`"),
+            title: match written.trim().is_empty() {
+                true => "Replace the space that is not ASCII with a space".to_string(),
+                false => format!("Replace `{written}` with `{replacement}`"),
+            },
             kind: Some(CodeActionKind::QUICKFIX),
             diagnostics: Some(vec![diagnostic]),
             edit: Some(WorkspaceEdit::new(HashMap::from([(

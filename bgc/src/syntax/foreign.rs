@@ -46,6 +46,12 @@ pub(super) fn unit_help(symbol: &str) -> String {
     "units are ASCII SI symbols with optional prefixes p n u µ m c d k M G (docs/language.md, Units)".to_string()
 }
 
+/// The ASCII spelling of a unit symbol with letters outside ASCII, where there is one: the ohm (`kΩ` → `kOhm`).
+pub(super) fn unit_spelling(symbol: &str) -> Option<String> {
+    let ascii = symbol.replace(['\u{3a9}', '\u{2126}'], "Ohm");
+    ascii.is_ascii().then_some(ascii)
+}
+
 /// `name` with each Greek letter spelled out (`τ_m` → `tau_m`, `Δx` → `Deltax`); `None` when some other letter
 /// outside ASCII has no spelling here.
 pub fn ascii_spelling(name: &str) -> Option<String> {

@@ -380,26 +380,37 @@ impl<'a> Lexer<'a> {
             _ => start,
         };
         let name = self.text.get(start..end).unwrap_or("");
-        let (what, help) = match self.in_unit() {
-            true => ("unit", super::foreign::unit_help(name)),
-            false => ("name", super::foreign::name_help(name)),
+        let (what, help, fix) = match self.in_unit() {
+            true => (
+                "unit",
+                super::foreign::unit_help(name),
+                super::foreign::unit_spelling(name),
+            ),
+            false => (
+                "name",
+                super::foreign::name_help(name),
+                super::foreign::ascii_spelling(name),
+            ),
         };
-        self.out.diagnostics.push(
-            Diagnostic::error(
-                "BG0104",
-                format!("the {what} `{name}` has letters outside ASCII"),
-            )
-            .with_primary(
-                self.span(start, end),
-                format!("not a {what} of the language"),
-            )
-            .with_help(help),
-        );
+        let mut d = Diagnostic::error(
+            "BG0104",
+            format!("the {what} `{name}` has letters outside ASCII"),
+        )
+        .with_primary(
+            self.span(start, end),
+            format!("not a {what} of the language"),
+        )
+        .with_help(help);
+        if let Some(fix) = fix {
+            d = d.with_fix(fix);
+        }
+        self.out.diagnostics.push(d);
         self.push(Tok::Ident, start, end);
     }
 
     /// Whether the tokens so far leave a `[` open: a unit is being written. Asked only for a name with letters
-    /// outside ASCII, so the common tokens pay nothing for it; a unit is a few tokens long.
+    /// outside ASCII or a typographic character, so the common tokens pay nothing for it; a unit is a few tokens
+    /// long, so the look back is bounded.
     fn in_unit(&self) -> bool {
         for t in self.out.tokens.iter().rev().take(64) {
             match t.kind {
@@ -602,16 +613,18 @@ impl<'a> Lexer<'a> {
             1 => format!("invalid character {shown:?}"),
             _ => format!("invalid characters {shown:?}"),
         };
+        let in_unit = stand_in == StandIn::Product && self.in_unit();
         self.out.diagnostics.push(
             Diagnostic::error("BG0104", msg)
                 .with_primary(self.span(start, end), "not part of the language")
-                .with_help(help),
+                .with_help(help)
+                .with_fix(stand_in.ascii(in_unit)),
         );
         let at_line_start = self.at_line_start;
         match stand_in {
             StandIn::Token(kind) => self.push(kind, start, end),
             // Factors of a unit are separated by a space.
-            StandIn::Product if self.inside_brackets() => {}
+            StandIn::Product if in_unit => {}
             StandIn::Product => self.push(Tok::Star, start, end),
             StandIn::Power(p) => {
                 self.push(Tok::Caret, start, start);
@@ -629,25 +642,11 @@ impl<'a> Lexer<'a> {
         self.out.diagnostics.push(
             Diagnostic::error("BG0104", "a string between typographic quotes")
                 .with_primary(self.span(start, start + len), "not part of the language")
-                .with_help(format!("write it between ASCII quotes: \"{text}\"")),
+                .with_help(format!("write it between ASCII quotes: \"{text}\""))
+                .with_fix(format!("\"{}\"", text.replace('\\', "\\\\"))),
         );
         self.out.strings.push((start as u32, text.to_string()));
         self.push(Tok::Str, start, start + len);
-    }
-
-    /// Whether the last `[` or `(` not yet closed in this statement is a `[` (a unit, a port index).
-    fn inside_brackets(&self) -> bool {
-        let mut depth = 0usize;
-        for t in self.out.tokens.iter().rev() {
-            match t.kind {
-                Tok::RBracket | Tok::RParen => depth += 1,
-                Tok::LBracket | Tok::LParen if depth > 0 => depth -= 1,
-                Tok::LBracket => return true,
-                Tok::LParen | Tok::Semi | Tok::LBrace | Tok::RBrace => return false,
-                _ => {}
-            }
-        }
-        false
     }
 
     /// A `#` (Python, shell) or `%` (MATLAB) that starts a line or follows the end of a statement: a comment in

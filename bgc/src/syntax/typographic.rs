@@ -18,6 +18,22 @@ pub(super) enum StandIn {
     Space,
 }
 
+impl StandIn {
+    /// The ASCII text to write instead (`in_unit`: the character is between the factors of a unit).
+    pub(super) fn ascii(self, in_unit: bool) -> String {
+        match self {
+            StandIn::Token(Tok::Minus) => "-".to_string(),
+            StandIn::Token(Tok::Slash) => "/".to_string(),
+            StandIn::Token(Tok::Arrow) => "->".to_string(),
+            StandIn::Token(other) => other.describe().trim_matches('`').to_string(),
+            StandIn::Product if in_unit => " ".to_string(),
+            StandIn::Product => "*".to_string(),
+            StandIn::Power(p) => format!("^{p}"),
+            StandIn::Space => " ".to_string(),
+        }
+    }
+}
+
 /// The typographic character or superscript run at the start of `rest`: its length in bytes, what it stands for
 /// and the help to print.
 pub(super) fn stand_in(rest: &str) -> Option<(usize, StandIn, &'static str)> {

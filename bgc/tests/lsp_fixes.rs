@@ -1,0 +1,64 @@
+//! Quick fixes that are certain: characters pasted from a document (`·`, `²`, `→`, `“…”`, a no-break space) and
+//! names in Greek letters, each replaced by its ASCII form. Applied together, they leave a model without errors.
+
+use crate::lsp_support;
+
+use lsp_support::{Client, apply, range, unsaved, uri};
+use lsp_types::request::CodeActionRequest;
+use lsp_types::{CodeActionOrCommand, TextDocumentIdentifier};
+
+const PASTED: &str = "model a {\n    domain rotational;\n    param J = 2 × 1 [kg·m²] “inertia”;\n    \
+                      param k = 3 [N·m·rad⁻¹];\n    param τ_m = 1 [N m];\n    Se s = −τ_m;\n    I i = J·k/k;\n    \
+                      C c = 1/k;\n    1\u{a0}j;\n    bond s → j -> i, c;\n}\n";
+
+#[test]
+fn the_fixes_of_pasted_characters_and_greek_names_leave_no_error() {
+    let mut client = Client::start();
+    let doc = uri(&unsaved("pasted.bg"));
+    client.open(&doc, PASTED);
+    let found = client.diagnostics(&doc, 1);
+    assert_eq!(found.len(), 13, "{found:#?}");
+    let actions = client
+        .request::<CodeActionRequest>(lsp_types::CodeActionParams {
+            text_document: TextDocumentIdentifier::new(doc.clone()),
+            range: range(0, 0, 11, 0),
+            context: Default::default(),
+            work_done_progress_params: Default::default(),
+            partial_result_params: Default::default(),
+        })
+        .expect("code actions answer")
+        .unwrap_or_default();
+    let mut edits = Vec::new();
+    let mut titles = Vec::new();
+    for action in &actions {
+        let CodeActionOrCommand::CodeAction(fix) = action else {
+            panic!("a code action")
+        };
+        titles.push(fix.title.clone());
+        if let Some(changes) = fix.edit.as_ref().and_then(|e| e.changes.as_ref()) {
+            edits.extend(changes[&doc].iter().cloned());
+        }
+    }
+    assert_eq!(titles.len(), 13, "{titles:#?}");
+    assert!(titles.contains(&"Replace `τ_m` with `tau_m`".to_string()));
+    assert!(titles.contains(&"Replace `⁻¹` with `^-1`".to_string()));
+    let fixed = apply(PASTED, &edits);
+    assert_eq!(
+        fixed,
+        "model a {\n    domain rotational;\n    param J = 2 * 1 [kg m^2] \"inertia\";\n    \
+         param k = 3 [N m rad^-1];\n    param tau_m = 1 [N m];\n    Se s = -tau_m;\n    I i = J*k/k;\n    \
+         C c = 1/k;\n    1 j;\n    bond s -> j -> i, c;\n}\n"
+    );
+    client.change(
+        &doc,
+        2,
+        vec![lsp_types::TextDocumentContentChangeEvent {
+            range: None,
+            range_length: None,
+            text: fixed,
+        }],
+    );
+    let left = client.diagnostics(&doc, 2);
+    assert!(left.is_empty(), "{left:#?}");
+    assert_eq!(client.shutdown(), Ok(()));
+}

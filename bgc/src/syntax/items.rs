@@ -6,6 +6,10 @@ use super::parser::{Fail, Parser};
 use crate::diagnostic::Diagnostic;
 use crate::span::Span;
 
+/// The syntax errors after which a file is no longer read: a file of garbage would otherwise make one per statement
+/// (the 64 MiB a file may have, gigabytes of diagnostics); the text rendering shows 100.
+pub(super) const MAX_SYNTAX_ERRORS: usize = 1000;
+
 impl Parser<'_> {
     /// The items of the file up to its end; junk between items is reported and skipped.
     pub(super) fn items(&mut self) -> Vec<Item> {
@@ -177,6 +181,10 @@ impl Parser<'_> {
                     // An empty statement has no meaning.
                     self.bump();
                 }
+                _ if self.diags.len() >= MAX_SYNTAX_ERRORS => {
+                    self.give_up(t);
+                    break;
+                }
                 _ => {
                     if let Some(s) = self.statement() {
                         body.push(s);
@@ -185,6 +193,23 @@ impl Parser<'_> {
             }
         }
         body
+    }
+
+    /// Stops reading the file after [`MAX_SYNTAX_ERRORS`]: the rest is skipped with one error that says so.
+    fn give_up(&mut self, at: Token) {
+        self.diags.push(
+            Diagnostic::error(
+                "BG0101",
+                format!(
+                    "more than {MAX_SYNTAX_ERRORS} syntax errors: the rest of the file is not read"
+                ),
+            )
+            .with_primary(self.tok_span(at), "reading stopped here")
+            .with_help("fix the errors above, or check that this is a `.bg` file"),
+        );
+        while self.peek().kind != Tok::Eof {
+            self.bump();
+        }
     }
 
     /// Reports a block whose `}` is missing when `found` (end of file or something that cannot be inside it) is met.

@@ -195,7 +195,13 @@ struct Lexer<'a> {
     junk: Option<(usize, usize)>,
     /// Whether only whitespace has been seen since the last newline.
     at_line_start: bool,
+    /// Diagnostics past [`MAX_LEXER_DIAGNOSTICS`]: counted, and summed up in one at the end.
+    omitted: Option<(Span, usize)>,
 }
+
+/// The diagnostics the lexer records one by one. A file of invalid characters would otherwise make millions (the
+/// 64 MiB a file may have, gigabytes of diagnostics); the text rendering shows 100.
+const MAX_LEXER_DIAGNOSTICS: usize = 1000;
 
 /// Splits `text` into tokens. See the module documentation.
 pub fn lex(file: FileId, text: &str) -> Lexed {
@@ -209,12 +215,33 @@ pub fn lex(file: FileId, text: &str) -> Lexed {
         out,
         junk: None,
         at_line_start: true,
+        omitted: None,
     };
     lx.run();
+    if let Some((first, count)) = lx.omitted {
+        lx.out.diagnostics.push(
+            Diagnostic::error("BG0104", format!("{count} more lexical errors are not listed"))
+                .with_primary(first, "the first of them")
+                .with_help(format!(
+                    "the first {MAX_LEXER_DIAGNOSTICS} are listed; fix those, or check that this is a `.bg` file"
+                )),
+        );
+    }
     lx.out
 }
 
 impl<'a> Lexer<'a> {
+    /// Records a diagnostic, or counts it past [`MAX_LEXER_DIAGNOSTICS`].
+    fn report(&mut self, d: Diagnostic) {
+        if self.out.diagnostics.len() < MAX_LEXER_DIAGNOSTICS {
+            self.out.diagnostics.push(d);
+            return;
+        }
+        let first = d.primary_span().unwrap_or(self.span(0, 0));
+        let (_, count) = self.omitted.get_or_insert((first, 0));
+        *count += 1;
+    }
+
     fn span(&self, start: usize, end: usize) -> Span {
         Span::new(self.file, start, end)
     }
@@ -263,7 +290,7 @@ impl<'a> Lexer<'a> {
                 .unwrap_or(
                     "names are ASCII letters, digits and `_`; text belongs in a \"string\"; comments start with `//`",
                 );
-            self.out.diagnostics.push(
+            self.report(
                 Diagnostic::error("BG0104", msg)
                     .with_primary(self.span(start, end), "not part of the language")
                     .with_help(help),
@@ -319,7 +346,7 @@ impl<'a> Lexer<'a> {
                 self.flush_junk();
                 let len = rest.find(['\n', '\r']).unwrap_or(rest.len());
                 let marker = rest.get(..1).unwrap_or("#");
-                self.out.diagnostics.push(
+                self.report(
                     Diagnostic::error("BG0104", format!("invalid character {marker:?}"))
                         .with_primary(
                             self.span(start, start + len),
@@ -404,7 +431,7 @@ impl<'a> Lexer<'a> {
         if let Some(fix) = fix {
             d = d.with_fix(fix);
         }
-        self.out.diagnostics.push(d);
+        self.report(d);
         self.push(Tok::Ident, start, end);
     }
 
@@ -530,7 +557,7 @@ impl<'a> Lexer<'a> {
                     "separate a number from a name by a space or an operator, as in `2*x`; units go in brackets, as in `2 [kg]`",
                 )
             };
-            self.out.diagnostics.push(
+            self.report(
                 Diagnostic::error("BG0103", msg)
                     .with_primary(span, "not a valid number")
                     .with_help(help),
@@ -541,7 +568,7 @@ impl<'a> Lexer<'a> {
         match n.parse::<f64>() {
             Ok(v) if v.is_finite() => self.push_number(start, end, v),
             _ => {
-                self.out.diagnostics.push(
+                self.report(
                     Diagnostic::error("BG0103", format!("number `{literal}` is not finite"))
                         .with_primary(span, "too large to be represented as a 64-bit float")
                         .with_help("numbers must be finite; the largest is about 1.8e308"),
@@ -570,7 +597,7 @@ impl<'a> Lexer<'a> {
                     Some((_, '\\')) => value.push('\\'),
                     Some((j, other)) if other != '\n' && other != '\r' => {
                         let esc = self.span(start + i, start + j + other.len_utf8());
-                        self.out.diagnostics.push(
+                        self.report(
                             Diagnostic::error(
                                 "BG0112",
                                 format!("unknown escape `\\{other}` in a string"),
@@ -593,7 +620,7 @@ impl<'a> Lexer<'a> {
             }
             None => {
                 let len = rest.find(['\n', '\r']).unwrap_or(rest.len());
-                self.out.diagnostics.push(
+                self.report(
                     Diagnostic::error("BG0102", "unterminated string")
                         .with_primary(self.span(start, start + len), "this string has no closing `\"`")
                         .with_help("close the string with `\"` on the same line; write a quote inside it as `\\\"`"),
@@ -614,7 +641,7 @@ impl<'a> Lexer<'a> {
             _ => format!("invalid characters {shown:?}"),
         };
         let in_unit = stand_in == StandIn::Product && self.in_unit();
-        self.out.diagnostics.push(
+        self.report(
             Diagnostic::error("BG0104", msg)
                 .with_primary(self.span(start, end), "not part of the language")
                 .with_help(help)
@@ -639,7 +666,7 @@ impl<'a> Lexer<'a> {
 
     /// A string between typographic quotes (`“moving mass”`): one error, and the string.
     fn typographic_string(&mut self, start: usize, len: usize, text: &str) {
-        self.out.diagnostics.push(
+        self.report(
             Diagnostic::error("BG0104", "a string between typographic quotes")
                 .with_primary(self.span(start, start + len), "not part of the language")
                 .with_help(format!("write it between ASCII quotes: \"{text}\""))

@@ -1,7 +1,7 @@
 //! The subcommands. Each returns the process status; all printing happens here.
 
 use super::io::{
-    is_stdin, keep_until_exit, loader_for, read_source, stderr, stderrln, stdout, stdoutln,
+    Root, is_stdin, keep_until_exit, read_root, read_source, stderr, stderrln, stdout, stdoutln,
 };
 use super::{DiagFormat, DrawFormat, ReportFormat, Status};
 use bgc::diagnostic::{Diagnostic, Severity, has_errors, render};
@@ -15,7 +15,11 @@ pub fn check(files: &[PathBuf], format: DiagFormat, color: bool) -> Status {
     let mut status = Status::Ok;
     let mut summaries = Vec::new();
     for path in files {
-        let (id, decode_diag) = match read_source(&mut sources, path) {
+        let Root {
+            id,
+            decode_error,
+            mut loader,
+        } = match read_root(&mut sources, path) {
             Ok(x) => x,
             Err(e) => {
                 stderrln(&format!("error: cannot read {}: {e}", path.display()));
@@ -23,18 +27,10 @@ pub fn check(files: &[PathBuf], format: DiagFormat, color: bool) -> Status {
                 continue;
             }
         };
-        if let Some(d) = decode_diag {
+        if let Some(d) = decode_error {
             all_diags.push(d);
             continue;
         }
-        let mut loader = match loader_for(path) {
-            Ok(l) => l,
-            Err(e) => {
-                stderrln(&format!("error: cannot read {}: {e}", path.display()));
-                status = Status::UsageOrIo;
-                continue;
-            }
-        };
         let (models, mut diags) = bgc::lower::lower(&mut sources, id, &mut loader);
         if !has_errors(&diags) {
             for m in &models {
@@ -196,21 +192,21 @@ pub(super) struct Loaded {
 /// and returns the status to exit with when the file cannot be used.
 pub(super) fn load_one(path: &Path, wanted: Option<&str>, color: bool) -> Result<Loaded, Status> {
     let mut sources = SourceMap::new();
-    let (id, decode_diag) = match read_source(&mut sources, path) {
+    let Root {
+        id,
+        decode_error,
+        mut loader,
+    } = match read_root(&mut sources, path) {
         Ok(x) => x,
         Err(e) => {
             stderrln(&format!("error: cannot read {}: {e}", path.display()));
             return Err(Status::UsageOrIo);
         }
     };
-    if let Some(d) = decode_diag {
+    if let Some(d) = decode_error {
         stderr(&render::to_text(&sources, &[d], color));
         return Err(Status::InputErrors);
     }
-    let mut loader = loader_for(path).map_err(|e| {
-        stderrln(&format!("error: cannot read {}: {e}", path.display()));
-        Status::UsageOrIo
-    })?;
     let (models, diags) = bgc::lower::lower(&mut sources, id, &mut loader);
     if has_errors(&diags) {
         stderr(&render::to_text(&sources, &diags, color));
@@ -321,24 +317,21 @@ pub fn draw(
 /// `bgc_runtime` trait implementations).
 pub fn rust(path: &Path, runtime: bool, color: bool) -> Status {
     let mut sources = SourceMap::new();
-    let (id, decode_diag) = match read_source(&mut sources, path) {
+    let Root {
+        id,
+        decode_error,
+        mut loader,
+    } = match read_root(&mut sources, path) {
         Ok(x) => x,
         Err(e) => {
             stderrln(&format!("error: cannot read {}: {e}", path.display()));
             return Status::UsageOrIo;
         }
     };
-    if let Some(d) = decode_diag {
+    if let Some(d) = decode_error {
         stderr(&render::to_text(&sources, &[d], color));
         return Status::InputErrors;
     }
-    let mut loader = match loader_for(path) {
-        Ok(l) => l,
-        Err(e) => {
-            stderrln(&format!("error: cannot read {}: {e}", path.display()));
-            return Status::UsageOrIo;
-        }
-    };
     match bgc::codegen::compile(&mut sources, id, &mut loader) {
         Ok(compiled) => {
             // Named as `bgc::build` names it, so that both print the same text.

@@ -30,9 +30,27 @@ pub fn is_stdin(path: &Path) -> bool {
     path == Path::new("-")
 }
 
+/// A model's root file read into the source map with the loader for its imports.
+pub struct Root {
+    pub id: FileId,
+    /// The file is not valid UTF-8 (it was added with the bad bytes replaced).
+    pub decode_error: Option<Diagnostic>,
+    pub loader: FsLoader,
+}
+
+/// Reads the root file `path` ([`read_source`]) and makes the loader for its imports ([`loader_for`]).
+pub fn read_root(sources: &mut SourceMap, path: &Path) -> std::io::Result<Root> {
+    let (id, decode_error) = read_source(sources, path)?;
+    Ok(Root {
+        id,
+        decode_error,
+        loader: loader_for(path)?,
+    })
+}
+
 /// The loader for the file `path`: [`loader`], and for standard input the current directory, which is where its
 /// imports are looked up (as beside a file).
-pub fn loader_for(path: &Path) -> std::io::Result<FsLoader> {
+fn loader_for(path: &Path) -> std::io::Result<FsLoader> {
     let mut loader = loader();
     if is_stdin(path) {
         loader.allow_directory(&std::env::current_dir()?)?;

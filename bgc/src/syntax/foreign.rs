@@ -32,12 +32,14 @@ pub(super) fn name_help(name: &str) -> String {
     }
 }
 
+/// The Greek capital omega and the ohm sign (U+2126), which look alike; the ohm is written `Ohm`.
+const OHM_SIGNS: [char; 2] = ['\u{3a9}', '\u{2126}'];
+
 /// The help for a unit symbol with letters outside ASCII: the ohm's ASCII symbol (`[kΩ]` → `[kOhm]`), else where
 /// the units are listed.
 pub(super) fn unit_help(symbol: &str) -> String {
-    // The Greek capital omega and the ohm sign (U+2126) look alike.
-    if symbol.contains(['\u{3a9}', '\u{2126}']) {
-        let ascii = symbol.replace(['\u{3a9}', '\u{2126}'], "Ohm");
+    if symbol.contains(OHM_SIGNS) {
+        let ascii = symbol.replace(OHM_SIGNS, "Ohm");
         return match ascii.as_str() {
             "Ohm" => "the ohm is written `Ohm`".to_string(),
             _ => format!("the ohm is written `Ohm`: `{ascii}`"),
@@ -48,7 +50,7 @@ pub(super) fn unit_help(symbol: &str) -> String {
 
 /// The ASCII spelling of a unit symbol with letters outside ASCII, where there is one: the ohm (`kΩ` → `kOhm`).
 pub(super) fn unit_spelling(symbol: &str) -> Option<String> {
-    let ascii = symbol.replace(['\u{3a9}', '\u{2126}'], "Ohm");
+    let ascii = symbol.replace(OHM_SIGNS, "Ohm");
     ascii.is_ascii().then_some(ascii)
 }
 

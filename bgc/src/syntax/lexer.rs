@@ -647,9 +647,8 @@ impl<'a> Lexer<'a> {
                 .with_help(help)
                 .with_fix(stand_in.ascii(in_unit)),
         );
-        let at_line_start = self.at_line_start;
         match stand_in {
-            StandIn::Token(kind) => self.push(kind, start, end),
+            StandIn::Token(kind, _) => self.push(kind, start, end),
             // Factors of a unit are separated by a space.
             StandIn::Product if in_unit => {}
             StandIn::Product => self.push(Tok::Star, start, end),
@@ -660,7 +659,7 @@ impl<'a> Lexer<'a> {
                 }
                 self.push_number(start, end, f64::from(p.unsigned_abs()));
             }
-            StandIn::Space => self.at_line_start = at_line_start,
+            StandIn::Space => {}
         }
     }
 

@@ -8,8 +8,8 @@ use super::lexer::Tok;
 /// What a typographic character stands for.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) enum StandIn {
-    /// One token (`−` → `-`, `÷` → `/`, `→` → `->`).
-    Token(Tok),
+    /// One token and its text (`−` → `-`, `÷` → `/`, `→` → `->`).
+    Token(Tok, &'static str),
     /// A product: `*` in an expression, a space between the factors of a unit.
     Product,
     /// A power written in superscripts (`²`, `⁻¹`): `^` and the exponent.
@@ -22,10 +22,7 @@ impl StandIn {
     /// The ASCII text to write instead (`in_unit`: the character is between the factors of a unit).
     pub(super) fn ascii(self, in_unit: bool) -> String {
         match self {
-            StandIn::Token(Tok::Minus) => "-".to_string(),
-            StandIn::Token(Tok::Slash) => "/".to_string(),
-            StandIn::Token(Tok::Arrow) => "->".to_string(),
-            StandIn::Token(other) => other.describe().trim_matches('`').to_string(),
+            StandIn::Token(_, text) => text.to_string(),
             StandIn::Product if in_unit => " ".to_string(),
             StandIn::Product => "*".to_string(),
             StandIn::Power(p) => format!("^{p}"),
@@ -43,13 +40,17 @@ pub(super) fn stand_in(rest: &str) -> Option<(usize, StandIn, &'static str)> {
         '·' | '×' | '⋅' => (c.len_utf8(), StandIn::Product, product),
         '−' | '–' => (
             c.len_utf8(),
-            StandIn::Token(Tok::Minus),
+            StandIn::Token(Tok::Minus, "-"),
             "write the minus sign as the ASCII `-`",
         ),
-        '÷' => (c.len_utf8(), StandIn::Token(Tok::Slash), "divide by `/`"),
+        '÷' => (
+            c.len_utf8(),
+            StandIn::Token(Tok::Slash, "/"),
+            "divide by `/`",
+        ),
         '→' | '⟶' => (
             c.len_utf8(),
-            StandIn::Token(Tok::Arrow),
+            StandIn::Token(Tok::Arrow, "->"),
             "a bond is written with `->`, as in `bond a -> b;`",
         ),
         '\u{a0}' | '\u{2009}' | '\u{202f}' | '\u{2007}' | '\u{200a}' => (

@@ -12,6 +12,7 @@ mod matrix_text;
 mod model;
 mod params;
 mod quantities;
+mod replay;
 mod simulate;
 mod sparse;
 
@@ -87,7 +88,7 @@ pub enum Coords {
     Declared,
 }
 
-/// The input reconstruction of `bgc fit`.
+/// How `bgc fit` and `bgc simulate --data` reconstruct a record's inputs between its samples.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum InputInterp {
     /// Zero-order hold: each sample holds until the next (the way loggers record commands).
@@ -215,6 +216,15 @@ enum Command {
         /// Absolute tolerance (all states and the energy quadratures).
         #[arg(long, default_value_t = 1e-9, allow_hyphen_values = true)]
         atol: f64,
+        /// Replay the inputs of a record (a CSV file as for `bgc fit --data`: a `t` column and one column per
+        /// input, values in the declared units or in the units of the header; columns of measured outputs are
+        /// read and ignored). Inputs given with --input are not in the record.
+        #[arg(long, value_name = "LOG.csv")]
+        data: Option<PathBuf>,
+        /// How the record's inputs are reconstructed between samples (before the first sample the first value
+        /// holds, after the last the last).
+        #[arg(long, value_enum, default_value_t = InputInterp::Zoh, requires = "data")]
+        interp: InputInterp,
         /// Print the effective parameter values (declared unit and SI) and initial state on standard error.
         #[arg(long, short)]
         verbose: bool,
@@ -394,6 +404,8 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
             solver,
             rtol,
             atol,
+            data,
+            interp,
             verbose,
         } => {
             let args = simulate::SimulateArgs {
@@ -405,6 +417,13 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
                 solver,
                 rtol,
                 atol,
+                record: data.as_deref().map(|path| simulate::RecordArg {
+                    path,
+                    replay: match interp {
+                        InputInterp::Zoh => bgc::simulate::samples::Replay::Hold,
+                        InputInterp::Linear => bgc::simulate::samples::Replay::Linear,
+                    },
+                }),
                 verbose,
             };
             simulate::simulate(&file, model.as_deref(), &args, color)

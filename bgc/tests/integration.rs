@@ -17,6 +17,7 @@ mod cli_fit;
 mod cli_hostile;
 mod cli_hostile_numbers;
 mod cli_messages;
+mod cli_replay;
 mod cli_root_files;
 mod cli_simulate;
 mod cli_simulate_large;

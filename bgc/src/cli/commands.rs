@@ -1,7 +1,8 @@
 //! The subcommands. Each returns the process status; all printing happens here.
 
 use super::io::{
-    Root, is_stdin, keep_until_exit, read_root, read_source, stderr, stderrln, stdout, stdoutln,
+    Root, is_stdin, keep_until_exit, read_root, read_source, stderr, stderrln, stdin_once, stdout,
+    stdoutln,
 };
 use super::{DiagFormat, DrawFormat, ReportFormat, Status};
 use bgc::diagnostic::{Diagnostic, Severity, has_errors, render};
@@ -10,6 +11,10 @@ use std::path::{Path, PathBuf};
 
 /// `bgc check FILE...`
 pub fn check(files: &[PathBuf], format: DiagFormat, color: bool) -> Status {
+    if let Err(msg) = stdin_once(files.iter().map(PathBuf::as_path)) {
+        stderrln(&format!("error: {msg}"));
+        return Status::UsageOrIo;
+    }
     let mut sources = SourceMap::new();
     let mut all_diags: Vec<Diagnostic> = Vec::new();
     let mut status = Status::Ok;
@@ -70,6 +75,10 @@ pub fn check(files: &[PathBuf], format: DiagFormat, color: bool) -> Status {
 
 /// `bgc fmt [--check] FILE...`
 pub fn fmt(files: &[PathBuf], check_only: bool, color: bool) -> Status {
+    if let Err(msg) = stdin_once(files.iter().map(PathBuf::as_path)) {
+        stderrln(&format!("error: {msg}"));
+        return Status::UsageOrIo;
+    }
     let mut status = Status::Ok;
     for path in files {
         match fmt_one(path, check_only, color) {

@@ -1,4 +1,4 @@
-//! The record of `bgc fit`: a CSV file whose header may carry units, as `bgc simulate` writes it.
+//! The record of `bgc fit` and `bgc simulate --data`: a CSV file whose header may carry units, as `bgc simulate` writes it.
 //!
 //! A header cell is a name (`x`) or a name and a unit in brackets (`x [mm]`, `t [s]`), in quotes or not, and the
 //! cells are separated as the runtime's reader separates them ([`Dialect`]). A column in a unit is
@@ -18,8 +18,39 @@ use std::collections::HashMap;
 /// The columns `bgc simulate` writes after the states and outputs.
 const ENERGY_COLUMNS: [&str; 3] = ["energy", "dissipated", "supplied"];
 
-/// Reads the record `text`, with each column in a unit converted to the model's unit.
+/// Reads the record `text` of a fit, with each column in a unit converted to the model's unit.
 pub fn read(model: &Model, eqs: &Equations, text: &str) -> Result<Record, String> {
+    let inputs: Vec<&str> = eqs.inputs.iter().map(String::as_str).collect();
+    read_with(model, eqs, text, &inputs, Record::from_csv)
+}
+
+/// Reads a record whose inputs are replayed in a simulation: each input but those in `elsewhere` (given another
+/// way, and then not in the record), and measured outputs if it has any.
+pub fn read_inputs(
+    model: &Model,
+    eqs: &Equations,
+    text: &str,
+    elsewhere: &[&str],
+) -> Result<Record, String> {
+    let inputs: Vec<&str> = eqs
+        .inputs
+        .iter()
+        .map(String::as_str)
+        .filter(|n| !elsewhere.contains(n))
+        .collect();
+    read_with(model, eqs, text, &inputs, Record::inputs_from_csv)
+}
+
+type Reader = fn(&str, &[&str], &[&str]) -> Result<Record, bgc_runtime::fit::RecordError>;
+
+/// Reads the record with the columns of `inputs`, converting units, by `reader`.
+fn read_with(
+    model: &Model,
+    eqs: &Equations,
+    text: &str,
+    inputs: &[&str],
+    reader: Reader,
+) -> Result<Record, String> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     // Blank lines before the header are kept, so that the reader's line numbers stay those of the file.
     let header_start = text
@@ -41,15 +72,24 @@ pub fn read(model: &Model, eqs: &Equations, text: &str) -> Result<Record, String
         });
         names.push(name.to_string());
     }
-    let inputs: Vec<&str> = eqs.inputs.iter().map(String::as_str).collect();
+    if let Some((c, name)) = names
+        .iter()
+        .enumerate()
+        .find(|(_, n)| eqs.inputs.contains(n) && !inputs.contains(&n.as_str()))
+    {
+        return Err(format!(
+            "input `{name}` is given on the command line and in column {} of the record: give it once",
+            c + 1
+        ));
+    }
     let outputs: Vec<&str> = eqs.outputs.iter().map(|o| o.name.as_str()).collect();
     let bare = format!(
         "{blank}{}\n{body}",
         names.join(&dialect.delimiter.to_string())
     );
-    let mut record = Record::from_csv(&bare, &inputs, &outputs)
+    let mut record = reader(&bare, inputs, &outputs)
         .map_err(|e| e.to_string() + &not_read(model, eqs, &names))?;
-    convert(&mut record, &names, &factors, &inputs, &outputs);
+    convert(&mut record, &names, &factors, inputs, &outputs);
     Ok(record)
 }
 
@@ -108,8 +148,8 @@ fn not_read(model: &Model, eqs: &Equations, names: &[String]) -> String {
         .find(|n| !is_output(n) && (ENERGY_COLUMNS.contains(&n.as_str()) || states.iter().any(|s| &s.name == *n)))
         .map(|n| {
             format!(
-                "; `{n}` is a column of `bgc simulate` (a state or an energy) that a fit does not read: a record \
-                 holds `t`, the inputs and measured outputs (declare an `output` for what was measured)"
+                "; `{n}` is a column of `bgc simulate` (a state or an energy), which a record does not hold: a \
+                 record holds `t`, the inputs and measured outputs (declare an `output` for what was measured)"
             )
         })
         .unwrap_or_default()

@@ -165,14 +165,33 @@ pub fn replace_file(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     written
 }
 
-/// The largest measured record `bgc fit --data` reads.
+/// The largest measured record `bgc fit --data` and `bgc simulate --data` read.
 pub const MAX_RECORD_BYTES: u64 = 256 << 20;
 
-/// Reads a measured record: a regular file or a pipe (`--data <(...)`), up to [`MAX_RECORD_BYTES`]. A device
-/// (`/dev/zero` never ends), a directory or a socket is refused without being read.
+/// Refuses a command line that names standard input (`-`) more than once: the first read would take it all and
+/// the others would see an empty file.
+pub fn stdin_once<'a>(paths: impl IntoIterator<Item = &'a Path>) -> Result<(), String> {
+    match paths.into_iter().filter(|p| is_stdin(p)).count() {
+        0 | 1 => Ok(()),
+        n => Err(format!(
+            "standard input (`-`) is named {n} times, but it can be read only once: save all but one of them to files"
+        )),
+    }
+}
+
+/// Reads a measured record: a regular file, a pipe (`--data <(...)`) or standard input (`-`), up to
+/// [`MAX_RECORD_BYTES`]. A device (`/dev/zero` never ends), a directory or a socket is refused without being read.
 pub fn read_record(path: &Path) -> std::io::Result<String> {
     use std::io::Read;
     let refuse = |why: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, why);
+    let mut bytes = Vec::new();
+    if is_stdin(path) {
+        std::io::stdin()
+            .lock()
+            .take(MAX_RECORD_BYTES + 1)
+            .read_to_end(&mut bytes)?;
+        return record_text(bytes);
+    }
     let kind = std::fs::metadata(path)?.file_type();
     #[cfg(unix)]
     {
@@ -184,10 +203,15 @@ pub fn read_record(path: &Path) -> std::io::Result<String> {
     if kind.is_dir() {
         return Err(refuse("not a regular file (a directory)".into()));
     }
-    let mut bytes = Vec::new();
     std::fs::File::open(path)?
         .take(MAX_RECORD_BYTES + 1)
         .read_to_end(&mut bytes)?;
+    record_text(bytes)
+}
+
+/// The text of a record read as `bytes`, refused when it is too large or not UTF-8.
+fn record_text(bytes: Vec<u8>) -> std::io::Result<String> {
+    let refuse = |why: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, why);
     if bytes.len() as u64 > MAX_RECORD_BYTES {
         return Err(refuse(format!(
             "the record is larger than the {} MiB it may have",

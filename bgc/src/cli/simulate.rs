@@ -4,6 +4,8 @@ use super::io::{output_failed, stderr, stderrln};
 use super::model::derive_one;
 use super::params::{Assignment, input_signals, param_values, values_or_zero, zero_inputs_warning};
 use super::quantities;
+pub use super::replay::RecordArg;
+use super::replay::recorded_inputs;
 use super::{Solver, Status};
 use bgc::simulate::System;
 use bgc::simulate::integrate::{Method, RunOptions, run_streaming_noted};
@@ -22,6 +24,8 @@ pub struct SimulateArgs<'a> {
     pub solver: Solver,
     pub rtol: f64,
     pub atol: f64,
+    /// The record whose inputs are replayed (`--data`, `--interp`).
+    pub record: Option<RecordArg<'a>>,
     /// Print the effective parameter values and initial state on standard error.
     pub verbose: bool,
 }
@@ -48,11 +52,25 @@ fn default_dt_out(args: &SimulateArgs<'_>) -> Result<f64, String> {
 
 /// `bgc simulate FILE --t-end T`
 pub fn simulate(path: &Path, wanted: Option<&str>, args: &SimulateArgs<'_>, color: bool) -> Status {
+    let record_path = args.record.map(|r| r.path);
+    if let Err(msg) = super::io::stdin_once(std::iter::once(path).chain(record_path)) {
+        stderrln(&format!("error: {msg}"));
+        return Status::UsageOrIo;
+    }
     let (d, _) = match derive_one(path, wanted, color, true) {
         Ok(x) => x,
         Err(s) => return s,
     };
-    match csv(&d.loaded.model, &d.eqs, args) {
+    let record = match args.record.map(|r| (r, super::io::read_record(r.path))) {
+        None => None,
+        Some((r, Ok(text))) => Some((r, text)),
+        Some((r, Err(e))) => {
+            stderrln(&format!("error: cannot read {}: {e}", r.path.display()));
+            return Status::UsageOrIo;
+        }
+    };
+    let record = record.as_ref().map(|(r, text)| (*r, text.as_str()));
+    match csv(&d.loaded.model, &d.eqs, args, record) {
         Ok(()) => Status::Ok,
         Err(Failure::Input(msg)) => {
             stderrln(&format!("error: {msg}"));
@@ -80,9 +98,22 @@ fn csv(
     model: &bgc::ir::Model,
     eqs: &bgc::equations::Equations,
     args: &SimulateArgs<'_>,
+    record: Option<(RecordArg<'_>, &str)>,
 ) -> Result<(), Failure> {
     let params = param_values(model, eqs, args.params)?;
-    let (signals, held_at_zero) = input_signals(model, args.inputs)?;
+    let (mut signals, mut held_at_zero) = input_signals(model, args.inputs)?;
+    if let Some((arg, text)) = record {
+        let recorded = recorded_inputs(model, eqs, arg, text, args.inputs, args.t_end)?;
+        for (i, signal) in recorded.signals {
+            held_at_zero.retain(|n| Some(n) != eqs.inputs.get(i));
+            if let Some(slot) = signals.get_mut(i) {
+                *slot = signal;
+            }
+        }
+        if let Some(w) = recorded.warning {
+            stderrln(&format!("warning: {w}"));
+        }
+    }
     if let Some(w) = zero_inputs_warning(&held_at_zero) {
         stderrln(&w);
     }

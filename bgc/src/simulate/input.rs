@@ -1,4 +1,4 @@
-//! Input signals given on the command line: expressions of time `t`.
+//! Input signals: expressions of time `t` given on the command line, or a record's samples ([`Samples`]).
 //!
 //! Grammar (usual precedence, `^` right-associative and binding tighter than unary minus, as in `-t^2 = -(t^2)`):
 //!
@@ -15,6 +15,7 @@
 //! the signal's breakpoints: the integrator restarts there, so a jump is resolved exactly instead of by step
 //! rejection. A signal's time derivative is [`Signal::derivative`] (module [`super::input_rate`]).
 
+use super::samples::Samples;
 use std::fmt;
 
 /// A parsed input signal.
@@ -29,6 +30,8 @@ pub enum Signal {
     Div(Box<Signal>, Box<Signal>),
     Pow(Box<Signal>, Box<Signal>),
     Call(SignalFunc, Vec<Signal>),
+    /// A recorded signal, replayed between its samples.
+    Samples(Samples),
 }
 
 /// The functions a signal may call.
@@ -95,6 +98,7 @@ impl Signal {
         match self {
             Signal::Num(v) => *v,
             Signal::Time => t,
+            Signal::Samples(s) => s.eval(t),
             Signal::Neg(a) => -a.eval(t),
             Signal::Add(a, b) => a.eval(t) + b.eval(t),
             Signal::Sub(a, b) => a.eval(t) - b.eval(t),
@@ -140,6 +144,7 @@ impl Signal {
     pub fn breakpoints(&self, out: &mut Vec<f64>) {
         match self {
             Signal::Num(_) | Signal::Time => {}
+            Signal::Samples(s) => s.breakpoints(out),
             Signal::Neg(a) => a.breakpoints(out),
             Signal::Add(a, b)
             | Signal::Sub(a, b)
@@ -165,7 +170,7 @@ impl Signal {
     pub fn uses_time(&self) -> bool {
         match self {
             Signal::Num(_) => false,
-            Signal::Time => true,
+            Signal::Time | Signal::Samples(_) => true,
             Signal::Neg(a) => a.uses_time(),
             Signal::Add(a, b)
             | Signal::Sub(a, b)

@@ -85,6 +85,7 @@ impl Signal {
         match self {
             Signal::Num(_) => num(0.0),
             Signal::Time => num(1.0),
+            Signal::Samples(s) => s.derivative().map_or(num(0.0), Signal::Samples),
             Signal::Neg(a) => neg(a.derivative()),
             Signal::Add(a, b) => add(a.derivative(), b.derivative()),
             Signal::Sub(a, b) => sub(a.derivative(), b.derivative()),

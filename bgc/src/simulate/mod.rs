@@ -40,6 +40,7 @@ pub mod input_rate;
 pub mod integrate;
 pub mod newton;
 pub mod program;
+pub mod samples;
 #[cfg(feature = "cli")]
 mod sparse_ode;
 

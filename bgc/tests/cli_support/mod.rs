@@ -42,9 +42,13 @@ pub fn bgc_stdin(args: &[&str], input: &str, dir: &std::path::Path) -> (i32, Str
         .spawn()
         .expect("bgc runs");
     if let Some(mut stdin) = child.stdin.take() {
-        stdin
-            .write_all(input.as_bytes())
-            .expect("bgc reads its input");
+        // A command refused before it reads its input closes the pipe: that is its answer, not a failure here.
+        match stdin.write_all(input.as_bytes()) {
+            Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+                panic!("bgc reads its input: {e}")
+            }
+            _ => {}
+        }
     }
     let out = child.wait_with_output().expect("bgc runs");
     (

@@ -127,7 +127,7 @@ impl Record {
             outputs,
             measured,
         };
-        r.check()?;
+        r.check(Measured::Required)?;
         Ok(r)
     }
 
@@ -137,6 +137,25 @@ impl Record {
         text: &str,
         input_names: &[&str],
         output_names: &[&str],
+    ) -> Result<Record, RecordError> {
+        Record::read_csv(text, input_names, output_names, Measured::Required)
+    }
+
+    /// Reads a CSV record of the inputs to replay (as [`Record::from_csv`] does), for a simulation: the columns of
+    /// measured outputs may be there (and are read) or not.
+    pub fn inputs_from_csv(
+        text: &str,
+        input_names: &[&str],
+        output_names: &[&str],
+    ) -> Result<Record, RecordError> {
+        Record::read_csv(text, input_names, output_names, Measured::Optional)
+    }
+
+    fn read_csv(
+        text: &str,
+        input_names: &[&str],
+        output_names: &[&str],
+        measured_columns: Measured,
     ) -> Result<Record, RecordError> {
         // A spreadsheet's "CSV UTF-8" begins with a byte-order mark, which is not part of the first column's name.
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
@@ -150,7 +169,7 @@ impl Record {
         let dialect = super::csv::Dialect::of_header(header);
         let header_cells = dialect.cells(header);
         let names: Vec<&str> = header_cells.iter().map(|c| c.as_ref()).collect();
-        let columns = Columns::map(&names, input_names, output_names)?;
+        let columns = Columns::map(&names, input_names, output_names, measured_columns)?;
         let mut times = Vec::new();
         let mut inputs = Vec::new();
         let mut measured = Vec::new();
@@ -205,10 +224,17 @@ impl Record {
             );
         }
         let outputs = columns.outputs.iter().map(|&(_, o)| o).collect();
-        Record::new(times, inputs, outputs, measured)
+        let record = Record {
+            times,
+            inputs,
+            outputs,
+            measured,
+        };
+        record.check(measured_columns)?;
+        Ok(record)
     }
 
-    fn check(&self) -> Result<(), RecordError> {
+    fn check(&self, measured_columns: Measured) -> Result<(), RecordError> {
         if self.times.len() < 2 {
             return Err(RecordError::TooShort);
         }
@@ -242,7 +268,7 @@ impl Record {
                 });
             }
         }
-        if self.sample_count() == 0 {
+        if measured_columns == Measured::Required && self.sample_count() == 0 {
             return Err(RecordError::NothingMeasured);
         }
         Ok(())
@@ -294,6 +320,13 @@ impl Record {
     }
 }
 
+/// Whether a record must hold measured outputs: a fit's must, a replay's may.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Measured {
+    Required,
+    Optional,
+}
+
 /// Which CSV column holds what.
 struct Columns {
     time: usize,
@@ -303,7 +336,12 @@ struct Columns {
 }
 
 impl Columns {
-    fn map(names: &[&str], inputs: &[&str], outputs: &[&str]) -> Result<Columns, RecordError> {
+    fn map(
+        names: &[&str],
+        inputs: &[&str],
+        outputs: &[&str],
+        measured: Measured,
+    ) -> Result<Columns, RecordError> {
         for (i, a) in names.iter().enumerate() {
             if let Some(j) = names[i + 1..].iter().position(|b| b == a) {
                 return Err(RecordError::DuplicateColumn {
@@ -347,7 +385,7 @@ impl Columns {
                 }
             }
         }
-        if output_columns.is_empty() {
+        if measured == Measured::Required && output_columns.is_empty() {
             return Err(RecordError::NoOutputs {
                 known: list(outputs),
             });

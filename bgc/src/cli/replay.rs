@@ -1,0 +1,89 @@
+//! `bgc simulate --data`: the inputs of a measured record as input signals.
+
+use super::params::Assignment;
+use bgc::equations::Equations;
+use bgc::ir::Model;
+use bgc::simulate::input::Signal;
+use bgc::simulate::samples::{Replay, Samples};
+use std::path::Path;
+
+/// The record to replay and how.
+#[derive(Clone, Copy, Debug)]
+pub struct RecordArg<'a> {
+    pub path: &'a Path,
+    pub replay: Replay,
+}
+
+/// The recorded signals, by model input index, for the inputs not given with `--input`, and a warning when the
+/// record does not cover the run `[0, t_end]`.
+pub struct Recorded {
+    pub signals: Vec<(usize, Signal)>,
+    pub warning: Option<String>,
+}
+
+/// Reads the record at `arg.path` (already read into `text`) and makes a signal of each input it holds.
+pub fn recorded_inputs(
+    model: &Model,
+    eqs: &Equations,
+    arg: RecordArg<'_>,
+    text: &str,
+    given: &[Assignment],
+    t_end: f64,
+) -> Result<Recorded, String> {
+    let elsewhere: Vec<&str> = given.iter().map(|a| a.name.as_str()).collect();
+    let place = arg.path.display();
+    let record = super::fit_record::read_inputs(model, eqs, text, &elsewhere)
+        .map_err(|e| format!("{place}: {e}"))?;
+    let read: Vec<usize> = (0..eqs.inputs.len())
+        .filter(|&i| !elsewhere.contains(&eqs.inputs[i].as_str()))
+        .collect();
+    let mut signals = Vec::with_capacity(read.len());
+    for (column, &input) in read.iter().enumerate() {
+        let values = record.inputs.iter().map(|row| row[column]).collect();
+        let samples = Samples::new(record.times.clone(), values, arg.replay)
+            .map_err(|e| format!("{place}: input `{}`: {e}", eqs.inputs[input]))?;
+        signals.push((input, Signal::Samples(samples)));
+    }
+    Ok(Recorded {
+        warning: coverage_warning(&place.to_string(), &record.times, t_end),
+        signals,
+    })
+}
+
+/// A warning when the record starts after 0 or ends before `t_end`: its end values then hold.
+fn coverage_warning(place: &str, times: &[f64], t_end: f64) -> Option<String> {
+    let (&first, &last) = (times.first()?, times.last()?);
+    let mut held = Vec::new();
+    if first > 0.0 {
+        held.push(format!("its first values hold from t = 0 to {first}"));
+    }
+    if last < t_end {
+        held.push(format!(
+            "its last values hold from t = {last} to --t-end {t_end}"
+        ));
+    }
+    (!held.is_empty()).then(|| {
+        format!(
+            "the record {place} covers t = {first} to {last} s: {}",
+            held.join(", and ")
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::coverage_warning;
+
+    #[test]
+    fn a_record_shorter_than_the_run_is_named() {
+        assert_eq!(coverage_warning("r.csv", &[0.0, 1.0], 1.0), None);
+        assert_eq!(coverage_warning("r.csv", &[-1.0, 2.0], 1.0), None);
+        assert_eq!(
+            coverage_warning("r.csv", &[0.5, 1.0], 2.0).as_deref(),
+            Some(
+                "the record r.csv covers t = 0.5 to 1 s: its first values hold from t = 0 to 0.5, and its last \
+                 values hold from t = 1 to --t-end 2"
+            )
+        );
+    }
+}

@@ -15,7 +15,7 @@ fn codes_and_messages(text: &str) -> Vec<(&'static str, String)> {
 /// reported again as unknown where it was used ("unknown name `u`", "bond to `mass1`, which does not exist").
 #[test]
 fn names_of_statements_that_do_not_parse_are_not_reported_again() {
-    let text = "model c1 {\n    domain translational;\n    param m = 2 [kg;\n    input u [N*m];\n    \
+    let text = "model c1 {\n    domain translational;\n    param m = 2 [kg;\n    input u [N/m/s];\n    \
                 Se src = u;\n    I mass1 = m +;\n    C spring = 1/3;\n    1 j;\n    \
                 bond src -> j -> mass1, spring;\n    output v [m/s] = f(mass1);\n    output w [m/s] = u/m;\n    \
                 output z [m/s] = v + w + zz;\n}\n";

@@ -471,8 +471,29 @@ impl<'a> Parser<'a> {
                 }
             }
             out.push((symbol, power));
+            self.multiplication_in_unit();
         }
         Ok(())
+    }
+
+    /// `*` or `.` between two factors (`[N*m]`, `[N.m]`, as other tools write units): one error with the space to
+    /// write instead, and the factors read on, so that the unit is the one meant and later checks see it.
+    fn multiplication_in_unit(&mut self) {
+        let (op, next) = (self.peek(), self.nth(1));
+        if matches!(op.kind, Tok::Star | Tok::Dot)
+            && next.kind == Tok::Ident
+            && !self.starts_line(next)
+        {
+            self.bump();
+            if let Some(help) = unit_operator_help(op.kind, false) {
+                self.diags.push(
+                    Diagnostic::error("BG0116", "malformed unit")
+                        .with_primary(self.tok_span(op), "not a unit")
+                        .with_help(help.to_string())
+                        .with_fix(" "),
+                );
+            }
+        }
     }
 
     fn bad_unit(&mut self, span: Span, help: &str) -> Fail {

@@ -704,6 +704,39 @@ fn operators_of_other_tools_in_a_unit_say_how_to_write_it() {
     }
 }
 
+/// Each `*` or `.` between factors is one error whose certain fix is a space, and the unit is read as meant, so the
+/// statement stands (before, the first one dropped the statement and the rest were never seen).
+#[test]
+fn each_multiplication_in_a_unit_is_fixed_by_a_space_and_the_unit_is_read() {
+    let src = "model m { param a = 1 [kg*m.s^-2]; }";
+    let (file, diags) = parse(FileId(0), src);
+    let found: Vec<(&str, Option<&str>, Option<usize>)> = diags
+        .iter()
+        .map(|d| (d.code.0, d.fix(), d.primary_span().map(|s| s.start as usize)))
+        .collect();
+    assert_eq!(
+        found,
+        [
+            ("BG0116", Some(" "), src.find('*')),
+            ("BG0116", Some(" "), src.find(".s")),
+        ]
+    );
+    let [Stmt::Param(p)] = body_of(&file) else {
+        panic!("{file:?}");
+    };
+    let factors: Vec<(&str, i32)> = p
+        .unit
+        .numerator
+        .iter()
+        .map(|(s, n)| (s.as_str(), *n))
+        .collect();
+    assert_eq!(factors, [("kg", 1), ("m", 1), ("s", -2)]);
+    // `*` that is not between two factors has no certain fix.
+    let (_, diags) = parse(FileId(0), "model m { param a = 1 [N m*]; }");
+    assert_eq!(diags.len(), 1, "{diags:#?}");
+    assert_eq!(diags[0].fix(), None);
+}
+
 #[test]
 fn a_bad_model_name_is_one_error_and_the_body_is_read() {
     let (file, diags) = parse(FileId(0), "model 3 { param a = 1 [1]; }");

@@ -248,24 +248,7 @@ impl<'a> Builder<'a> {
                 let mut d = Diagnostic::error("BG0312", format!("{err} in `[{text}]`"))
                     .with_primary(u.span, err.to_string());
                 if let crate::units::UnitError::UnknownSymbol { symbol } = &err {
-                    let known = [
-                        "m", "g", "kg", "s", "A", "K", "mol", "cd", "rad", "sr", "Hz", "N", "Pa",
-                        "J", "W", "C", "V", "F", "Ohm", "S", "Wb", "T", "H", "min", "h", "deg",
-                        "rpm", "L",
-                    ];
-                    let near = closest(symbol, known.into_iter());
-                    let case_slip = near
-                        .as_ref()
-                        .is_some_and(|c| c.eq_ignore_ascii_case(symbol));
-                    d = d.with_help(match (near, joined_factors(symbol)) {
-                        (Some(c), _) if case_slip => format!("did you mean `{c}`?"),
-                        // `[Ns/m]`, `[kgm^2]`: two units written together.
-                        (_, Some((a, b))) => format!(
-                            "unit factors are separated by a space: `{a} {b}`, as in `[N m]`"
-                        ),
-                        (Some(c), None) => format!("did you mean `{c}`?"),
-                        (None, None) => "units are SI symbols with optional prefixes p n u µ m c d k M G (docs/language.md, Units)".to_string(),
-                    });
+                    d = d.with_help(super::unit_help::unknown_symbol_help(symbol));
                 }
                 self.diags.push(d);
                 self.last_unit_ok = false;
@@ -611,18 +594,4 @@ fn declares_name(stmt: &Stmt) -> bool {
             | Stmt::Element(_)
             | Stmt::Instance(_)
     )
-}
-
-/// `symbol` as two unit symbols written without the space between them (`Ns` is `N s`), when it splits so.
-fn joined_factors(symbol: &str) -> Option<(&str, &str)> {
-    use crate::units::parse_symbol;
-    (1..symbol.len())
-        .filter(|&i| symbol.is_char_boundary(i))
-        .map(|i| symbol.split_at(i))
-        // Two factors of one quantity (`kg g`, `N N`) are a typo of one unit (`kgg`, `NN`), not a product.
-        .find(|(a, b)| {
-            parse_symbol(a)
-                .zip(parse_symbol(b))
-                .is_some_and(|(x, y)| x.dim != y.dim)
-        })
 }

@@ -24,6 +24,7 @@ mod references;
 mod scope;
 mod signals;
 mod structure;
+mod unit_help;
 mod unit_hints;
 
 #[cfg(test)]

@@ -397,6 +397,16 @@ impl<'a> Parser<'a> {
                 ));
             }
             one = Some(t);
+        } else if self.at(Tok::Minus) && self.nth(1).kind == Tok::RBracket {
+            // `[-]`, the dimensionless unit of engineering tables.
+            let t = self.bump();
+            self.diags.push(
+                Diagnostic::error("BG0116", "malformed unit")
+                    .with_primary(self.tok_span(t), "not a unit")
+                    .with_help("a dimensionless quantity has the unit `[1]`")
+                    .with_fix("1"),
+            );
+            one = Some(t);
         }
         if one.is_none() {
             self.unit_factors(&mut numerator)?;
@@ -470,30 +480,58 @@ impl<'a> Parser<'a> {
                     }
                 }
             }
+            if power == 1
+                && let Some(p) = self.power_without_caret(t)
+            {
+                power = p;
+            }
             out.push((symbol, power));
             self.multiplication_in_unit();
         }
         Ok(())
     }
 
-    /// `*` or `.` between two factors (`[N*m]`, `[N.m]`, as other tools write units): one error with the space to
-    /// write instead, and the factors read on, so that the unit is the one meant and later checks see it.
+    /// `*`, `.` or `-` between two factors (`[N*m]`, `[N.m]`, `[N-m]`, as other tools write units): one error with
+    /// the space to write instead, and the factors read on, so that the unit is the one meant and later checks see
+    /// it.
     fn multiplication_in_unit(&mut self) {
         let (op, next) = (self.peek(), self.nth(1));
-        if matches!(op.kind, Tok::Star | Tok::Dot)
+        if matches!(op.kind, Tok::Star | Tok::Dot | Tok::Minus)
             && next.kind == Tok::Ident
             && !self.starts_line(next)
         {
             self.bump();
-            if let Some(help) = unit_operator_help(op.kind, false) {
-                self.diags.push(
-                    Diagnostic::error("BG0116", "malformed unit")
-                        .with_primary(self.tok_span(op), "not a unit")
-                        .with_help(help.to_string())
-                        .with_fix(" "),
-                );
-            }
+            self.diags.push(
+                Diagnostic::error("BG0116", "malformed unit")
+                    .with_primary(self.tok_span(op), "not a unit")
+                    .with_help(UNIT_PRODUCT_HELP.to_string())
+                    .with_fix(" "),
+            );
         }
+    }
+
+    /// A negative power written right after its factor without `^` (`[s-1]`, `[m s-2]`): one error whose fix
+    /// inserts the `^`, and the power.
+    fn power_without_caret(&mut self, factor: Token) -> Option<i32> {
+        let (minus, digits) = (self.peek(), self.nth(1));
+        let adjacent = minus.start == factor.end && digits.start == minus.end;
+        if !(adjacent && minus.kind == Tok::Minus && digits.kind == Tok::Number) {
+            return None;
+        }
+        let text = self.tok_text(digits).to_string();
+        let v: i32 = text.parse().ok().filter(|v| *v != 0)?;
+        self.bump();
+        self.bump();
+        self.diags.push(
+            Diagnostic::error("BG0116", "malformed unit")
+                .with_primary(self.tok_span(minus), "not a unit")
+                .with_help(format!(
+                    "a unit's power follows `^`: `{}^-{text}`",
+                    self.tok_text(factor)
+                ))
+                .with_fix("^-"),
+        );
+        Some(-v)
     }
 
     fn bad_unit(&mut self, span: Span, help: &str) -> Fail {
@@ -506,13 +544,17 @@ impl<'a> Parser<'a> {
     }
 }
 
+const UNIT_PRODUCT_HELP: &str = "unit factors multiply by a space, as in `[N m]` or `[kg m^2]`";
+
 /// What to write instead of an operator that other tools put in units (`[N*m]`, `[N.m]`, `[m/s/s]`), which the
 /// unit grammar does not have.
 fn unit_operator_help(tok: Tok, after_slash: bool) -> Option<&'static str> {
     match tok {
-        Tok::Star | Tok::Dot => {
-            Some("unit factors multiply by a space, as in `[N m]` or `[kg m^2]`")
-        }
+        Tok::Star | Tok::Dot => Some(UNIT_PRODUCT_HELP),
+        Tok::Minus | Tok::Plus | Tok::Number | Tok::Caret => Some(
+            "a unit is SI symbols separated by spaces, each with an optional non-zero whole power after `^`: \
+             `[kg m^2/s^2]`, `[s^-1]`",
+        ),
         Tok::Slash if after_slash => Some(
             "a unit has one `/`, and every factor after it is in the denominator: `[m/s^2]` or `[kg/m s]`",
         ),

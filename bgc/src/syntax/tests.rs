@@ -712,7 +712,13 @@ fn each_multiplication_in_a_unit_is_fixed_by_a_space_and_the_unit_is_read() {
     let (file, diags) = parse(FileId(0), src);
     let found: Vec<(&str, Option<&str>, Option<usize>)> = diags
         .iter()
-        .map(|d| (d.code.0, d.fix(), d.primary_span().map(|s| s.start as usize)))
+        .map(|d| {
+            (
+                d.code.0,
+                d.fix(),
+                d.primary_span().map(|s| s.start as usize),
+            )
+        })
         .collect();
     assert_eq!(
         found,
@@ -735,6 +741,46 @@ fn each_multiplication_in_a_unit_is_fixed_by_a_space_and_the_unit_is_read() {
     let (_, diags) = parse(FileId(0), "model m { param a = 1 [N m*]; }");
     assert_eq!(diags.len(), 1, "{diags:#?}");
     assert_eq!(diags[0].fix(), None);
+}
+
+/// Hyphens as other texts write units: a product (`[N-m]`), a power without `^` (`[m s-2]`) and the
+/// dimensionless `[-]` of engineering tables. Each is one error with its certain fix, and the unit is read as meant.
+#[test]
+fn hyphens_in_a_unit_are_read_as_meant_with_their_fix() {
+    for (unit, fix, numerator, denominator) in [
+        ("[N-m]", " ", vec![("N", 1), ("m", 1)], vec![]),
+        ("[m s-2]", "^-", vec![("m", 1), ("s", -2)], vec![]),
+        (
+            "[kg/m s-1]",
+            "^-",
+            vec![("kg", 1)],
+            vec![("m", 1), ("s", -1)],
+        ),
+        ("[-]", "1", vec![], vec![]),
+    ] {
+        let src = format!("model m {{ param a = 1 {unit}; }}");
+        let (file, diags) = parse(FileId(0), &src);
+        let fixes: Vec<Option<&str>> = diags.iter().map(|d| d.fix()).collect();
+        assert_eq!(fixes, [Some(fix)], "{unit}: {diags:#?}");
+        let at = src.find(unit).unwrap_or(0) + unit.find('-').unwrap_or(0);
+        assert_eq!(
+            diags[0].primary_span().map(|s| s.start as usize),
+            Some(at),
+            "{unit}"
+        );
+        let [Stmt::Param(p)] = body_of(&file) else {
+            panic!("{unit}: {file:?}");
+        };
+        let read =
+            |fs: &[(String, i32)]| fs.iter().map(|(s, n)| (s.clone(), *n)).collect::<Vec<_>>();
+        let want = |fs: Vec<(&str, i32)>| {
+            fs.into_iter()
+                .map(|(s, n)| (s.to_string(), n))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(read(&p.unit.numerator), want(numerator), "{unit}");
+        assert_eq!(read(&p.unit.denominator), want(denominator), "{unit}");
+    }
 }
 
 #[test]

@@ -5,6 +5,7 @@
 
 mod excerpt;
 pub mod render;
+pub mod suggest;
 
 use crate::span::Span;
 use serde::Serialize;

@@ -8,6 +8,10 @@
 //! pascal, `m` the metre) and only then as an SI prefix followed by a prefixable unit (`mm`, `kN`, `µs`, `mA`).
 //! The kilogram is the base unit; the gram is `1e-3 kg` and takes prefixes (`mg`); `kg` itself is matched exactly.
 
+mod help;
+
+pub use help::unknown_symbol_help;
+
 use crate::ir::Domain;
 use crate::syntax::ast::UnitExpr;
 use serde::Serialize;
@@ -268,6 +272,9 @@ pub fn parse_unit_text(text: &str) -> Result<Unit, String> {
     let factors = |part: &str| -> Result<Vec<(String, i32)>, String> {
         let mut out = Vec::new();
         for f in part.split_whitespace() {
+            if let Some(help) = operator_in_factor(f) {
+                return Err(format!("`{f}`: {help}"));
+            }
             let (symbol, power) = match f.split_once('^') {
                 Some((b, p)) => match p.parse::<i32>() {
                     Ok(v) if v != 0 && !p.starts_with('+') => (b, v),
@@ -304,7 +311,29 @@ pub fn parse_unit_text(text: &str) -> Result<Unit, String> {
         denominator,
         span: crate::span::Span::default(),
     })
-    .map_err(|e| e.to_string())
+    .map_err(|e| match &e {
+        UnitError::UnknownSymbol { symbol } => format!("{e}: {}", unknown_symbol_help(symbol)),
+        _ => e.to_string(),
+    })
+}
+
+/// What to write for a factor with an operator inside, as other tools write units: `N*m`, `N.m`, `N-m` (a space
+/// between the factors) or `s-1` (`s^-1`).
+fn operator_in_factor(factor: &str) -> Option<String> {
+    // Only before a `^`: `s^-1` is a power.
+    let base = factor.split_once('^').map_or(factor, |(b, _)| b);
+    let (stem, rest) = base.split_once(['*', '.', '-'])?;
+    if stem.is_empty() || rest.is_empty() {
+        return None;
+    }
+    let power = rest.bytes().all(|b| b.is_ascii_digit()) && base.contains('-');
+    Some(match power {
+        true => format!("a unit's power follows `^`: `{stem}^-{rest}`"),
+        false => format!(
+            "unit factors multiply by a space: `{}`",
+            factor.replace(['*', '.', '-'], " ")
+        ),
+    })
 }
 
 /// The unit as it was written, `N m/rad`, for messages.
@@ -647,6 +676,28 @@ mod tests {
         assert!(parse_unit_text("furlong").is_err());
         assert!(parse_unit_text("m^0").is_err());
         assert!(parse_unit_text("m/s/s").is_err());
+        // Units as other tools write them are refused with what to write.
+        for (text, said) in [
+            ("N-m", "`N-m`: unit factors multiply by a space: `N m`"),
+            (
+                "kg*m^2",
+                "`kg*m^2`: unit factors multiply by a space: `kg m^2`",
+            ),
+            ("N m-1", "`m-1`: a unit's power follows `^`: `m^-1`"),
+            (
+                "lbf",
+                "unknown unit `lbf`: units are SI: write the value in SI units (1 lbf = 4.4482216152605 N)",
+            ),
+            ("m2", "unknown unit `m2`: a unit's power follows `^`: `m^2`"),
+        ] {
+            assert_eq!(parse_unit_text(text), Err(said.to_string()), "{text}");
+        }
+        for (text, dim) in [("s^-1", D_HZ), ("kg m^2 s^-2", D_J), ("N m rad^-1 s^-1", D_W)] {
+            assert_eq!(parse_unit_text(text).map(|u| u.dim), Ok(dim), "{text}");
+        }
+        for text in ["m-", "-", "m*"] {
+            assert!(parse_unit_text(text).is_err(), "{text}");
+        }
     }
 
     #[test]

@@ -3,8 +3,9 @@
 //! names inside the instance. A bond whose end does not resolve is left out (reported as BG0203 or BG0205).
 
 use super::builder::{BondInfo, Builder};
-use super::scope::{End, Entity, closest};
+use super::scope::{End, Entity};
 use crate::diagnostic::Diagnostic;
+use crate::diagnostic::suggest::closest;
 use crate::ir::{self, Domain};
 use crate::syntax::ast::{BondStmt, Ident, NodeRef};
 

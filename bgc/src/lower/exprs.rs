@@ -8,8 +8,9 @@
 
 use super::builder::Builder;
 use super::consteval::{eval, is_literal, not_finite};
-use super::scope::{Entity, closest};
+use super::scope::Entity;
 use crate::diagnostic::Diagnostic;
+use crate::diagnostic::suggest::closest;
 use crate::ir::{self, Func, PortVar};
 use crate::syntax::ast::{self, BinOp, ExprKind};
 use crate::units::{Dim, Unit};

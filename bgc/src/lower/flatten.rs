@@ -9,8 +9,9 @@
 use super::builder::{Builder, NodeInfo, ParamInfo};
 use super::consteval::eval;
 use super::exprs::{Allow, Cx, Q};
-use super::scope::{Entity, Scope, closest, duplicate};
+use super::scope::{Entity, Scope, duplicate};
 use crate::diagnostic::Diagnostic;
+use crate::diagnostic::suggest::closest;
 use crate::ir::{self, Domain};
 use crate::syntax::ast::{self, ElementKind, Ident, InstanceDecl, ModelDecl, ModelKind, Stmt};
 use crate::units::{Unit, parse_unit, unit_text};
@@ -248,7 +249,7 @@ impl<'a> Builder<'a> {
                 let mut d = Diagnostic::error("BG0312", format!("{err} in `[{text}]`"))
                     .with_primary(u.span, err.to_string());
                 if let crate::units::UnitError::UnknownSymbol { symbol } = &err {
-                    d = d.with_help(super::unit_help::unknown_symbol_help(symbol));
+                    d = d.with_help(crate::units::unknown_symbol_help(symbol));
                 }
                 self.diags.push(d);
                 self.last_unit_ok = false;

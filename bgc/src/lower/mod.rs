@@ -24,7 +24,6 @@ mod references;
 mod scope;
 mod signals;
 mod structure;
-mod unit_help;
 mod unit_hints;
 
 #[cfg(test)]
@@ -44,9 +43,9 @@ use petgraph::Direction;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+pub use crate::diagnostic::suggest::closest;
 pub use imports::{STD_DISPLAY_NAME, STD_NAME, STD_SOURCE, normalize};
 pub use instances::add_instance_context;
-pub use scope::closest;
 
 /// Where lowering gets the text of imported files. The loader decides which file an import names and what
 /// identifies it (its key: two imports with one key are one file, so a diamond of imports loads it once and a file

@@ -1,6 +1,7 @@
 //! "Did you mean" suggestions for misspelt keywords.
 
 use super::parser::KEYWORDS;
+use crate::diagnostic::suggest::edit_distance;
 
 /// The keyword `word` is most likely a misspelling of: one edit away (two for words of six letters or more), case
 /// ignored. Element kinds are left out: short words like `C` are one edit away from too many names.
@@ -19,24 +20,6 @@ pub fn keyword_like(word: &str) -> Option<&'static str> {
         .map(|(k, _)| k)
 }
 
-/// Levenshtein distance over bytes, one row at a time.
-fn edit_distance(a: &str, b: &str) -> usize {
-    let b = b.as_bytes();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.bytes().enumerate() {
-        let mut cur = Vec::with_capacity(b.len() + 1);
-        cur.push(i + 1);
-        for (j, cb) in b.iter().enumerate() {
-            let diagonal = prev.get(j).copied().unwrap_or(usize::MAX - 1) + usize::from(ca != *cb);
-            let up = prev.get(j + 1).copied().unwrap_or(usize::MAX - 1) + 1;
-            let left = cur.last().copied().unwrap_or(usize::MAX - 1) + 1;
-            cur.push(diagonal.min(up).min(left));
-        }
-        prev = cur;
-    }
-    prev.last().copied().unwrap_or(0)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -47,6 +30,5 @@ mod tests {
         assert_eq!(keyword_like("ouput"), Some("output"));
         assert_eq!(keyword_like("Bond"), Some("bond"));
         assert_eq!(keyword_like("spring_damper"), None);
-        assert_eq!(edit_distance("kitten", "sitting"), 3);
     }
 }

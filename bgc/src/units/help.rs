@@ -1,8 +1,8 @@
 //! The help of an unknown unit symbol (BG0312): what the writer most likely meant, from the ways units are written
 //! elsewhere (a power without `^`, spellings such as `sec`, imperial units, two symbols written together).
 
-use super::scope::closest;
-use crate::units::parse_symbol;
+use super::parse_symbol;
+use crate::diagnostic::suggest::closest;
 
 /// The units a misspelt symbol is compared with.
 const KNOWN: [&str; 28] = [
@@ -47,7 +47,7 @@ const IMPERIAL: [(&str, &str); 16] = [
 ];
 
 /// The help for the unknown unit `symbol`.
-pub(super) fn unknown_symbol_help(symbol: &str) -> String {
+pub fn unknown_symbol_help(symbol: &str) -> String {
     if let Some((_, write)) = SPELLINGS.iter().find(|(s, _)| *s == symbol) {
         return format!("write `{write}`");
     }

@@ -329,9 +329,9 @@ fn bad_records_are_refused_with_the_row_or_column_named() {
         err.contains("column 3 `speed`") && err.contains("no input or output"),
         "{err}"
     );
-    let (code, err) = refused(&pend, "time,theta_pend\n0,0\n0.1,0\n", "J_p");
+    let (code, err) = refused(&pend, "secs,theta_pend\n0,0\n0.1,0\n", "J_p");
     assert_eq!(code, 1);
-    assert!(err.contains("no `t` column"), "{err}");
+    assert!(err.contains("no `t` (or `time`) column"), "{err}");
     // back_support has inputs tau_m and omega_h: both must be in the record.
     let back = repo("models/back_support.bg");
     let (code, err) = refused(&back, "t,tau_m,omega_m\n0,0,0\n0.1,0,0\n", "J_g");

@@ -89,6 +89,32 @@ fn interpolated_samples_are_the_signal_between_them_and_hold_after_the_record() 
     assert!(replayed.col("p_mass")[8] > 0.5, "the force acted");
 }
 
+/// A record whose time column is `time` (as FMPy and Modelica tools write it), here in milliseconds, is read as
+/// one whose column is `t` in seconds.
+#[test]
+fn a_time_column_named_time_is_the_time() {
+    let model = temp_model("replay_time", PUSHED_MASS);
+    let args = |data: &str| {
+        let mut all = vec![
+            "simulate".to_string(),
+            model.clone(),
+            "--data".into(),
+            data.into(),
+        ];
+        all.extend(["--t-end", "1", "--dt-out", "0.25"].map(String::from));
+        all
+    };
+    let run = |data: &str| {
+        let all = args(data);
+        let refs: Vec<&str> = all.iter().map(String::as_str).collect();
+        bgc(&refs)
+    };
+    let (code, with_t, err) = run(&record("replay_t", "t,F\n0,1\n0.5,-1\n1,0\n"));
+    assert_eq!(code, 0, "{err}");
+    let (code, with_time, err) = run(&record("replay_time", "time [ms],F\n0,1\n500,-1\n1000,0\n"));
+    assert_eq!((code, with_time), (0, with_t), "{err}");
+}
+
 /// A record read from standard input gives the run of the same record read from a file.
 #[test]
 fn a_record_may_come_from_standard_input() {

@@ -15,6 +15,9 @@ use bgc_runtime::fit::Record;
 use bgc_runtime::fit::csv::Dialect;
 use std::collections::HashMap;
 
+/// The names of the time column: `t`, as `bgc simulate` writes it, or `time`, as FMPy and Modelica tools do.
+const TIME_COLUMNS: [&str; 2] = ["t", "time"];
+
 /// The columns `bgc simulate` writes after the states and outputs.
 const ENERGY_COLUMNS: [&str; 3] = ["energy", "dissipated", "supplied"];
 
@@ -98,11 +101,15 @@ fn declared(model: &Model) -> HashMap<String, Declared> {
     let mut all = quantities::inputs(model);
     all.extend(quantities::outputs(model));
     if let Ok(unit) = parse_unit_text("s") {
-        all.push(Declared {
-            name: "t".into(),
-            unit,
-            text: "s".into(),
-        });
+        for name in TIME_COLUMNS {
+            if !all.iter().any(|d| d.name == name) {
+                all.push(Declared {
+                    name: name.into(),
+                    unit,
+                    text: "s".into(),
+                });
+            }
+        }
     }
     all.into_iter().map(|d| (d.name.clone(), d)).collect()
 }
@@ -123,7 +130,11 @@ fn convert(
             .copied()
             .unwrap_or(1.0)
     };
-    let t = factor("t");
+    // The time column is `t`, else `time` (the runtime's reader takes them in that order).
+    let t = match names.iter().any(|n| n == "t") {
+        true => factor("t"),
+        false => factor("time"),
+    };
     record.times.iter_mut().for_each(|v| *v *= t);
     let per_input: Vec<f64> = inputs.iter().map(|n| factor(n)).collect();
     for row in &mut record.inputs {

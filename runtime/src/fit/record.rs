@@ -1,6 +1,6 @@
 //! A measured record: sample times, the inputs applied and the outputs measured, read from CSV and checked.
 //!
-//! The CSV has a header with a `t` column, one column per model input and one per measured output, by name. An
+//! The CSV has a header with a `t` column (or `time`), one column per model input and one per measured output, by name. An
 //! empty output cell is a missing sample; every other cell must be a finite number. Inputs are held between
 //! samples ([`Interp::Zoh`], the way a logger records a digitally commanded signal) or interpolated linearly.
 
@@ -33,7 +33,7 @@ pub struct Record {
 pub enum RecordError {
     #[error("the record is empty: it needs a header line and at least two samples")]
     TooShort,
-    #[error("the record has no `t` column (the header is `{header}`)")]
+    #[error("the record has no `t` (or `time`) column (the header is `{header}`)")]
     NoTime { header: String },
     #[error("the record has no column for the model input `{name}`; inputs must all be given")]
     MissingInput { name: String },
@@ -351,9 +351,12 @@ impl Columns {
                 });
             }
         }
+        // `time`, as FMPy, Modelica tools and MATLAB's timetables name it, when no model quantity has that name.
+        let time_alias = !inputs.contains(&"time") && !outputs.contains(&"time");
         let time = names
             .iter()
             .position(|&n| n == "t")
+            .or_else(|| names.iter().position(|&n| n == "time" && time_alias))
             .ok_or_else(|| RecordError::NoTime {
                 header: names.join(","),
             })?;

@@ -692,7 +692,11 @@ mod tests {
         ] {
             assert_eq!(parse_unit_text(text), Err(said.to_string()), "{text}");
         }
-        for (text, dim) in [("s^-1", D_HZ), ("kg m^2 s^-2", D_J), ("N m rad^-1 s^-1", D_W)] {
+        for (text, dim) in [
+            ("s^-1", D_HZ),
+            ("kg m^2 s^-2", D_J),
+            ("N m rad^-1 s^-1", D_W),
+        ] {
             assert_eq!(parse_unit_text(text).map(|u| u.dim), Ok(dim), "{text}");
         }
         for text in ["m-", "-", "m*"] {

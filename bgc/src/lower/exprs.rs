@@ -382,16 +382,21 @@ impl Builder<'_> {
     ) -> Option<Q> {
         match (qa, qb) {
             (Q::Dim(x), Q::Dim(y)) if x != y => {
-                self.diags.push(
-                    Diagnostic::error(
-                        "BG0310",
-                        format!("quantities of different units are {verb}: {x} and {y}"),
-                    )
-                    .with_primary(e.span, "the units differ")
-                    .with_secondary(a.span, format!("this is in {x}"))
-                    .with_secondary(b.span, format!("this is in {y}"))
-                    .with_help("both sides must have one unit; check for a missing factor"),
-                );
+                let mut d = Diagnostic::error(
+                    "BG0310",
+                    format!("quantities of different units are {verb}: {x} and {y}"),
+                )
+                .with_primary(e.span, "the units differ")
+                .with_secondary(a.span, format!("this is in {x}"))
+                .with_secondary(b.span, format!("this is in {y}"))
+                .with_help("both sides must have one unit; check for a missing factor");
+                if [x, y].into_iter().any(angle_like) {
+                    d = d.with_note(
+                        "angles are pure numbers in SI: `rad` is 1, `rad/s` is 1/s and `rad/s^2` is 1/s^2, so \
+                         an angle and an angular velocity show as 1 and 1/s",
+                    );
+                }
+                self.diags.push(d);
                 None
             }
             (Q::Free, q) | (q, Q::Free) => Some(q),
@@ -686,4 +691,11 @@ fn other_tool_function(name: &str) -> Option<&'static str> {
         }
         _ => return None,
     })
+}
+
+/// Whether `d` is what an angle, an angular velocity or acceleration shows as (1, 1/s, 1/s^2), whose `rad` SI
+/// leaves out of the displayed unit.
+fn angle_like(d: Dim) -> bool {
+    let [m, kg, s, a, k, mol, cd] = d.0;
+    [m, kg, a, k, mol, cd] == [0; 6] && (-2..=0).contains(&s)
 }

@@ -1015,3 +1015,22 @@ fn names_and_units_outside_ascii_are_one_error_each_with_the_ascii_spelling() {
         "{messages:?}"
     );
 }
+
+/// An angle added to an angular velocity shows as "1/s and 1", since SI's `rad` is 1: the error says so, and only
+/// where an angle-like unit is one of the two.
+#[test]
+fn a_mismatch_of_angle_like_units_explains_the_missing_rad() {
+    let model = |expr: &str| {
+        format!(
+            "model r {{\n    domain rotational;\n    param w0 = 3 [rad/s];\n    param th = 1 [rad];\n    \
+             param m = 2 [kg];\n    param L = 1 [m];\n    output z [1] = {expr};\n}}\n"
+        )
+    };
+    for (expr, noted) in [("w0 + th", true), ("m + th", true), ("m + L", false)] {
+        let (_, diags, _) = lower_text(&model(expr));
+        let mismatch: Vec<&Diagnostic> = diags.iter().filter(|d| d.code.0 == "BG0310").collect();
+        assert_eq!(mismatch.len(), 1, "{expr}: {diags:#?}");
+        let says = mismatch[0].notes.iter().any(|n| n.contains("`rad` is 1"));
+        assert_eq!(says, noted, "{expr}: {:?}", mismatch[0].notes);
+    }
+}

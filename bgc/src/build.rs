@@ -344,7 +344,7 @@ fn write_if_changed(path: &Path, text: &str) -> Result<bool, Error> {
     if std::fs::read(path).is_ok_and(|old| old == text.as_bytes()) {
         return Ok(false);
     }
-    std::fs::write(path, text).map_err(|source| Error::Io {
+    crate::files::write_whole(path, text.as_bytes()).map_err(|source| Error::Io {
         path: path.to_path_buf(),
         source,
     })?;

@@ -12,6 +12,7 @@ mod concurrent;
 pub mod diagnostic;
 pub mod draw;
 pub mod equations;
+pub mod files;
 pub mod fmu;
 pub mod ir;
 pub mod lower;

@@ -139,7 +139,7 @@ fn fmt_one(path: &Path, check_only: bool, color: bool) -> std::io::Result<bool> 
         stderrln(&format!("{name}: not in the canonical layout"));
         return Ok(false);
     }
-    super::io::replace_file(path, formatted.as_bytes())?;
+    bgc::files::write_whole(path, formatted.as_bytes())?;
     Ok(true)
 }
 
@@ -312,7 +312,7 @@ pub fn draw(
     };
     match output {
         Some(out) => {
-            if let Err(e) = std::fs::write(out, text) {
+            if let Err(e) = bgc::files::write_whole(out, text.as_bytes()) {
                 stderrln(&format!("error: cannot write {}: {e}", out.display()));
                 return Status::UsageOrIo;
             }

@@ -7,7 +7,7 @@ use std::path::Path;
 const WIDTH: u32 = 900;
 const PANEL_HEIGHT: u32 = 300;
 
-/// Writes the SVG.
+/// Writes the SVG, whole or not at all.
 pub fn write(
     path: &Path,
     record: &Record,
@@ -15,7 +15,21 @@ pub fn write(
     names: &[String],
 ) -> Result<(), Box<dyn std::error::Error>> {
     let panels = names.len().max(1) as u32;
-    let root = SVGBackend::new(path, (WIDTH, PANEL_HEIGHT * panels)).into_drawing_area();
+    let mut svg = String::new();
+    draw(&mut svg, panels, record, report, names)?;
+    bgc::files::write_whole(path, svg.as_bytes())?;
+    Ok(())
+}
+
+/// Draws the panels into `svg`.
+fn draw(
+    svg: &mut String,
+    panels: u32,
+    record: &Record,
+    report: &FitReport,
+    names: &[String],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let root = SVGBackend::with_string(svg, (WIDTH, PANEL_HEIGHT * panels)).into_drawing_area();
     root.fill(&WHITE)?;
     let areas = root.split_evenly((names.len().max(1), 1));
     let t0 = record.times.first().copied().unwrap_or(0.0);

@@ -132,39 +132,6 @@ pub fn refuse_overwrite(output: &Path, sources: &SourceMap, others: &[&Path]) ->
     }
 }
 
-/// Replaces the contents of the file at `path` (through links) with `bytes`, or leaves it as it was: the new
-/// text goes to a file beside it, with the same permissions, which is then renamed over it. Writing in place
-/// would leave a truncated model behind when the disk is full or the process is stopped halfway; it is done only
-/// where the directory cannot take a new file.
-pub fn replace_file(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    use std::io::Write;
-    let target = std::fs::canonicalize(path)?;
-    let permissions = std::fs::metadata(&target)?.permissions();
-    let name = target
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let temp = target.with_file_name(format!(".{name}.bgc-{}.tmp", std::process::id()));
-    let mut file = match std::fs::File::create(&temp) {
-        Ok(file) => file,
-        // A writable file in a directory that is not: only writing in place is possible.
-        Err(e) if e.kind() == std::io::ErrorKind::PermissionDenied => {
-            return std::fs::write(&target, bytes);
-        }
-        Err(e) => return Err(e),
-    };
-    let written = (|| {
-        file.write_all(bytes)?;
-        file.sync_all()?;
-        std::fs::set_permissions(&temp, permissions)?;
-        std::fs::rename(&temp, &target)
-    })();
-    if written.is_err() {
-        let _ = std::fs::remove_file(&temp);
-    }
-    written
-}
-
 /// The largest measured record `bgc fit --data` and `bgc simulate --data` read.
 pub const MAX_RECORD_BYTES: u64 = 256 << 20;
 

@@ -152,7 +152,7 @@ impl Config {
             &format!("binaries/{platform}/{}.so", sources.identifier),
             &bytes,
         )?;
-        std::fs::write(fmu, archive.finish()?).map_err(|e| io(fmu, e))?;
+        crate::files::write_whole(fmu, &archive.finish()?).map_err(|e| io(fmu, e))?;
         Ok(Built {
             fmu: fmu.to_path_buf(),
             identifier: sources.identifier,

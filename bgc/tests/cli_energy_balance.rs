@@ -172,8 +172,9 @@ fn a_relative_tolerance_below_rounding_is_refused_up_front() {
         assert_eq!(code, 1, "{rtol}: {err}");
         assert!(out.is_empty(), "{rtol}: {out}");
         assert!(
-            err.starts_with("error: rtol = ")
-                && err.contains(" is not allowed: it is below 100 times the machine epsilon"),
+            err.starts_with(&format!(
+                "error: --rtol {rtol} is not allowed: it is below 100 times the machine epsilon"
+            )),
             "{rtol}: {err}"
         );
     }

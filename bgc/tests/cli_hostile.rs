@@ -614,6 +614,35 @@ fn a_tiny_t_end_is_refused_in_its_own_name() {
     }
 }
 
+/// An option no run can have is named as the command line spells it, before anything else is said about the run.
+/// Before, `--t-end nan` said "t_end = NaN is not allowed" after a warning about the inputs not given.
+#[test]
+fn an_impossible_simulate_option_is_named_as_the_flag_and_said_first() {
+    let dir = scratch("bad-options");
+    let oscillator = corpus("oscillator.bg");
+    for (flag, value) in [
+        ("--t-end", "nan"),
+        ("--t-end", "-inf"),
+        ("--dt-out", "-1"),
+        ("--atol", "0"),
+        ("--rtol", "1e-20"),
+    ] {
+        let mut args = vec!["simulate", oscillator.as_str(), flag, value];
+        if flag != "--t-end" {
+            args.extend(["--t-end", "1"]);
+        }
+        let run = bgc(&dir, &args);
+        assert_eq!(run.status, 1, "{}", run.transcript());
+        let first = run.stderr.lines().next().unwrap_or("");
+        let value = if value == "nan" { "NaN" } else { value };
+        assert!(
+            first.starts_with(&format!("error: {flag} {value} is not allowed: ")),
+            "{}",
+            run.transcript()
+        );
+    }
+}
+
 /// A dense state space of 4,002 states (16 million entries in `A`) is refused before any matrix is formed, with the
 /// way out named; `--sparse` gives the same model's non-zero entries.
 #[test]

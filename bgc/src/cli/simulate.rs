@@ -7,8 +7,8 @@ use super::quantities;
 pub use super::replay::RecordArg;
 use super::replay::recorded_inputs;
 use super::{Solver, Status};
-use bgc::simulate::System;
 use bgc::simulate::integrate::{Method, RunOptions, run_streaming_noted};
+use bgc::simulate::{SimError, System};
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::ops::ControlFlow;
@@ -100,6 +100,21 @@ fn csv(
     args: &SimulateArgs<'_>,
     record: Option<(RecordArg<'_>, &str)>,
 ) -> Result<(), Failure> {
+    let opts = RunOptions {
+        t_end: args.t_end,
+        dt_out: default_dt_out(args)?,
+        method: match args.solver {
+            Solver::Bdf => Method::Bdf,
+            Solver::Esdirk34 => Method::Esdirk34,
+            Solver::TrBdf2 => Method::TrBdf2,
+            Solver::Tsit45 => Method::Tsit45,
+        },
+        rtol: args.rtol,
+        atol: args.atol,
+        max_steps: 10_000_000,
+    };
+    // The options are checked before anything else is said about the run.
+    opts.check().map_err(option_error)?;
     let params = param_values(model, eqs, args.params)?;
     let (mut signals, mut held_at_zero) = input_signals(model, args.inputs)?;
     if let Some((arg, text)) = record {
@@ -140,19 +155,6 @@ fn csv(
             args.x0,
         ));
     }
-    let opts = RunOptions {
-        t_end: args.t_end,
-        dt_out: default_dt_out(args)?,
-        method: match args.solver {
-            Solver::Bdf => Method::Bdf,
-            Solver::Esdirk34 => Method::Esdirk34,
-            Solver::TrBdf2 => Method::TrBdf2,
-            Solver::Tsit45 => Method::Tsit45,
-        },
-        rtol: args.rtol,
-        atol: args.atol,
-        max_steps: 10_000_000,
-    };
     // Rows go out as they are computed (a long run's memory does not grow with its length), and the run stops as
     // soon as the output is closed.
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
@@ -208,10 +210,30 @@ fn csv(
     flushed.map_err(Failure::Output)
 }
 
-/// The time column: decimal (`0.25`, `12.5`) where that is short, else with an exponent (`1e-300`, `1e20`), which
-/// Display would write out in hundreds of digits; both are the shortest form that reads back exactly.
+/// An option that no run can have, named as the command line spells it (`--t-end`, not the field `t_end`).
+fn option_error(e: SimError) -> String {
+    match e {
+        SimError::BadSetting {
+            name,
+            value,
+            reason,
+        } => {
+            let mut shown = String::new();
+            write_time(&mut shown, value);
+            format!(
+                "--{} {shown} is not allowed: {reason}",
+                name.replace('_', "-")
+            )
+        }
+        other => other.to_string(),
+    }
+}
+
+/// The time column (and a time or tolerance in a message): decimal (`0.25`, `12.5`) where that is short, else with
+/// an exponent (`1e-300`, `1e20`), which Display would write out in hundreds of digits; both are the shortest form
+/// that reads back exactly.
 fn write_time(line: &mut String, t: f64) {
-    let _ = if t == 0.0 || (1e-4..1e16).contains(&t.abs()) {
+    let _ = if t == 0.0 || !t.is_finite() || (1e-4..1e16).contains(&t.abs()) {
         write!(line, "{t}")
     } else {
         write!(line, "{t:e}")

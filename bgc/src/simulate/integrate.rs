@@ -69,7 +69,9 @@ pub const MIN_RTOL: f64 = 100.0 * f64::EPSILON;
 pub const MAX_ROWS: usize = 10_000_000;
 
 impl RunOptions {
-    fn check(&self) -> Result<(), SimError> {
+    /// Refuses options no run can have (a non-finite or non-positive time, step or tolerance, too many rows); a
+    /// run checks them first.
+    pub fn check(&self) -> Result<(), SimError> {
         let positive: [(&'static str, f64); 4] = [
             ("t_end", self.t_end),
             ("dt_out", self.dt_out),

@@ -213,3 +213,40 @@ fn json_diagnostics_carry_their_certain_fix() {
         ]
     );
 }
+
+/// A file without a model passed `bgc check` without a word, so an empty or truncated file looked checked. Each file
+/// now gets its summary line: what it holds, or that it declares nothing.
+#[test]
+fn a_file_without_a_model_says_what_it_holds() {
+    let dir = crate::scratch::path("no_model_summary");
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{e}"));
+    let files = [
+        ("empty.bg", ""),
+        ("comments.bg", "// a model will come here\n"),
+        (
+            "lib.bg",
+            "component Spring {\n    domain translational;\n    param k = 1 [N/m];\n    C c = 1/k;\n    0 a;\n    \
+             port p = a;\n    bond a -> c;\n}\n",
+        ),
+        ("uses.bg", "import \"lib.bg\";\n"),
+    ];
+    let mut args = vec!["check".to_string()];
+    for (name, text) in files {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap_or_else(|e| panic!("{e}"));
+        args.push(path.display().to_string());
+    }
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, out, err) = crate::cli_support::bgc(&refs);
+    assert_eq!((code, err.as_str()), (0, ""));
+    let lines: Vec<&str> = out.lines().map(|l| l.rsplit('/').next().unwrap_or(l)).collect();
+    assert_eq!(
+        lines,
+        [
+            "empty.bg: no model: the file declares nothing",
+            "comments.bg: no model: the file declares nothing",
+            "lib.bg: no model; 1 component",
+            "uses.bg: no model; 1 import",
+        ]
+    );
+}

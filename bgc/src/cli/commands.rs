@@ -44,6 +44,9 @@ pub fn check(files: &[PathBuf], format: DiagFormat, color: bool) -> Status {
                 diags.extend(found);
             }
         }
+        if !has_errors(&diags) && models.is_empty() {
+            summaries.push(no_model_summary(&sources, id));
+        }
         if !has_errors(&diags) {
             for m in &models {
                 summaries.push(format!(
@@ -71,6 +74,34 @@ pub fn check(files: &[PathBuf], format: DiagFormat, color: bool) -> Status {
         status = Status::InputErrors;
     }
     status
+}
+
+/// The summary line of a file that declares no model: what it holds instead (components for other files to
+/// import), or that it declares nothing at all, so that an empty or truncated file does not pass unremarked.
+fn no_model_summary(sources: &SourceMap, id: bgc::span::FileId) -> String {
+    let (name, text) = sources
+        .get(id)
+        .map(|f| (f.name.as_str(), f.text.as_str()))
+        .unwrap_or_default();
+    let (file, _) = bgc::syntax::parse(id, text);
+    let components = file
+        .items
+        .iter()
+        .filter(|i| matches!(i, bgc::syntax::ast::Item::Model(_)))
+        .count();
+    let imports = file.items.len() - components;
+    match (components, imports) {
+        (0, 0) => format!("{name}: no model: the file declares nothing"),
+        (c, i) => {
+            let plural = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
+            let held: Vec<String> = [(c, "component"), (i, "import")]
+                .into_iter()
+                .filter(|(n, _)| *n > 0)
+                .map(|(n, what)| plural(n, what))
+                .collect();
+            format!("{name}: no model; {}", held.join(", "))
+        }
+    }
 }
 
 /// `bgc fmt [--check] FILE...`

@@ -159,6 +159,11 @@ fn a_record_that_cannot_be_replayed_is_refused_with_the_cause() {
         ),
         ("t,F\n0,1\n1,nan\n", &[][..], "line 3, column `F` is NaN"),
         ("t,F [m]\n0,1\n1,2\n", &[][..], "the record's column"),
+        (
+            "t,F\n0,1\n",
+            &[][..],
+            "the record has too few samples (1): it needs a header line and at least two",
+        ),
     ];
     for (k, (text, extra, want)) in cases.iter().enumerate() {
         let data = record(&format!("replay_error_{k}"), text);

@@ -193,4 +193,15 @@ fn inputs_at_a_time_refuse_a_wrong_buffer_and_a_nan_time() {
     assert!(!record.input_at(Interp::Zoh, 0.25, &mut long));
     assert!(!record.input_at(Interp::Linear, f64::NAN, &mut u));
     assert_eq!(u, [1.0, 10.0]);
+    // Samples near the largest f64: the values in between, not the overflow of their difference (NaN before).
+    let huge = Record::new(
+        vec![0.0, 1.0],
+        vec![vec![1e308], vec![-1e308]],
+        vec![0],
+        vec![vec![0.0], vec![0.0]],
+    )
+    .expect("a valid record");
+    let mut v = [0.0; 1];
+    assert!(huge.input_at(Interp::Linear, 0.25, &mut v));
+    assert_eq!(v, [5e307]);
 }

@@ -91,7 +91,11 @@ impl Samples {
         };
         match self.replay {
             Replay::Hold => v0,
-            Replay::Linear => v0 + (v1 - v0) * ((t - t0) / (t1 - t0)).clamp(0.0, 1.0),
+            Replay::Linear => {
+                // The weighted mean, not `v0 + s (v1 − v0)`: the difference of two finite samples may overflow.
+                let s = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
+                v0 * (1.0 - s) + v1 * s
+            }
             Replay::Slope => (v1 - v0) / (t1 - t0),
         }
     }
@@ -159,6 +163,16 @@ mod tests {
         let mut b = Vec::new();
         s.breakpoints(&mut b);
         assert!(b.is_empty(), "a kink is no jump: {b:?}");
+    }
+
+    /// Between samples near the largest `f64` the values lie between them; `v0 + s (v1 − v0)` overflowed to NaN.
+    #[test]
+    fn samples_near_the_largest_number_interpolate_without_overflow() {
+        let s = Samples::new(vec![0.0, 1.0], vec![1e308, -1e308], Replay::Linear)
+            .expect("valid samples");
+        assert_eq!(s.eval(0.5), 0.0);
+        assert_eq!(s.eval(0.25), 5e307);
+        assert_eq!(s.eval(1.0), -1e308);
     }
 
     #[test]

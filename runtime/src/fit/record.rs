@@ -31,8 +31,10 @@ pub struct Record {
 /// Why a record was refused; rows are numbered as lines of the file (the header is line 1).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum RecordError {
-    #[error("the record is empty: it needs a header line and at least two samples")]
-    TooShort,
+    #[error(
+        "the record has too few samples ({samples}): it needs a header line and at least two samples"
+    )]
+    TooShort { samples: usize },
     #[error("the record has no `t` (or `time`) column (the header is `{header}`)")]
     NoTime { header: String },
     #[error("the record has no column for the model input `{name}`; inputs must all be given")]
@@ -164,7 +166,7 @@ impl Record {
             .enumerate()
             .filter(|(_, l)| !l.trim().is_empty());
         let Some((_, header)) = lines.next() else {
-            return Err(RecordError::TooShort);
+            return Err(RecordError::TooShort { samples: 0 });
         };
         let dialect = super::csv::Dialect::of_header(header);
         let header_cells = dialect.cells(header);
@@ -236,7 +238,9 @@ impl Record {
 
     fn check(&self, measured_columns: Measured) -> Result<(), RecordError> {
         if self.times.len() < 2 {
-            return Err(RecordError::TooShort);
+            return Err(RecordError::TooShort {
+                samples: self.times.len(),
+            });
         }
         for (k, w) in self.times.windows(2).enumerate() {
             if w[1] <= w[0] || w[1].is_nan() {
@@ -296,8 +300,9 @@ impl Record {
         match (interp, self.times.get(k + 1), self.inputs.get(k + 1)) {
             (Interp::Linear, Some(&t1), Some(next)) => {
                 let s = ((t - self.times[k]) / (t1 - self.times[k])).clamp(0.0, 1.0);
+                // The weighted mean, not `a + s (b − a)`: the difference of two finite samples may overflow.
                 for ((o, a), b) in u.iter_mut().zip(here).zip(next) {
-                    *o = a + s * (b - a);
+                    *o = a * (1.0 - s) + b * s;
                 }
             }
             _ => u.copy_from_slice(here),

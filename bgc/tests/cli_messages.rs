@@ -239,7 +239,10 @@ fn a_file_without_a_model_says_what_it_holds() {
     let refs: Vec<&str> = args.iter().map(String::as_str).collect();
     let (code, out, err) = crate::cli_support::bgc(&refs);
     assert_eq!((code, err.as_str()), (0, ""));
-    let lines: Vec<&str> = out.lines().map(|l| l.rsplit('/').next().unwrap_or(l)).collect();
+    let lines: Vec<&str> = out
+        .lines()
+        .map(|l| l.rsplit('/').next().unwrap_or(l))
+        .collect();
     assert_eq!(
         lines,
         [

@@ -115,6 +115,27 @@ fn a_time_column_named_time_is_the_time() {
     assert_eq!((code, with_time), (0, with_t), "{err}");
 }
 
+/// Tab-separated text (a spreadsheet's "Text (Tab delimited)") with a decimal comma and an empty output cell is
+/// the record written with commas.
+#[test]
+fn a_tab_separated_record_is_read_as_a_comma_separated_one() {
+    let model = temp_model("replay_tab", PUSHED_MASS);
+    let run = |name: &str, text: &str| {
+        let data = record(name, text);
+        let (code, out, err) = bgc(&[
+            "simulate", &model, "--data", &data, "--t-end", "1", "--dt-out", "0.5",
+        ]);
+        assert_eq!(code, 0, "{text}: {err}");
+        out
+    };
+    let commas = run("replay_commas", "t,F,v\n0,1.5,0.1\n0.5,-1,\n1,0,0.3\n");
+    let tabs = run(
+        "replay_tabs",
+        "t [s]\tF\tv\n0\t1,5\t0,1\n0,5\t-1\t\n1\t0\t0,3\n",
+    );
+    assert_eq!(tabs, commas);
+}
+
 /// A record read from standard input gives the run of the same record read from a file.
 #[test]
 fn a_record_may_come_from_standard_input() {
@@ -164,6 +185,11 @@ fn a_record_that_cannot_be_replayed_is_refused_with_the_cause() {
             &[][..],
             "the record has too few samples (1): it needs a header line and at least two",
         ),
+        (
+            "t,F,\n0,1,\n1,2,\n",
+            &[][..],
+            "column 3 has no name in the header",
+        ),
     ];
     for (k, (text, extra, want)) in cases.iter().enumerate() {
         let data = record(&format!("replay_error_{k}"), text);
@@ -173,6 +199,14 @@ fn a_record_that_cannot_be_replayed_is_refused_with_the_cause() {
         assert_eq!((code, out.as_str()), (1, ""), "{text}: {err}");
         assert!(err.contains(want), "{text}: {err}");
     }
+    // The note about a column of `bgc simulate` belongs to that column's error only, not to another one's.
+    let data = record("replay_error_twice", "t,F,t,energy\n0,1,0,0\n1,2,1,0\n");
+    let (code, _, err) = bgc(&["simulate", &model, "--t-end", "1", "--data", &data]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("column `t` appears twice (columns 1 and 3)") && !err.contains("energy"),
+        "{err}"
+    );
     let (code, _, err) = bgc(&["simulate", &model, "--t-end", "1", "--interp", "linear"]);
     assert_eq!(code, 2, "--interp without --data: {err}");
     assert!(err.contains("--data"), "{err}");

@@ -93,7 +93,8 @@ fn no_model_summary(sources: &SourceMap, id: bgc::span::FileId) -> String {
     match (components, imports) {
         (0, 0) => format!("{name}: no model: the file declares nothing"),
         (c, i) => {
-            let plural = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
+            let plural =
+                |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
             let held: Vec<String> = [(c, "component"), (i, "import")]
                 .into_iter()
                 .filter(|(n, _)| *n > 0)

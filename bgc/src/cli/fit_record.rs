@@ -11,8 +11,8 @@ use super::quantities::{self, Declared, factor_to_declared, split_unit};
 use bgc::equations::Equations;
 use bgc::ir::Model;
 use bgc::units::parse_unit_text;
-use bgc_runtime::fit::Record;
 use bgc_runtime::fit::csv::Dialect;
+use bgc_runtime::fit::{Record, RecordError};
 use std::collections::HashMap;
 
 /// The names of the time column: `t`, as `bgc simulate` writes it, or `time`, as FMPy and Modelica tools do.
@@ -90,8 +90,10 @@ fn read_with(
         "{blank}{}\n{body}",
         names.join(&dialect.delimiter.to_string())
     );
-    let mut record = reader(&bare, inputs, &outputs)
-        .map_err(|e| e.to_string() + &not_read(model, eqs, &names))?;
+    let mut record = reader(&bare, inputs, &outputs).map_err(|e| match &e {
+        RecordError::UnknownColumn { name, .. } => e.to_string() + &not_read(model, eqs, name),
+        _ => e.to_string(),
+    })?;
     convert(&mut record, &names, &factors, inputs, &outputs);
     Ok(record)
 }
@@ -150,18 +152,17 @@ fn convert(
     }
 }
 
-/// A sentence for a column that `bgc simulate` writes and a fit does not read, or nothing.
-fn not_read(model: &Model, eqs: &Equations, names: &[String]) -> String {
-    let states = quantities::states(model, eqs);
-    let is_output = |n: &str| eqs.outputs.iter().any(|o| o.name == n);
-    names
-        .iter()
-        .find(|n| !is_output(n) && (ENERGY_COLUMNS.contains(&n.as_str()) || states.iter().any(|s| &s.name == *n)))
-        .map(|n| {
-            format!(
-                "; `{n}` is a column of `bgc simulate` (a state or an energy), which a record does not hold: a \
-                 record holds `t`, the inputs and measured outputs (declare an `output` for what was measured)"
-            )
-        })
-        .unwrap_or_default()
+/// A sentence for a column that `bgc simulate` writes and a record does not hold (a state, an energy), or nothing.
+fn not_read(model: &Model, eqs: &Equations, name: &str) -> String {
+    let simulated = ENERGY_COLUMNS.contains(&name)
+        || quantities::states(model, eqs)
+            .iter()
+            .any(|s| s.name == name);
+    if !simulated {
+        return String::new();
+    }
+    format!(
+        "; `{name}` is a column of `bgc simulate` (a state or an energy), which a record does not hold: a record holds \
+         `t`, the inputs and measured outputs (declare an `output` for what was measured)"
+    )
 }

@@ -50,6 +50,10 @@ pub enum RecordError {
         inputs: String,
         outputs: String,
     },
+    #[error(
+        "column {column} has no name in the header: name it `t`, an input or a measured output"
+    )]
+    UnnamedColumn { column: usize },
     #[error("column `{name}` appears twice (columns {first} and {second})")]
     DuplicateColumn {
         name: String,
@@ -383,6 +387,9 @@ impl Columns {
             }
             match outputs.iter().position(|o| o == name) {
                 Some(o) => output_columns.push((c, o)),
+                None if name.is_empty() => {
+                    return Err(RecordError::UnnamedColumn { column: c + 1 });
+                }
                 None => {
                     return Err(RecordError::UnknownColumn {
                         column: c + 1,

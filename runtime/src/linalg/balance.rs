@@ -6,8 +6,15 @@
 
 use nalgebra::{DMatrix, DVector};
 
-/// The diagonal of `D` such that `D⁻¹ A D` has comparable off-diagonal row and column 1-norms.
+/// The diagonal of `D` such that `D⁻¹ A D` has comparable off-diagonal row and column 1-norms: powers of two whose
+/// reciprocals are finite, for any `a` (a row or column with a non-finite entry is left unscaled).
 pub fn balancing_scales(a: &DMatrix<f64>) -> DVector<f64> {
+    balance(a).0
+}
+
+/// The scales of [`balancing_scales`] and the balanced `D⁻¹ A D`, as the iteration formed it (no product of an entry
+/// with a ratio of scales that could overflow on the way).
+fn balance(a: &DMatrix<f64>) -> (DVector<f64>, DMatrix<f64>) {
     let n = a.nrows();
     let mut m = a.clone();
     let mut d = DVector::from_element(n, 1.0);
@@ -25,12 +32,15 @@ pub fn balancing_scales(a: &DMatrix<f64>) -> DVector<f64> {
             if c == 0.0 || r == 0.0 || !(c.is_finite() && r.is_finite()) {
                 continue;
             }
-            let f = power_of_two((r / c).sqrt());
+            let Some(f) = osborne_factor(r, c, d[i]) else {
+                continue;
+            };
             // Only rescale when it reduces the combined norm noticeably (LAPACK's 0.95 criterion).
             if (c * f + r / f) < 0.95 * (c + r) {
                 changed = true;
                 d[i] *= f;
-                for j in 0..n {
+                // The diagonal is unchanged: multiplying it by `f` first could overflow before the division.
+                for j in (0..n).filter(|&j| j != i) {
                     m[(j, i)] *= f;
                     m[(i, j)] /= f;
                 }
@@ -40,7 +50,17 @@ pub fn balancing_scales(a: &DMatrix<f64>) -> DVector<f64> {
             break;
         }
     }
-    d
+    (d, m)
+}
+
+/// The factor of one step of Osborne's iteration for a state whose scale is `scale`, with off-diagonal row and
+/// column norms `r` and `c` (positive and finite): `√(r/c)` to the nearest power of two, taken from the logarithms
+/// (`r / c` overflows for r = 1e300, c = 1e-300). `None` when the new scale or its reciprocal would not be a normal
+/// number, however many sweeps have multiplied it.
+pub fn osborne_factor(r: f64, c: f64, scale: f64) -> Option<f64> {
+    let f = 2f64.powi((0.5 * (r.log2() - c.log2())).round().clamp(-1000.0, 1000.0) as i32);
+    let scaled = scale * f;
+    (scaled.is_normal() && scaled.recip().is_normal()).then_some(f)
 }
 
 /// The power of two nearest to `x` (in the logarithmic sense); `x` must be positive and finite.
@@ -65,10 +85,7 @@ pub fn unit_scale(largest: f64) -> f64 {
 /// The Frobenius norm of the balanced `D⁻¹ A D`: the magnitude that eigenvalue errors scale with, free of the
 /// units chosen for the states.
 pub fn balanced_norm(a: &DMatrix<f64>) -> f64 {
-    let d = balancing_scales(a);
-    frobenius(&DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| {
-        a[(i, j)] * d[j] / d[i]
-    }))
+    frobenius(&balance(a).1)
 }
 
 /// The Frobenius norm of `m` without overflow or underflow of the squares: entries beyond about 1e154 (or below
@@ -102,6 +119,25 @@ mod tests {
         assert_eq!(b.trace(), a.trace());
         assert!((b.determinant() - a.determinant()).abs() < 1e-12 * a.determinant().abs());
         assert!(balanced_norm(&a) < 1e3);
+    }
+
+    /// Couplings at the ends of the f64 range (1e300 against 5e-324, found by a fuzzer): every scale and its
+    /// reciprocal stay finite (the ratio of the row and column norms overflowed, and a scale became infinite).
+    #[test]
+    fn balancing_extreme_couplings_keeps_scales_finite() {
+        let a = DMatrix::from_column_slice(
+            3,
+            3,
+            &[5e-324, 1e-300, 1e300, 0.0, 1e-300, 5e-324, 0.0, 1e160, 5e-324],
+        );
+        let d = balancing_scales(&a);
+        assert!(d.iter().all(|s| s.is_normal() && s.recip().is_normal()), "{d:?}");
+        assert!(balanced_norm(&a).is_finite());
+        // A diagonal near the largest f64 in a row that is scaled up: it was multiplied before the division and
+        // overflowed, so the balanced norm of a finite matrix was infinite.
+        let a = DMatrix::from_row_slice(2, 2, &[1e300, 1e10, 1e-10, 0.0]);
+        let norm = balanced_norm(&a);
+        assert!((norm - 1e300).abs() <= 1e-12 * 1e300, "{norm}");
     }
 
     /// The scale and its reciprocal are finite powers of two for every positive finite magnitude.

@@ -275,7 +275,8 @@ pub fn observability_rank(
     numerical_rank(&observability_matrix(a, c)?, rel_tol)
 }
 
-/// The `scale` argument of [`Domain::is_stable`] for eigenvalues of `a`.
+/// The `scale` argument of [`Domain::is_stable`] for eigenvalues of `a`: NaN when `a` has a non-finite entry (the
+/// solvers refuse such a matrix before they ask).
 pub fn stability_scale(a: &DMatrix<f64>, domain: Domain) -> f64 {
     match domain {
         Domain::Continuous => balanced_norm(a),

@@ -13,7 +13,7 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 
-use super::balance::{frobenius, power_of_two};
+use super::balance::{frobenius, osborne_factor, power_of_two};
 use super::check::{self, MatrixError};
 use super::lyapunov::LyapunovError;
 use super::pbh::{self, Domain, PbhError};
@@ -373,13 +373,18 @@ fn hamiltonian_scales(a: &DMatrix<f64>, g: &DMatrix<f64>, q: &DMatrix<f64>) -> D
             if c == 0.0 || r == 0.0 || !(c.is_finite() && r.is_finite()) {
                 continue;
             }
-            let f = power_of_two((r / c).sqrt());
+            let Some(f) = osborne_factor(r, c, d[i]) else {
+                continue;
+            };
             if c * f + r / f < 0.95 * (c + r) {
                 changed = true;
                 d[i] *= f;
                 for j in 0..n {
-                    a[(j, i)] *= f;
-                    a[(i, j)] /= f;
+                    // `A`'s diagonal is unchanged (scaled up first, it could overflow before the division).
+                    if j != i {
+                        a[(j, i)] *= f;
+                        a[(i, j)] /= f;
+                    }
                     q[(j, i)] *= f;
                     q[(i, j)] *= f;
                     g[(j, i)] /= f;

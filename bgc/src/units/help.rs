@@ -10,8 +10,17 @@ const KNOWN: [&str; 28] = [
     "F", "Ohm", "S", "Wb", "T", "H", "min", "h", "deg", "rpm", "L",
 ];
 
-/// Spellings of other tools and texts, with the symbol to write.
-const SPELLINGS: [(&str, &str); 12] = [
+/// Spellings of other tools and texts, with the symbol to write: compounds of datasheets first, which splitting
+/// into two symbols would get wrong (`Nms` is not `N ms`).
+const SPELLINGS: [(&str, &str); 20] = [
+    ("Nms", "N m s"),
+    ("mNm", "mN m"),
+    ("mNms", "mN m s"),
+    ("kgm", "kg m"),
+    ("gcm", "g cm"),
+    ("Ah", "A h"),
+    ("mAh", "mA h"),
+    ("RPM", "rpm"),
     ("sec", "s"),
     ("secs", "s"),
     ("msec", "ms"),
@@ -26,8 +35,8 @@ const SPELLINGS: [(&str, &str); 12] = [
     ("Nm", "N m"),
 ];
 
-/// Imperial and US customary units, with their value in SI.
-const IMPERIAL: [(&str, &str); 16] = [
+/// Units outside SI (imperial and US customary ones, and others of datasheets), with their value in SI.
+const NOT_SI: [(&str, &str); 22] = [
     ("in", "0.0254 m"),
     ("inch", "0.0254 m"),
     ("ft", "0.3048 m"),
@@ -44,6 +53,19 @@ const IMPERIAL: [(&str, &str); 16] = [
     ("psi", "6894.757293168361 Pa"),
     ("mph", "0.44704 m/s"),
     ("slug", "14.593902937206364 kg"),
+    ("gf", "0.00980665 N"),
+    ("kgf", "9.80665 N"),
+    ("bar", "100000 Pa"),
+    ("atm", "101325 Pa"),
+    ("kph", "1/3.6 m/s (write `km/h`)"),
+    ("rev", "2 pi rad (write revolutions per minute as `rpm`)"),
+];
+
+/// Symbols that read as two units but are one that is not SI, with what to write.
+const MISREAD: [(&str, &str); 3] = [
+    ("degC", "temperatures are in `K`: a difference of 1 degC is 1 K, and 0 degC is 273.15 K"),
+    ("degF", "temperatures are in `K`: a difference of 1 degF is 5/9 K"),
+    ("Nm2", "a pressure is `Pa` (N/m^2); for a product write `N m^2`"),
 ];
 
 /// The help for the unknown unit `symbol`.
@@ -51,8 +73,14 @@ pub fn unknown_symbol_help(symbol: &str) -> String {
     if let Some((_, write)) = SPELLINGS.iter().find(|(s, _)| *s == symbol) {
         return format!("write `{write}`");
     }
-    if let Some((_, si)) = IMPERIAL.iter().find(|(s, _)| *s == symbol) {
+    if let Some((_, si)) = NOT_SI.iter().find(|(s, _)| *s == symbol) {
         return format!("units are SI: write the value in SI units (1 {symbol} = {si})");
+    }
+    if let Some((_, help)) = MISREAD.iter().find(|(s, _)| *s == symbol) {
+        return help.to_string();
+    }
+    if let Some(known) = KNOWN.iter().find(|k| k.eq_ignore_ascii_case(symbol)) {
+        return format!("did you mean `{known}`?");
     }
     if let Some((stem, power)) = power_without_caret(symbol) {
         return format!("a unit's power follows `^`: `{stem}^{power}`");
@@ -113,6 +141,12 @@ mod tests {
                 "units are SI: write the value in SI units (1 lbf = 4.4482216152605 N)",
             ),
             ("Kg", "did you mean `kg`?"),
+            ("RPM", "write `rpm`"),
+            ("HZ", "did you mean `Hz`?"),
+            ("Nms", "write `N m s`"),
+            ("mAh", "write `mA h`"),
+            ("degC", "temperatures are in `K`: a difference of 1 degC is 1 K, and 0 degC is 273.15 K"),
+            ("bar", "units are SI: write the value in SI units (1 bar = 100000 Pa)"),
             (
                 "Ns",
                 "unit factors are separated by a space: `N s`, as in `[N m]`",

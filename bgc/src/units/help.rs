@@ -36,7 +36,7 @@ const SPELLINGS: [(&str, &str); 20] = [
 ];
 
 /// Units outside SI (imperial and US customary ones, and others of datasheets), with their value in SI.
-const NOT_SI: [(&str, &str); 22] = [
+const NOT_SI: [(&str, &str); 20] = [
     ("in", "0.0254 m"),
     ("inch", "0.0254 m"),
     ("ft", "0.3048 m"),
@@ -57,12 +57,12 @@ const NOT_SI: [(&str, &str); 22] = [
     ("kgf", "9.80665 N"),
     ("bar", "100000 Pa"),
     ("atm", "101325 Pa"),
-    ("kph", "1/3.6 m/s (write `km/h`)"),
-    ("rev", "2 pi rad (write revolutions per minute as `rpm`)"),
 ];
 
 /// Symbols that read as two units but are one that is not SI, with what to write.
-const MISREAD: [(&str, &str); 3] = [
+const MISREAD: [(&str, &str); 5] = [
+    ("rev", "a revolution is 2 pi rad: write angles in `rad` or `deg`, and revolutions per minute as `rpm`"),
+    ("kph", "write `km/h`"),
     ("degC", "temperatures are in `K`: a difference of 1 degC is 1 K, and 0 degC is 273.15 K"),
     ("degF", "temperatures are in `K`: a difference of 1 degF is 5/9 K"),
     ("Nm2", "a pressure is `Pa` (N/m^2); for a product write `N m^2`"),

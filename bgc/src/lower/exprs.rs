@@ -237,12 +237,16 @@ impl Builder<'_> {
                     Some(_) => {}
                     None => self.unmatched_name = true,
                 }
-                d = match (suggestion, cx.allow) {
-                    (Some(c), _) => d.with_help(format!("did you mean `{c}`?")),
-                    (None, Allow::Constant) => d.with_help(
+                d = match (suggestion, other_tool_constant(name), cx.allow) {
+                    (Some(c), _, _) => d.with_help(format!("did you mean `{c}`?")),
+                    (None, Some((help, Some(fix))), _) => d.with_help(help).with_fix(fix),
+                    (None, Some((help, None)), _) => d.with_help(help),
+                    (None, None, Allow::Constant) => d.with_help(
                         "a parameter default may use only parameters declared before it",
                     ),
-                    (None, _) => d.with_help("declare it as a `param`, `input`, `output` or `var`"),
+                    (None, None, _) => {
+                        d.with_help("declare it as a `param`, `input`, `output` or `var`")
+                    }
                 };
                 self.diags.push(d);
                 None
@@ -667,6 +671,18 @@ pub(crate) fn var_letter(v: PortVar) -> &'static str {
         PortVar::Momentum => "p",
         PortVar::Displacement => "q",
     }
+}
+
+/// What bgc writes for a constant of other tools and languages (`PI`, `M_PI`, Euler's `e`), with the certain fix.
+fn other_tool_constant(name: &str) -> Option<(&'static str, Option<&'static str>)> {
+    Some(match name {
+        "PI" | "Pi" | "M_PI" => ("write `pi`", Some("pi")),
+        "e" | "E" | "M_E" => (
+            "Euler's number is `exp(1)`, and `e^x` is `exp(x)` (`e(x)` is the effort of element `x`)",
+            None,
+        ),
+        _ => return None,
+    })
 }
 
 /// What bgc writes for a function name of other modelling tools and languages, or `None`.

@@ -423,9 +423,10 @@ fn two_unit_symbols_written_together_are_told_apart_from_a_case_slip() {
             "Ns/m",
             Some("unit factors are separated by a space: `N s`, as in `[N m]`"),
         ),
+        ("kgm^2", Some("write `kg m`")),
         (
-            "kgm^2",
-            Some("unit factors are separated by a space: `kg m`, as in `[N m]`"),
+            "Wh",
+            Some("unit factors are separated by a space: `W h`, as in `[N m]`"),
         ),
         // `K g` would split too, but a case slip of a known unit comes first.
         ("Kg", Some("did you mean `kg`?")),
@@ -1032,5 +1033,34 @@ fn a_mismatch_of_angle_like_units_explains_the_missing_rad() {
         assert_eq!(mismatch.len(), 1, "{expr}: {diags:#?}");
         let says = mismatch[0].notes.iter().any(|n| n.contains("`rad` is 1"));
         assert_eq!(says, noted, "{expr}: {:?}", mismatch[0].notes);
+    }
+}
+
+/// Constants as other tools spell them: `PI` and `M_PI` get `pi` as their certain fix, Euler's `e` the way to write
+/// it (it is no name here: `e(x)` is an effort).
+#[test]
+fn constants_of_other_tools_say_how_to_write_them() {
+    for (value, help, fix) in [
+        ("2*PI", "write `pi`", Some("pi")),
+        ("M_PI/2", "write `pi`", Some("pi")),
+        (
+            "e^2",
+            "Euler's number is `exp(1)`, and `e^x` is `exp(x)`",
+            None,
+        ),
+    ] {
+        let text = format!("model m {{\n    param a = {value} [1];\n    output y [1] = a;\n}}\n");
+        let (_, diags, _) = lower_text(&text);
+        let unknown: Vec<&Diagnostic> = diags.iter().filter(|d| d.code.0 == "BG0201").collect();
+        assert_eq!(unknown.len(), 1, "{value}: {diags:#?}");
+        assert!(
+            unknown[0]
+                .help
+                .as_deref()
+                .is_some_and(|h| h.starts_with(help)),
+            "{value}: {:?}",
+            unknown[0].help
+        );
+        assert_eq!(unknown[0].fix(), fix, "{value}");
     }
 }

@@ -130,9 +130,10 @@ pub fn code_actions(analysis: &Analysis, uri: &Uri, range: Range) -> Vec<CodeAct
             ..lsp_types::Diagnostic::default()
         };
         out.push(CodeActionOrCommand::CodeAction(CodeAction {
-            title: match written.trim().is_empty() {
-                true => "Replace the space that is not ASCII with a space".to_string(),
-                false => format!("Replace `{written}` with `{replacement}`"),
+            title: match (written.trim().is_empty(), replacement.is_empty()) {
+                (true, _) => "Replace the space that is not ASCII with a space".to_string(),
+                (false, true) => format!("Remove `{written}`"),
+                (false, false) => format!("Replace `{written}` with `{replacement}`"),
             },
             kind: Some(CodeActionKind::QUICKFIX),
             diagnostics: Some(vec![diagnostic]),

@@ -116,12 +116,14 @@ impl<'a> Parser<'a> {
         let mut levels = 0;
         let result = (|| {
             let mut lhs = operand(self, index)?;
+            self.elementwise_dot();
             while let Some(op) = operator(self.peek().kind) {
                 self.enter_chain()?;
                 levels += 1;
                 self.bump();
                 let rhs = operand(self, index)?;
                 lhs = binary(op, lhs, rhs);
+                self.elementwise_dot();
             }
             Ok(lhs)
         })();
@@ -150,8 +152,28 @@ impl<'a> Parser<'a> {
         self.power(index)
     }
 
+    /// MATLAB's element-wise `.*`, `./` and `.^` (a dot right before the operator): one error whose fix removes
+    /// the dot, and the operator is read, so that the expression is the one meant.
+    fn elementwise_dot(&mut self) {
+        let (dot, op) = (self.peek(), self.nth(1));
+        if dot.kind == Tok::Dot
+            && matches!(op.kind, Tok::Star | Tok::Slash | Tok::Caret)
+            && op.start == dot.end
+        {
+            self.bump();
+            let written = self.tok_text(op).to_string();
+            self.diags.push(
+                Diagnostic::error("BG0101", format!("`.{written}` is not an operator"))
+                    .with_primary(self.tok_span(dot), "MATLAB's element-wise operator")
+                    .with_help(format!("every quantity is a number: write `{written}`"))
+                    .with_fix(""),
+            );
+        }
+    }
+
     fn power(&mut self, index: bool) -> PResult<Expr> {
         let base = self.primary(index)?;
+        self.elementwise_dot();
         if self.eat(Tok::Caret).is_none() {
             return Ok(base);
         }

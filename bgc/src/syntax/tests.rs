@@ -783,6 +783,41 @@ fn hyphens_in_a_unit_are_read_as_meant_with_their_fix() {
     }
 }
 
+/// MATLAB's element-wise operators: one error each whose fix removes the dot, and the expression is the one meant
+/// (`m.^2/m` is `(m^2)/m`), so no error follows from it.
+#[test]
+fn elementwise_operators_are_read_as_the_operator_with_the_dot_removed() {
+    let with_dots = "model m { param a = 1 [1]; param b = a.^2 ./a.*3 [1]; }";
+    let without = "model m { param a = 1 [1]; param b = a^2/a*3 [1]; }";
+    let (file, diags) = parse(FileId(0), with_dots);
+    let found: Vec<(Option<&str>, Option<usize>)> = diags
+        .iter()
+        .map(|d| (d.fix(), d.primary_span().map(|s| s.start as usize)))
+        .collect();
+    let dots: Vec<(Option<&str>, Option<usize>)> = with_dots
+        .match_indices(['.'])
+        .map(|(i, _)| (Some(""), Some(i)))
+        .collect();
+    assert_eq!(found, dots);
+    let (plain, none) = parse(FileId(0), without);
+    assert!(none.is_empty(), "{none:#?}");
+    // The tree without places: numbers, names and operators.
+    fn shape(e: &Expr) -> String {
+        match &e.kind {
+            ExprKind::Binary(op, a, b) => format!("({} {op:?} {})", shape(a), shape(b)),
+            ExprKind::Number(v) => v.to_string(),
+            ExprKind::Name(n) => n.clone(),
+            other => format!("{other:?}"),
+        }
+    }
+    let value = |f: &File| match body_of(f) {
+        [_, Stmt::Param(p)] => shape(&p.default),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(value(&file), "(((a Pow 2) Div a) Mul 3)");
+    assert_eq!(value(&plain), value(&file));
+}
+
 #[test]
 fn a_bad_model_name_is_one_error_and_the_body_is_read() {
     let (file, diags) = parse(FileId(0), "model 3 { param a = 1 [1]; }");

@@ -62,3 +62,56 @@ fn the_fixes_of_pasted_characters_and_greek_names_leave_no_error() {
     assert!(left.is_empty(), "{left:#?}");
     assert_eq!(client.shutdown(), Ok(()));
 }
+
+/// Units and operators as other tools write them (`[N*m]`, `[N-m]`, `[s-1]`, `[-]`, `.^`, `PI`): each error's fix is
+/// certain, and applied together they leave a model without errors.
+#[test]
+fn the_fixes_of_other_tools_spellings_leave_no_error() {
+    const WRITTEN: &str = "model b {\n    domain rotational;\n    param J = 2 [kg*m^2];\n    \
+                           param k = 3 [N-m/rad];\n    param w = 2*PI [s-1];\n    param r = 0.5 [-];\n    \
+                           Se s = 1;\n    I i = J.*r.^2;\n    C c = 1/k;\n    output y [1] = w/w;\n    \
+                           1 j;\n    bond s -> j -> i, c;\n}\n";
+    let mut client = Client::start();
+    let doc = uri(&unsaved("other_tools.bg"));
+    client.open(&doc, WRITTEN);
+    let found = client.diagnostics(&doc, 1);
+    assert_eq!(found.len(), 7, "{found:#?}");
+    let actions = client
+        .request::<CodeActionRequest>(lsp_types::CodeActionParams {
+            text_document: TextDocumentIdentifier::new(doc.clone()),
+            range: range(0, 0, 13, 0),
+            context: Default::default(),
+            work_done_progress_params: Default::default(),
+            partial_result_params: Default::default(),
+        })
+        .expect("code actions answer")
+        .unwrap_or_default();
+    let mut edits = Vec::new();
+    for action in &actions {
+        let CodeActionOrCommand::CodeAction(fix) = action else {
+            panic!("a code action")
+        };
+        if let Some(changes) = fix.edit.as_ref().and_then(|e| e.changes.as_ref()) {
+            edits.extend(changes[&doc].iter().cloned());
+        }
+    }
+    let fixed = apply(WRITTEN, &edits);
+    assert_eq!(
+        fixed,
+        "model b {\n    domain rotational;\n    param J = 2 [kg m^2];\n    param k = 3 [N m/rad];\n    \
+         param w = 2*pi [s^-1];\n    param r = 0.5 [1];\n    Se s = 1;\n    I i = J*r^2;\n    C c = 1/k;\n    \
+         output y [1] = w/w;\n    1 j;\n    bond s -> j -> i, c;\n}\n"
+    );
+    client.change(
+        &doc,
+        2,
+        vec![lsp_types::TextDocumentContentChangeEvent {
+            range: None,
+            range_length: None,
+            text: fixed,
+        }],
+    );
+    let left = client.diagnostics(&doc, 2);
+    assert!(left.is_empty(), "{left:#?}");
+    assert_eq!(client.shutdown(), Ok(()));
+}

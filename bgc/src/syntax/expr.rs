@@ -402,10 +402,19 @@ impl<'a> Parser<'a> {
     /// `[N m/rad]`, `[kg m^2]`, `[1]`, `[1/s]`: factors with optional integer powers, one optional `/`, everything
     /// after which is the denominator.
     pub(super) fn unit(&mut self) -> PResult<UnitExpr> {
+        if self.at(Tok::Ident) {
+            // `param m = 1 kg;`: the unit without its brackets.
+            let symbol = self.tok_text(self.peek()).to_string();
+            return Err(self.expected(
+                "a unit in brackets",
+                &format!("a unit goes in brackets: `[{symbol}]`"),
+            ));
+        }
         let open = self.expect(
             Tok::LBracket,
             "a unit in brackets",
-            "write the unit after the name, as in `[N m]`, `[m/s^2]` or `[1]` for dimensionless",
+            "every parameter, input and output has a unit in brackets, as in `[N m]`, `[m/s^2]` or `[1]` for \
+             dimensionless",
         )?;
         let mut numerator = Vec::new();
         let mut denominator = Vec::new();

@@ -3,11 +3,31 @@
 use super::parser::KEYWORDS;
 use crate::diagnostic::suggest::edit_distance;
 
+/// Keywords of other modelling languages (Modelica, 20-sim's SIDOPS, MATLAB, Python) with bgc's keyword for the
+/// same statement.
+const OTHER_LANGUAGES: [(&str, &str); 12] = [
+    ("parameter", "param"),
+    ("parameters", "param"),
+    ("const", "param"),
+    ("constant", "param"),
+    ("constants", "param"),
+    ("let", "param"),
+    ("inputs", "input"),
+    ("outputs", "output"),
+    ("variable", "var"),
+    ("variables", "var"),
+    ("connect", "bond"),
+    ("submodel", "component"),
+];
+
 /// The keyword `word` is most likely a misspelling of: one edit away (two for words of six letters or more), case
 /// ignored. Element kinds are left out: short words like `C` are one edit away from too many names.
 pub fn keyword_like(word: &str) -> Option<&'static str> {
     if word.len() > 32 {
         return None;
+    }
+    if let Some((_, kw)) = OTHER_LANGUAGES.iter().find(|(w, _)| *w == word) {
+        return Some(kw);
     }
     let lower = word.to_ascii_lowercase();
     KEYWORDS
@@ -30,5 +50,8 @@ mod tests {
         assert_eq!(keyword_like("ouput"), Some("output"));
         assert_eq!(keyword_like("Bond"), Some("bond"));
         assert_eq!(keyword_like("spring_damper"), None);
+        assert_eq!(keyword_like("parameter"), Some("param"));
+        assert_eq!(keyword_like("const"), Some("param"));
+        assert_eq!(keyword_like("connect"), Some("bond"));
     }
 }

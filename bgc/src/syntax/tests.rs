@@ -818,6 +818,22 @@ fn elementwise_operators_are_read_as_the_operator_with_the_dot_removed() {
     assert_eq!(value(&plain), value(&file));
 }
 
+/// Statements as other languages write them get the statement bgc has: Modelica's `parameter`, a `const`, a unit
+/// without its brackets.
+#[test]
+fn statements_of_other_languages_say_what_to_write() {
+    for (stmt, help) in [
+        ("parameter m = 1 [kg];", "did you mean the keyword `param`?"),
+        ("const m = 1 [kg];", "did you mean the keyword `param`?"),
+        ("param m = 1 kg;", "a unit goes in brackets: `[kg]`"),
+        ("input u N;", "a unit goes in brackets: `[N]`"),
+    ] {
+        let (_, diags) = parse(FileId(0), &format!("model m {{ {stmt} }}"));
+        assert_eq!(diags.len(), 1, "{stmt}: {diags:#?}");
+        assert_eq!(diags[0].help.as_deref(), Some(help), "{stmt}");
+    }
+}
+
 #[test]
 fn a_bad_model_name_is_one_error_and_the_body_is_read() {
     let (file, diags) = parse(FileId(0), "model 3 { param a = 1 [1]; }");

@@ -403,11 +403,25 @@ impl<'a> Parser<'a> {
     /// after which is the denominator.
     pub(super) fn unit(&mut self) -> PResult<UnitExpr> {
         if self.at(Tok::Ident) {
-            // `param m = 1 kg;`: the unit without its brackets.
-            let symbol = self.tok_text(self.peek()).to_string();
+            // `param k = 2 N/m;`: the unit without its brackets, up to the end of the statement on this line.
+            let first = self.peek();
+            let mut last = first;
+            let mut k = 1;
+            while matches!(
+                self.nth(k).kind,
+                Tok::Ident | Tok::Slash | Tok::Caret | Tok::Minus | Tok::Number
+            ) && !self.starts_line(self.nth(k))
+            {
+                last = self.nth(k);
+                k += 1;
+            }
+            let unit = self
+                .text
+                .get(first.start as usize..last.end as usize)
+                .unwrap_or("");
             return Err(self.expected(
                 "a unit in brackets",
-                &format!("a unit goes in brackets: `[{symbol}]`"),
+                &format!("a unit goes in brackets: `[{unit}]`"),
             ));
         }
         let open = self.expect(

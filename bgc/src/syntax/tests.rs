@@ -827,6 +827,14 @@ fn statements_of_other_languages_say_what_to_write() {
         ("const m = 1 [kg];", "did you mean the keyword `param`?"),
         ("param m = 1 kg;", "a unit goes in brackets: `[kg]`"),
         ("input u N;", "a unit goes in brackets: `[N]`"),
+        (
+            "param k = 2 N/m \"spring\";",
+            "a unit goes in brackets: `[N/m]`",
+        ),
+        (
+            "param g = 9.81 m/s^2;",
+            "a unit goes in brackets: `[m/s^2]`",
+        ),
     ] {
         let (_, diags) = parse(FileId(0), &format!("model m {{ {stmt} }}"));
         assert_eq!(diags.len(), 1, "{stmt}: {diags:#?}");

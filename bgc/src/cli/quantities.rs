@@ -134,9 +134,16 @@ pub fn factor_to_declared(what: &str, d: &Declared, written: Option<&str>) -> Re
     };
     let unit = parse_unit_text(text).map_err(|e| format!("{what} `{}`: {e}", d.name))?;
     if unit.dim != d.unit.dim {
+        // The declared unit as written, and in SI where that reads differently (`[mH]` (kg m^2/s^2 A^2), but not
+        // `[N s]` (N s)).
+        let si = d.unit.dim.to_string();
+        let declared = match si == d.text.trim() {
+            true => format!("[{}]", d.text),
+            false => format!("[{}] ({si})", d.text),
+        };
         return Err(format!(
-            "{what} `{}` is in [{}] ({}), but [{text}] is in {}",
-            d.name, d.text, d.unit.dim, unit.dim
+            "{what} `{}` is in {declared}, but [{text}] is in {}",
+            d.name, unit.dim
         ));
     }
     Ok(unit.scale / d.unit.scale)

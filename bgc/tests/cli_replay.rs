@@ -136,6 +136,29 @@ fn a_tab_separated_record_is_read_as_a_comma_separated_one() {
     assert_eq!(tabs, commas);
 }
 
+/// A record with nothing to replay (a model without inputs, or every input given with `--input`) is said so,
+/// instead of being read and silently left unused.
+#[test]
+fn a_record_with_nothing_to_replay_is_said_so() {
+    let model = temp_model("replay_nothing", PUSHED_MASS);
+    let only_t = record("replay_nothing_t", "t\n0\n1\n");
+    let (code, _, err) = bgc(&[
+        "simulate", &model, "--t-end", "1", "--data", &only_t, "--input", "F=1",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("every input is given with --input: nothing of the record"),
+        "{err}"
+    );
+    let pendulum = crate::cli_support::repo("models/pendulum_rig.bg");
+    let (code, _, err) = bgc(&["simulate", &pendulum, "--t-end", "0.1", "--data", &only_t]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("the model has no inputs: nothing of the record"),
+        "{err}"
+    );
+}
+
 /// A record read from standard input gives the run of the same record read from a file.
 #[test]
 fn a_record_may_come_from_standard_input() {

@@ -44,10 +44,16 @@ pub fn recorded_inputs(
             .map_err(|e| format!("{place}: input `{}`: {e}", eqs.inputs[input]))?;
         signals.push((input, Signal::Samples(samples)));
     }
-    Ok(Recorded {
-        warning: coverage_warning(&place.to_string(), &record.times, t_end),
-        signals,
-    })
+    let warning = match (read.is_empty(), eqs.inputs.is_empty()) {
+        (true, true) => Some(format!(
+            "the model has no inputs: nothing of the record {place} is replayed"
+        )),
+        (true, false) => Some(format!(
+            "every input is given with --input: nothing of the record {place} is replayed"
+        )),
+        (false, _) => coverage_warning(&place.to_string(), &record.times, t_end),
+    };
+    Ok(Recorded { warning, signals })
 }
 
 /// A warning when the record starts after 0 or ends before `t_end`: its end values then hold.

@@ -39,7 +39,11 @@ pub fn recorded_inputs(
         .collect();
     let mut signals = Vec::with_capacity(read.len());
     for (column, &input) in read.iter().enumerate() {
-        let values = record.inputs.iter().map(|row| row[column]).collect();
+        let values = record
+            .inputs
+            .iter()
+            .map(|row| row.get(column).copied().unwrap_or(f64::NAN))
+            .collect();
         let samples = Samples::new(record.times.clone(), values, arg.replay)
             .map_err(|e| format!("{place}: input `{}`: {e}", eqs.inputs[input]))?;
         signals.push((input, Signal::Samples(samples)));

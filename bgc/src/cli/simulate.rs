@@ -7,6 +7,7 @@ use super::quantities;
 pub use super::replay::RecordArg;
 use super::replay::recorded_inputs;
 use super::{Solver, Status};
+use bgc::simulate::input::Signal;
 use bgc::simulate::integrate::{Method, RunOptions, run_streaming_noted};
 use bgc::simulate::{SimError, System};
 use std::fmt::Write as _;
@@ -116,22 +117,7 @@ fn csv(
     // The options are checked before anything else is said about the run.
     opts.check().map_err(option_error)?;
     let params = param_values(model, eqs, args.params)?;
-    let (mut signals, mut held_at_zero) = input_signals(model, args.inputs)?;
-    if let Some((arg, text)) = record {
-        let recorded = recorded_inputs(model, eqs, arg, text, args.inputs, args.t_end)?;
-        for (i, signal) in recorded.signals {
-            held_at_zero.retain(|n| Some(n) != eqs.inputs.get(i));
-            if let Some(slot) = signals.get_mut(i) {
-                *slot = signal;
-            }
-        }
-        if let Some(w) = recorded.warning {
-            stderrln(&format!("warning: {w}"));
-        }
-    }
-    if let Some(w) = zero_inputs_warning(&held_at_zero) {
-        stderrln(&w);
-    }
+    let signals = signals(model, eqs, args, record)?;
     let (system, warnings) =
         System::new(eqs, params.clone(), signals).map_err(|e| e.to_string())?;
     // An energy term without a closed form is left out of its column: the balance cannot be checked then.
@@ -208,6 +194,33 @@ fn csv(
         n => format!("{e} (the {n} rows before it were printed)"),
     })?;
     flushed.map_err(Failure::Output)
+}
+
+/// The input signals: the expressions of `--input`, the record's samples for the others, 0 for the rest (with a
+/// warning that names them).
+fn signals(
+    model: &bgc::ir::Model,
+    eqs: &bgc::equations::Equations,
+    args: &SimulateArgs<'_>,
+    record: Option<(RecordArg<'_>, &str)>,
+) -> Result<Vec<Signal>, String> {
+    let (mut signals, mut held_at_zero) = input_signals(model, args.inputs)?;
+    if let Some((arg, text)) = record {
+        let recorded = recorded_inputs(model, eqs, arg, text, args.inputs, args.t_end)?;
+        for (i, signal) in recorded.signals {
+            held_at_zero.retain(|n| Some(n) != eqs.inputs.get(i));
+            if let Some(slot) = signals.get_mut(i) {
+                *slot = signal;
+            }
+        }
+        if let Some(w) = recorded.warning {
+            stderrln(&format!("warning: {w}"));
+        }
+    }
+    if let Some(w) = zero_inputs_warning(&held_at_zero) {
+        stderrln(&w);
+    }
+    Ok(signals)
 }
 
 /// An option that no run can have, named as the command line spells it (`--t-end`, not the field `t_end`).

@@ -61,11 +61,23 @@ const NOT_SI: [(&str, &str); 20] = [
 
 /// Symbols that read as two units but are one that is not SI, with what to write.
 const MISREAD: [(&str, &str); 5] = [
-    ("rev", "a revolution is 2 pi rad: write angles in `rad` or `deg`, and revolutions per minute as `rpm`"),
+    (
+        "rev",
+        "a revolution is 2 pi rad: write angles in `rad` or `deg`, and revolutions per minute as `rpm`",
+    ),
     ("kph", "write `km/h`"),
-    ("degC", "temperatures are in `K`: a difference of 1 degC is 1 K, and 0 degC is 273.15 K"),
-    ("degF", "temperatures are in `K`: a difference of 1 degF is 5/9 K"),
-    ("Nm2", "a pressure is `Pa` (N/m^2); for a product write `N m^2`"),
+    (
+        "degC",
+        "temperatures are in `K`: a difference of 1 degC is 1 K, and 0 degC is 273.15 K",
+    ),
+    (
+        "degF",
+        "temperatures are in `K`: a difference of 1 degF is 5/9 K",
+    ),
+    (
+        "Nm2",
+        "a pressure is `Pa` (N/m^2); for a product write `N m^2`",
+    ),
 ];
 
 /// The help for the unknown unit `symbol`.
@@ -145,8 +157,14 @@ mod tests {
             ("HZ", "did you mean `Hz`?"),
             ("Nms", "write `N m s`"),
             ("mAh", "write `mA h`"),
-            ("degC", "temperatures are in `K`: a difference of 1 degC is 1 K, and 0 degC is 273.15 K"),
-            ("bar", "units are SI: write the value in SI units (1 bar = 100000 Pa)"),
+            (
+                "degC",
+                "temperatures are in `K`: a difference of 1 degC is 1 K, and 0 degC is 273.15 K",
+            ),
+            (
+                "bar",
+                "units are SI: write the value in SI units (1 bar = 100000 Pa)",
+            ),
             (
                 "Ns",
                 "unit factors are separated by a space: `N s`, as in `[N m]`",

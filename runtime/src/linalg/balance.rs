@@ -128,10 +128,15 @@ mod tests {
         let a = DMatrix::from_column_slice(
             3,
             3,
-            &[5e-324, 1e-300, 1e300, 0.0, 1e-300, 5e-324, 0.0, 1e160, 5e-324],
+            &[
+                5e-324, 1e-300, 1e300, 0.0, 1e-300, 5e-324, 0.0, 1e160, 5e-324,
+            ],
         );
         let d = balancing_scales(&a);
-        assert!(d.iter().all(|s| s.is_normal() && s.recip().is_normal()), "{d:?}");
+        assert!(
+            d.iter().all(|s| s.is_normal() && s.recip().is_normal()),
+            "{d:?}"
+        );
         assert!(balanced_norm(&a).is_finite());
         // A diagonal near the largest f64 in a row that is scaled up: it was multiplied before the division and
         // overflowed, so the balanced norm of a finite matrix was infinite.

@@ -303,7 +303,11 @@ fn a_product_the_record_cannot_split_is_named_and_held() {
 
 /// Runs `bgc fit` on `model` with a record and returns the exit code and standard error.
 fn refused(model: &str, record: &str, free: &str) -> (i32, String) {
-    let data = temp_file(&format!("bad-{}.csv", record.len()), record);
+    // One file per call: tests run in parallel, and two records of one length (the name this had) overwrote each
+    // other between writing and reading.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let data = temp_file(&format!("bad-{call}.csv"), record);
     let (code, _, err) = bgc(&["fit", model, "--data", &data, "--free", free]);
     (code, err)
 }

@@ -11,9 +11,8 @@ use std::path::{Path, PathBuf};
 
 /// `bgc check FILE...`
 pub fn check(files: &[PathBuf], format: DiagFormat, color: bool) -> Status {
-    if let Err(msg) = stdin_once(files.iter().map(PathBuf::as_path)) {
-        stderrln(&format!("error: {msg}"));
-        return Status::UsageOrIo;
+    if let Err(status) = stdin_once(files.iter().map(PathBuf::as_path)) {
+        return status;
     }
     let mut sources = SourceMap::new();
     let mut all_diags: Vec<Diagnostic> = Vec::new();
@@ -44,10 +43,10 @@ pub fn check(files: &[PathBuf], format: DiagFormat, color: bool) -> Status {
                 diags.extend(found);
             }
         }
-        if !has_errors(&diags) && models.is_empty() {
-            summaries.push(no_model_summary(&sources, id));
-        }
         if !has_errors(&diags) {
+            if models.is_empty() {
+                summaries.push(no_model_summary(&sources, id));
+            }
             for m in &models {
                 summaries.push(format!(
                     "{}: model `{}`: {} elements and junctions, {} bonds, {} parameters",
@@ -107,9 +106,8 @@ fn no_model_summary(sources: &SourceMap, id: bgc::span::FileId) -> String {
 
 /// `bgc fmt [--check] FILE...`
 pub fn fmt(files: &[PathBuf], check_only: bool, color: bool) -> Status {
-    if let Err(msg) = stdin_once(files.iter().map(PathBuf::as_path)) {
-        stderrln(&format!("error: {msg}"));
-        return Status::UsageOrIo;
+    if let Err(status) = stdin_once(files.iter().map(PathBuf::as_path)) {
+        return status;
     }
     let mut status = Status::Ok;
     for path in files {

@@ -32,9 +32,8 @@ pub struct FitArgs<'a> {
 
 /// `bgc fit FILE --data LOG.csv --free NAMES`
 pub fn run(path: &Path, wanted: Option<&str>, args: &FitArgs<'_>, color: bool) -> Status {
-    if let Err(msg) = super::io::stdin_once([path, args.data]) {
-        stderrln(&format!("error: {msg}"));
-        return Status::UsageOrIo;
+    if let Err(status) = super::io::stdin_once([path, args.data]) {
+        return status;
     }
     let (d, _) = match derive_one(path, wanted, color, true) {
         Ok(x) => x,

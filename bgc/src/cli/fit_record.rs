@@ -44,7 +44,7 @@ pub fn read_inputs(
     read_with(model, eqs, text, &inputs, Record::inputs_from_csv)
 }
 
-type Reader = fn(&str, &[&str], &[&str]) -> Result<Record, bgc_runtime::fit::RecordError>;
+type Reader = fn(&str, &[&str], &[&str]) -> Result<Record, RecordError>;
 
 /// Reads the record with the columns of `inputs`, converting units, by `reader`.
 fn read_with(
@@ -132,11 +132,10 @@ fn convert(
             .copied()
             .unwrap_or(1.0)
     };
-    // The time column is `t`, else `time` (the runtime's reader takes them in that order).
-    let t = match names.iter().any(|n| n == "t") {
-        true => factor("t"),
-        false => factor("time"),
-    };
+    let t = Record::time_column(names, inputs, outputs)
+        .and_then(|c| factors.get(c))
+        .copied()
+        .unwrap_or(1.0);
     record.times.iter_mut().for_each(|v| *v *= t);
     let per_input: Vec<f64> = inputs.iter().map(|n| factor(n)).collect();
     for row in &mut record.inputs {

@@ -136,13 +136,17 @@ pub fn refuse_overwrite(output: &Path, sources: &SourceMap, others: &[&Path]) ->
 pub const MAX_RECORD_BYTES: u64 = 256 << 20;
 
 /// Refuses a command line that names standard input (`-`) more than once: the first read would take it all and
-/// the others would see an empty file.
-pub fn stdin_once<'a>(paths: impl IntoIterator<Item = &'a Path>) -> Result<(), String> {
+/// the others would see an empty file. Prints the error; the caller ends with the status returned.
+pub fn stdin_once<'a>(paths: impl IntoIterator<Item = &'a Path>) -> Result<(), crate::cli::Status> {
     match paths.into_iter().filter(|p| is_stdin(p)).count() {
         0 | 1 => Ok(()),
-        n => Err(format!(
-            "standard input (`-`) is named {n} times, but it can be read only once: save all but one of them to files"
-        )),
+        n => {
+            stderrln(&format!(
+                "error: standard input (`-`) is named {n} times, but it can be read only once: save all but one \
+                 of them to files"
+            ));
+            Err(crate::cli::Status::UsageOrIo)
+        }
     }
 }
 

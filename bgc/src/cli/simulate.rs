@@ -53,25 +53,29 @@ fn default_dt_out(args: &SimulateArgs<'_>) -> Result<f64, String> {
 
 /// `bgc simulate FILE --t-end T`
 pub fn simulate(path: &Path, wanted: Option<&str>, args: &SimulateArgs<'_>, color: bool) -> Status {
-    let record_path = args.record.map(|r| r.path);
-    if let Err(msg) = super::io::stdin_once(std::iter::once(path).chain(record_path)) {
-        stderrln(&format!("error: {msg}"));
-        return Status::UsageOrIo;
+    if let Err(status) =
+        super::io::stdin_once(std::iter::once(path).chain(args.record.map(|r| r.path)))
+    {
+        return status;
     }
     let (d, _) = match derive_one(path, wanted, color, true) {
         Ok(x) => x,
         Err(s) => return s,
     };
-    let record = match args.record.map(|r| (r, super::io::read_record(r.path))) {
-        None => None,
-        Some((r, Ok(text))) => Some((r, text)),
-        Some((r, Err(e))) => {
-            stderrln(&format!("error: cannot read {}: {e}", r.path.display()));
+    let read = |path: &Path| super::io::read_record(path).map_err(|e| (path.to_path_buf(), e));
+    let text = match args.record.map(|r| read(r.path)).transpose() {
+        Ok(text) => text,
+        Err((path, e)) => {
+            stderrln(&format!("error: cannot read {}: {e}", path.display()));
             return Status::UsageOrIo;
         }
     };
-    let record = record.as_ref().map(|(r, text)| (*r, text.as_str()));
-    match csv(&d.loaded.model, &d.eqs, args, record) {
+    match csv(
+        &d.loaded.model,
+        &d.eqs,
+        args,
+        args.record.zip(text.as_deref()),
+    ) {
         Ok(()) => Status::Ok,
         Err(Failure::Input(msg)) => {
             stderrln(&format!("error: {msg}"));

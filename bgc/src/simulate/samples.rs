@@ -71,23 +71,20 @@ impl Samples {
 
     /// The value at `t`.
     pub fn eval(&self, t: f64) -> f64 {
-        // The sample at or before `t`; `None` before the first.
-        let at = self.times.partition_point(|&s| s <= t).checked_sub(1);
-        let (Some(k), Some(&last)) = (at, self.values.last()) else {
+        // The sample at or before `t`: before the first, the first value holds.
+        let Some(k) = self.times.partition_point(|&s| s <= t).checked_sub(1) else {
             return match self.replay {
                 Replay::Slope => 0.0,
                 _ => self.values.first().copied().unwrap_or(f64::NAN),
             };
         };
         let (v0, t0) = (self.values[k], self.times[k]);
-        let (v1, t1) = match (self.values.get(k + 1), self.times.get(k + 1)) {
-            (Some(&v1), Some(&t1)) => (v1, t1),
-            _ => {
-                return match self.replay {
-                    Replay::Slope => 0.0,
-                    _ => last,
-                };
-            }
+        // From the last sample on, the last value holds.
+        let (Some(&v1), Some(&t1)) = (self.values.get(k + 1), self.times.get(k + 1)) else {
+            return match self.replay {
+                Replay::Slope => 0.0,
+                _ => v0,
+            };
         };
         match self.replay {
             Replay::Hold => v0,

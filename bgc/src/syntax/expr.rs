@@ -116,14 +116,12 @@ impl<'a> Parser<'a> {
         let mut levels = 0;
         let result = (|| {
             let mut lhs = operand(self, index)?;
-            self.elementwise_dot();
             while let Some(op) = operator(self.peek().kind) {
                 self.enter_chain()?;
                 levels += 1;
                 self.bump();
                 let rhs = operand(self, index)?;
                 lhs = binary(op, lhs, rhs);
-                self.elementwise_dot();
             }
             Ok(lhs)
         })();
@@ -153,7 +151,8 @@ impl<'a> Parser<'a> {
     }
 
     /// MATLAB's element-wise `.*`, `./` and `.^` (a dot right before the operator): one error whose fix removes
-    /// the dot, and the operator is read, so that the expression is the one meant.
+    /// the dot, and the operator is read, so that the expression is the one meant. Called after every operand
+    /// ([`Self::power`]), so it sees the dot before any binary operator.
     fn elementwise_dot(&mut self) {
         let (dot, op) = (self.peek(), self.nth(1));
         if dot.kind == Tok::Dot
@@ -446,10 +445,11 @@ impl<'a> Parser<'a> {
             // `[-]`, the dimensionless unit of engineering tables.
             let t = self.bump();
             self.diags.push(
-                Diagnostic::error("BG0116", "malformed unit")
-                    .with_primary(self.tok_span(t), "not a unit")
-                    .with_help("a dimensionless quantity has the unit `[1]`")
-                    .with_fix("1"),
+                malformed_unit(
+                    self.tok_span(t),
+                    "a dimensionless quantity has the unit `[1]`",
+                )
+                .with_fix("1"),
             );
             one = Some(t);
         }
@@ -546,12 +546,8 @@ impl<'a> Parser<'a> {
             && !self.starts_line(next)
         {
             self.bump();
-            self.diags.push(
-                Diagnostic::error("BG0116", "malformed unit")
-                    .with_primary(self.tok_span(op), "not a unit")
-                    .with_help(UNIT_PRODUCT_HELP.to_string())
-                    .with_fix(" "),
-            );
+            self.diags
+                .push(malformed_unit(self.tok_span(op), UNIT_PRODUCT_HELP).with_fix(" "));
         }
     }
 
@@ -568,25 +564,29 @@ impl<'a> Parser<'a> {
         self.bump();
         self.bump();
         self.diags.push(
-            Diagnostic::error("BG0116", "malformed unit")
-                .with_primary(self.tok_span(minus), "not a unit")
-                .with_help(format!(
+            malformed_unit(
+                self.tok_span(minus),
+                format!(
                     "a unit's power follows `^`: `{}^-{text}`",
                     self.tok_text(factor)
-                ))
-                .with_fix("^-"),
+                ),
+            )
+            .with_fix("^-"),
         );
         Some(-v)
     }
 
     fn bad_unit(&mut self, span: Span, help: &str) -> Fail {
-        self.diags.push(
-            Diagnostic::error("BG0116", "malformed unit")
-                .with_primary(span, "not a unit")
-                .with_help(help.to_string()),
-        );
+        self.diags.push(malformed_unit(span, help));
         Fail
     }
+}
+
+/// BG0116 at `span`, with `help`: the one form of every unit error of the parser.
+fn malformed_unit(span: Span, help: impl Into<String>) -> Diagnostic {
+    Diagnostic::error("BG0116", "malformed unit")
+        .with_primary(span, "not a unit")
+        .with_help(help)
 }
 
 const UNIT_PRODUCT_HELP: &str = "unit factors multiply by a space, as in `[N m]` or `[kg m^2]`";

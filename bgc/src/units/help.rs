@@ -97,15 +97,11 @@ pub fn unknown_symbol_help(symbol: &str) -> String {
     if let Some((stem, power)) = power_without_caret(symbol) {
         return format!("a unit's power follows `^`: `{stem}^{power}`");
     }
-    let near = closest(symbol, KNOWN.into_iter());
-    let case_slip = near
-        .as_ref()
-        .is_some_and(|c| c.eq_ignore_ascii_case(symbol));
-    match (near, joined_factors(symbol)) {
-        (Some(c), _) if case_slip => format!("did you mean `{c}`?"),
-        // `[Ns/m]`, `[kgm^2]`: two units written together.
-        (_, Some((a, b))) => format!("unit factors are separated by a space: `{a} {b}`, as in `[N m]`"),
-        (Some(c), None) => format!("did you mean `{c}`?"),
+    // A case slip of a known unit was answered above, so two units written together (`[Ns/m]`, `[kgm^2]`) come
+    // before the nearest unit.
+    match (joined_factors(symbol), closest(symbol, KNOWN.into_iter())) {
+        (Some((a, b)), _) => format!("unit factors are separated by a space: `{a} {b}`, as in `[N m]`"),
+        (None, Some(c)) => format!("did you mean `{c}`?"),
         (None, None) => {
             "units are SI symbols with optional prefixes p n u µ m c d k M G (docs/language.md, Units)".to_string()
         }

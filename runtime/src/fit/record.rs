@@ -282,6 +282,21 @@ impl Record {
         Ok(())
     }
 
+    /// The time column among the header's `names`: `t`, else `time` (as FMPy, Modelica tools and MATLAB's
+    /// timetables name it) when no input or output has that name.
+    pub fn time_column<S: AsRef<str>>(
+        names: &[S],
+        inputs: &[&str],
+        outputs: &[&str],
+    ) -> Option<usize> {
+        let time_alias = !inputs.contains(&"time") && !outputs.contains(&"time");
+        names.iter().position(|n| n.as_ref() == "t").or_else(|| {
+            names
+                .iter()
+                .position(|n| n.as_ref() == "time" && time_alias)
+        })
+    }
+
     /// The number of measured (non-missing) values.
     pub fn sample_count(&self) -> usize {
         self.measured
@@ -360,13 +375,8 @@ impl Columns {
                 });
             }
         }
-        // `time`, as FMPy, Modelica tools and MATLAB's timetables name it, when no model quantity has that name.
-        let time_alias = !inputs.contains(&"time") && !outputs.contains(&"time");
-        let time = names
-            .iter()
-            .position(|&n| n == "t")
-            .or_else(|| names.iter().position(|&n| n == "time" && time_alias))
-            .ok_or_else(|| RecordError::NoTime {
+        let time =
+            Record::time_column(names, inputs, outputs).ok_or_else(|| RecordError::NoTime {
                 header: names.join(","),
             })?;
         let mut input_columns = Vec::with_capacity(inputs.len());

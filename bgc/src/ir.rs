@@ -418,6 +418,23 @@ pub struct Allowance {
 }
 
 impl Model {
+    /// Its size in words, as `check` and the editor's hover say it: "5 elements and junctions, 4 bonds, 3
+    /// parameters" (in the singular for one).
+    pub fn size_in_words(&self) -> String {
+        let counted =
+            |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
+        format!(
+            "{}, {}, {}",
+            counted(
+                self.graph.node_count(),
+                "element or junction",
+                "elements and junctions"
+            ),
+            counted(self.graph.edge_count(), "bond", "bonds"),
+            counted(self.params.len(), "parameter", "parameters")
+        )
+    }
+
     /// The node with this qualified name.
     pub fn node_by_name(&self, name: &str) -> Option<NodeIndex> {
         self.graph

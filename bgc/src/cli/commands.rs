@@ -49,12 +49,10 @@ pub fn check(files: &[PathBuf], format: DiagFormat, color: bool) -> Status {
             }
             for m in &models {
                 summaries.push(format!(
-                    "{}: model `{}`: {} elements and junctions, {} bonds, {} parameters",
+                    "{}: model `{}`: {}",
                     sources.get(id).map(|f| f.name.as_str()).unwrap_or_default(),
                     m.name,
-                    m.graph.node_count(),
-                    m.graph.edge_count(),
-                    m.params.len()
+                    m.size_in_words()
                 ));
             }
         }

@@ -304,12 +304,7 @@ fn model_facts(analysis: &Analysis, id: usize, s: &Symbol) -> Vec<String> {
     for m in analysis.models.iter().filter(|m| {
         m.model.spans.model == s.decl_span || m.model.name == s.name && s.kind == SymbolKind::Model
     }) {
-        out.push(format!(
-            "{} elements and junctions, {} bonds, {} parameters",
-            m.model.graph.node_count(),
-            m.model.graph.edge_count(),
-            m.model.params.len()
-        ));
+        out.push(m.model.size_in_words());
         if let Some(eqs) = &m.equations {
             let names: Vec<&str> = eqs.states.iter().map(|s| s.name.as_str()).collect();
             out.push(format!("{} states: {}", names.len(), names.join(", ")));

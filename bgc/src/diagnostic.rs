@@ -6,6 +6,7 @@
 mod excerpt;
 pub mod render;
 pub mod suggest;
+pub mod unprintable;
 
 use crate::span::Span;
 use serde::Serialize;

@@ -43,14 +43,19 @@ impl Span {
 pub struct SourceFile {
     /// The name shown in diagnostics (the path as given).
     pub name: String,
+    /// The text, with each carriage return that is a line break of its own written as `\n` (see
+    /// [`SourceFile::new`]).
     pub text: String,
     /// Byte offset of the start of each line.
     line_starts: Vec<usize>,
 }
 
 impl SourceFile {
+    /// The file `name` with `text`. A line may end in `\n`, `\r\n` or (as classic Mac OS wrote it, and as the
+    /// Language Server Protocol allows) `\r` alone; the last is made `\n` here, a byte for a byte, so that the
+    /// lexer, the line numbers and the rendered excerpts all see one kind of line break at the same offsets.
     pub fn new(name: impl Into<String>, text: impl Into<String>) -> Self {
-        let text = text.into();
+        let text = lone_carriage_returns_as_newlines(text.into());
         let line_starts = line_starts(text.as_bytes());
         SourceFile {
             name: name.into(),
@@ -96,6 +101,21 @@ fn line_starts(bytes: &[u8]) -> Vec<usize> {
     starts
 }
 
+/// `text` with every `\r` that is not followed by `\n` replaced by `\n`.
+fn lone_carriage_returns_as_newlines(text: String) -> String {
+    if !text.contains('\r') {
+        return text;
+    }
+    let mut bytes = text.into_bytes();
+    for i in 0..bytes.len() {
+        if bytes[i] == b'\r' && bytes.get(i + 1) != Some(&b'\n') {
+            bytes[i] = b'\n';
+        }
+    }
+    // One ASCII byte for another keeps the text UTF-8.
+    String::from_utf8(bytes).unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned())
+}
+
 /// All files of one compilation; a [`FileId`] indexes into it.
 #[derive(Clone, Debug, Default)]
 pub struct SourceMap {
@@ -133,7 +153,17 @@ impl SourceMap {
 
 #[cfg(test)]
 mod tests {
-    use super::line_starts;
+    use super::{SourceFile, line_starts};
+
+    #[test]
+    fn a_lone_carriage_return_is_a_line_break_at_the_same_offset() {
+        let f = SourceFile::new("a.bg", "ab\rcd\r\nef\r");
+        assert_eq!(f.text, "ab\ncd\r\nef\n");
+        assert_eq!(f.line_col(3), (2, 1));
+        assert_eq!(f.line_col(7), (3, 1));
+        let unchanged = "µ\r\nx\n";
+        assert_eq!(SourceFile::new("b.bg", unchanged).text, unchanged);
+    }
 
     #[test]
     fn line_starts_follow_every_newline() {

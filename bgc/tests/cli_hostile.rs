@@ -788,3 +788,78 @@ fn fmt_replaces_a_file_whole_through_its_link_with_its_permissions() {
         .unwrap_or_default();
     assert_eq!(names.len(), 2, "{names:?}");
 }
+
+/// A description with terminal escapes, a direction override and U+FFFE was accepted: `check` passed, `fmu` wrote
+/// a `modelDescription.xml` that XML readers refuse, and a diagnostic on such a line sent the escape to the
+/// terminal (a red screen, or a line overwritten by a lone `\r`). Each is now an error at its character, and
+/// every excerpt shows control characters by visible stand-ins.
+#[test]
+fn control_characters_are_refused_in_strings_and_never_echoed() {
+    let dir = scratch("controls");
+    write(
+        &dir.join("a.bg"),
+        "model a {\n  domain electrical;\n  param r = 1 [Ohm] \"x\u{1b}[2J\u{7}y\u{202e}z\u{fffe}\";\n  Se s = 1;\n  R res = r;\n  bond s -> res;\n}\n",
+    );
+    for args in [&["check", "a.bg"][..], &["fmu", "a.bg", "-o", "a.fmu"]] {
+        let run = bgc(&dir, args);
+        assert_eq!(run.status, 1, "{}", run.transcript());
+        assert_eq!(
+            run.stderr
+                .matches("error[BG0104]: invalid character")
+                .count(),
+            4,
+            "{}",
+            run.transcript()
+        );
+        assert!(
+            run.stderr.contains("\"x␛[2J␇y\u{fffd}z\u{fffd}\""),
+            "{}",
+            run.transcript()
+        );
+        let raw = run
+            .stderr
+            .chars()
+            .filter(|&c| c.is_control() && c != '\n')
+            .count();
+        assert_eq!(raw, 0, "{}", run.transcript());
+    }
+    assert!(!dir.join("a.fmu").exists());
+    // A stray control character elsewhere on a line: named, and shown by its stand-in under a caret.
+    write(
+        &dir.join("b.bg"),
+        "model b {\u{1}\r  domain electrical;\r}\r",
+    );
+    let run = bgc(&dir, &["check", "b.bg"]);
+    assert_eq!(run.status, 1, "{}", run.transcript());
+    assert!(
+        run.stderr
+            .contains("1 │ model b {␁\n  │          ^ not part of the language"),
+        "{}",
+        run.transcript()
+    );
+}
+
+/// A file with classic Mac OS line breaks (a lone `\r`): its first comment ran to the end of the file, so the
+/// whole model was "unclosed" on "line 1". Each `\r` now ends a line, for the lexer, the line numbers and `fmt`.
+#[test]
+fn a_file_with_carriage_return_line_breaks_reads_as_lines() {
+    let dir = scratch("cr-lines");
+    let text = "model a {\r  // the source\r  domain electrical;\r  Se s = 1;\r  R res = 2 [Ohm]\r  bond s -> res;\r}\r";
+    write(&dir.join("a.bg"), text);
+    let run = bgc(&dir, &["check", "a.bg"]);
+    assert_eq!(run.status, 1, "{}", run.transcript());
+    assert!(run.stderr.contains("┌─ a.bg:5:13"), "{}", run.transcript());
+    assert!(
+        run.stderr.contains("5 │   R res = 2 [Ohm]\n"),
+        "{}",
+        run.transcript()
+    );
+    write(&dir.join("a.bg"), &text.replace(" [Ohm]", ";"));
+    let run = bgc(&dir, &["fmt", "a.bg"]);
+    assert_eq!(run.status, 0, "{}", run.transcript());
+    let formatted = std::fs::read_to_string(dir.join("a.bg")).unwrap_or_default();
+    assert!(
+        formatted.starts_with("model a {\n    // the source\n    domain electrical;\n"),
+        "{formatted:?}"
+    );
+}

@@ -3,8 +3,11 @@
 //! codespan-reporting prints every line a label touches in full. A minified or generated file can hold a whole
 //! model on one line of megabytes, and echoing it for each of many diagnostics writes gigabytes. [`Excerpts`]
 //! serves codespan the real files, except that a label on a line longer than [`MAX_LINE_BYTES`] is moved into a
-//! one-line window of that line around the label, reported with its real line and column numbers.
+//! one-line window of that line around the label, reported with its real line and column numbers. A line holding
+//! a control character or a direction override is shown in such a window too, with each of them replaced by a
+//! visible stand-in (`␛` for escape), so that echoing a hostile file cannot drive the terminal.
 
+use super::unprintable;
 use codespan_reporting::files::{self, Error, Files, SimpleFiles};
 use std::ops::Range;
 
@@ -59,7 +62,8 @@ impl<'a> Excerpts<'a> {
         let Ok(line) = f.line_range((), line_index) else {
             return (file, range);
         };
-        if line.len() <= MAX_LINE_BYTES {
+        let shown_from = text.get(line.start..range.end.max(line.end)).unwrap_or("");
+        if line.len() <= MAX_LINE_BYTES && !needs_stand_ins(shown_from) {
             return (file, range);
         }
         let end = range.end.clamp(range.start, line.end);
@@ -75,7 +79,10 @@ impl<'a> Excerpts<'a> {
             }
         };
         let win = &self.windows[w];
-        let shift = |at: usize| win.lead + at.clamp(win.start, win.end) - win.start;
+        let shift = |at: usize| {
+            let before = text.get(win.start..at.clamp(win.start, win.end));
+            win.lead + before.map_or(0, shown_len)
+        };
         (self.count + w, shift(range.start)..shift(end))
     }
 
@@ -84,7 +91,7 @@ impl<'a> Excerpts<'a> {
     }
 }
 
-/// The window of `line` around `start..end`, widened to char boundaries.
+/// The window of `line` around `start..end` (all of a short line), widened to char boundaries.
 fn cut(
     text: &str,
     file: usize,
@@ -93,10 +100,20 @@ fn cut(
     start: usize,
     end: usize,
 ) -> Window {
-    let mut from = start.saturating_sub(CONTEXT_BYTES).max(line.start);
-    let mut to = (end + CONTEXT_BYTES)
-        .min(line.end)
-        .min(from + MAX_WINDOW_BYTES);
+    // A short line (here for its stand-ins) is shown whole.
+    let short = line.len() <= MAX_LINE_BYTES;
+    let mut from = if short {
+        line.start
+    } else {
+        start.saturating_sub(CONTEXT_BYTES).max(line.start)
+    };
+    let mut to = if short {
+        line.end
+    } else {
+        (end + CONTEXT_BYTES)
+            .min(line.end)
+            .min(from + MAX_WINDOW_BYTES)
+    };
     while from > line.start && !text.is_char_boundary(from) {
         from -= 1;
     }
@@ -121,9 +138,35 @@ fn cut(
         line_index,
         start: from,
         end: to,
-        text: format!("{lead}{body}{tail}"),
+        text: format!("{lead}{}{tail}", unprintable::shown(body)),
         lead: lead.len(),
     }
+}
+
+/// Whether `text` holds a character that must be shown by a stand-in (line breaks aside).
+fn needs_stand_ins(text: &str) -> bool {
+    let mut chars = text.chars().peekable();
+    while let Some(c) = chars.next() {
+        let line_break = c == '\n' || (c == '\r' && chars.peek().is_none_or(|&n| n == '\n'));
+        if unprintable::is_unprintable(c) && !line_break {
+            return true;
+        }
+    }
+    false
+}
+
+/// The byte length of `text` as a window shows it.
+fn shown_len(text: &str) -> usize {
+    text.chars()
+        .map(|c| {
+            let shown = if unprintable::is_unprintable(c) {
+                unprintable::stand_in(c)
+            } else {
+                c
+            };
+            shown.len_utf8()
+        })
+        .sum()
 }
 
 impl<'a> Files<'a> for Excerpts<'a> {

@@ -3,6 +3,7 @@
 use super::Version;
 use super::structure::Dependencies;
 use super::variables::{Role, Variable};
+use crate::diagnostic::unprintable::{is_unprintable, stand_in};
 use crate::units::Dim;
 use std::fmt::Write;
 
@@ -299,9 +300,32 @@ pub fn escape(s: &str) -> String {
             '"' => out.push_str("&quot;"),
             '\'' => out.push_str("&apos;"),
             '\n' | '\r' | '\t' => out.push(' '),
-            c if (c as u32) < 0x20 => {}
+            // Not characters of XML 1.0 (a reader refuses the whole file), nor meant to be shown: the stand-in.
+            c if is_unprintable(c) => out.push(stand_in(c)),
             c => out.push(c),
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::escape;
+
+    /// XML 1.0's `Char` production: what a conforming reader accepts anywhere in a document.
+    fn xml_char(c: char) -> bool {
+        matches!(c, '\t' | '\n' | '\r' | '\u{20}'..='\u{D7FF}' | '\u{E000}'..='\u{FFFD}' | '\u{10000}'..)
+    }
+
+    #[test]
+    fn an_attribute_holds_only_characters_of_xml_and_no_markup() {
+        let hostile = "a\u{1}b\u{1b}[31m\u{7f}\u{85}\u{202e}\u{fffe}\u{ffff}<\"&'>\u{10348}";
+        let out = escape(hostile);
+        assert!(out.chars().all(xml_char), "{out:?}");
+        assert!(!out.contains(['<', '>', '"', '\'']), "{out:?}");
+        assert_eq!(
+            out,
+            "a␁b␛[31m␡\u{fffd}\u{fffd}\u{fffd}\u{fffd}&lt;&quot;&amp;&apos;&gt;\u{10348}"
+        );
+    }
 }

@@ -4,6 +4,7 @@
 use super::analysis::Analysis;
 use super::diagnostics::{Lines, severity};
 use super::lines::LineIndex;
+use crate::diagnostic::unprintable::shown;
 use lsp_types::{
     CodeAction, CodeActionKind, CodeActionOrCommand, NumberOrString, Range, TextEdit, Uri,
     WorkspaceEdit,
@@ -130,10 +131,11 @@ pub fn code_actions(analysis: &Analysis, uri: &Uri, range: Range) -> Vec<CodeAct
             ..lsp_types::Diagnostic::default()
         };
         out.push(CodeActionOrCommand::CodeAction(CodeAction {
-            title: match (written.trim().is_empty(), replacement.is_empty()) {
-                (true, _) => "Replace the space that is not ASCII with a space".to_string(),
-                (false, true) => format!("Remove `{written}`"),
-                (false, false) => format!("Replace `{written}` with `{replacement}`"),
+            // A control character is named by its stand-in: the title is shown as it is.
+            title: match (replacement.is_empty(), written.trim().is_empty()) {
+                (true, _) => format!("Remove `{}`", shown(written)),
+                (false, true) => "Replace the space that is not ASCII with a space".to_string(),
+                (false, false) => format!("Replace `{}` with `{replacement}`", shown(written)),
             },
             kind: Some(CodeActionKind::QUICKFIX),
             diagnostics: Some(vec![diagnostic]),

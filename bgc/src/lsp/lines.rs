@@ -16,9 +16,16 @@ pub struct LineIndex {
 }
 
 impl LineIndex {
+    /// The lines of `text`, each ended by `\n`, `\r\n` or a lone `\r` (the protocol's three line breaks).
     pub fn new(text: &str) -> LineIndex {
+        let bytes = text.as_bytes();
+        let lone_cr = |i: usize| bytes.get(i + 1) != Some(&b'\n');
         let starts = std::iter::once(0)
-            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+            .chain(
+                text.match_indices(['\n', '\r'])
+                    .filter(|&(i, m)| m == "\n" || lone_cr(i))
+                    .map(|(i, _)| i + 1),
+            )
             .collect();
         LineIndex {
             starts,
@@ -108,5 +115,18 @@ mod tests {
         assert_eq!(index.offset(text, Position::new(0, 1)), 0);
         assert_eq!(index.offset(text, Position::new(0, 2)), 4);
         assert_eq!(index.position(text, 2), Position::new(0, 0));
+    }
+
+    #[test]
+    fn a_lone_carriage_return_ends_a_line_as_the_protocol_says() {
+        let text = "ab\rcd\r\nef\ngh";
+        let index = LineIndex::new(text);
+        for (offset, line, column) in [(1, 0, 1), (3, 1, 0), (4, 1, 1), (7, 2, 0), (10, 3, 0)] {
+            assert_eq!(index.position(text, offset), Position::new(line, column));
+            assert_eq!(index.offset(text, Position::new(line, column)), offset);
+        }
+        // Past the end of a line: before its break, whichever it is.
+        assert_eq!(index.offset(text, Position::new(0, 9)), 2);
+        assert_eq!(index.offset(text, Position::new(1, 9)), 5);
     }
 }

@@ -8,6 +8,7 @@
 
 use super::typographic::StandIn;
 use crate::diagnostic::Diagnostic;
+use crate::diagnostic::unprintable::{is_unprintable, stand_in};
 use crate::span::{FileId, Span};
 use nom::branch::alt;
 use nom::bytes::complete::{tag, take_while, take_while1};
@@ -144,7 +145,8 @@ fn number(i: &str) -> IResult<&str, &str> {
 }
 
 fn line_comment(i: &str) -> IResult<&str, &str> {
-    recognize((tag("//"), take_while(|c| c != '\n'))).parse(i)
+    // A comment ends at any line break, a lone `\r` too (as a string does).
+    recognize((tag("//"), take_while(|c| c != '\n' && c != '\r'))).parse(i)
 }
 
 fn whitespace(i: &str) -> IResult<&str, &str> {
@@ -609,6 +611,10 @@ impl<'a> Lexer<'a> {
                     }
                     _ => break,
                 },
+                c if is_unprintable(c) => {
+                    self.unprintable_in_string(start + i, c);
+                    value.push(stand_in(c));
+                }
                 c => value.push(c),
             }
         }
@@ -630,6 +636,18 @@ impl<'a> Lexer<'a> {
                 rest.get(len..).unwrap_or("")
             }
         }
+    }
+
+    /// A control character or a direction override inside a string at `at`: an error whose fix removes it. The
+    /// string keeps a visible stand-in, so that no message or generated file quoting it holds the character.
+    fn unprintable_in_string(&mut self, at: usize, c: char) {
+        let span = self.span(at, at + c.len_utf8());
+        self.report(
+            Diagnostic::error("BG0104", format!("invalid character {:?} in a string", c.to_string()))
+                .with_primary(span, "not allowed in a string")
+                .with_help("strings hold printable text: a control character or a direction override would show the text other than it is, in a terminal, an editor or an FMU's description; remove it")
+                .with_fix(""),
+        );
     }
 
     /// A typographic character (`·`, `²`, `→`, ...; see [`super::typographic`]): one error, and the tokens of what it

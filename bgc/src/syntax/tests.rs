@@ -883,3 +883,56 @@ fn a_file_of_garbage_is_a_bounded_list_of_errors() {
         Some("more than 1000 syntax errors: the rest of the file is not read")
     );
 }
+
+#[test]
+fn a_control_character_or_direction_override_in_a_string_is_refused_and_kept_out() {
+    let text = "model m {\n  param k = 1 [1] \"a\u{1b}[31mb\u{202e}c\u{fffe}\";\n}\n";
+    let (file, diags) = parse(FileId(0), text);
+    let found: Vec<(&str, &str, Option<&str>)> = diags
+        .iter()
+        .map(|d| {
+            let at = d.labels.iter().find(|l| l.primary).map(|l| l.span.range());
+            (
+                d.code.0,
+                at.and_then(|r| text.get(r)).unwrap_or(""),
+                d.fix(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        found,
+        vec![
+            ("BG0104", "\u{1b}", Some("")),
+            ("BG0104", "\u{202e}", Some("")),
+            ("BG0104", "\u{fffe}", Some("")),
+        ]
+    );
+    assert!(
+        diags[0].message.contains(r#""\u{1b}""#),
+        "{}",
+        diags[0].message
+    );
+    // The statement is kept, its description holding visible stand-ins only.
+    let Some(Item::Model(m)) = file.items.first() else {
+        panic!("{file:?}")
+    };
+    match m.body.first() {
+        Some(Stmt::Param(p)) => {
+            assert_eq!(p.description.as_deref(), Some("a␛[31mb\u{fffd}c\u{fffd}"))
+        }
+        other => panic!("{other:?}"),
+    }
+    // A tab and text in any script are printable.
+    assert!(codes("model m { param k = 1 [1] \"a\tµ → Ω 日\"; }").is_empty());
+}
+
+#[test]
+fn a_lone_carriage_return_ends_a_comment() {
+    // Classic Mac OS line breaks: the comment ends at its line's `\r`, not at the end of the file.
+    let text = "model m {\r  // a comment\r  domain electrical;\r  Se s = 1;\r  R r = 2;\r  bond s -> r;\r}\r";
+    let file = parse_ok(text);
+    let Some(Item::Model(m)) = file.items.first() else {
+        panic!("{file:?}")
+    };
+    assert_eq!(m.body.len(), 4, "{:#?}", m.body);
+}

@@ -837,6 +837,45 @@ fn control_characters_are_refused_in_strings_and_never_echoed() {
         "{}",
         run.transcript()
     );
+    // What a message quotes of the command line or a record: a file name, an option's value, a column.
+    let no_raw_controls = |run: &Run| {
+        let raw = run
+            .stdout
+            .chars()
+            .chain(run.stderr.chars())
+            .filter(|&c| c.is_control() && c != '\n')
+            .count();
+        assert_eq!(raw, 0, "{}", run.transcript());
+    };
+    let model = "model m {\n  domain electrical;\n  input v [V];\n  Se s = v;\n  R res = 2;\n  bond s -> res;\n}\n";
+    write(&dir.join("m\u{1b}[31m.bg"), model);
+    let run = bgc(&dir, &["check", "m\u{1b}[31m.bg"]);
+    assert_eq!(run.status, 0, "{}", run.transcript());
+    assert!(
+        run.stdout.starts_with("m␛[31m.bg: model `m`"),
+        "{}",
+        run.transcript()
+    );
+    no_raw_controls(&run);
+    write(&dir.join("m.bg"), model);
+    write(&dir.join("rec.csv"), "t,v\u{1b}[2J\n0,1\n1,1\n");
+    for args in [
+        &["check", "gone\u{1b}[2J.bg"][..],
+        &[
+            "simulate",
+            "m.bg",
+            "--t-end",
+            "1",
+            "--input",
+            "v=1\u{1b}[2J",
+        ],
+        &["simulate", "m.bg", "--t-end", "1", "--data", "rec.csv"],
+    ] {
+        let run = bgc(&dir, args);
+        assert!(run.status != 0, "{}", run.transcript());
+        assert!(run.stderr.contains("␛[2J"), "{}", run.transcript());
+        no_raw_controls(&run);
+    }
 }
 
 /// A file with classic Mac OS line breaks (a lone `\r`): its first comment ran to the end of the file, so the

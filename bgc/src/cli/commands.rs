@@ -5,6 +5,7 @@ use super::io::{
     stdoutln,
 };
 use super::{DiagFormat, DrawFormat, ReportFormat, Status};
+use bgc::diagnostic::unprintable::shown;
 use bgc::diagnostic::{Diagnostic, Severity, has_errors, render};
 use bgc::span::SourceMap;
 use std::path::{Path, PathBuf};
@@ -61,7 +62,8 @@ pub fn check(files: &[PathBuf], format: DiagFormat, color: bool) -> Status {
     emit(&sources, &all_diags, format, color);
     if format == DiagFormat::Text {
         for s in &summaries {
-            stdoutln(s);
+            // A summary names its file as given: without the control characters a file name may hold.
+            stdoutln(&shown(s));
         }
         if !all_diags.is_empty() {
             stderrln(&count_line(&all_diags));

@@ -237,7 +237,8 @@ pub fn stdoutln(text: &str) {
     stdout(&format!("{text}\n"));
 }
 
-/// [`stderr`] with a line end.
+/// [`stderr`] with a line end, for a message: what it quotes of the user's input (a file name, a record's column,
+/// an option's value) is shown without its control characters, which would drive the terminal.
 pub fn stderrln(text: &str) {
-    stderr(&format!("{text}\n"));
+    stderr(&format!("{}\n", bgc::diagnostic::unprintable::shown(text)));
 }

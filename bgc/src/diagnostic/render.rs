@@ -1,6 +1,7 @@
 //! Rendering diagnostics: rustc-like text and JSON.
 
 use super::excerpt::Excerpts;
+use super::unprintable::shown;
 use super::{Diagnostic, Severity};
 use crate::span::SourceMap;
 use codespan_reporting::diagnostic as cs;
@@ -23,7 +24,7 @@ pub fn to_text(sources: &SourceMap, diags: &[Diagnostic], color: bool) -> String
     let mut files = SimpleFiles::new();
     let mut count = 0;
     for (_, f) in sources.files() {
-        files.add(f.name.clone(), f.text.clone());
+        files.add(shown(&f.name), f.text.clone());
         count += 1;
     }
     let config = term::Config::default();
@@ -47,7 +48,7 @@ pub fn to_text(sources: &SourceMap, diags: &[Diagnostic], color: bool) -> String
                 "{}[{}]: {}\n",
                 severity_word(d.severity),
                 d.code.0,
-                d.message
+                shown(&d.message)
             ));
         }
     }
@@ -99,16 +100,17 @@ fn to_codespan(d: &Diagnostic, excerpts: &mut Excerpts<'_>) -> cs::Diagnostic<us
                 cs::LabelStyle::Secondary
             };
             let (file, range) = excerpts.place(l.span.file.0 as usize, l.span.range());
-            cs::Label::new(style, file, range).with_message(&l.message)
+            cs::Label::new(style, file, range).with_message(shown(&l.message))
         })
         .collect();
-    let mut notes = d.notes.clone();
+    // Messages quote what the user wrote (a file name, a record's column): never a control character as it is.
+    let mut notes: Vec<String> = d.notes.iter().map(|n| shown(n)).collect();
     if let Some(h) = &d.help {
-        notes.push(format!("help: {h}"));
+        notes.push(format!("help: {}", shown(h)));
     }
     cs::Diagnostic::new(severity)
         .with_code(d.code.0)
-        .with_message(&d.message)
+        .with_message(shown(&d.message))
         .with_labels(labels)
         .with_notes(notes)
 }

@@ -32,10 +32,16 @@ pub fn stand_in(c: char) -> char {
     }
 }
 
-/// `text` with every unprintable character replaced by its [`stand_in`].
+/// `text` with every unprintable character but the line break `\n` replaced by its [`stand_in`].
 pub fn shown(text: &str) -> String {
     text.chars()
-        .map(|c| if is_unprintable(c) { stand_in(c) } else { c })
+        .map(|c| {
+            if c != '\n' && is_unprintable(c) {
+                stand_in(c)
+            } else {
+                c
+            }
+        })
         .collect()
 }
 

@@ -197,6 +197,15 @@ fn the_c_interface_refuses_misuse_and_keeps_instances_apart() {
     assert_eq!(v["derivatives_of_co_simulation"], error, "{v}");
     assert_eq!(v["derivatives_before_init"], error, "{v}");
     assert_eq!(v["derivatives_in_init"], serde_json::json!(0), "{v}");
+    // A non-physical parameter is refused in words (before: the error's `Debug` form, `NonPhysical { name: ...`).
+    let logged: Vec<String> =
+        serde_json::from_value(v["non_physical_logged"].clone()).unwrap_or_default();
+    assert!(
+        logged.len() == 1
+            && logged[0].contains("= -1.0 is not physical: ")
+            && !logged[0].contains('{'),
+        "{v}"
+    );
     // Instance a is driven by a motor torque, b is not: b stays at rest.
     let a: Vec<f64> = serde_json::from_value(v["a"].clone()).unwrap_or_default();
     let b: Vec<f64> = serde_json::from_value(v["b"].clone()).unwrap_or_default();

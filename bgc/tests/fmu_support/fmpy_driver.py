@@ -189,6 +189,12 @@ def interface(fmu):
     out["derivatives_before_init"] = lib.fmi2GetDerivatives(me, dx, ctypes.c_size_t(nx))
     lib.fmi2EnterInitializationMode(me)
     out["derivatives_in_init"] = lib.fmi2GetDerivatives(me, dx, ctypes.c_size_t(nx))
+    # A negative value for each parameter in turn, until one is refused: what the log says.
+    messages.clear()
+    for r in params:
+        if lib.fmi2SetReal(me, (ctypes.c_uint * 1)(r), ctypes.c_size_t(1), (ctypes.c_double * 1)(-1.0)) != 0:
+            break
+    out["non_physical_logged"] = [m for s, m in messages if s == 3]
     lib.fmi2FreeInstance(me)
     for c in (a, b):
         lib.fmi2SetupExperiment(c, 1, ctypes.c_double(1e-8), ctypes.c_double(0.0), 0, ctypes.c_double(0.0))

@@ -183,7 +183,7 @@ impl Instance {
                 Var::Param(i) if before_init => self
                     .params
                     .set(i, value)
-                    .map_err(|e| format!("parameter `{}` = {value}: {e:?}", var.name()))?,
+                    .map_err(|e| e.to_string())?,
                 Var::State(i) if before_init => self.x[i] = value,
                 Var::Input(i) => self.u[i] = value,
                 Var::Param(_) | Var::State(_) => {

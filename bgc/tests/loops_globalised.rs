@@ -83,7 +83,7 @@ mod model {
 fn main() {
     let p = model::Params::default();
     let x = model::State::zeros();
-    for u in [8.0, 10.0, 20.0, 100.0] {
+    for u in [8.0, 10.0, 20.0, 100.0, f64::NAN] {
         let mut inputs = model::Inputs::zeros();
         inputs[0] = u;
         match model::solve_loops(&p, 0.0, &x, &inputs) {
@@ -106,7 +106,14 @@ fn the_generated_solve_loops_solves_the_steep_diode_loop() {
     let printed = build_and_run(&dir, "diode", &code, MAIN, LIBM_STD);
     let _ = std::fs::remove_dir_all(&dir);
     let lines: Vec<&str> = printed.lines().collect();
-    assert_eq!(lines.len(), ROOTS.len(), "{printed}");
+    assert_eq!(lines.len(), ROOTS.len() + 1, "{printed}");
+    // An input of NaN: refused, in words (before: "(NonFinite after 0 iterations, ...)").
+    assert_eq!(
+        lines[ROOTS.len()],
+        "NaN error the algebraic loop for `loop_f_diode` was not solved: a residual or its derivative was not finite \
+         after 0 iterations (residual NaN)",
+        "{printed}"
+    );
     for ((u, root), line) in ROOTS.iter().zip(&lines) {
         let fields: Vec<&str> = line.split(' ').collect();
         let z: f64 = fields

@@ -426,11 +426,17 @@ pub struct LoopError {
 impl core::fmt::Display for LoopError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         let tear = TEAR_NAMES.get(self.tear).copied().unwrap_or(\"?\");
+        let why = match self.kind {
+            LoopFailure::NoDescent => \"no damped Newton step decreased the residual\",
+            LoopFailure::IterationLimit => \"Newton's method did not converge\",
+            LoopFailure::Singular => \"the loop's Jacobian was singular\",
+            LoopFailure::NonFinite => \"a residual or its derivative was not finite\",
+        };
         write!(
             f,
-            \"the algebraic loop for `{tear}` was not solved ({:?} after {} iterations, \\
-             residual {:e})\",
-            self.kind, self.iterations, self.residual
+            \"the algebraic loop for `{tear}` was not solved: {why} after {} iterations \\
+             (residual {:e})\",
+            self.iterations, self.residual
         )
     }
 }

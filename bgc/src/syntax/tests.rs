@@ -664,6 +664,30 @@ fn decode_points_at_the_first_bad_byte() {
 }
 
 #[test]
+fn a_file_in_utf16_is_one_error_that_says_so() {
+    use super::decode;
+    let text = "model m {\n}\n";
+    let le: Vec<u8> = text.encode_utf16().flat_map(u16::to_le_bytes).collect();
+    let be: Vec<u8> = text.encode_utf16().flat_map(u16::to_be_bytes).collect();
+    let cases = [
+        ([&[0xFF, 0xFE][..], &le].concat(), "byte-order mark"),
+        ([&[0xFE, 0xFF][..], &be].concat(), "byte-order mark"),
+        (le, "every other byte is zero"),
+    ];
+    for (bytes, why) in cases {
+        let d = decode(FileId(0), &bytes).expect_err("UTF-16");
+        assert_eq!(d.code.0, "BG0100");
+        assert!(
+            d.message.starts_with("the file is UTF-16 text, not UTF-8") && d.message.contains(why),
+            "{}",
+            d.message
+        );
+    }
+    // One stray zero byte in a UTF-8 file is left to the lexer (an invalid character, located).
+    assert!(decode(FileId(0), b"model m {\0\n  domain electrical;\n}\n").is_ok());
+}
+
+#[test]
 fn byte_order_mark_is_ignored() {
     let f = parse_ok("\u{feff}model m { param a = 1 [kg]; }");
     assert_eq!(body_of(&f).len(), 1);

@@ -12,6 +12,7 @@ mod matrix_text;
 mod model;
 mod params;
 mod quantities;
+mod record_text;
 mod replay;
 mod simulate;
 mod sparse;

@@ -134,6 +134,20 @@ fn a_tab_separated_record_is_read_as_a_comma_separated_one() {
         "t [s]\tF\tv\n0\t1,5\t0,1\n0,5\t-1\t\n1\t0\t0,3\n",
     );
     assert_eq!(tabs, commas);
+    // A spreadsheet's "Unicode text": UTF-16 with its byte-order mark (before: "stream did not contain valid
+    // UTF-8").
+    let text = "t [s]\tF\tv\n0\t1,5\t0,1\n0,5\t-1\t\n1\t0\t0,3\n";
+    let utf16: Vec<u8> = [0xFF, 0xFE]
+        .into_iter()
+        .chain(text.encode_utf16().flat_map(u16::to_le_bytes))
+        .collect();
+    let path = crate::scratch::path("replay_utf16.txt");
+    std::fs::write(&path, utf16).expect("record written");
+    let data = path.display().to_string();
+    let (code, out, err) = bgc(&[
+        "simulate", &model, "--data", &data, "--t-end", "1", "--dt-out", "0.5",
+    ]);
+    assert_eq!((code, out), (0, commas), "{err}");
 }
 
 /// A record with nothing to replay (a model without inputs, or every input given with `--input`) is said so,

@@ -180,7 +180,7 @@ pub fn read_record(path: &Path) -> std::io::Result<String> {
     record_text(bytes)
 }
 
-/// The text of a record read as `bytes`, refused when it is too large or not UTF-8.
+/// The text of a record read as `bytes`, refused when it is too large or not text (see [`super::record_text`]).
 fn record_text(bytes: Vec<u8>) -> std::io::Result<String> {
     let refuse = |why: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, why);
     if bytes.len() as u64 > MAX_RECORD_BYTES {
@@ -189,12 +189,7 @@ fn record_text(bytes: Vec<u8>) -> std::io::Result<String> {
             MAX_RECORD_BYTES >> 20
         )));
     }
-    String::from_utf8(bytes).map_err(|_| {
-        std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            "stream did not contain valid UTF-8",
-        )
-    })
+    super::record_text::record_text(bytes)
 }
 
 /// Writes to standard output. A closed pipe (`bgc ... | head`) is not an error: the output is simply no longer

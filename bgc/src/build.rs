@@ -540,14 +540,13 @@ impl SourceLoader for FsLoader {
 
     fn load(&mut self, key: &Path) -> std::io::Result<String> {
         let bytes = read_source_file(key)?;
-        String::from_utf8(bytes).map_err(|e| {
-            std::io::Error::new(
+        // The root file's check (UTF-16 said as such, the first bad byte), in the words of an import error.
+        match crate::syntax::decode(crate::span::FileId(0), &bytes) {
+            Ok(text) => Ok(text.to_string()),
+            Err(d) => Err(std::io::Error::new(
                 std::io::ErrorKind::InvalidData,
-                format!(
-                    "not valid UTF-8 (first bad byte at offset {})",
-                    e.utf8_error().valid_up_to()
-                ),
-            )
-        })
+                d.message.trim_start_matches("the file is ").to_string(),
+            )),
+        }
     }
 }

@@ -902,3 +902,41 @@ fn a_file_with_carriage_return_line_breaks_reads_as_lines() {
         "{formatted:?}"
     );
 }
+
+/// An import saved as UTF-16 was "not valid UTF-8 (first bad byte at offset 0)"; it is now said to be UTF-16, as
+/// for a file on the command line, and a Latin-1 import names its first bad byte.
+#[test]
+fn an_import_in_another_encoding_says_which() {
+    let dir = scratch("import-encoding");
+    let component = "component c {\n  port a;\n  R r = 1;\n  bond a -> r;\n}\n";
+    let utf16: Vec<u8> = [0xFF, 0xFE]
+        .into_iter()
+        .chain(component.encode_utf16().flat_map(u16::to_le_bytes))
+        .collect();
+    std::fs::write(dir.join("wide.bg"), utf16).unwrap_or_else(|e| panic!("{e}"));
+    std::fs::write(
+        dir.join("latin.bg"),
+        b"// R\xE4der\ncomponent c { port a; R r = 1; bond a -> r; }\n",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    for (import, why) in [
+        (
+            "wide.bg",
+            "cannot import `wide.bg`: UTF-16 text, not UTF-8: it starts with a UTF-16 byte-order mark",
+        ),
+        (
+            "latin.bg",
+            "cannot import `latin.bg`: not valid UTF-8: byte 0xE4 at offset 4",
+        ),
+    ] {
+        write(
+            &dir.join("m.bg"),
+            &format!(
+                "import \"{import}\";\nmodel m {{\n  domain electrical;\n  Se s = 1;\n  c x;\n  bond s -> x.a;\n}}\n"
+            ),
+        );
+        let run = bgc(&dir, &["check", "m.bg"]);
+        assert_eq!(run.status, 1, "{}", run.transcript());
+        assert!(run.stderr.contains(why), "{}", run.transcript());
+    }
+}

@@ -7,6 +7,9 @@
 //! the first publication for the new version: for back_support all its diagnostics; for the chain, which is above
 //! the server's size for deriving equations on the loop (`Options::background_above`), those of parse, lowering
 //! and causality, while the equations follow from the worker thread.
+//!
+//! `fmt_check` times the unified diff of `bgc fmt --check` (shared with range formatting) on a file of 800,000
+//! lines, 100,000 of them changed.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use lsp_server::{Connection, Message, Notification, Request, RequestId};
@@ -188,5 +191,31 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+/// `bgc fmt --check`'s diff of a model of 100,000 stages (800,000 lines) written with `1/k`, one line in eight
+/// changed by the canonical layout's `1 / k`.
+fn bench_format_diff(c: &mut Criterion) {
+    let mut text = String::from(
+        "model chain {\n    domain translational;\n    param m = 1 [kg];\n    param k = 1 [N/m];\n    Se src = 1;\n    1 v0;\n    bond src -> v0;\n",
+    );
+    for i in 0..100_000 {
+        text.push_str(&format!(
+            "    I m{i} = m;\n    bond v{i} -> m{i};\n    0 x{i};\n    C c{i} = 1/k;\n    bond v{i} -> x{i};\n    \
+             bond x{i} -> c{i};\n    1 v{};\n    bond x{i} -> v{};\n",
+            i + 1,
+            i + 1
+        ));
+    }
+    text.push_str("}\n");
+    let formatted = bgc::syntax::format_source(bgc::span::FileId(0), &text).expect("a valid model");
+    let mut group = c.benchmark_group("fmt_check");
+    group.sample_size(10);
+    group.bench_function("unified_diff_100k_changed_lines", |b| {
+        b.iter(|| {
+            bgc::lsp::line_diff::unified(&text, &formatted, "a.bg", "a.bg (canonical layout)")
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, bench_format_diff);
 criterion_main!(benches);

@@ -160,11 +160,12 @@ fn fmt_one(path: &Path, check_only: bool, color: bool) -> std::io::Result<bool> 
             true => super::io::STDIN_NAME.to_string(),
             false => path.display().to_string(),
         };
-        let diff = similar::TextDiff::from_lines(&text, &formatted)
-            .unified_diff()
-            .context_radius(3)
-            .header(&name, &format!("{name} (canonical layout)"))
-            .to_string();
+        let diff = bgc::lsp::line_diff::unified(
+            &text,
+            &formatted,
+            &name,
+            &format!("{name} (canonical layout)"),
+        );
         stdout(&diff);
         stderrln(&format!("{name}: not in the canonical layout"));
         return Ok(false);

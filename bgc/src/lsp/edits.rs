@@ -34,11 +34,12 @@ pub fn format(text: &str) -> Option<Vec<TextEdit>> {
 pub fn format_range(text: &str, range: Range) -> Option<Vec<TextEdit>> {
     let formatted = crate::syntax::format_source(crate::span::FileId(0), text).ok()?;
     let starts = line_starts(text);
-    let new_lines: Vec<&str> = formatted.split_inclusive('\n').collect();
+    let old_lines = super::line_diff::lines(text);
+    let new_lines = super::line_diff::lines(&formatted);
     let (first, last) = (range.start.line as usize, range.end.line as usize);
     let lines = LineIndex::new(text);
     let mut edits = Vec::new();
-    for op in similar::TextDiff::from_lines(text, &formatted).ops() {
+    for op in super::line_diff::ops(&old_lines, &new_lines) {
         let (tag, old, new) = op.as_tag_tuple();
         if tag == similar::DiffTag::Equal {
             continue;

@@ -20,6 +20,7 @@ pub mod edits;
 pub mod files;
 pub mod hover;
 pub mod index;
+pub mod line_diff;
 pub mod lines;
 pub mod navigation;
 pub mod server;

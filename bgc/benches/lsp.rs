@@ -8,7 +8,7 @@
 //! the server's size for deriving equations on the loop (`Options::background_above`), those of parse, lowering
 //! and causality, while the equations follow from the worker thread.
 //!
-//! `fmt_check` times the unified diff of `bgc fmt --check` (shared with range formatting) on a file of 800,000
+//! `lsp_references` times find-all-references of a parameter with 100,000 uses. `fmt_check` times the unified diff of `bgc fmt --check` (shared with range formatting) on a file of 800,000
 //! lines, 100,000 of them changed.
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -217,5 +217,34 @@ fn bench_format_diff(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench, bench_format_diff);
+/// Find all references (and rename, which edits them) of a parameter that 100,000 elements use.
+fn bench_references(c: &mut Criterion) {
+    let mut text = String::from(
+        "model chain {\n    domain translational;\n    param m = 1 [kg];\n    Se src = 1;\n    1 v0;\n    bond src -> v0;\n",
+    );
+    for i in 0..100_000 {
+        text.push_str(&format!("    I m{i} = m;\n    bond v0 -> m{i};\n"));
+    }
+    text.push_str("}\n");
+    let analysis = bgc::lsp::analysis::analyse_front(
+        "/tmp/chain.bg",
+        &text,
+        &mut bgc::lower::MemoryLoader::new(),
+    );
+    let param = text.find("param m").expect("the parameter") + "param ".len();
+    let (id, _) =
+        bgc::lsp::navigation::symbol_at(&analysis, analysis.root, param).expect("a symbol");
+    let key = bgc::lsp::navigation::key(&analysis, id).expect("a key");
+    let mut group = c.benchmark_group("lsp_references");
+    group.sample_size(10);
+    group.bench_function("parameter_used_by_100k_elements", |b| {
+        b.iter(|| {
+            let found = bgc::lsp::navigation::references(&[&analysis], &key, true);
+            assert_eq!(found.len(), 100_001);
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, bench_format_diff, bench_references);
 criterion_main!(benches);

@@ -111,9 +111,11 @@ pub(crate) fn mass_form(f: &[Expr], implicit_rows: &[bool]) -> Result<MassForm, 
             break;
         }
         fresh.iter().for_each(|&i| known[i] = true);
-        let values: Vec<Option<Expr>> = (0..n)
-            .map(|i| fresh.contains(&i).then(|| f[i].clone()))
-            .collect();
+        // Indexed, not searched: `fresh` may hold nearly every state of a large model.
+        let mut values: Vec<Option<Expr>> = vec![None; n];
+        for &i in &fresh {
+            values[i] = Some(f[i].clone());
+        }
         for fi in f.iter_mut().filter(|fi| fi.any_sym(&is_rate)) {
             *fi = symbols::subst(fi, &mut |s| match s {
                 Sym::StateDot(j) => values.get(j).cloned().flatten(),
@@ -121,19 +123,19 @@ pub(crate) fn mass_form(f: &[Expr], implicit_rows: &[bool]) -> Result<MassForm, 
             });
         }
     }
-    let mut rows: Vec<usize> = (0..n)
-        .filter(|&i| implicit(i) || (!known[i] && f[i].any_sym(&is_rate)))
+    let mut in_rows: Vec<bool> = (0..n)
+        .map(|i| implicit(i) || (!known[i] && f[i].any_sym(&is_rate)))
         .collect();
     for fi in &f {
         fi.for_each_sym(&mut |s| {
             if let Sym::StateDot(j) = s
-                && !rows.contains(&j)
+                && let Some(row) = in_rows.get_mut(j)
             {
-                rows.push(j);
+                *row = true;
             }
         });
     }
-    rows.sort_unstable();
+    let rows: Vec<usize> = (0..n).filter(|&i| in_rows[i]).collect();
     let mut matrix = Vec::with_capacity(rows.len());
     for &i in &rows {
         let mut row = Vec::with_capacity(rows.len());

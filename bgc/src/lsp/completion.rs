@@ -11,7 +11,7 @@ use super::index::SymbolKind;
 use crate::ir::Func;
 use crate::span::FileId;
 use crate::syntax::ast::ElementKind;
-use lsp_types::{CompletionItem, CompletionItemKind};
+use lsp_types::{CompletionItem, CompletionItemKind, CompletionList, CompletionResponse};
 
 const STATEMENT_KEYWORDS: [&str; 12] = [
     "model",
@@ -54,6 +54,37 @@ fn item(label: &str, kind: CompletionItemKind, detail: String) -> CompletionItem
         detail: Some(detail),
         ..CompletionItem::default()
     }
+}
+
+/// The most completions one answer holds. A generated model has hundreds of thousands of names in scope: all of
+/// them made a 28 MB answer to every keystroke. Past this many, the answer holds those that start with the word
+/// being typed (ignoring case), up to this many, and says it is incomplete, so the editor asks again as the word
+/// grows; below it, the editor gets everything and filters as it likes (fuzzily).
+pub const MAX_ITEMS: usize = 1000;
+
+/// The answer to a completion request at a byte offset of the root file: [`complete`], cut to [`MAX_ITEMS`].
+pub fn respond(analysis: &Analysis, offset: usize) -> CompletionResponse {
+    let items = complete(analysis, offset);
+    if items.len() <= MAX_ITEMS {
+        return CompletionResponse::Array(items);
+    }
+    let text = analysis.root_text();
+    let before = text.get(..offset.min(text.len())).unwrap_or(text);
+    let word_len = before
+        .chars()
+        .rev()
+        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+        .count();
+    let word = before[before.len() - word_len..].to_ascii_lowercase();
+    let items = items
+        .into_iter()
+        .filter(|i| i.label.to_ascii_lowercase().starts_with(&word))
+        .take(MAX_ITEMS)
+        .collect();
+    CompletionResponse::List(CompletionList {
+        is_incomplete: true,
+        items,
+    })
 }
 
 /// The completions at a byte offset of the root file.
@@ -191,5 +222,59 @@ fn completion_kind(kind: SymbolKind) -> CompletionItemKind {
         SymbolKind::Input | SymbolKind::Output | SymbolKind::Var => CompletionItemKind::VARIABLE,
         SymbolKind::Element | SymbolKind::Instance => CompletionItemKind::VALUE,
         SymbolKind::Port => CompletionItemKind::INTERFACE,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn labels(response: CompletionResponse) -> (bool, Vec<String>) {
+        match response {
+            CompletionResponse::Array(items) => {
+                (false, items.into_iter().map(|i| i.label).collect())
+            }
+            CompletionResponse::List(list) => (
+                list.is_incomplete,
+                list.items.into_iter().map(|i| i.label).collect(),
+            ),
+        }
+    }
+
+    #[test]
+    fn a_model_with_more_names_than_an_answer_holds_gets_those_of_the_typed_word() {
+        let mut text = String::from(
+            "model m {\n    domain electrical;\n    Se s = 1;\n    1 j;\n    bond s -> j;\n",
+        );
+        for k in 0..3 * MAX_ITEMS {
+            text.push_str(&format!("    R r{k} = 1;\n    bond j -> r{k};\n"));
+        }
+        text.push_str("    output y [V] = e(R2);\n}\n");
+        let analysis = crate::lsp::analysis::analyse_front(
+            "m.bg",
+            &text,
+            &mut crate::lower::MemoryLoader::new(),
+        );
+        let at = |needle: &str| text.find(needle).map(|i| i + needle.len()).unwrap_or(0);
+        // After `e(R2`: the names starting with `r2` (ignoring case), all 1,111 of them but cut to the limit.
+        let (incomplete, found) = labels(respond(&analysis, at("e(R2")));
+        assert!(incomplete);
+        assert_eq!(found.len(), MAX_ITEMS);
+        assert!(found.iter().all(|l| l.starts_with("r2")), "{found:?}");
+        // After `e(R2`'s `e(`: nothing typed yet, the first MAX_ITEMS names.
+        let (incomplete, found) = labels(respond(&analysis, at("e(")));
+        assert!(incomplete && found.len() == MAX_ITEMS);
+        // A small model gets its whole list, for the editor to filter.
+        let small = "model m {\n    domain electrical;\n    Se s = 1;\n    R r = 2;\n    bond s -> r;\n    output y [V] = e(r);\n}\n";
+        let analysis = crate::lsp::analysis::analyse_front(
+            "s.bg",
+            small,
+            &mut crate::lower::MemoryLoader::new(),
+        );
+        let (incomplete, found) = labels(respond(&analysis, small.find("e(r").unwrap_or(0) + 2));
+        assert!(
+            !incomplete && found.iter().any(|l| l == "r") && found.iter().any(|l| l == "sin"),
+            "{found:?}"
+        );
     }
 }

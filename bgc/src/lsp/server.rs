@@ -23,9 +23,8 @@ use lsp_types::request::{
     PrepareRenameRequest, RangeFormatting, References, Rename, Request as _,
 };
 use lsp_types::{
-    CompletionResponse, DocumentSymbolResponse, GotoDefinitionResponse, Hover, HoverContents,
-    MarkupContent, MarkupKind, PrepareRenameResponse, PublishDiagnosticsParams,
-    TextDocumentPositionParams, Uri,
+    DocumentSymbolResponse, GotoDefinitionResponse, Hover, HoverContents, MarkupContent,
+    MarkupKind, PrepareRenameResponse, PublishDiagnosticsParams, TextDocumentPositionParams, Uri,
 };
 use serde_json::Value;
 use std::collections::{BTreeSet, HashMap};
@@ -187,7 +186,7 @@ impl Server {
                 let p: lsp_types::CompletionParams = parse(params)?;
                 let found = self
                     .at(&p.text_document_position)
-                    .map(|(a, offset)| CompletionResponse::Array(completion::complete(a, offset)));
+                    .map(|(a, offset)| completion::respond(a, offset));
                 to_value(found)
             }
             CodeActionRequest::METHOD => {

@@ -267,3 +267,64 @@ fn chain_of_modulated_transformers_follows_lagrange() {
         }
     }
 }
+
+/// `n` voltage sources in series on one 1-junction with a load resistor: the junction's flow `(u0 + ... )/r`
+/// is in the power of every source.
+fn many_sources(n: usize) -> String {
+    let mut s = String::from(
+        "model many {\n    domain electrical;\n    param r = 2 [Ohm];\n    1 j;\n    R load = r;\n    bond j -> load;\n",
+    );
+    for k in 0..n {
+        s.push_str(&format!(
+            "    input u{k} [V];\n    Se s{k} = u{k};\n    bond s{k} -> j;\n"
+        ));
+    }
+    s.push_str("}\n");
+    s
+}
+
+/// The power of each of 2,000 sources holds the sum of all their voltages: printed term by term that was 4,000
+/// copies of the sum (quadratic text, 8 GB at 30,000 sources). The sum is printed once, in a `where` definition,
+/// and the terms over it; the terms themselves stay explicit and right (`P_k = u_k (Σ u)/r`, `P_load = (Σ u)²/r`).
+#[test]
+fn energy_terms_sharing_a_large_sum_print_it_once() {
+    let n = 2000;
+    let eqs = equations(&many_sources(n));
+    let text = bgc::equations::to_text(&eqs);
+    // The last input twice: in the sum's definition and in its own source's power.
+    assert_eq!(
+        text.matches("u1999").count(),
+        2,
+        "{}",
+        &text[..text.len().min(2000)]
+    );
+    let s7 = text
+        .lines()
+        .find(|l| l.starts_with("  supplied s7 = "))
+        .unwrap_or_default();
+    assert!(s7.len() < 40 && s7.contains("u7"), "{s7}");
+    assert!(text.len() < 40 * n + 20_000, "{} bytes", text.len());
+    // The values: inputs u_k = k/1000 V, r = 2 Ohm.
+    let u: Vec<f64> = (0..n).map(|k| k as f64 / 1000.0).collect();
+    let flow = u.iter().sum::<f64>() / 2.0;
+    let value = |name: &str| {
+        let term = eqs
+            .energy
+            .iter()
+            .find(|t| t.element == name)
+            .and_then(|t| t.value.clone());
+        let term = term.unwrap_or_else(|| panic!("no energy of {name}"));
+        bgc::equations::symbols::eval(&term, &|s| match s {
+            Sym::Input(k) => u.get(k).copied(),
+            Sym::Param(_) => Some(2.0),
+            _ => None,
+        })
+        .unwrap_or(f64::NAN)
+    };
+    assert!((value("s7") - u[7] * flow).abs() <= 1e-12 * (u[7] * flow).abs());
+    assert!((value("load") - 2.0 * flow * flow).abs() <= 1e-12 * 2.0 * flow * flow);
+    // A small model prints as before: no definitions.
+    let small = bgc::equations::to_text(&equations(&many_sources(3)));
+    assert!(!small.contains("where"), "{small}");
+    assert!(small.contains("  supplied s0 = "), "{small}");
+}

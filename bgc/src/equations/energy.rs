@@ -168,7 +168,7 @@ pub(crate) fn terms(
     model: &Model,
     ctx: &Ctx,
     resolver: &mut Resolver,
-    rate_of: &dyn Fn(&Expr) -> Expr,
+    rates_of: &dyn Fn(&[Expr]) -> Vec<Expr>,
     mass: &[super::field::MassBlock],
     diags: &mut Vec<Diagnostic>,
 ) -> Vec<EnergyTerm> {
@@ -181,7 +181,7 @@ pub(crate) fn terms(
         }
         if w.kind.is_field() {
             if let Some((kind, raw)) = super::field::energy(model, ctx, node, mass, diags) {
-                let value = raw.and_then(|r| resolver.expr(&r).ok().map(|v| rate_of(&v)));
+                let value = raw.and_then(|r| resolver.expr(&r).ok());
                 out.push(EnergyTerm {
                     element: w.name.clone(),
                     kind,
@@ -227,12 +227,19 @@ pub(crate) fn terms(
         // (`Sym::InputDot`): its power is `e·f` with `e = I·du/dt` (or `f = C·du/dt`), and leaving that out would
         // break the energy balance whenever the input varies. A consumer supplies `du/dt` (the simulator
         // differentiates the input signals) or leaves the term out and says so (generated code).
-        let value = raw.and_then(|r| resolver.expr(&r).ok().map(|v| rate_of(&v)));
+        let value = raw.and_then(|r| resolver.expr(&r).ok());
         out.push(EnergyTerm {
             element: w.name.clone(),
             kind,
             value,
         });
+    }
+    // The state rates substituted into all terms at once: terms that share a large subexpression (a junction's
+    // flow in the power of each of its many sources) cost its size once.
+    let present: Vec<Expr> = out.iter().filter_map(|t| t.value.clone()).collect();
+    let mut substituted = rates_of(&present).into_iter();
+    for t in out.iter_mut().filter(|t| t.value.is_some()) {
+        t.value = substituted.next();
     }
     drop_needing_acceleration(model, &mut out, diags);
     out
@@ -241,12 +248,10 @@ pub(crate) fn terms(
 /// Leaves out (with a warning) the power of each element that needs an acceleration the equations give only
 /// through a mass matrix.
 fn drop_needing_acceleration(model: &Model, terms: &mut [EnergyTerm], diags: &mut Vec<Diagnostic>) {
+    let values: Vec<Expr> = terms.iter().filter_map(|t| t.value.clone()).collect();
+    let mut needs = symbols::each_has_sym(&values, &|s| matches!(s, Sym::StateDot(_))).into_iter();
     for term in terms {
-        if term
-            .value
-            .as_ref()
-            .is_some_and(|v| v.any_sym(&|s| matches!(s, Sym::StateDot(_))))
-        {
+        if term.value.is_some() && needs.next().unwrap_or(false) {
             term.value = None;
             let d = Diagnostic::warning(
                 codes::ENERGY,

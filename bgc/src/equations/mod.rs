@@ -70,6 +70,7 @@ mod param_chain;
 mod print;
 mod resolve;
 mod sensitivity;
+mod shared;
 mod solve;
 mod sparse_linear;
 pub mod symbols;
@@ -464,13 +465,13 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
         .iter()
         .flat_map(|b| b.states.iter().copied())
         .collect();
-    let rate_of = |e: &Expr| {
-        symbols::subst(e, &mut |s| match s {
-            Sym::StateDot(j) if kinematic_rows.contains(&j) => None,
-            Sym::StateDot(j) => solved.get(j).cloned(),
-            _ => None,
-        })
+    let rate_value = |s: Sym| match s {
+        Sym::StateDot(j) if kinematic_rows.contains(&j) => None,
+        Sym::StateDot(j) => solved.get(j).cloned(),
+        _ => None,
     };
+    let rate_of = |e: &Expr| symbols::subst(e, &mut |s| rate_value(s));
+    let rates_of = |es: &[Expr]| symbols::subst_all(es, &mut |s| rate_value(s));
     eqs.f = solved
         .iter()
         .zip(&rate_ok)
@@ -584,7 +585,7 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
                 model,
                 &ctx,
                 &mut resolver,
-                &rate_of,
+                &rates_of,
                 &built.mass,
                 &mut diags,
             );

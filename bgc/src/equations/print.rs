@@ -11,6 +11,7 @@ use super::symbols::{self, Sym, SymExt};
 use super::{Equations, Intermediate, StateKind};
 use crate::symbolic::{Expr, Symbol, to_latex_with, to_text_with};
 use serde_json::{Value, json};
+use std::collections::HashMap;
 
 pub(crate) struct Readable {
     pub rates: Vec<Expr>,
@@ -209,9 +210,16 @@ fn name_of(eqs: &Equations, s: Sym, style: Style) -> String {
 
 /// Prints `e` with the engine's printers, each symbol named by `eqs`.
 fn expr(eqs: &Equations, e: &Expr, style: Style) -> String {
-    let name = |s: &Symbol| match Sym::of(s) {
-        Some(t) => name_of(eqs, t, style),
-        None => s.name().to_string(),
+    expr_named(eqs, e, style, &HashMap::new())
+}
+
+/// [`expr`] with the definitions of shared subexpressions (`extra`) named as it says.
+fn expr_named(eqs: &Equations, e: &Expr, style: Style, extra: &HashMap<Symbol, String>) -> String {
+    let name = |s: &Symbol| match (Sym::of(s), extra.get(s)) {
+        (_, Some(n)) if style == Style::Latex => latex_name(n),
+        (_, Some(n)) => n.clone(),
+        (Some(t), None) => name_of(eqs, t, style),
+        (None, None) => s.name().to_string(),
     };
     match style {
         Style::Text => to_text_with(e, &name),
@@ -306,15 +314,39 @@ pub fn to_text(eqs: &Equations) -> String {
     }
     if !eqs.energy.is_empty() {
         out.push_str("energy (stored energy, dissipated and supplied power):\n");
-        for t in &eqs.energy {
-            let value = t
-                .value
-                .as_ref()
-                .map_or_else(|| NOT_COMPUTED.to_string(), |v| expr_text(eqs, v));
+        let (definitions, values, names) = energy_values(eqs);
+        for (name, value) in &definitions {
+            let value = expr_named(eqs, value, Style::Text, &names);
+            out.push_str(&format!("  where {name} = {value}\n"));
+        }
+        for (t, value) in eqs.energy.iter().zip(&values) {
+            let value = value.as_ref().map_or_else(
+                || NOT_COMPUTED.to_string(),
+                |v| expr_named(eqs, v, Style::Text, &names),
+            );
             out.push_str(&format!("  {} {} = {value}\n", t.kind.name(), t.element));
         }
     }
     out
+}
+
+/// The definitions of shared subexpressions, the energy terms' values over them and their names (see
+/// [`super::shared`]); no definitions and the values as they are for terms that do not repeat much.
+type EnergyValues = (
+    Vec<(String, Expr)>,
+    Vec<Option<Expr>>,
+    HashMap<Symbol, String>,
+);
+
+fn energy_values(eqs: &Equations) -> EnergyValues {
+    match super::shared::shared_energy(eqs) {
+        Some(s) => (s.definitions, s.values, s.names),
+        None => (
+            Vec::new(),
+            eqs.energy.iter().map(|t| t.value.clone()).collect(),
+            HashMap::new(),
+        ),
+    }
 }
 
 /// What an energy term without a closed form prints (a warning, BG0607, says why).
@@ -407,18 +439,23 @@ pub fn to_latex(eqs: &Equations) -> String {
             .collect(),
     );
     if !eqs.energy.is_empty() {
+        let (definitions, values, names) = energy_values(eqs);
+        let shared = definitions.iter().map(|(name, value)| {
+            (
+                latex_name(name),
+                expr_named(eqs, value, Style::Latex, &names),
+            )
+        });
+        let terms = eqs.energy.iter().zip(&values).map(|(t, value)| {
+            let value = value.as_ref().map_or_else(
+                || format!("\\text{{{NOT_COMPUTED}}}"),
+                |v| expr_named(eqs, v, Style::Latex, &names),
+            );
+            (energy_latex(t), value)
+        });
         group(
             "energy: stored energy E, dissipated and supplied power P",
-            eqs.energy
-                .iter()
-                .map(|t| {
-                    let value = t.value.as_ref().map_or_else(
-                        || format!("\\text{{{NOT_COMPUTED}}}"),
-                        |v| expr_latex(eqs, v),
-                    );
-                    (energy_latex(t), value)
-                })
-                .collect(),
+            shared.chain(terms).collect(),
         );
     }
     out
@@ -427,6 +464,8 @@ pub fn to_latex(eqs: &Equations) -> String {
 /// The equations as JSON: readable and explicit forms of every rate and output, as text.
 pub fn to_json(eqs: &Equations) -> Value {
     let text = |e: &Option<Expr>| e.as_ref().map(|e| expr_text(eqs, e));
+    let (definitions, values, names) = energy_values(eqs);
+    let energy: Vec<_> = eqs.energy.iter().zip(values).collect();
     json!({
         "model": eqs.model,
         "params": eqs.params.iter().map(|(n, v)| json!({"name": n, "default": v})).collect::<Vec<_>>(),
@@ -463,10 +502,14 @@ pub fn to_json(eqs: &Equations) -> Value {
             "tears": b.names,
             "residuals": b.residuals.iter().map(|r| expr_text(eqs, r)).collect::<Vec<_>>(),
         })).collect::<Vec<_>>(),
-        "energy": eqs.energy.iter().map(|t| json!({
+        "energy": energy.iter().map(|(t, value)| json!({
             "element": t.element,
             "kind": t.kind.name(),
-            "value": text(&t.value),
+            "value": value.as_ref().map(|v| expr_named(eqs, v, Style::Text, &names)),
+        })).collect::<Vec<_>>(),
+        "energy_shared": definitions.iter().map(|(name, value)| json!({
+            "name": name,
+            "value": expr_named(eqs, value, Style::Text, &names),
         })).collect::<Vec<_>>(),
     })
 }

@@ -220,7 +220,16 @@ impl Expr {
     /// Replaces each symbol for which `f` returns an expression, all at once, and simplifies the result. Each
     /// distinct node is rebuilt once; a node none of whose symbols is replaced is kept as it is.
     pub fn substitute_with(&self, f: &dyn Fn(&Symbol) -> Option<Expr>) -> Expr {
-        let dag = Dag::new([self]);
+        Expr::substitute_all(std::slice::from_ref(self), f)
+            .pop()
+            .unwrap_or_else(|| self.clone())
+    }
+
+    /// [`Expr::substitute_with`] of several expressions at once: each distinct node of all of them is rebuilt
+    /// once, so expressions that share a large subexpression (the power of each of 30,000 sources holding their
+    /// common flow) cost its size once, not once each.
+    pub fn substitute_all(exprs: &[Expr], f: &dyn Fn(&Symbol) -> Option<Expr>) -> Vec<Expr> {
+        let dag = Dag::new(exprs);
         let mut memo = Memo::new(&dag);
         for (i, e) in dag.order.iter().enumerate() {
             let out = match e.node() {
@@ -230,7 +239,32 @@ impl Expr {
             };
             memo.set(i, out);
         }
-        memo.get(self).cloned().unwrap_or_else(|| self.clone())
+        exprs
+            .iter()
+            .map(|e| memo.get(e).cloned().unwrap_or_else(|| e.clone()))
+            .collect()
+    }
+
+    /// For each expression, whether a symbol of it satisfies `pred`: one walk of the distinct nodes of all.
+    pub fn each_depends_on(exprs: &[Expr], pred: &dyn Fn(&Symbol) -> bool) -> Vec<bool> {
+        let dag = Dag::new(exprs);
+        let mut memo = Memo::new(&dag);
+        for (i, e) in dag.order.iter().enumerate() {
+            let found = match e.node() {
+                Node::Const(_) => false,
+                Node::Sym(s) => pred(s),
+                node => {
+                    let mut any = false;
+                    node.for_each_child(|c| any |= memo.get(c).copied().unwrap_or(false));
+                    any
+                }
+            };
+            memo.set(i, found);
+        }
+        exprs
+            .iter()
+            .map(|e| memo.get(e).copied().unwrap_or(false))
+            .collect()
     }
 
     /// Rebuilds the node from its children transformed by `f`, simplifying; the node itself when `f` changes no

@@ -342,3 +342,34 @@ fn a_sparse_jacobian_of_a_long_chain_has_its_non_zeros_only() {
         i.abs_diff(*j) <= 1 && e.as_const() == Some(want)
     }));
 }
+
+/// Substituting into many expressions at once gives each what substituting into it alone gives, and visits the
+/// shared part once: 60 levels of the shared chain, each level and its square an expression of its own.
+#[test]
+fn substituting_into_many_at_once_is_substituting_into_each() {
+    let levels: Vec<Expr> = (0..60).map(shared_chain).collect();
+    let exprs: Vec<Expr> = levels
+        .iter()
+        .flat_map(|e| [e.clone(), e * e + p("k")])
+        .collect();
+    let visits = Cell::new(0usize);
+    let f = |sym: &Symbol| {
+        visits.set(visits.get() + 1);
+        (sym.name() == "x").then(|| s("y") + p("k"))
+    };
+    let together = Expr::substitute_all(&exprs, &f);
+    // `x` and `k`, each looked up once for all 120 expressions.
+    assert_eq!(visits.get(), 2);
+    for (e, t) in exprs.iter().zip(&together) {
+        assert_eq!(*t, e.substitute_with(&f));
+    }
+    let reads_y = Expr::each_depends_on(&together, &|sym: &Symbol| sym.name() == "y");
+    assert!(reads_y.iter().all(|&r| r));
+    let reads_k = Expr::each_depends_on(&exprs, &|sym: &Symbol| sym.name() == "k");
+    let expected: Vec<bool> = exprs
+        .iter()
+        .map(|e| e.depends_on(&Symbol::param("k")))
+        .collect();
+    assert_eq!(reads_k, expected);
+    assert_eq!(reads_k.iter().filter(|&&r| r).count(), 60);
+}

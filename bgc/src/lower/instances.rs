@@ -10,6 +10,22 @@ fn contains(outer: Span, inner: Span) -> bool {
     outer.file == inner.file && outer.start <= inner.start && inner.end <= outer.end
 }
 
+/// The first node (in node order) of `place` whose declaration contains `primary`. `place` holds the nodes declared
+/// at one place, sorted by span and then node: one declaration in a component has a node per instance (30,000 of
+/// them), so its run of equal spans is stepped over by a binary search, not scanned (a scan per diagnostic was
+/// quadratic).
+fn first_containing(place: &[(Span, usize)], primary: Span) -> Option<usize> {
+    let mut best: Option<usize> = None;
+    let mut at = 0;
+    while let Some(&(span, node)) = place.get(at) {
+        if contains(span, primary) {
+            best = Some(best.map_or(node, |b| b.min(node)));
+        }
+        at += place[at..].partition_point(|&(s, _)| s == span).max(1);
+    }
+    best
+}
+
 /// Adds to each diagnostic whose primary label lies in a node declared by a component instance in another file a
 /// secondary label at that instance (`in instance `gb`, declared here`), unless a label already marks it.
 pub fn add_instance_context(model: &Model, diags: &mut [Diagnostic]) {
@@ -22,7 +38,7 @@ pub fn add_instance_context(model: &Model, diags: &mut [Diagnostic]) {
     // took minutes on a model with an error in each of 300,000 elements).
     let key = |s: Span| (s.file.0, s.start);
     let mut by_place: Vec<(Span, usize)> = spans.nodes.iter().copied().zip(0..).collect();
-    by_place.sort_by_key(|&(s, i)| (key(s), i));
+    by_place.sort_by_key(|&(s, i)| (key(s), s.end, i));
     for d in diags.iter_mut() {
         let Some(primary) = d.labels.iter().find(|l| l.primary).map(|l| l.span) else {
             continue;
@@ -34,11 +50,9 @@ pub fn add_instance_context(model: &Model, diags: &mut [Diagnostic]) {
             continue;
         };
         let first = by_place.partition_point(|&(s, _)| key(s) < key(last));
-        let node = by_place[first..after]
-            .iter()
-            .find(|&&(s, _)| contains(s, primary))
-            .map(|&(_, i)| i);
-        let Some(i) = node else { continue };
+        let Some(i) = first_containing(&by_place[first..after], primary) else {
+            continue;
+        };
         let Some(Some(instance)) = spans.node_instances.get(i).copied() else {
             continue;
         };
@@ -47,8 +61,7 @@ pub fn add_instance_context(model: &Model, diags: &mut [Diagnostic]) {
         }
         let name = model
             .graph
-            .node_weights()
-            .nth(i)
+            .node_weight(petgraph::graph::NodeIndex::new(i))
             .map(|n| n.name.clone())
             .unwrap_or_default();
         let prefix = name

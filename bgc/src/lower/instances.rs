@@ -77,3 +77,25 @@ pub fn add_instance_context(model: &Model, diags: &mut [Diagnostic]) {
         });
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::first_containing;
+    use crate::span::{FileId, Span};
+
+    #[test]
+    fn the_first_node_whose_declaration_contains_the_label_is_found_among_many() {
+        let span = |start, end| Span::new(FileId(0), start, end);
+        // At one place: a short declaration with 10,000 nodes (one per instance), a longer one with two.
+        let mut place: Vec<(Span, usize)> =
+            (0..10_000).map(|i| (span(10, 20), 2 * i + 7)).collect();
+        place.extend([(span(10, 40), 5), (span(10, 40), 30_000)]);
+        place.sort_by_key(|&(s, i)| (s.end, i));
+        assert_eq!(first_containing(&place, span(12, 14)), Some(5));
+        assert_eq!(first_containing(&place, span(25, 30)), Some(5));
+        assert_eq!(first_containing(&place, span(45, 50)), None);
+        let short: Vec<(Span, usize)> = (0..3).map(|i| (span(10, 20), i + 1)).collect();
+        assert_eq!(first_containing(&short, span(15, 16)), Some(1));
+        assert_eq!(first_containing(&[], span(15, 16)), None);
+    }
+}

@@ -837,6 +837,18 @@ fn control_characters_are_refused_in_strings_and_never_echoed() {
         "{}",
         run.transcript()
     );
+    // A line that codespan shows between two labels (a comment holding an escape sequence): `?` in its place.
+    write(
+        &dir.join("d.bg"),
+        "model d {\n  domain translational;\n  Se s = 1;\n  1 j;\n  // \u{1b}[2J between\n  I a = 1;\n  I b = 2;\n  bond s -> j;\n  bond j -> a;\n  bond j -> b;\n}\n",
+    );
+    let run = bgc(&dir, &["check", "d.bg"]);
+    assert_eq!(run.status, 0, "{}", run.transcript());
+    assert!(
+        run.stderr.contains("5 │   // ?[2J between\n"),
+        "{}",
+        run.transcript()
+    );
     // What a message quotes of the command line or a record: a file name, an option's value, a column.
     let no_raw_controls = |run: &Run| {
         let raw = run

@@ -5,7 +5,8 @@
 //! serves codespan the real files, except that a label on a line longer than [`MAX_LINE_BYTES`] is moved into a
 //! one-line window of that line around the label, reported with its real line and column numbers. A line holding
 //! a control character or a direction override is shown in such a window too, with each of them replaced by a
-//! visible stand-in (`␛` for escape), so that echoing a hostile file cannot drive the terminal.
+//! visible stand-in (`␛` for escape), so that echoing a hostile file cannot drive the terminal; the lines codespan
+//! shows between labels come from copies with those characters replaced at the same offsets (`?`).
 
 use super::unprintable;
 use codespan_reporting::files::{self, Error, Files, SimpleFiles};
@@ -36,15 +37,19 @@ struct Window {
 /// The files as codespan sees them for one diagnostic: the real ones (ids `0..n`) and the windows (`n..`).
 pub struct Excerpts<'a> {
     real: &'a SimpleFiles<String, String>,
+    /// The files' texts as they are (`real` may hold copies with control characters replaced, at the same
+    /// offsets): windows are cut from these, with visible stand-ins.
+    originals: &'a [&'a str],
     count: usize,
     windows: Vec<Window>,
 }
 
 impl<'a> Excerpts<'a> {
-    pub fn new(real: &'a SimpleFiles<String, String>, count: usize) -> Self {
+    pub fn new(real: &'a SimpleFiles<String, String>, originals: &'a [&'a str]) -> Self {
         Excerpts {
             real,
-            count,
+            originals,
+            count: originals.len(),
             windows: Vec::new(),
         }
     }
@@ -55,7 +60,11 @@ impl<'a> Excerpts<'a> {
         let Ok(f) = self.real.get(file) else {
             return (file, range);
         };
-        let text = f.source().as_str();
+        let text = self
+            .originals
+            .get(file)
+            .copied()
+            .unwrap_or(f.source().as_str());
         let Ok(line_index) = f.line_index((), range.start) else {
             return (file, range);
         };

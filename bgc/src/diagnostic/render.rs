@@ -1,7 +1,7 @@
 //! Rendering diagnostics: rustc-like text and JSON.
 
 use super::excerpt::Excerpts;
-use super::unprintable::shown;
+use super::unprintable::{same_length, shown};
 use super::{Diagnostic, Severity};
 use crate::span::SourceMap;
 use codespan_reporting::diagnostic as cs;
@@ -21,16 +21,18 @@ pub fn to_text(sources: &SourceMap, diags: &[Diagnostic], color: bool) -> String
         // Nothing to show: no need for a copy of every file.
         return String::new();
     }
+    // codespan prints the lines between labels from these copies, in which no control character is left (at the
+    // same byte offsets); the labels' own lines are windows of the real text with visible stand-ins.
     let mut files = SimpleFiles::new();
-    let mut count = 0;
+    let mut originals = Vec::new();
     for (_, f) in sources.files() {
-        files.add(shown(&f.name), f.text.clone());
-        count += 1;
+        files.add(shown(&f.name), same_length(&f.text).into_owned());
+        originals.push(f.text.as_str());
     }
     let config = term::Config::default();
     let mut out = String::new();
     for d in diags.iter().take(MAX_SHOWN) {
-        let mut excerpts = Excerpts::new(&files, count);
+        let mut excerpts = Excerpts::new(&files, &originals);
         let cs_diag = to_codespan(d, &mut excerpts);
         let mut buf: Vec<u8> = Vec::new();
         let ok = if color {

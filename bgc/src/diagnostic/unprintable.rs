@@ -45,6 +45,31 @@ pub fn shown(text: &str) -> String {
         .collect()
 }
 
+/// `text` with every unprintable character but the line breaks replaced by one of the same UTF-8 length (`?`,
+/// `¿` or U+FFFD), so that every byte offset into `text` stays valid: for the lines an excerpt shows around its
+/// labels, which it does not show through a window.
+pub fn same_length(text: &str) -> std::borrow::Cow<'_, str> {
+    if !text
+        .chars()
+        .any(|c| c != '\n' && c != '\r' && is_unprintable(c))
+    {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let replaced = text
+        .chars()
+        .map(|c| match c {
+            '\n' | '\r' => c,
+            c if is_unprintable(c) => match c.len_utf8() {
+                1 => '?',
+                2 => '¿',
+                _ => '\u{FFFD}',
+            },
+            c => c,
+        })
+        .collect();
+    std::borrow::Cow::Owned(replaced)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -71,5 +96,13 @@ mod tests {
         );
         assert_eq!(stand_in('\0'), '␀');
         assert_eq!(stand_in('\u{1f}'), '␟');
+        let text = "a\u{c}b\u{85}c\u{202e}d\u{fffe}\r\n";
+        let kept = same_length(text);
+        assert_eq!(kept, "a?b¿c\u{fffd}d\u{fffd}\r\n");
+        assert_eq!(kept.len(), text.len());
+        assert!(matches!(
+            same_length("plain\r\n"),
+            std::borrow::Cow::Borrowed(_)
+        ));
     }
 }

@@ -541,12 +541,8 @@ impl SourceLoader for FsLoader {
     fn load(&mut self, key: &Path) -> std::io::Result<String> {
         let bytes = read_source_file(key)?;
         // The root file's check (UTF-16 said as such, the first bad byte), in the words of an import error.
-        match crate::syntax::decode(crate::span::FileId(0), &bytes) {
-            Ok(text) => Ok(text.to_string()),
-            Err(d) => Err(std::io::Error::new(
-                std::io::ErrorKind::InvalidData,
-                d.message.trim_start_matches("the file is ").to_string(),
-            )),
-        }
+        crate::syntax::text_of(&bytes)
+            .map(str::to_string)
+            .map_err(|cause| std::io::Error::new(std::io::ErrorKind::InvalidData, cause))
     }
 }

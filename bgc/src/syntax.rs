@@ -34,7 +34,7 @@ mod snapshot_tests;
 #[cfg(test)]
 mod tests;
 
-pub use decode::decode;
+pub use decode::{Utf16, decode, text_of};
 pub use format::{
     expr as format_expr, format, format_source, node as format_node, number as format_number,
     unit as format_unit,

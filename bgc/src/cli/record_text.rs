@@ -5,27 +5,32 @@
 //! the first byte that is not UTF-8 is, and what it is in Latin-1, the usual other encoding of a record's header
 //! (`µs`, `°`): the record is one the user can re-save, not one bgc should guess at.
 
+use bgc::syntax::Utf16;
 use std::io::{Error, ErrorKind};
 
 /// The record's text, or why its bytes are not text bgc reads.
 pub fn record_text(bytes: Vec<u8>) -> std::io::Result<String> {
     let invalid = |why: String| Error::new(ErrorKind::InvalidData, why);
-    if let Some(rest) = bytes.strip_prefix(&[0xFF, 0xFE]) {
-        return utf16(rest, u16::from_le_bytes).map_err(invalid);
-    }
-    if let Some(rest) = bytes.strip_prefix(&[0xFE, 0xFF]) {
-        return utf16(rest, u16::from_be_bytes).map_err(invalid);
-    }
-    let head = bytes.get(..bytes.len().min(512)).unwrap_or(&[]);
-    if head.len() >= 4 && 4 * head.iter().filter(|&&b| b == 0).count() >= head.len() {
-        return Err(invalid(
-            "the record looks like UTF-16 without a byte-order mark (every other byte is zero): save it as \
-             UTF-8, or as UTF-16 with its byte-order mark"
-                .into(),
-        ));
-    }
-    String::from_utf8(bytes)
-        .map_err(|e| invalid(not_utf8(e.as_bytes(), e.utf8_error().valid_up_to())))
+    let unit = match Utf16::detect(&bytes) {
+        Some(Utf16::Marked {
+            little_endian: true,
+        }) => u16::from_le_bytes,
+        Some(Utf16::Marked {
+            little_endian: false,
+        }) => u16::from_be_bytes,
+        Some(Utf16::ZeroBytes) => {
+            return Err(invalid(
+                "the record looks like UTF-16 without a byte-order mark (every other byte is zero): save it as \
+                 UTF-8, or as UTF-16 with its byte-order mark"
+                    .into(),
+            ));
+        }
+        None => {
+            return String::from_utf8(bytes)
+                .map_err(|e| invalid(not_utf8(e.as_bytes(), e.utf8_error().valid_up_to())));
+        }
+    };
+    utf16(bytes.get(2..).unwrap_or(&[]), unit).map_err(invalid)
 }
 
 /// UTF-16 code units from pairs of bytes, decoded; an odd byte or a lone surrogate is an error.

@@ -90,7 +90,8 @@ impl<'a> Excerpts<'a> {
         let win = &self.windows[w];
         let shift = |at: usize| {
             let before = text.get(win.start..at.clamp(win.start, win.end));
-            win.lead + before.map_or(0, shown_len)
+            // The window's text is `shown` of the line: the offset is the length of what it shows before.
+            win.lead + before.map_or(0, |b| unprintable::shown(b).len())
         };
         (self.count + w, shift(range.start)..shift(end))
     }
@@ -162,20 +163,6 @@ fn needs_stand_ins(text: &str) -> bool {
         }
     }
     false
-}
-
-/// The byte length of `text` as a window shows it.
-fn shown_len(text: &str) -> usize {
-    text.chars()
-        .map(|c| {
-            let shown = if unprintable::is_unprintable(c) {
-                unprintable::stand_in(c)
-            } else {
-                c
-            };
-            shown.len_utf8()
-        })
-        .sum()
 }
 
 impl<'a> Files<'a> for Excerpts<'a> {

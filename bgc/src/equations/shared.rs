@@ -8,7 +8,7 @@
 //! do not repeat much are printed as they are, so ordinary models print as before.
 
 use super::Equations;
-use crate::symbolic::{Expr, Node, Symbol, cse};
+use crate::symbolic::{Expr, Symbol, cse};
 use std::collections::{HashMap, HashSet};
 
 /// The terms are printed over definitions when their trees have at least this many nodes in all ...
@@ -70,19 +70,7 @@ fn repeats_much(values: &[Expr]) -> bool {
     if total < MIN_TREE_NODES || total < MIN_REPETITION.saturating_mul(values.len()) {
         return false;
     }
-    let mut seen: HashSet<Expr> = HashSet::new();
-    let mut stack: Vec<Expr> = values.to_vec();
-    while let Some(e) = stack.pop() {
-        if !seen.insert(e.clone()) {
-            continue;
-        }
-        match e.node() {
-            Node::Const(_) | Node::Sym(_) => {}
-            Node::Add(xs) | Node::Mul(xs) | Node::Call(_, xs) => stack.extend(xs.iter().cloned()),
-            Node::Pow(b, x) => stack.extend([b.clone(), x.clone()]),
-        }
-    }
-    total / MIN_REPETITION > seen.len()
+    total / MIN_REPETITION > Expr::distinct_nodes(values)
 }
 
 /// Every name a printed term may use: parameters, inputs, states, outputs, intermediates and bond variables.

@@ -246,41 +246,45 @@ pub fn subst(e: &Expr, f: &mut dyn FnMut(Sym) -> Option<Expr>) -> Expr {
 /// [`subst`] of several expressions at once, each distinct node of all of them once (see
 /// [`Expr::substitute_all`]).
 pub fn subst_all(es: &[Expr], f: &mut dyn FnMut(Sym) -> Option<Expr>) -> Vec<Expr> {
-    // Small trees as trees, without a table (most terms of a large model are); the large ones together.
-    let large: Vec<Expr> = es
-        .iter()
-        .filter(|e| e.node_count() > SMALL)
-        .cloned()
-        .collect();
-    let mut large_done = {
-        let f = RefCell::new(&mut *f);
-        Expr::substitute_all(&large, &|s: &Symbol| {
-            Sym::of(s).and_then(|t| (f.borrow_mut())(t))
-        })
-        .into_iter()
-    };
-    es.iter()
-        .map(|e| match e.node_count() <= SMALL {
-            true => subst_small(e, f),
-            false => large_done.next().unwrap_or_else(|| e.clone()),
-        })
-        .collect()
+    let f = RefCell::new(f);
+    by_size(
+        es,
+        |e| subst_small(e, &mut *f.borrow_mut()),
+        |large| {
+            Expr::substitute_all(large, &|s: &Symbol| {
+                Sym::of(s).and_then(|t| (f.borrow_mut())(t))
+            })
+        },
+    )
 }
 
 /// For each expression, whether one of its symbols satisfies `pred`: small trees each on their own, the large
 /// ones in one walk of their distinct nodes.
 pub fn each_has_sym(es: &[Expr], pred: &dyn Fn(Sym) -> bool) -> Vec<bool> {
-    let large: Vec<Expr> = es
+    by_size(
+        es,
+        |e| e.any_sym(pred),
+        |large| Expr::each_depends_on(large, &|s: &Symbol| Sym::of(s).is_some_and(pred)),
+    )
+}
+
+/// `small` of each tree of at most [`SMALL`] nodes, walked as a tree without a table (most terms of a large model
+/// are), and `large` of all the others at once, so that what they share is visited once; in the order of `es`.
+fn by_size<T>(
+    es: &[Expr],
+    mut small: impl FnMut(&Expr) -> T,
+    large: impl FnOnce(&[Expr]) -> Vec<T>,
+) -> Vec<T> {
+    let big: Vec<Expr> = es
         .iter()
         .filter(|e| e.node_count() > SMALL)
         .cloned()
         .collect();
-    let mut large_done =
-        Expr::each_depends_on(&large, &|s: &Symbol| Sym::of(s).is_some_and(pred)).into_iter();
+    let mut big_done = large(&big).into_iter();
     es.iter()
         .map(|e| match e.node_count() <= SMALL {
-            true => e.any_sym(pred),
-            false => large_done.next().unwrap_or(false),
+            true => small(e),
+            false => big_done.next().unwrap_or_else(|| small(e)),
         })
         .collect()
 }

@@ -69,13 +69,7 @@ pub fn respond(analysis: &Analysis, offset: usize) -> CompletionResponse {
         return CompletionResponse::Array(items);
     }
     let text = analysis.root_text();
-    let before = text.get(..offset.min(text.len())).unwrap_or(text);
-    let word_len = before
-        .chars()
-        .rev()
-        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
-        .count();
-    let word = before[before.len() - word_len..].to_ascii_lowercase();
+    let word = text[typed_word(text, offset)].to_ascii_lowercase();
     let items = items
         .into_iter()
         .filter(|i| i.label.to_ascii_lowercase().starts_with(&word))
@@ -87,32 +81,37 @@ pub fn respond(analysis: &Analysis, offset: usize) -> CompletionResponse {
     })
 }
 
+/// The name being typed at `offset` (moved back to a character boundary): the ASCII letters, digits and `_`
+/// before it.
+fn typed_word(text: &str, offset: usize) -> std::ops::Range<usize> {
+    let mut end = offset.min(text.len());
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    let len = text[..end]
+        .bytes()
+        .rev()
+        .take_while(|b| b.is_ascii_alphanumeric() || *b == b'_')
+        .count();
+    end - len..end
+}
+
 /// The completions at a byte offset of the root file.
 pub fn complete(analysis: &Analysis, offset: usize) -> Vec<CompletionItem> {
     let text = analysis.root_text();
-    let mut offset = offset.min(text.len());
-    while !text.is_char_boundary(offset) {
-        offset -= 1;
-    }
-    let line_start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
-    let line = &text[line_start..offset];
-    let word_start = line
-        .char_indices()
-        .rev()
-        .take_while(|(_, c)| c.is_ascii_alphanumeric() || *c == '_')
-        .last()
-        .map_or(line.len(), |(i, _)| i);
-    let before = &line[..word_start];
+    let word = typed_word(text, offset);
+    let line_start = text[..word.start].rfind('\n').map_or(0, |i| i + 1);
+    let before = &text[line_start..word.start];
     if before.rfind('[') > before.rfind(']') {
         return units();
     }
     if let Some(qualifier) = before.strip_suffix('.') {
-        return members(analysis, qualifier, line_start + word_start);
+        return members(analysis, qualifier, word.start);
     }
     if before.trim().is_empty() {
         return statement_start(analysis);
     }
-    in_scope(analysis, analysis.root, offset)
+    in_scope(analysis, analysis.root, word.end)
 }
 
 fn units() -> Vec<CompletionItem> {

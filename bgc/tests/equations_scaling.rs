@@ -10,8 +10,9 @@ use bgc::equations::{Equations, derive, expr_text};
 use bgc::lower::{MemoryLoader, lower};
 use bgc::simulate::System;
 use bgc::span::SourceMap;
+use bgc::symbolic::Expr;
 
-use crate::equations_support::families::{ladder, mtf_chain, output_chain};
+use crate::equations_support::families::{gear_train, ladder, mtf_chain, output_chain};
 
 /// Lowers, analyses and derives one model from source text; any error fails the test.
 pub fn equations(text: &str) -> Equations {
@@ -327,4 +328,63 @@ fn energy_terms_sharing_a_large_sum_print_it_once() {
     let small = bgc::equations::to_text(&equations(&many_sources(3)));
     assert!(!small.contains("where"), "{small}");
     assert!(small.contains("  supplied s0 = "), "{small}");
+}
+
+/// The gear train's efforts by hand: junction `k` moves at `v_k = p / 1.001^k`; the effort into transformer `k` is
+/// `e_k = (0.1 v_k + q_k + e_{k+1}) / 1.001` (power `e f` is kept across each ratio) with `e_{N+1} = 0`; and
+/// `ṗ = u − e_1`.
+fn gear_efforts(p: f64, q: &[f64]) -> Vec<f64> {
+    let n = q.len();
+    let mut e = vec![0.0; n + 1];
+    for k in (1..=n).rev() {
+        let v = p / 1.001f64.powi(k as i32);
+        e[k - 1] = (0.1 * v + q[k - 1] + e[k]) / 1.001;
+    }
+    e.truncate(n);
+    e
+}
+
+/// Each effort of a gear train holds the next through a numeric ratio: shared, the outputs are stored in a size
+/// linear in the train (each merged into one flat sum, they took 505,501 nodes at 1,000 stages), and they and the
+/// rate of the input mass are the hand-derived ones.
+#[test]
+fn the_efforts_along_a_gear_train_are_shared_and_hand_derived() {
+    let n = 1000;
+    let eqs = equations(&gear_train(n));
+    let outputs: Vec<Expr> = eqs
+        .outputs
+        .iter()
+        .map(|o| o.explicit.clone().expect("output derived"))
+        .collect();
+    let stored = Expr::distinct_nodes(&outputs);
+    assert!(stored <= 40 * n, "{stored} nodes for {n} stages");
+    let params = eqs.default_params();
+    let mut x = vec![0.0; eqs.states.len()];
+    let p = 0.8;
+    x[state(&eqs, "p_m0")] = p;
+    let q: Vec<f64> = (1..=n).map(|k| ((k % 7) as f64 - 3.0) * 0.25).collect();
+    for (k, qk) in q.iter().enumerate() {
+        x[state(&eqs, &format!("q_c{}", k + 1))] = *qk;
+    }
+    let u = 1.5;
+    let want = gear_efforts(p, &q);
+    let y = eqs
+        .outputs_at(&params, &x, &[u], 0.0)
+        .unwrap_or_else(|e| panic!("{e}"));
+    for (k, (got, want)) in y.iter().zip(&want).enumerate() {
+        assert!(
+            (got - want).abs() < 1e-12 * (1.0 + want.abs()),
+            "e{}: {got} vs {want}",
+            k + 1
+        );
+    }
+    let rates = eqs
+        .rates_at(&params, &x, &[u], 0.0)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let dp = rates[state(&eqs, "p_m0")];
+    assert!(
+        (dp - (u - want[0])).abs() < 1e-12 * (1.0 + dp.abs()),
+        "{dp} vs {}",
+        u - want[0]
+    );
 }

@@ -78,3 +78,19 @@ pub fn mtf_chain(n: usize) -> String {
     }
     s + "}\n"
 }
+
+/// A gear train: `Se u -> 1 j0 {I m0 = 1} -> TF t1 -> 1 j1 {R r1 = 0.1, C c1 = 1} -> TF t2 -> … -> 1 jN`, every
+/// ratio the number 1.001, with outputs `e_k = e(g_k)`, the effort on the bond `g_k` into transformer `k`. Each
+/// such effort holds the next (`(e(r_k) + e(c_k) + e_{k+1})` through a numeric ratio), a chain of sums.
+pub fn gear_train(n: usize) -> String {
+    let mut s = String::from(
+        "model gears {\n    domain translational;\n    input u [N];\n    Se src = u;\n    1 j0;\n    I m0 = 1;\n    bond src -> j0 -> m0;\n",
+    );
+    for k in 1..=n {
+        let p = k - 1;
+        s += &format!(
+            "    TF t{k} = 1.001;\n    1 j{k};\n    R r{k} = 0.1;\n    C c{k} = 1;\n    bond g{k}: j{p} -> t{k};\n    bond t{k} -> j{k} -> r{k}, c{k};\n    output e{k} [N] = e(g{k});\n"
+        );
+    }
+    s + "}\n"
+}

@@ -47,6 +47,9 @@ pub(crate) struct Resolver<'a> {
     cache: Vec<Option<Expr>>,
     mark: Vec<Mark>,
     torn: Vec<bool>,
+    /// The variables whose value holds a tear, an algebraic loop's solution or the rate of a storage in derivative
+    /// causality, directly or through others: the values that are multiplied out.
+    looped: Vec<bool>,
     /// The torn variables kept implicit, with their residuals `E(Tear(v)) − Tear(v)`, in the order they closed.
     implicit: Vec<(usize, Expr)>,
     /// Multiplies out the values; it remembers the expansions of earlier values, which later values hold.
@@ -63,6 +66,7 @@ impl<'a> Resolver<'a> {
             cache: vec![None; n],
             mark: vec![Mark::New; n],
             torn: vec![false; n],
+            looped: vec![false; n],
             implicit: Vec::new(),
             expander: Expander::default(),
         }
@@ -115,11 +119,23 @@ impl<'a> Resolver<'a> {
                 }
                 continue;
             }
-            stack.pop();
+            let deps = stack.pop().map(|(_, deps, _)| deps).unwrap_or_default();
+            // Only a value that an algebraic loop or a storage in derivative causality reaches is multiplied out
+            // (there like terms cancel); elsewhere values are shared as they are.
+            let rate = matches!(self.built.defs.get(w), Some(Some(Def::Rate(_))));
+            self.looped[w] =
+                rate || self.torn[w] || deps.iter().any(|&d| self.torn[d] || self.looped[d]);
+            let looped = self.looped[w];
             let value = self
                 .compute(w)
                 .and_then(|value| self.close_loop(w, value))
-                .map(|value| compact(&mut self.expander, value));
+                .map(|value| {
+                    if looped {
+                        compact(&mut self.expander, value)
+                    } else {
+                        value
+                    }
+                });
             match value {
                 Ok(value) => {
                     self.cache[w] = Some(value);

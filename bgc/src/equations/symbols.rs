@@ -482,17 +482,26 @@ impl Expander {
         self.memo.get(e).cloned().unwrap_or_else(|| e.clone())
     }
 
-    /// The expansion of a sum or product whose children are expanded.
+    /// The expansion of a sum or product whose children are expanded: one flat sum, however long (the engine
+    /// keeps a long sum whole inside another, which would keep its terms from meeting their like terms here).
     fn combine(&self, n: &Expr) -> Expr {
         let get = |c: &Expr| self.memo.get(c).cloned().unwrap_or_else(|| c.clone());
         match n.node() {
-            Node::Add(ts) => Expr::sum(ts.iter().map(get)),
+            Node::Add(ts) => {
+                let mut terms = Vec::with_capacity(ts.len());
+                ts.iter().for_each(|t| flat_terms(&get(t), 1.0, &mut terms));
+                Expr::sum(terms)
+            }
             Node::Mul(fs) => {
+                let mut coeff = 1.0;
                 let mut terms = vec![Expr::one()];
                 for f in fs {
                     let f = get(f);
                     match f.node() {
-                        Node::Add(inner) => {
+                        Node::Const(c) => coeff *= c,
+                        Node::Add(_) => {
+                            let mut inner = Vec::new();
+                            flat_terms(&f, 1.0, &mut inner);
                             if terms.len() * inner.len() > MAX_TERMS {
                                 return n.clone();
                             }
@@ -504,9 +513,31 @@ impl Expander {
                         _ => terms.iter_mut().for_each(|t| *t = &*t * &f),
                     }
                 }
-                Expr::sum(terms)
+                let mut out = Vec::with_capacity(terms.len());
+                terms.iter().for_each(|t| flat_terms(t, coeff, &mut out));
+                Expr::sum(out)
             }
             _ => n.clone(),
+        }
+    }
+}
+
+/// The terms of `e` times `coeff`, through sums and numeric multiples of sums at any depth, appended to `out`.
+fn flat_terms(e: &Expr, coeff: f64, out: &mut Vec<Expr>) {
+    let mut stack = vec![(e.clone(), coeff)];
+    while let Some((e, c)) = stack.pop() {
+        match e.node() {
+            Node::Add(ts) => stack.extend(ts.iter().rev().map(|t| (t.clone(), c))),
+            Node::Mul(fs) => {
+                if let [k, sum] = fs.as_slice()
+                    && let (Some(k), Node::Add(_)) = (k.as_const(), sum.node())
+                {
+                    stack.push((sum.clone(), c * k));
+                } else {
+                    out.push(&e * c);
+                }
+            }
+            _ => out.push(&e * c),
         }
     }
 }

@@ -1,11 +1,12 @@
 //! Simplifying constructors: every expression is put in canonical form as it is built.
 //!
 //! Rules applied on construction:
-//! - sums: nested sums are flattened, constants folded, like terms collected (`2*x + 3*x = 5*x`), zero terms dropped
-//!   (`x + 0 = x`, `x - x = 0`);
+//! - sums: nested sums of at most [`FLAT_SUM`] terms are flattened, constants folded, like terms collected
+//!   (`2*x + 3*x = 5*x`), zero terms dropped (`x + 0 = x`, `x - x = 0`); a longer sum inside a sum is one term of it
+//!   (so `S - S = 0` still holds for it, but its terms do not meet the outer sum's);
 //! - products: nested products flattened, constants folded, like factors collected by adding exponents
 //!   (`x*x = x^2`, `x^a * x^b = x^(a+b)`, `x/x = 1`), `x*1 = x`, `x*0 = 0`, and a numeric coefficient times a single
-//!   sum is distributed (`-(a - b) = b - a`, so `-(-x) = x`);
+//!   sum of at most [`FLAT_SUM`] terms is distributed (`-(a - b) = b - a`, so `-(-x) = x`);
 //! - sums inside products and under integer powers have their sign taken out, so that their first non-constant
 //!   term has a positive coefficient: `(y - x)*z = -(x - y)*z`, `(-x - 1)^2 = (x + 1)^2`. Other numeric factors are
 //!   not taken out of sums (that would need inexact divisions and print `3*(x + 0.3333333333333333)`), so
@@ -143,6 +144,7 @@ impl Expr {
         if coeff != 1.0 {
             if let [single] = out.as_slice()
                 && let Node::Add(terms) = single.node()
+                && terms.len() <= FLAT_SUM
             {
                 return Expr::sum(terms.iter().map(|t| t * coeff));
             }
@@ -297,12 +299,19 @@ impl Exponents {
     }
 }
 
-/// Adds `term` (each of its terms, for a sum) to a sum being collected: a constant to `constant`, any other term
+/// The most terms a sum may have and still be merged into a sum or product that holds it: a longer sum stays one
+/// term of the outer sum (`a + S`), and a numeric coefficient stays a factor of it (`c*S`). Merging copies every
+/// term, so a chain of sums each holding the next (the efforts along a chain of junctions, each multiplied by a
+/// transformer's ratio) would cost the square of the chain's length; kept whole, each link costs at most this
+/// many terms and the chain is shared.
+pub(super) const FLAT_SUM: usize = 32;
+
+/// Adds `term` (each of its terms, for a sum of at most [`FLAT_SUM`] terms) to a sum being collected: a constant to `constant`, any other term
 /// with its numeric coefficient.
 fn collect_term(term: &Expr, constant: &mut f64, collected: &mut Vec<(f64, Expr)>) {
     match term.node() {
         Node::Const(c) => *constant += c,
-        Node::Add(terms) => {
+        Node::Add(terms) if terms.len() <= FLAT_SUM => {
             for t in terms {
                 collect_term(t, constant, collected);
             }

@@ -127,12 +127,13 @@ impl fmt::Display for Symbol {
 ///
 /// Invariants of canonical form:
 /// - `Const` is never `-0.0` (stored as `0.0`) and every NaN is the one `f64::NAN`.
-/// - `Add` has at least two terms, no `Add` among them, at most one `Const` (first, non-zero), no two terms that
-///   differ only by their numeric coefficient, and the terms are sorted.
+/// - `Add` has at least two terms, no `Add` of at most `FLAT_SUM` (32) terms among them (longer ones stay whole),
+///   at most one `Const` (first, non-zero), no two terms that differ only by their numeric coefficient, and the
+///   terms are sorted.
 /// - `Mul` has at least two factors, no `Mul` among them, at most one `Const` (first, neither 0 nor 1), no two
-///   factors with the same base, the factors sorted, and it is never `c * (a + b)` (a numeric coefficient times a
-///   single sum is distributed); a sum among its factors has a positive coefficient on its first non-constant
-///   term.
+///   factors with the same base, the factors sorted, and it is never `c * (a + b)` for a sum of at most `FLAT_SUM`
+///   terms (a numeric coefficient times such a single sum is distributed); a sum among its factors has a positive
+///   coefficient on its first non-constant term.
 /// - `Pow` has an exponent that is not 0 or 1; when the exponent is an integer constant the base is neither a product
 ///   nor a power (those are distributed / merged), and a sum base is normalised as in a product.
 ///   `sqrt(x)` is `Pow(x, 0.5)`.

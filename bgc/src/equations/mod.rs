@@ -58,6 +58,7 @@
 mod build;
 mod coords;
 mod coords_symbolic;
+mod copies;
 pub(crate) mod dense;
 mod energy;
 mod field;

@@ -48,21 +48,7 @@ pub(crate) fn readable(
     mut taken: UniqueNames,
 ) -> Readable {
     let n = built.defs.len();
-    let mut rep: Vec<usize> = (0..n).collect();
-    for (v, slot) in rep.iter_mut().enumerate() {
-        let mut cur = v;
-        // A chain of copies is at most as long as the number of variables.
-        for _ in 0..n {
-            match built.defs.get(cur).and_then(Option::as_ref) {
-                Some(Def::Plain(e)) => match e.as_sym() {
-                    Some(Sym::Var(w)) if w != cur => cur = w,
-                    _ => break,
-                },
-                _ => break,
-            }
-        }
-        *slot = cur;
-    }
+    let rep = super::copies::representatives(&built.defs);
     // The flow of a junction with a velocity state is that state (its massless inertia's bond copies it).
     let velocity: Vec<Option<usize>> = built
         .defs

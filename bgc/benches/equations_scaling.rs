@@ -8,7 +8,8 @@
 //!   wall at the first; a 0-junction and a `C` between neighbours; `2N` states.
 //!
 //! The `rust/...` groups time what `bgc rust` does after parsing (equations, Jacobians, code generation) on the
-//! benchmark chain and the output chain: sparse Jacobians and shared subexpressions keep both linear in the model.
+//! benchmark chain, the output chain and the gear train: sparse Jacobians (a row that reads many states in one
+//! reverse walk) and shared subexpressions keep them linear in the model.
 //!
 //! Run with `cargo bench -p bgc --bench equations_scaling`. The same generators, at small sizes, are checked against
 //! hand-derived values in `tests/equations_scaling.rs`.
@@ -85,6 +86,8 @@ fn bench(c: &mut Criterion) {
     family(c, "benchmark_chain", &[1000, 10_000], benchmark_chain);
     rust_family(c, "output_chain", &[6, 12, 24], output_chain);
     rust_family(c, "benchmark_chain", &[100, 1000, 10000], benchmark_chain);
+    // The rate of the input mass reads every state: its Jacobian row is differentiated in one reverse walk.
+    rust_family(c, "gear_train", &[1000, 10_000], gear_train);
 }
 
 criterion_group!(benches, bench);

@@ -46,14 +46,27 @@ impl Expr {
             columns.entry(v).or_default().push(j);
         }
         let mut rows_of: Vec<Vec<usize>> = vec![Vec::new(); vars.len()];
+        let mut out = Vec::new();
         for (i, read) in Expr::symbols_read(exprs).iter().enumerate() {
-            for j in read.iter().filter_map(|s| columns.get(s)).flatten() {
+            let wrt: Vec<&Symbol> = read.iter().filter(|s| columns.contains_key(s)).collect();
+            if wrt.len() > WIDE_ROW {
+                // A row that reads many variables: its whole gradient in one walk of it.
+                let Some(e) = exprs.get(i) else { continue };
+                for (s, d) in wrt.iter().zip(gradient(e, &wrt)) {
+                    for &j in columns.get(*s).into_iter().flatten() {
+                        if !d.is_zero() {
+                            out.push((i, j, d.clone()));
+                        }
+                    }
+                }
+                continue;
+            }
+            for j in wrt.iter().filter_map(|s| columns.get(*s)).flatten() {
                 if let Some(rows) = rows_of.get_mut(*j) {
                     rows.push(i);
                 }
             }
         }
-        let mut out = Vec::new();
         for ((j, v), rows) in vars.iter().enumerate().zip(&rows_of) {
             let picked: Vec<Expr> = rows.iter().filter_map(|&i| exprs.get(i).cloned()).collect();
             for (&i, d) in rows.iter().zip(diff_all(&picked, v)) {
@@ -70,6 +83,72 @@ impl Expr {
     pub fn symbols_read(exprs: &[Expr]) -> Vec<BTreeSet<Symbol>> {
         exprs.iter().map(Expr::free_symbols).collect()
     }
+}
+
+/// Rows of a Jacobian that read more variables than this are differentiated in reverse mode ([`gradient`]): by
+/// columns, each of the row's variables would walk the whole row, the square of its size for a row that reads a
+/// variable in each of its terms (the rate of a mass held by many springs).
+const WIDE_ROW: usize = 64;
+
+/// `∂e/∂x` for each `x` of `wrt`, in one walk of `e` (reverse mode): each node's adjoint `∂e/∂node` is the sum,
+/// over the nodes that hold it, of their adjoints times their partial derivative by it; a variable's derivative is
+/// its node's adjoint. Only the nodes that read one of `wrt` get an adjoint.
+fn gradient(e: &Expr, wrt: &[&Symbol]) -> Vec<Expr> {
+    let dag = Dag::new([e]);
+    let wanted: BTreeSet<&Symbol> = wrt.iter().copied().collect();
+    let index = |c: &Expr| dag.index(c);
+    let mut reads = vec![false; dag.len()];
+    for (i, n) in dag.order.iter().enumerate() {
+        let mut r = n.as_symbol().is_some_and(|s| wanted.contains(s));
+        n.node()
+            .for_each_child(|c| r |= index(c).is_some_and(|k| reads[k]));
+        reads[i] = r;
+    }
+    let mut parts: Vec<Vec<Expr>> = vec![Vec::new(); dag.len()];
+    if let Some(root) = index(e) {
+        parts[root].push(Expr::one());
+    }
+    let mut of_symbol: BTreeMap<&Symbol, Expr> = BTreeMap::new();
+    // Post-order puts every node after the nodes it holds: backwards, a node's adjoint is complete when reached.
+    for i in (0..dag.len()).rev() {
+        if !reads[i] || parts[i].is_empty() {
+            continue;
+        }
+        let adjoint = Expr::sum(std::mem::take(&mut parts[i]));
+        let n = dag.order[i];
+        if let Some(s) = n.as_symbol() {
+            of_symbol.insert(s, adjoint);
+            continue;
+        }
+        if adjoint.is_zero() {
+            continue;
+        }
+        let mut seen: Vec<&Expr> = Vec::new();
+        n.node().for_each_child(|c| {
+            if seen.iter().any(|s| s.same_node(c)) {
+                return;
+            }
+            seen.push(c);
+            if let Some(k) = index(c).filter(|&k| reads[k]) {
+                parts[k].push(&adjoint * partial(n, c));
+            }
+        });
+    }
+    wrt.iter()
+        .map(|s| of_symbol.get(s).cloned().unwrap_or_else(Expr::zero))
+        .collect()
+}
+
+/// `∂n/∂c` for a node `n` and one of its children `c` (every occurrence of it).
+fn partial(n: &Expr, c: &Expr) -> Expr {
+    let unused = Symbol::time();
+    diff_node(n, &unused, &|u| u.same_node(c), &|u| {
+        if u.same_node(c) {
+            Expr::one()
+        } else {
+            Expr::zero()
+        }
+    })
 }
 
 /// `d e / d x` for each `e` of `exprs`, over one walk of their nodes: first which nodes depend on `x`, then the

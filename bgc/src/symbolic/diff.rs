@@ -141,6 +141,14 @@ fn gradient(e: &Expr, wrt: &[&Symbol]) -> Vec<Expr> {
 
 /// `∂n/∂c` for a node `n` and one of its children `c` (every occurrence of it).
 fn partial(n: &Expr, c: &Expr) -> Expr {
+    match n.node() {
+        // The terms of a sum and the factors of a product are distinct, so `c` is one of them: a sum's partial is
+        // 1 and a product's the other factors, without the product rule's walk of every term or factor (which
+        // made a long sum's gradient cost the square of its length).
+        Node::Add(_) => return Expr::one(),
+        Node::Mul(fs) => return Expr::product(fs.iter().filter(|f| !f.same_node(c)).cloned()),
+        _ => {}
+    }
     let unused = Symbol::time();
     diff_node(n, &unused, &|u| u.same_node(c), &|u| {
         if u.same_node(c) {

@@ -9,6 +9,7 @@ use bgc::equations::symbols::{Sym, SymExt};
 use bgc::equations::{Equations, derive, expr_text};
 use bgc::lower::{MemoryLoader, lower};
 use bgc::simulate::System;
+use bgc::simulate::input::Signal;
 use bgc::span::SourceMap;
 use bgc::symbolic::Expr;
 
@@ -387,4 +388,50 @@ fn the_efforts_along_a_gear_train_are_shared_and_hand_derived() {
         "{dp} vs {}",
         u - want[0]
     );
+}
+
+/// The simulation's Jacobian of a gear train: the rate of the input mass is one long sum held whole that reads
+/// every state, differentiated in one walk, and its entries are the hand-derived ones, `∂ṗ/∂q_k = −1.001^−k` and
+/// `∂ṗ/∂p = −Σ_k 0.1·1.001^−2k` (from `ṗ = u − e_1` with the efforts of `gear_efforts`).
+#[test]
+fn the_simulations_jacobian_of_a_gear_train_is_hand_derived() {
+    let n = 200;
+    let eqs = equations(&gear_train(n));
+    let signal = Signal::parse("0").unwrap_or_else(|e| panic!("{e}"));
+    let (system, _) =
+        System::new(&eqs, eqs.default_params(), vec![signal]).unwrap_or_else(|e| panic!("{e}"));
+    let pattern = system.jacobian_pattern().expect("a symbolic Jacobian");
+    let mut y = vec![0.5; eqs.states.len()];
+    y.extend([0.0, 0.0]);
+    let mut values = vec![0.0; pattern.len()];
+    system
+        .jacobian_values(&y, &[0.0], 0.0, &mut values, &mut Vec::new())
+        .expect("a symbolic Jacobian");
+    let p = state(&eqs, "p_m0");
+    let row: Vec<(usize, f64)> = pattern
+        .iter()
+        .zip(&values)
+        .filter(|((r, _), _)| *r == p)
+        .map(|((_, c), v)| (*c, *v))
+        .collect();
+    assert_eq!(row.len(), n + 1, "the input mass's rate reads every state");
+    for (c, got) in row {
+        let want = if c == p {
+            -(1..=n)
+                .map(|k| 0.1 / 1.001f64.powi(2 * k as i32))
+                .sum::<f64>()
+        } else {
+            let k: i32 = eqs.states[c]
+                .name
+                .trim_start_matches("q_c")
+                .parse()
+                .expect("a spring");
+            -1.001f64.powi(-k)
+        };
+        assert!(
+            (got - want).abs() < 1e-12 * want.abs().max(1.0),
+            "{}: {got} vs {want}",
+            eqs.states[c].name
+        );
+    }
 }

@@ -46,7 +46,8 @@ mod sparse_ode;
 
 use crate::equations::symbols::{self, Sym, SymExt, add};
 use crate::equations::{EnergyKind, Equations, block_jacobian, residual_scale};
-use crate::symbolic::{Expr, Node};
+use crate::ir::Func;
+use crate::symbolic::{Expr, Node, Symbol, WIDE_ROW};
 use input::Signal;
 use newton::{BlockPrograms, Loops};
 use program::{CompileError, Layout, Program, Values};
@@ -638,7 +639,15 @@ fn symbolic_jacobian(
         };
         let mut parts: std::collections::BTreeMap<usize, Vec<Expr>> = Default::default();
         for term in terms {
-            for c in states_read(term, n) {
+            let read = states_read(term, n);
+            if read.len() > WIDE_ROW {
+                // A term that reads many states (a long sum held whole): its gradient in one walk.
+                for (c, d) in read.iter().zip(state_gradient(term, &read)?) {
+                    parts.entry(*c).or_default().push(d);
+                }
+                continue;
+            }
+            for c in read {
                 let d = symbols::diff(term, Sym::State(c)).ok()?;
                 parts.entry(c).or_default().push(d);
             }
@@ -651,6 +660,24 @@ fn symbolic_jacobian(
         }
     }
     Some(entries)
+}
+
+/// `∂e/∂x_c` for each state `c` of `read` (those `e` reads), in one walk of `e`; `None` when `e` reads one of them
+/// under `min` or `max` (not differentiable), as [`symbols::diff`] refuses it.
+fn state_gradient(e: &Expr, read: &[usize]) -> Option<Vec<Expr>> {
+    let vars: Vec<Symbol> = read.iter().map(|&c| Sym::State(c).symbol()).collect();
+    if let Some((_, under)) = e.symbols_under_calls(&[Func::Min, Func::Max])
+        && vars.iter().any(|v| under.contains(v))
+    {
+        return None;
+    }
+    let mut gradient = vec![Expr::zero(); read.len()];
+    for (_, j, d) in Expr::sparse_jacobian(std::slice::from_ref(e), &vars) {
+        if let Some(slot) = gradient.get_mut(j) {
+            *slot = d;
+        }
+    }
+    Some(gradient)
 }
 
 /// The model states (below `n`) that `e` reads, each once.

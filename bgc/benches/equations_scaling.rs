@@ -4,6 +4,7 @@
 //! - outputs defined through earlier outputs, `y_i = sin(y_{i-1}·y_{i-1}) + cos(y_{i-1})` (`levels`),
 //! - a chain of modulated transformers with every inertia but one dependent (`n`),
 //! - a gear train of numeric ratios whose efforts each hold the next (`n`),
+//! - pairs of resistors in parallel on one junction, each pair an algebraic loop of its own (`n`),
 //! - the benchmark chain: `Se` drives mass 1; each 1-junction has `I` (m = 1) and `R` (b = 0.5); a `C` to the
 //!   wall at the first; a 0-junction and a `C` between neighbours; `2N` states.
 //!
@@ -21,7 +22,7 @@ use bgc::causality::analyse;
 use bgc::lower::{MemoryLoader, lower};
 use bgc::span::SourceMap;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use families::{benchmark_chain, gear_train, ladder, mtf_chain, output_chain};
+use families::{benchmark_chain, gear_train, ladder, mtf_chain, output_chain, parallel_pairs};
 use std::hint::black_box;
 
 /// Lowers, assigns causality and derives; returns the number of states so that nothing is optimised away.
@@ -83,6 +84,7 @@ fn bench(c: &mut Criterion) {
     // Each value of the MTF chain holds the next junction's: the expressions, and so the cost, grow as N².
     family(c, "mtf_chain", &[25, 50, 100], mtf_chain);
     family(c, "gear_train", &[1000, 10_000], gear_train);
+    family(c, "parallel_pairs", &[1000, 10_000], parallel_pairs);
     family(c, "benchmark_chain", &[1000, 10_000], benchmark_chain);
     rust_family(c, "output_chain", &[6, 12, 24], output_chain);
     rust_family(c, "benchmark_chain", &[100, 1000, 10000], benchmark_chain);

@@ -13,7 +13,9 @@ use bgc::simulate::input::Signal;
 use bgc::span::SourceMap;
 use bgc::symbolic::Expr;
 
-use crate::equations_support::families::{gear_train, ladder, mtf_chain, output_chain};
+use crate::equations_support::families::{
+    gear_train, ladder, mtf_chain, output_chain, parallel_pairs,
+};
 
 /// Lowers, analyses and derives one model from source text; any error fails the test.
 pub fn equations(text: &str) -> Equations {
@@ -434,4 +436,30 @@ fn the_simulations_jacobian_of_a_gear_train_is_hand_derived() {
             eqs.states[c].name
         );
     }
+}
+
+/// Pairs of resistors in parallel on a mass's junction, each pair an algebraic loop of its own, solved where it
+/// closes: the mass feels `Σ_k a_k b_k / (a_k + b_k)` times its velocity (each pair's effort is the velocity times
+/// the pair's parallel resistance).
+#[test]
+fn pairs_of_parallel_resistors_are_each_solved_as_their_own_loop() {
+    let n = 500;
+    let eqs = equations(&parallel_pairs(n));
+    assert_eq!(eqs.loops.len(), n, "one loop per pair");
+    let (p, u) = (0.7, 2.0);
+    let rates = eqs
+        .rates_at(&eqs.default_params(), &[p], &[u], 0.0)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let resistance: f64 = (0..n)
+        .map(|k| {
+            let (a, b) = ((1 + k % 3) as f64, (2 + k % 5) as f64);
+            a * b / (a + b)
+        })
+        .sum();
+    let want = u - resistance * p;
+    assert!(
+        (rates[0] - want).abs() < 1e-12 * want.abs().max(1.0),
+        "{} vs {want}",
+        rates[0]
+    );
 }

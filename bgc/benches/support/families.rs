@@ -94,3 +94,18 @@ pub fn gear_train(n: usize) -> String {
     }
     s + "}\n"
 }
+
+/// `Se u -> 1 j {I m = 1}` and `n` pairs of resistors in parallel, each pair on a 0-junction bonded to `j`
+/// (`a_k = 1 + k mod 3`, `b_k = 2 + k mod 5`): every pair is an algebraic loop of its own.
+pub fn parallel_pairs(n: usize) -> String {
+    let mut s = String::from(
+        "model pairs {\n    domain translational;\n    input u [N];\n    Se src = u;\n    1 j;\n    I m = 1;\n    bond src -> j -> m;\n",
+    );
+    for k in 0..n {
+        let (a, b) = (1 + k % 3, 2 + k % 5);
+        s += &format!(
+            "    0 n{k};\n    R a{k} = {a};\n    R b{k} = {b};\n    bond j -> n{k} -> a{k}, b{k};\n"
+        );
+    }
+    s + "}\n"
+}

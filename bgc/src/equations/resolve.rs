@@ -47,6 +47,11 @@ pub(crate) struct Resolver<'a> {
     cache: Vec<Option<Expr>>,
     mark: Vec<Mark>,
     torn: Vec<bool>,
+    /// The variables in the order their values were completed (a variable forgotten and computed again is listed
+    /// again).
+    completed: Vec<usize>,
+    /// Per variable: the length of `completed` when it was last opened.
+    opened_at: Vec<usize>,
     /// The variables whose value holds a tear, an algebraic loop's solution or the rate of a storage in derivative
     /// causality, directly or through others: the values that are multiplied out.
     looped: Vec<bool>,
@@ -67,6 +72,8 @@ impl<'a> Resolver<'a> {
             mark: vec![Mark::New; n],
             torn: vec![false; n],
             looped: vec![false; n],
+            completed: Vec::new(),
+            opened_at: vec![0; n],
             implicit: Vec::new(),
             expander: Expander::default(),
         }
@@ -140,6 +147,7 @@ impl<'a> Resolver<'a> {
                 Ok(value) => {
                     self.cache[w] = Some(value);
                     self.mark[w] = Mark::Done;
+                    self.completed.push(w);
                 }
                 Err(e) => {
                     self.forget(w);
@@ -156,6 +164,9 @@ impl<'a> Resolver<'a> {
     /// Starts computing `v`: marks it busy and lists the variables its definition reads.
     fn open(&mut self, v: usize) -> (usize, Vec<usize>, usize) {
         self.mark[v] = Mark::Busy;
+        if let Some(at) = self.opened_at.get_mut(v) {
+            *at = self.completed.len();
+        }
         let deps = match self.built.defs.get(v).and_then(Option::as_ref) {
             Some(Def::Plain(e) | Def::Rate(e)) => vars_read(e),
             None => Vec::new(),
@@ -197,7 +208,9 @@ impl<'a> Resolver<'a> {
         }
         let solved = compact(&mut self.expander, div(b, gain));
         // Values computed inside the loop, and the residuals of implicit loops inside it, hold the tear: replace it
-        // everywhere.
+        // there. The tear exists only while `v` is being computed, so only the values completed since `v` was opened
+        // can hold it (looking through every value at each loop cost the number of loops times the model).
+        let since = self.opened_at.get(v).copied().unwrap_or(0);
         let expander = &mut self.expander;
         let mut replace = |e: &mut Expr| {
             if e.contains(tear) {
@@ -207,7 +220,11 @@ impl<'a> Resolver<'a> {
                 );
             }
         };
-        self.cache.iter_mut().flatten().for_each(&mut replace);
+        for &w in self.completed.get(since..).unwrap_or_default() {
+            if let Some(Some(e)) = self.cache.get_mut(w) {
+                replace(e);
+            }
+        }
         self.implicit.iter_mut().for_each(|(_, r)| replace(r));
         Ok(solved)
     }

@@ -7,8 +7,8 @@
 //! - products: nested products flattened, constants folded, like factors collected by adding exponents
 //!   (`x*x = x^2`, `x^a * x^b = x^(a+b)`, `x/x = 1`), `x*1 = x`, `x*0 = 0`, and a numeric coefficient times a single
 //!   sum of at most [`FLAT_SUM`] terms is distributed (`-(a - b) = b - a`, so `-(-x) = x`);
-//! - sums inside products and under integer powers have their sign taken out, so that their first non-constant
-//!   term has a positive coefficient: `(y - x)*z = -(x - y)*z`, `(-x - 1)^2 = (x + 1)^2`. Other numeric factors are
+//! - sums inside products (of at most [`FLAT_SUM`] terms) and under integer powers have their sign taken out, so
+//!   that their first non-constant term has a positive coefficient: `(y - x)*z = -(x - y)*z`, `(-x - 1)^2 = (x + 1)^2`. Other numeric factors are
 //!   not taken out of sums (that would need inexact divisions and print `3*(x + 0.3333333333333333)`), so
 //!   `2*(x + 1)*y` and `(2*x + 2)*y` stay different forms of the same value; [`Expr::expand`] maps both to
 //!   `2*x*y + 2*y`. Likewise, as a product is built pairwise, `(2*(x + 1))*y` is `(2*x + 2)*y`: the numeric
@@ -347,7 +347,8 @@ fn collect_factor(f: &Expr, coeff: &mut f64, bases: &mut Vec<(Expr, Expr)>) {
             }
         }
         Node::Pow(b, e) => bases.push((b.clone(), e.clone())),
-        Node::Add(_) => match split_content(f) {
+        // A long sum keeps its sign (it stays whole as a term of sums too, where it meets its multiples).
+        Node::Add(terms) if terms.len() <= FLAT_SUM => match split_content(f) {
             Some((content, primitive)) => {
                 *coeff *= content;
                 bases.push((primitive, Expr::one()));

@@ -132,8 +132,9 @@ impl fmt::Display for Symbol {
 ///   terms are sorted.
 /// - `Mul` has at least two factors, no `Mul` among them, at most one `Const` (first, neither 0 nor 1), no two
 ///   factors with the same base, the factors sorted, and it is never `c * (a + b)` for a sum of at most `FLAT_SUM`
-///   terms (a numeric coefficient times such a single sum is distributed); a sum among its factors has a positive
-///   coefficient on its first non-constant term.
+///   terms (a numeric coefficient times such a single sum is distributed); a sum of at most `FLAT_SUM` terms among
+///   its factors has a positive coefficient on its first non-constant term (a longer one keeps its sign, as it does
+///   as a term of a sum, so that `S + S = 2*S`).
 /// - `Pow` has an exponent that is not 0 or 1; when the exponent is an integer constant the base is neither a product
 ///   nor a power (those are distributed / merged), and a sum base is normalised as in a product.
 ///   `sqrt(x)` is `Pow(x, 0.5)`.

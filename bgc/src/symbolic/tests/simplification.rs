@@ -208,6 +208,12 @@ fn a_long_sum_stays_whole_inside_sums_and_numeric_multiples() {
     // Multiplied out, it is the flat sum with every term scaled.
     let flat = Expr::sum((0..40).map(|i| 2.0 * s(&format!("t{i}"))));
     assert_eq!(scaled.expand(), flat);
+    // A long sum whose first term is negative keeps its sign, in a sum and in a product alike.
+    let negative = Expr::sum((0..40).map(|i| -s(&format!("n{i}"))));
+    assert_eq!(&negative + &negative, 2.0 * &negative);
+    assert!((&negative + &negative - 2.0 * &negative).is_zero());
+    assert_eq!(-(-&negative), negative);
+    assert!((&x * &negative - &negative * &x).is_zero());
     // A short sum is still merged and distributed.
     let short = long_sum("u", 5);
     assert!(matches!((&x + 2.0 * &short).node(), Node::Add(ts) if ts.len() == 6));

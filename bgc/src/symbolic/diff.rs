@@ -85,9 +85,9 @@ impl Expr {
     }
 }
 
-/// Rows of a Jacobian that read more variables than this are differentiated in reverse mode ([`gradient`]): by
-/// columns, each of the row's variables would walk the whole row, the square of its size for a row that reads a
-/// variable in each of its terms (the rate of a mass held by many springs).
+/// Rows of a Jacobian that read more variables than this are differentiated in reverse mode (one walk for all of
+/// the row's variables): by columns, each of the row's variables would walk the whole row, the square of its size
+/// for a row that reads a variable in each of its terms (the rate of a mass held by many springs).
 pub const WIDE_ROW: usize = 64;
 
 /// `∂e/∂x` for each `x` of `wrt`, in one walk of `e` (reverse mode): each node's adjoint `∂e/∂node` is the sum,

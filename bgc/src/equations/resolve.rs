@@ -127,8 +127,9 @@ impl<'a> Resolver<'a> {
                 continue;
             }
             let deps = stack.pop().map(|(_, deps, _)| deps).unwrap_or_default();
-            // Only a value that an algebraic loop or a storage in derivative causality reaches is multiplied out
-            // (there like terms cancel); elsewhere values are shared as they are.
+            // A value that an algebraic loop or a storage in derivative causality reaches is multiplied out (there
+            // like terms cancel), and so is any value of at most `COMPACT_TREE` nodes as a tree; a larger value
+            // elsewhere is shared as it is.
             let rate = matches!(self.built.defs.get(w), Some(Some(Def::Rate(_))));
             self.looped[w] =
                 rate || self.torn[w] || deps.iter().any(|&d| self.torn[d] || self.looped[d]);
@@ -137,7 +138,7 @@ impl<'a> Resolver<'a> {
                 .compute(w)
                 .and_then(|value| self.close_loop(w, value))
                 .map(|value| {
-                    if looped {
+                    if looped || value.node_count() <= COMPACT_TREE {
                         compact(&mut self.expander, value)
                     } else {
                         value
@@ -323,6 +324,11 @@ fn vars_read(e: &Expr) -> Vec<usize> {
         })
         .collect()
 }
+
+/// Values outside algebraic loops up to this size as a tree are multiplied out too: a small model's values keep one
+/// form however they are reached, and multiplying out a value this size costs at most this much, so a chain of
+/// values that each hold the next stays linear (only the first few links are this small).
+const COMPACT_TREE: usize = 1024;
 
 /// `e` multiplied out when that makes it no larger. A value is copied into every variable that uses it: in a chain
 /// of algebraic loops each rung's solution `b / (1 − a)` holds the previous ones as nested products of sums, which

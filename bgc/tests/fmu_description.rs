@@ -92,3 +92,37 @@ fn model_structure_lists_the_hand_derived_dependencies() {
         "{d3}"
     );
 }
+
+/// One mass on a junction with `n - 1` compliances: `n` states.
+fn star(n: usize) -> String {
+    let mut s = String::from(
+        "model star {\n    domain translational;\n    input u [N];\n    Se src = u;\n    1 j;\n    I m = 1;\n    bond src -> j -> m;\n",
+    );
+    for k in 1..n {
+        s += &format!("    C c{k} = 1;\n    bond j -> c{k};\n");
+    }
+    s + "}\n"
+}
+
+fn package(text: String) -> Result<bgc::fmu::Sources, String> {
+    let mut sources = SourceMap::new();
+    let root = sources.add("star.bg", text);
+    let compiled = bgc::codegen::compile(&mut sources, root, &mut FsLoader::default())
+        .unwrap_or_else(|d| panic!("{d:?}"));
+    package_sources(&compiled, None, Version::Fmi2, "star.bg")
+}
+
+/// The FMU's solver holds the dense state Jacobian on the importer's stack, at most 256 KiB: a model of 181
+/// states is packaged (its solver's LU is of dynamic size, since nalgebra decomposes fixed sizes only up to 127,
+/// and a model of 131 states did not compile), one of 182 is refused with the reason and what to use instead.
+#[test]
+fn a_model_of_more_than_181_states_is_refused_with_its_reason() {
+    let sources = package(star(181)).unwrap_or_else(|e| panic!("{e}"));
+    assert!(sources.description.contains("<ModelVariables>"));
+    let Err(err) = package(star(182)) else {
+        panic!("a model of 182 states was packaged")
+    };
+    assert!(err.contains("model `star` has 182 states"), "{err}");
+    assert!(err.contains("at most 181 states"), "{err}");
+    assert!(err.contains("bgc simulate"), "{err}");
+}

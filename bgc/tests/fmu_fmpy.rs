@@ -1,7 +1,7 @@
 //! FMUs of `bgc fmu` (FMI 2.0 and 3.0) in FMPy, a real importer, and FMI 2.0 Co-Simulation also in the Open
 //! Simulation Platform's libcosim, a second one: `fmpy validate` accepts the FMU of every model in `models/`, and
 //! the simulations of the back-support plant, the walking leg (mass matrix), the diode loop (nonlinear
-//! algebraic loop) and a voltage divider (no states), through Model Exchange (FMPy's CVode) and Co-Simulation (the FMU's own integrator), give the
+//! algebraic loop), a voltage divider (no states) and a mass on 149 springs (150 states), through Model Exchange (FMPy's CVode) and Co-Simulation (the FMU's own integrator), give the
 //! outputs of `bgc simulate` to 1e-6 of each output's range; the directional derivatives equal central
 //! differences of the derivatives and outputs, and every dependency they show is listed in `ModelStructure`.
 
@@ -57,6 +57,18 @@ const NO_STATES: Scenario = Scenario {
     rows: &[&[0.0, 0.0], &[0.5, 0.0], &[0.5, 4.0], &[1.0, 4.0]],
     x0: &[],
     jumps: &[0.5],
+};
+
+/// 150 states, above the 127 that nalgebra decomposes at a fixed size: the FMU's library did not compile
+/// (`Const<151>: ToTypenum` in its solver's LU); the solver's LU is of dynamic size now.
+const WIDE: Scenario = Scenario {
+    model: "bgc/tests/fmu_support/wide_star.bg",
+    t_end: 0.5,
+    dt: 5e-3,
+    inputs: &[("u", "step(0.1)")],
+    rows: &[&[0.0, 0.0], &[0.1, 0.0], &[0.1, 1.0], &[0.5, 1.0]],
+    x0: &[],
+    jumps: &[0.1],
 };
 
 /// The required agreement with `bgc simulate`, relative to each output's range.
@@ -156,6 +168,11 @@ fn walking_leg_fmu_follows_bgc_simulate() {
 fn diode_loop_fmu_follows_bgc_simulate() {
     agrees(&DIODE, 2);
     agrees(&DIODE, 3);
+}
+
+#[test]
+fn a_model_of_150_states_follows_bgc_simulate() {
+    agrees(&WIDE, 2);
 }
 
 #[test]

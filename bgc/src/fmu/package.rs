@@ -43,6 +43,11 @@ const TEMPLATE: [(&str, &str); 9] = [
     ("src/fmi3.rs", include_str!("template/fmi3.rs")),
 ];
 
+/// The most states an FMU takes: its solver and its directional derivatives hold `N_STATES x N_STATES` Jacobians
+/// on the importing tool's stack, each at most 256 KiB (181² · 8 bytes) here, the bound the generated code keeps
+/// its dense Jacobians within.
+const MAX_STATES: usize = 181;
+
 /// The crate of model `model` of `file` (the only one when `None`) for FMI `version`; `source_name` names the file
 /// in the generated module's header.
 pub fn package_sources(
@@ -65,6 +70,15 @@ pub fn package_sources(
             format!("has no model `{name}`; it declares {}", names.join(", "))
         })?,
     };
+    let states = chosen.equations.states.len();
+    if states > MAX_STATES {
+        return Err(format!(
+            "model `{}` has {states} states: an FMU's solver holds the {states} x {states} state Jacobian on the \
+             stack of the importing tool's thread, so `bgc fmu` exports models of at most {MAX_STATES} states (a \
+             Jacobian of 256 KiB); simulate it with `bgc simulate`, or generate its Rust module with `bgc rust`",
+            chosen.model.name
+        ));
+    }
     let identifier = identifier(&chosen.model.name);
     let guid = guid(file.hash, &chosen.model.name, version);
     let vars = variables(chosen);
@@ -115,7 +129,8 @@ pub fn package_sources(
 
 /// The manifest: the library as a `cdylib`, with the crates the generated module needs (the versions bgc's own
 /// workspace uses), optimised, and a workspace of its own wherever it lies. nalgebra comes without its default
-/// features: the generated code needs only `core` (see `codegen::rust`), and without the `macros` feature the build
+/// features: the generated code needs only `core` (see `codegen::rust`), the solver `alloc` for its LU of a
+/// dynamic size (nalgebra decomposes fixed sizes only up to 127), and without the `macros` feature the build
 /// compiles no proc-macro crates (`syn` and its kin), the larger part of a first FMU build.
 fn manifest(crate_name: &str, lib_name: &str, feature: &str) -> String {
     format!(
@@ -123,7 +138,7 @@ fn manifest(crate_name: &str, lib_name: &str, feature: &str) -> String {
          [package]\nname = \"{crate_name}\"\nversion = \"0.1.0\"\nedition = \"2024\"\npublish = false\n\n\
          [lib]\nname = \"{lib_name}\"\ncrate-type = [\"cdylib\"]\npath = \"src/lib.rs\"\n\n\
          [features]\ndefault = [\"{feature}\"]\nfmi2 = []\nfmi3 = []\n\n\
-         [dependencies]\nnalgebra = {{ version = \"0.35\", default-features = false, features = [\"libm\"] }}\nlibm = \"0.2\"\n\n\
+         [dependencies]\nnalgebra = {{ version = \"0.35\", default-features = false, features = [\"libm\", \"alloc\"] }}\nlibm = \"0.2\"\n\n\
          [profile.release]\nopt-level = 2\ndebug = false\npanic = \"unwind\"\n\n\
          [workspace]\n",
         version = rust::BGC_VERSION

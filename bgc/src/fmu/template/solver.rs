@@ -8,7 +8,6 @@
 //! instead of resolving them, which an explicit method would have to. The difference of the two last entries of
 //! the table's diagonal estimates the local error; the step size follows it.
 
-use crate::model as m;
 use crate::plant::{self, NX, Params};
 
 /// Substep counts 1..=K: order K.
@@ -102,7 +101,11 @@ impl Integrator {
         for j in 0..K {
             let n = j + 1;
             let hs = h / n as f64;
-            let lu = (m::JacX::identity() - jac * hs).lu();
+            // A matrix of dynamic size: nalgebra decomposes fixed sizes only up to 127.
+            let lu = nalgebra::DMatrix::from_fn(NX, NX, |r, c| {
+                f64::from(u8::from(r == c)) - jac[(r, c)] * hs
+            })
+            .lu();
             let mut y = x.to_vec();
             for i in 0..n {
                 if i == 0 {
@@ -110,7 +113,7 @@ impl Integrator {
                 } else {
                     plant::rhs(p, t + i as f64 * hs, &y, u, &mut f);
                 }
-                let rhs = m::State::from_iterator(f.iter().map(|v| v * hs));
+                let rhs = nalgebra::DVector::from_iterator(NX, f.iter().map(|v| v * hs));
                 let delta = lu.solve(&rhs)?;
                 for (yk, d) in y.iter_mut().zip(delta.iter()) {
                     *yk += d;

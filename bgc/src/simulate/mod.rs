@@ -671,13 +671,7 @@ fn state_gradient(e: &Expr, read: &[usize]) -> Option<Vec<Expr>> {
     {
         return None;
     }
-    let mut gradient = vec![Expr::zero(); read.len()];
-    for (_, j, d) in Expr::sparse_jacobian(std::slice::from_ref(e), &vars) {
-        if let Some(slot) = gradient.get_mut(j) {
-            *slot = d;
-        }
-    }
-    Some(gradient)
+    Some(e.gradient(&vars))
 }
 
 /// The model states (below `n`) that `e` reads, each once.

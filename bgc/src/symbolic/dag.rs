@@ -85,6 +85,19 @@ impl<'a> Dag<'a> {
     pub fn len(&self) -> usize {
         self.order.len()
     }
+
+    /// Per node of [`Dag::order`]: whether it reads a symbol for which `pred` holds (a symbol itself, or a node
+    /// with such a child).
+    pub fn reading(&self, pred: impl Fn(&super::expr::Symbol) -> bool) -> Vec<bool> {
+        let mut reads = vec![false; self.len()];
+        for (i, e) in self.order.iter().enumerate() {
+            let mut r = e.as_symbol().is_some_and(&pred);
+            e.node()
+                .for_each_child(|c| r |= self.index(c).is_some_and(|k| reads[k]));
+            reads[i] = r;
+        }
+        reads
+    }
 }
 
 /// One value per node of a [`Dag`], filled in post-order.

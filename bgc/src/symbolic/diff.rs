@@ -79,6 +79,12 @@ impl Expr {
         out
     }
 
+    /// `∂self/∂x` for each `x` of `wrt`, in one walk of `self` (reverse mode): what a row of more than
+    /// [`WIDE_ROW`] variables costs in [`Expr::sparse_jacobian`], for a caller that has the variables at hand.
+    pub fn gradient(&self, wrt: &[Symbol]) -> Vec<Expr> {
+        gradient(self, &wrt.iter().collect::<Vec<_>>())
+    }
+
     /// For each expression, the symbols it reads: one walk per expression over its distinct nodes.
     pub fn symbols_read(exprs: &[Expr]) -> Vec<BTreeSet<Symbol>> {
         exprs.iter().map(Expr::free_symbols).collect()
@@ -97,13 +103,7 @@ fn gradient(e: &Expr, wrt: &[&Symbol]) -> Vec<Expr> {
     let dag = Dag::new([e]);
     let wanted: BTreeSet<&Symbol> = wrt.iter().copied().collect();
     let index = |c: &Expr| dag.index(c);
-    let mut reads = vec![false; dag.len()];
-    for (i, n) in dag.order.iter().enumerate() {
-        let mut r = n.as_symbol().is_some_and(|s| wanted.contains(s));
-        n.node()
-            .for_each_child(|c| r |= index(c).is_some_and(|k| reads[k]));
-        reads[i] = r;
-    }
+    let reads = dag.reading(|s| wanted.contains(s));
     let mut parts: Vec<Vec<Expr>> = vec![Vec::new(); dag.len()];
     if let Some(root) = index(e) {
         parts[root].push(Expr::one());
@@ -149,8 +149,9 @@ fn partial(n: &Expr, c: &Expr) -> Expr {
         Node::Mul(fs) => return Expr::product(fs.iter().filter(|f| !f.same_node(c)).cloned()),
         _ => {}
     }
-    let unused = Symbol::time();
-    diff_node(n, &unused, &|u| u.same_node(c), &|u| {
+    // `diff_node` reads its variable only at a symbol, and `n` holds a child: any symbol serves, made once.
+    static UNUSED: std::sync::LazyLock<Symbol> = std::sync::LazyLock::new(Symbol::time);
+    diff_node(n, &UNUSED, &|u| u.same_node(c), &|u| {
         if u.same_node(c) {
             Expr::one()
         } else {
@@ -163,20 +164,7 @@ fn partial(n: &Expr, c: &Expr) -> Expr {
 /// derivative of each of those from its children's.
 fn diff_all(exprs: &[Expr], x: &Symbol) -> Vec<Expr> {
     let dag = Dag::new(exprs);
-    let mut depends = vec![false; dag.len()];
-    for (i, e) in dag.order.iter().enumerate() {
-        let mut d = e.as_symbol() == Some(x);
-        e.node().for_each_child(|c| {
-            d |= dag
-                .index(c)
-                .and_then(|k| depends.get(k))
-                .copied()
-                .unwrap_or(false);
-        });
-        if let Some(slot) = depends.get_mut(i) {
-            *slot = d;
-        }
-    }
+    let depends = dag.reading(|s| s == x);
     let mut memo: Memo<Expr> = Memo::new(&dag);
     for (i, e) in dag.order.iter().enumerate() {
         if !depends.get(i).copied().unwrap_or(false) {

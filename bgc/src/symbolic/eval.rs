@@ -248,22 +248,10 @@ impl Expr {
     /// For each expression, whether a symbol of it satisfies `pred`: one walk of the distinct nodes of all.
     pub fn each_depends_on(exprs: &[Expr], pred: &dyn Fn(&Symbol) -> bool) -> Vec<bool> {
         let dag = Dag::new(exprs);
-        let mut memo = Memo::new(&dag);
-        for (i, e) in dag.order.iter().enumerate() {
-            let found = match e.node() {
-                Node::Const(_) => false,
-                Node::Sym(s) => pred(s),
-                node => {
-                    let mut any = false;
-                    node.for_each_child(|c| any |= memo.get(c).copied().unwrap_or(false));
-                    any
-                }
-            };
-            memo.set(i, found);
-        }
+        let reads = dag.reading(pred);
         exprs
             .iter()
-            .map(|e| memo.get(e).copied().unwrap_or(false))
+            .map(|e| dag.index(e).is_some_and(|i| reads[i]))
             .collect()
     }
 

@@ -578,9 +578,15 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
         }
         None => resolver_rates(&built, &solved, &implicit),
     };
-    // The readable form on a second thread while this one derives the energy terms: neither reads the other.
-    let (readable, ()) = crate::concurrent::join(
-        || print::readable(&built, &shown_rates, &output_values, taken.clone()),
+    // The readable form and the check for values that cannot be finite on a second thread, while this one derives
+    // the energy terms: neither reads what the other makes, and the two halves take about the same time.
+    let ((readable, finite_diags), ()) = crate::concurrent::join(
+        || {
+            let mut found = Vec::new();
+            not_finite(model, &built.states, &eqs.f, &eqs.outputs, &mut found);
+            let readable = print::readable(&built, &shown_rates, &output_values, taken.clone());
+            (readable, found)
+        },
         || {
             eqs.energy = energy::terms(
                 model,
@@ -590,9 +596,9 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
                 &built.mass,
                 &mut diags,
             );
-            not_finite(model, &built.states, &eqs.f, &eqs.outputs, &mut diags);
         },
     );
+    diags.extend(finite_diags);
     for o in &mut eqs.outputs {
         o.value = readable.alias(&o.value);
     }

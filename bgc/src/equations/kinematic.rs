@@ -24,7 +24,7 @@ use crate::syntax::ast::ElementKind;
 use petgraph::Direction;
 use petgraph::graph::{EdgeIndex, NodeIndex};
 use petgraph::visit::EdgeRef;
-use std::collections::BTreeSet;
+use std::collections::{HashMap, HashSet};
 
 /// Rounds of augmentation per phase: each round can only add junctions, and a model needs more than one only
 /// when a new velocity exposes another dividing modulus or couples another inertia.
@@ -57,12 +57,12 @@ pub(crate) fn augment_if_needed(model: &Model, causality: &Causality) -> Option<
                 None => velocity_junctions(model, causality, &[], phase)?,
             };
             let before = junctions.len();
-            let fresh: Vec<NodeIndex> = needed.into_iter().rev().fold(Vec::new(), |mut acc, j| {
-                if !junctions.contains(&j) && !acc.contains(&j) {
-                    acc.push(j);
-                }
-                acc
-            });
+            let mut seen: HashSet<NodeIndex> = junctions.iter().copied().collect();
+            let fresh: Vec<NodeIndex> = needed
+                .into_iter()
+                .rev()
+                .filter(|&j| seen.insert(j))
+                .collect();
             // A quotient found later lies further down the causal path: its velocity is hinted first, so that
             // the flows propagate back from it through the moduli as products (a chain of MTFs gets its
             // velocity at the far end). The coupled inertias' velocities come after all of them.
@@ -111,6 +111,11 @@ fn has_modulated_two_port(model: &Model) -> bool {
 /// flow or effort depends on a quotient by a modulus that varies with the state, the junction behind each such
 /// quotient and the junction of each independent inertia it depends on. `None` when such a junction is not a
 /// 1-junction (the remedy does not apply).
+///
+/// Each junction is listed once, at its last place in the order "storage by storage (as the causality lists them),
+/// then quotient by quotient, or variable by variable": the caller orders the new velocities by that place. One
+/// walk of the definitions finds, for every variable, the last storage that depends on it, so the cost is linear
+/// in the model, not one walk per storage.
 fn velocity_junctions(
     model: &Model,
     causality: &Causality,
@@ -119,50 +124,75 @@ fn velocity_junctions(
 ) -> Option<Vec<NodeIndex>> {
     let (mut ctx, states) = build::context(model, causality, velocities);
     let built = build::build(model, causality, &mut ctx, states, &mut Vec::new());
-    let dividing = dividing_flows(model, causality, &ctx);
-    let mut out = Vec::new();
-    for s in causality.derivative() {
-        let Some((b, _)) = ctx.port.get(s.node.index()).copied().flatten() else {
-            continue;
-        };
-        let own = match model.graph[s.node].kind {
-            ElementKind::I => effort_var(b),
-            _ => flow_var(b),
-        };
-        let reached = closure(&built, own);
-        if phase == Phase::Dividing {
-            for &(var, junction) in &dividing {
-                if reached.contains(&var) {
-                    out.push(one_junction(model, junction)?);
+    let port_var = |n: NodeIndex, var: fn(EdgeIndex) -> usize| {
+        ctx.port
+            .get(n.index())
+            .copied()
+            .flatten()
+            .map(|(b, _)| var(b))
+    };
+    // The own variable of each storage in derivative causality, numbered in the causality's order.
+    let owns: Vec<(usize, usize)> = causality
+        .derivative()
+        .filter_map(|s| match model.graph[s.node].kind {
+            ElementKind::I => port_var(s.node, effort_var),
+            _ => port_var(s.node, flow_var),
+        })
+        .enumerate()
+        .collect();
+    // `(place, junction)` for each time the junction is found.
+    let mut found: Vec<((usize, usize), NodeIndex)> = Vec::new();
+    match phase {
+        Phase::Dividing => {
+            let last = last_depending(built.defs.len(), &|v| reads(&built, v), &owns);
+            for (d, &(var, junction)) in dividing_flows(model, causality, &ctx).iter().enumerate() {
+                if let Some(s) = last.get(var).copied().flatten() {
+                    found.push(((s, d), one_junction(model, junction)?));
                 }
             }
-            continue;
         }
-        let coupled = velocities.iter().any(|&n| {
-            ctx.port
-                .get(n.index())
+        Phase::Coupled => {
+            // Only the storages that depend on a velocity state's flow are coupled to it.
+            let flows: Vec<usize> = velocities
+                .iter()
+                .filter_map(|&n| port_var(n, flow_var))
+                .collect();
+            let reaches = depends_on_any(built.defs.len(), &|v| reads(&built, v), &flows);
+            let coupled: Vec<(usize, usize)> = owns
+                .iter()
                 .copied()
-                .flatten()
-                .is_some_and(|(b, _)| reached.contains(&flow_var(b)))
-        });
-        if !coupled {
-            continue;
-        }
-        for &v in &reached {
-            let Some(n) = built.definer.get(v).copied().flatten() else {
-                continue;
-            };
-            let independent_inertia = model.graph[n].kind == ElementKind::I
-                && ctx.node_state.get(n.index()).copied().flatten().is_some()
-                && !velocities.contains(&n);
-            if independent_inertia && v % 2 == 1 {
-                let (bond, _) = ctx.port.get(n.index()).copied().flatten()?;
-                let (a, z) = model.graph.edge_endpoints(bond)?;
-                out.push(one_junction(model, if a == n { z } else { a })?);
+                .filter(|&(_, own)| reaches.get(own).copied().unwrap_or(false))
+                .collect();
+            let last = last_depending(built.defs.len(), &|v| reads(&built, v), &coupled);
+            for (v, s) in last.iter().enumerate() {
+                let (Some(s), Some(n)) = (*s, built.definer.get(v).copied().flatten()) else {
+                    continue;
+                };
+                let independent_inertia = model.graph[n].kind == ElementKind::I
+                    && ctx.node_state.get(n.index()).copied().flatten().is_some()
+                    && !velocities.contains(&n);
+                if independent_inertia && v % 2 == 1 {
+                    let (bond, _) = ctx.port.get(n.index()).copied().flatten()?;
+                    let (a, z) = model.graph.edge_endpoints(bond)?;
+                    found.push(((s, v), one_junction(model, if a == n { z } else { a })?));
+                }
             }
         }
     }
-    Some(out)
+    Some(at_last_place(found))
+}
+
+/// The junctions in the order of their last places, each once.
+fn at_last_place(found: Vec<((usize, usize), NodeIndex)>) -> Vec<NodeIndex> {
+    let mut last: HashMap<NodeIndex, (usize, usize)> = HashMap::new();
+    for (place, junction) in found {
+        let at = last.entry(junction).or_insert(place);
+        *at = (*at).max(place);
+    }
+    let mut placed: Vec<((usize, usize), NodeIndex)> =
+        last.into_iter().map(|(j, p)| (p, j)).collect();
+    placed.sort_unstable();
+    placed.into_iter().map(|(_, j)| j).collect()
 }
 
 fn one_junction(model: &Model, n: NodeIndex) -> Option<NodeIndex> {
@@ -212,23 +242,66 @@ fn dividing_flows(model: &Model, causality: &Causality, ctx: &Ctx) -> Vec<(usize
     out
 }
 
-/// The bond variables `v` depends on through the definitions (an explicit work stack: no recursion).
-fn closure(built: &Built, v: usize) -> BTreeSet<usize> {
-    let mut seen = BTreeSet::new();
-    let mut stack = vec![v];
-    while let Some(w) = stack.pop() {
-        if !seen.insert(w) {
-            continue;
-        }
-        if let Some(Some(Def::Plain(e) | Def::Rate(e))) = built.defs.get(w) {
-            e.for_each_sym(&mut |s| {
-                if let Sym::Var(x) = s {
-                    stack.push(x);
-                }
-            });
+/// The bond variables the definition of `v` reads.
+fn reads(built: &Built, v: usize) -> Vec<usize> {
+    let mut out = Vec::new();
+    if let Some(Some(Def::Plain(e) | Def::Rate(e))) = built.defs.get(v) {
+        e.for_each_sym(&mut |s| {
+            if let Sym::Var(x) = s {
+                out.push(x);
+            }
+        });
+    }
+    out
+}
+
+/// Per variable (of `n`, each reading those `reads` gives), the largest number among `sources` (`(number, variable)`, numbers increasing) whose
+/// variable depends on it through the definitions (itself included), or `None`.
+///
+/// The sources are walked from the last: a variable already reached was reached from a larger number, and so was
+/// everything it depends on, so each variable is visited once (an explicit work stack: no recursion).
+fn last_depending(
+    n: usize,
+    reads: &dyn Fn(usize) -> Vec<usize>,
+    sources: &[(usize, usize)],
+) -> Vec<Option<usize>> {
+    let mut last: Vec<Option<usize>> = vec![None; n];
+    for &(number, root) in sources.iter().rev() {
+        let mut stack = vec![root];
+        while let Some(v) = stack.pop() {
+            match last.get_mut(v) {
+                Some(slot @ None) => *slot = Some(number),
+                _ => continue,
+            }
+            stack.extend(reads(v));
         }
     }
-    seen
+    last
+}
+
+/// Per variable (of `n`, each reading those `reads` gives), whether it depends on any of `targets` through the definitions (itself included): one walk
+/// of the definitions backwards from the targets.
+fn depends_on_any(n: usize, reads: &dyn Fn(usize) -> Vec<usize>, targets: &[usize]) -> Vec<bool> {
+    let mut readers: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for v in 0..n {
+        for x in reads(v) {
+            if let Some(r) = readers.get_mut(x) {
+                r.push(v);
+            }
+        }
+    }
+    let mut reached = vec![false; n];
+    let mut stack: Vec<usize> = targets.to_vec();
+    while let Some(v) = stack.pop() {
+        match reached.get_mut(v) {
+            Some(seen @ false) => *seen = true,
+            _ => continue,
+        }
+        if let Some(r) = readers.get(v) {
+            stack.extend(r.iter().copied());
+        }
+    }
+    reached
 }
 
 /// `model` with a massless inertia bonded to each junction, hinted to integral causality; returns the new nodes.
@@ -323,5 +396,58 @@ pub(crate) fn block(
         element: names.join("_"),
         states: rows,
         matrix,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{depends_on_any, last_depending};
+
+    /// Everything `root` depends on, one walk per root: the definition the linear walks must agree with.
+    fn closure(reads: &[Vec<usize>], root: usize) -> Vec<bool> {
+        let mut seen = vec![false; reads.len()];
+        let mut stack = vec![root];
+        while let Some(v) = stack.pop() {
+            if !std::mem::replace(&mut seen[v], true) {
+                stack.extend(reads[v].iter().copied());
+            }
+        }
+        seen
+    }
+
+    #[test]
+    fn one_walk_finds_what_a_walk_per_source_finds_on_graphs_with_cycles() {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move |below: usize| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % below as u64) as usize
+        };
+        for _ in 0..200 {
+            let n = 1 + next(40);
+            let reads: Vec<Vec<usize>> = (0..n)
+                .map(|_| (0..next(3)).map(|_| next(n)).collect())
+                .collect();
+            let read = |v: usize| reads[v].clone();
+            // Sources numbered in increasing order, some variables twice, some not at all.
+            let sources: Vec<(usize, usize)> =
+                (0..next(6)).map(|k| (3 * k + next(3), next(n))).collect();
+            let last = last_depending(n, &read, &sources);
+            for (v, got) in last.iter().enumerate() {
+                let want = sources
+                    .iter()
+                    .filter(|&&(_, root)| closure(&reads, root)[v])
+                    .map(|&(number, _)| number)
+                    .max();
+                assert_eq!(*got, want, "variable {v} of {reads:?} from {sources:?}");
+            }
+            let targets: Vec<usize> = (0..next(3)).map(|_| next(n)).collect();
+            let depends = depends_on_any(n, &read, &targets);
+            for (v, got) in depends.iter().enumerate() {
+                let want = targets.iter().any(|&t| closure(&reads, v)[t]);
+                assert_eq!(*got, want, "variable {v} of {reads:?} to {targets:?}");
+            }
+        }
     }
 }

@@ -22,7 +22,9 @@ use bgc::causality::analyse;
 use bgc::lower::{MemoryLoader, lower};
 use bgc::span::SourceMap;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use families::{benchmark_chain, gear_train, ladder, mtf_chain, output_chain, parallel_pairs};
+use families::{
+    benchmark_chain, gear_train, gyrator_chain, ladder, mtf_chain, output_chain, parallel_pairs,
+};
 use std::hint::black_box;
 
 /// Lowers, assigns causality and derives; returns the number of states so that nothing is optimised away.
@@ -84,6 +86,8 @@ fn bench(c: &mut Criterion) {
     // The velocities behind the chain's moduli are found in one walk of the definitions, not one per inertia.
     family(c, "mtf_chain", &[25, 100, 1000], mtf_chain);
     family(c, "gear_train", &[1000, 10_000], gear_train);
+    // Every compliance in derivative causality: the rates are solved by a sparse elimination of the coupled block.
+    family(c, "gyrator_chain", &[1000, 10_000], gyrator_chain);
     family(c, "parallel_pairs", &[1000, 10_000], parallel_pairs);
     family(c, "benchmark_chain", &[1000, 10_000], benchmark_chain);
     rust_family(c, "output_chain", &[6, 12, 24], output_chain);

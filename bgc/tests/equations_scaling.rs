@@ -14,7 +14,7 @@ use bgc::span::SourceMap;
 use bgc::symbolic::Expr;
 
 use crate::equations_support::families::{
-    gear_train, ladder, mtf_chain, output_chain, parallel_pairs,
+    gear_train, gyrator_chain, ladder, mtf_chain, output_chain, parallel_pairs,
 };
 
 /// Lowers, analyses and derives one model from source text; any error fails the test.
@@ -475,4 +475,52 @@ fn pairs_of_parallel_resistors_are_each_solved_as_their_own_loop() {
         "{} vs {want}",
         rates[0]
     );
+}
+
+/// The gyrator chain's rates by hand. The gyrator `g_i` (ratio `r`) imposes the effort `r v_{i-1}` on compliance
+/// `c_i` (`C = 1/k`), so `q̇_i = r v̇_{i-1}/k` and the gyrator's effort back on `j_{i-1}` is `r (q̇_i + v_i)`.
+/// With `v = p/J` and `e_0 = tau`, `e_i = r v_{i-1}`: `(J + r²/k) v̇_i = e_i − b v_i − r v_{i+1}` for `i < n`,
+/// and `J v̇_n = e_n − b v_n`; the rates are `ṗ_i = J v̇_i`.
+fn gyrator_rates(p: &[f64], tau: f64, (j, b, k, r): (f64, f64, f64, f64)) -> Vec<f64> {
+    let n = p.len() - 1;
+    let v: Vec<f64> = p.iter().map(|p| p / j).collect();
+    (0..=n)
+        .map(|i| {
+            let e = if i == 0 { tau } else { r * v[i - 1] };
+            if i == n {
+                e - b * v[i]
+            } else {
+                j * (e - b * v[i] - r * v[i + 1]) / (j + r * r / k)
+            }
+        })
+        .collect()
+}
+
+/// Every compliance of the gyrator chain is in derivative causality and coupled to its neighbours through the
+/// rates: the coupled block is solved as a sparse system, and each rate is the hand-derived one.
+#[test]
+fn a_chain_of_gyrators_with_every_compliance_dependent_follows_the_hand_derivation() {
+    let n = 400;
+    let eqs = equations(&gyrator_chain(n));
+    assert_eq!(eqs.states.len(), n + 1, "only the inertias have states");
+    let params = eqs.default_params();
+    let p: Vec<f64> = (0..=n)
+        .map(|i| ((i % 5) as f64 - 2.0) * 0.3 + 0.01 * i as f64)
+        .collect();
+    let mut x = vec![0.0; eqs.states.len()];
+    for (i, pi) in p.iter().enumerate() {
+        x[state(&eqs, &format!("p_i{i}"))] = *pi;
+    }
+    let tau = 0.7;
+    let rates = eqs
+        .rates_at(&params, &x, &[tau], 0.0)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let want = gyrator_rates(&p, tau, (1.0, 0.1, 2.0, 1.5));
+    for (i, want) in want.iter().enumerate() {
+        let got = rates[state(&eqs, &format!("p_i{i}"))];
+        assert!(
+            (got - want).abs() < 1e-12 * (1.0 + want.abs()),
+            "dp_i{i}/dt: {got} vs {want}"
+        );
+    }
 }

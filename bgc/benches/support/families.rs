@@ -79,6 +79,22 @@ pub fn mtf_chain(n: usize) -> String {
     s + "}\n"
 }
 
+/// `Se tau -> 1 j0 {I J, R b} -> GY g1 -> 0 z1 {C 1/k} -> 1 j1 {I J, R b} -> GY g2 -> … -> 1 jN`: each gyrator
+/// turns the inertia's flow before it into the effort of the compliance after it, so every compliance is in
+/// derivative causality, coupled to its neighbours through the rates.
+pub fn gyrator_chain(n: usize) -> String {
+    let mut s = String::from(
+        "model gychain {\n    domain rotational;\n    param J = 1 [kg m^2];\n    param b = 0.1 [N m s/rad];\n    param k = 2 [N m/rad];\n    param gr = 1.5 [N m s/rad];\n    input tau [N m];\n    Se drive = tau;\n    1 j0;\n    I i0 = J;\n    R r0 = b;\n    bond drive -> j0;\n    bond j0 -> i0;\n    bond j0 -> r0;\n",
+    );
+    for i in 1..=n {
+        let p = i - 1;
+        s += &format!(
+            "    0 z{i};\n    C c{i} = 1/k;\n    GY g{i} = gr;\n    bond j{p} -> g{i} -> z{i};\n    bond z{i} -> c{i};\n    1 j{i};\n    I i{i} = J;\n    R r{i} = b;\n    bond z{i} -> j{i};\n    bond j{i} -> i{i};\n    bond j{i} -> r{i};\n"
+        );
+    }
+    s + "}\n"
+}
+
 /// A gear train: `Se u -> 1 j0 {I m0 = 1} -> TF t1 -> 1 j1 {R r1 = 0.1, C c1 = 1} -> TF t2 -> … -> 1 jN`, every
 /// ratio the number 1.001, with outputs `e_k = e(g_k)`, the effort on the bond `g_k` into transformer `k`. Each
 /// such effort holds the next (`(e(r_k) + e(c_k) + e_{k+1})` through a numeric ratio), a chain of sums.

@@ -23,6 +23,10 @@ use std::path::Path;
 pub(crate) fn fixture(name: &str) -> Equations {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/fixtures/{name}.bg"));
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    from_text(name, text)
+}
+
+fn from_text(name: &str, text: String) -> Equations {
     let mut sources = SourceMap::new();
     let root = sources.add(format!("{name}.bg"), text);
     let (models, mut diags) = lower(&mut sources, root, &mut MemoryLoader::new());
@@ -259,5 +263,62 @@ fn capacitor_behind_a_modulated_gyrator_is_regular_where_the_modulus_vanishes() 
         let want = (-c * m * dm * w * w - b * w) / (j + c * m * m);
         let got = r[state(&eqs, "f_a")];
         assert!((got - want).abs() < 1e-12, "θ = {theta}: {got} vs {want}");
+    }
+}
+
+/// `n` levers side by side, lever `k`: `Se tau -> 1 a_k {I J, R b} -> MTF m_k -> 1 o_k {I J}` with the modulus
+/// `n_k = 1 + 0.5 cos θ_k`, `θ_k = ∫ f(a_k)`.
+fn levers(n: usize) -> String {
+    let mut s = String::from(
+        "model levers {\n    domain rotational;\n    param J = 1 [kg m^2];\n    param b = 0.1 [N m s/rad];\n    input tau [N m];\n",
+    );
+    for k in 0..n {
+        s += &format!(
+            "    var th{k} [rad] = int(f(a{k}));\n    Se d{k} = tau;\n    1 a{k};\n    I ia{k} = J;\n    R ra{k} = b;\n    1 o{k};\n    I io{k} = J;\n    MTF m{k} = 1 + 0.5*cos(th{k});\n    bond d{k} -> a{k};\n    bond a{k} -> ia{k};\n    bond a{k} -> ra{k};\n    bond a{k} -> m{k} -> o{k};\n    bond o{k} -> io{k};\n"
+        );
+    }
+    s + "}\n"
+}
+
+/// Levers that share nothing have mass matrices that share nothing: one 1×1 block each, named after its junction,
+/// not one square with a row per lever. By hand, with `w = f(o)`, `f(a) = n w` and the power balance
+/// `d/dt(½ J (n w)² + ½ J w²) = (τ − b n w) n w`: `J (n² + 1) ẇ = n (τ − b n w) + ½ J n² w² sin θ`.
+#[test]
+fn separate_levers_have_separate_mass_blocks_and_the_hand_derived_rates() {
+    let count = 40;
+    let eqs = from_text("levers", levers(count));
+    assert_eq!(eqs.mass.len(), count, "{:?}", eqs.mass);
+    for (k, block) in eqs.mass.iter().enumerate() {
+        let lever = count - 1 - k;
+        assert_eq!(block.element, format!("o{lever}"));
+        assert_eq!(block.states, [state(&eqs, &format!("f_o{lever}"))]);
+        assert_eq!(block.matrix.len(), 1);
+    }
+    let (j, b, tau) = (1.0, 0.1, 0.8);
+    let mut x = vec![0.0; eqs.states.len()];
+    let point = |k: usize| (0.37 * k as f64 - 2.0, 0.6 - 0.05 * k as f64);
+    for k in 0..count {
+        let (theta, w) = point(k);
+        x[state(&eqs, &format!("th{k}"))] = theta;
+        x[state(&eqs, &format!("f_o{k}"))] = w;
+    }
+    let rates = eqs
+        .rates_at(&eqs.default_params(), &x, &[tau], 0.0)
+        .unwrap_or_else(|e| panic!("{e}"));
+    for k in 0..count {
+        let (theta, w) = point(k);
+        let n = 1.0 + 0.5 * theta.cos();
+        let dw =
+            (n * (tau - b * n * w) + 0.5 * j * n * n * w * w * theta.sin()) / (j * (n * n + 1.0));
+        let pairs = [
+            (rates[state(&eqs, &format!("f_o{k}"))], dw),
+            (rates[state(&eqs, &format!("th{k}"))], n * w),
+        ];
+        for (got, want) in pairs {
+            assert!(
+                (got - want).abs() < 1e-12 * (1.0 + want.abs()),
+                "lever {k}: {got} vs {want}"
+            );
+        }
     }
 }

@@ -19,7 +19,6 @@ use super::build::{self, Built, Ctx, Def, effort_var, flow_var};
 use super::symbols::{Sym, SymExt};
 use crate::causality::Causality;
 use crate::ir::{Bond, Expr as IrExpr, Hint, Model, Node, Relation};
-use crate::symbolic::Expr;
 use crate::syntax::ast::ElementKind;
 use petgraph::Direction;
 use petgraph::graph::{EdgeIndex, NodeIndex};
@@ -375,28 +374,41 @@ pub(crate) fn junction_of(model: &Model, velocity: NodeIndex) -> Option<NodeInde
         .map(|e| e.source())
 }
 
-/// The mass block of the velocity states: named after their junctions (`cart_pivot`).
-pub(crate) fn block(
+/// The mass blocks of the velocity states, each named after its junctions (`cart_pivot`), or `kinematics` when it
+/// holds none; a name another block (or an I-field's) already has gets the block's number after it.
+pub(crate) fn blocks(
     model: &Model,
     states: &[super::StateSpec],
-    rows: Vec<usize>,
-    matrix: Vec<Vec<Expr>>,
-) -> super::MassBlock {
-    let mut names: Vec<String> = rows
-        .iter()
-        .filter_map(|&i| states.get(i))
-        .filter(|s| s.kind == super::StateKind::Velocity)
-        .filter_map(|s| s.node.and_then(|n| model.graph.node_weight(n)))
-        .map(|w| build::sanitize(&w.name))
-        .collect();
-    if names.is_empty() {
-        names.push("kinematics".into());
+    blocks: Vec<super::solve::MassRows>,
+    fields: &[super::MassBlock],
+) -> Vec<super::MassBlock> {
+    let mut taken: HashSet<String> = fields.iter().map(|b| b.element.clone()).collect();
+    let mut out = Vec::with_capacity(blocks.len());
+    for (k, (rows, matrix)) in blocks.into_iter().enumerate() {
+        let names: Vec<String> = rows
+            .iter()
+            .filter_map(|&i| states.get(i))
+            .filter(|s| s.kind == super::StateKind::Velocity)
+            .filter_map(|s| s.node.and_then(|n| model.graph.node_weight(n)))
+            .map(|w| build::sanitize(&w.name))
+            .collect();
+        let base = match names.is_empty() {
+            true => "kinematics".to_string(),
+            false => names.join("_"),
+        };
+        let mut element = base.clone();
+        let mut suffix = k + 1;
+        while !taken.insert(element.clone()) {
+            element = format!("{base}_{suffix}");
+            suffix += 1;
+        }
+        out.push(super::MassBlock {
+            element,
+            states: rows,
+            matrix,
+        });
     }
-    super::MassBlock {
-        element: names.join("_"),
-        states: rows,
-        matrix,
-    }
+    out
 }
 
 #[cfg(test)]

@@ -393,10 +393,10 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
             ));
         }
     }
-    let mut kinematic_mass = None;
+    let mut kinematic_mass: Vec<MassBlock> = Vec::new();
     let solved_rates = if built.implicit_rows.iter().any(|&r| r) {
-        solve::mass_form(&implicit, &built.implicit_rows).map(|(f, rows, matrix)| {
-            kinematic_mass = Some(kinematic::block(model, &built.states, rows, matrix));
+        solve::mass_form(&implicit, &built.implicit_rows).map(|(f, blocks)| {
+            kinematic_mass = kinematic::blocks(model, &built.states, blocks, &built.mass);
             f
         })
     } else {
@@ -462,12 +462,14 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
     }
     // The rate of a mass-matrix row of the velocity states is not `solved[j]` (that holds the generalised force):
     // it stays `ẋ_j`, and whatever still holds it has no closed form.
-    let kinematic_rows: Vec<usize> = kinematic_mass
-        .iter()
-        .flat_map(|b| b.states.iter().copied())
-        .collect();
+    let mut kinematic_rows = vec![false; nstates];
+    for &j in kinematic_mass.iter().flat_map(|b| b.states.iter()) {
+        if let Some(row) = kinematic_rows.get_mut(j) {
+            *row = true;
+        }
+    }
     let rate_value = |s: Sym| match s {
-        Sym::StateDot(j) if kinematic_rows.contains(&j) => None,
+        Sym::StateDot(j) if kinematic_rows.get(j).copied().unwrap_or(false) => None,
         Sym::StateDot(j) => solved.get(j).cloned(),
         _ => None,
     };
@@ -565,19 +567,13 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
     for s in &built.states {
         taken.reserve(&s.name);
     }
-    let shown_rates = match &kinematic_mass {
-        // The generalised forces of the mass-matrix rows are shown explicit (the junction's balance holds `ẋ`).
-        Some(block) => {
-            let mut r = resolver_rates(&built, &solved, &implicit);
-            for &i in &block.states {
-                if let (Some(slot), Some(v)) = (r.get_mut(i), solved.get(i)) {
-                    *slot = v.clone();
-                }
-            }
-            r
+    let mut shown_rates = resolver_rates(&built, &solved, &implicit);
+    // The generalised forces of the mass-matrix rows are shown explicit (the junction's balance holds `ẋ`).
+    for &i in kinematic_mass.iter().flat_map(|b| b.states.iter()) {
+        if let (Some(slot), Some(v)) = (shown_rates.get_mut(i), solved.get(i)) {
+            *slot = v.clone();
         }
-        None => resolver_rates(&built, &solved, &implicit),
-    };
+    }
     // The readable form and the check for values that cannot be finite on a second thread, while this one derives
     // the energy terms: neither reads what the other makes, and the two halves take about the same time.
     let ((readable, finite_diags), ()) = crate::concurrent::join(

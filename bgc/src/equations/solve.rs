@@ -105,15 +105,20 @@ pub(crate) fn solve_rates_with(
     Ok(out)
 }
 
-/// The rates (generalised forces in the block rows), the block's rows and its matrix `M`.
-pub(crate) type MassForm = (Vec<Expr>, Vec<usize>, Vec<Vec<Expr>>);
+/// One block of `M`: its rows (states) and its matrix.
+pub(crate) type MassRows = (Vec<usize>, Vec<Vec<Expr>>);
+
+/// The rates (generalised forces in the block rows) and the blocks of `M`.
+pub(crate) type MassForm = (Vec<Expr>, Vec<MassRows>);
 
 /// The rates of a system with implicit rows (`0 = F_i(x, u, ẋ)` for the velocity states of
 /// [`super::kinematic`]) in the mass-matrix form: rows whose rate is explicit and free of `ẋ` are substituted
 /// into the others; the remaining rows `U` (the implicit ones and those coupled through `ẋ`) give
 /// `M ẋ_U = F` with `M_ab = δ_ab − ∂F_a/∂ẋ_b` for an explicit row, `−∂F_a/∂ẋ_b` for an implicit one, and
 /// `F = F(ẋ = 0)`. No symbolic division: the consumers solve `M` numerically, so a pivot that vanishes at some
-/// configuration is never divided by. Returns the rates (the generalised forces in the rows `U`), `U` and `M`.
+/// configuration is never divided by. Returns the rates (the generalised forces in the rows `U`) and `M` split
+/// into the blocks that no entry couples (each block's rows in increasing order, the blocks by their first row):
+/// a thousand separate levers are a thousand 1×1 blocks, not one square of a million entries.
 pub(crate) fn mass_form(f: &[Expr], implicit_rows: &[bool]) -> Result<MassForm, SolveError> {
     let n = f.len();
     let is_rate = |s: Sym| matches!(s, Sym::StateDot(_));
@@ -154,33 +159,107 @@ pub(crate) fn mass_form(f: &[Expr], implicit_rows: &[bool]) -> Result<MassForm, 
         });
     }
     let rows: Vec<usize> = (0..n).filter(|&i| in_rows[i]).collect();
-    let mut matrix = Vec::with_capacity(rows.len());
-    for &i in &rows {
-        let mut row = Vec::with_capacity(rows.len());
-        for &j in &rows {
+    let mut place: Vec<Option<usize>> = vec![None; n];
+    for (k, &i) in rows.iter().enumerate() {
+        place[i] = Some(k);
+    }
+    // Per row, its entries that are not zero, by place: `δ − ∂F_i/∂ẋ_j` for the rates it reads, and its
+    // identity entry; ∂F_i/∂ẋ_j of a rate it does not read is zero.
+    let mut entries: Vec<Vec<(usize, Expr)>> = Vec::with_capacity(rows.len());
+    for (k, &i) in rows.iter().enumerate() {
+        let identity = |c: usize| {
+            if c == k && !implicit(i) {
+                Expr::one()
+            } else {
+                Expr::zero()
+            }
+        };
+        let mut read: Vec<(usize, usize)> = f[i]
+            .syms()
+            .into_iter()
+            .filter_map(|s| match s {
+                Sym::StateDot(j) => place.get(j).copied().flatten().map(|c| (c, j)),
+                _ => None,
+            })
+            .collect();
+        read.sort_unstable();
+        let mut row: Vec<(usize, Expr)> = Vec::with_capacity(read.len() + 1);
+        for (c, j) in read {
             let d = symbols::diff(&f[i], Sym::StateDot(j))
                 .map_err(|_| SolveError::NotDifferentiable(i))?;
             if d.any_sym(&is_rate) {
                 return Err(SolveError::Nonlinear(i));
             }
-            let identity = if i == j && !implicit(i) {
-                Expr::one()
-            } else {
-                Expr::zero()
-            };
             // −d term by term, so that `M + m` prints as such rather than `-(-M - m)`.
             let minus_d = match d.node() {
                 Node::Add(terms) => symbols::add(terms.iter().cloned().map(symbols::neg).collect()),
                 _ => symbols::neg(d),
             };
-            row.push(symbols::add(vec![identity, minus_d]));
+            row.push((c, symbols::add(vec![identity(c), minus_d])));
         }
-        matrix.push(row);
+        if !row.iter().any(|(c, _)| *c == k) && !identity(k).is_zero() {
+            row.push((k, Expr::one()));
+            row.sort_by_key(|(c, _)| *c);
+        }
+        row.retain(|(_, e)| !e.is_zero());
+        entries.push(row);
     }
     for &i in &rows {
         f[i] = symbols::subst(&f[i], &mut |s| is_rate(s).then(Expr::zero));
     }
-    Ok((f, rows, matrix))
+    let blocks = coupled_blocks(&entries)
+        .into_iter()
+        .map(|places| {
+            let matrix = places
+                .iter()
+                .map(|&a| {
+                    places
+                        .iter()
+                        .map(|b| {
+                            entries[a]
+                                .binary_search_by_key(b, |(c, _)| *c)
+                                .map_or_else(|_| Expr::zero(), |at| entries[a][at].1.clone())
+                        })
+                        .collect()
+                })
+                .collect();
+            (places.iter().map(|&k| rows[k]).collect(), matrix)
+        })
+        .collect();
+    Ok((f, blocks))
+}
+
+/// The places of the rows that the entries couple, directly or through other rows: each group in increasing
+/// order, the groups by their first place.
+fn coupled_blocks(entries: &[Vec<(usize, Expr)>]) -> Vec<Vec<usize>> {
+    let n = entries.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut v: usize) -> usize {
+        while parent[v] != v {
+            parent[v] = parent[parent[v]];
+            v = parent[v];
+        }
+        v
+    }
+    for (a, row) in entries.iter().enumerate() {
+        for &(b, _) in row {
+            if b < n {
+                let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+                parent[ra.max(rb)] = ra.min(rb);
+            }
+        }
+    }
+    let mut group_of: Vec<Option<usize>> = vec![None; n];
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for v in 0..n {
+        let r = root(&mut parent, v);
+        let g = *group_of[r].get_or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[g].push(v);
+    }
+    groups
 }
 
 /// The states whose rate `ẋ_j` appears in some of `f`, in increasing order (one walk over each expression).

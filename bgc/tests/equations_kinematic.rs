@@ -322,3 +322,40 @@ fn separate_levers_have_separate_mass_blocks_and_the_hand_derived_rates() {
         }
     }
 }
+
+/// The sparse linearisation of models with mass-matrix rows gives the dense one's numbers: the cart-pole of MTFs
+/// (one block coupling two velocities), the same as an I-field, and separate levers (one block each).
+#[test]
+fn the_sparse_linearisation_of_mass_matrix_rows_is_the_dense_one() {
+    use bgc::equations::{ModelRows, SparseNumericStateSpace, linearise_sparse, state_selection};
+    let models = [
+        fixture("fields/cart_pole_mtf"),
+        fixture("fields/cart_pole_field"),
+        from_text("levers", levers(5)),
+    ];
+    for eqs in &models {
+        assert!(!eqs.mass.is_empty());
+        let rows = ModelRows::new(eqs);
+        let selection = state_selection(eqs, &rows);
+        let n = eqs.state_count(selection);
+        let params = eqs.default_params();
+        for seed in 0..4 {
+            let x0: Vec<f64> = (0..n)
+                .map(|i| 0.3 * ((i + seed) % 5) as f64 - 0.55)
+                .collect();
+            let u0: Vec<f64> = (0..eqs.inputs.len())
+                .map(|k| 0.8 - 0.4 * (k + seed) as f64)
+                .collect();
+            let dense = linearise(eqs, selection, &params, &x0, &u0, 0.0)
+                .unwrap_or_else(|e| panic!("{}: {e}", eqs.model));
+            let sparse = linearise_sparse(eqs, &rows, selection, (&params, &x0, &u0, 0.0))
+                .unwrap_or_else(|e| panic!("{}: {e}", eqs.model));
+            assert_eq!(
+                sparse,
+                SparseNumericStateSpace::from_dense(&dense),
+                "{} at {x0:?}",
+                eqs.model
+            );
+        }
+    }
+}

@@ -217,14 +217,13 @@ fn energy_coords(
         return symbolic_json(eqs, &j, &fixed);
     }
     let no_state_space = |e: LinearError| format!("no state space: {e}");
-    let plain = eqs.tear_blocks.is_empty() && eqs.mass.is_empty();
-    if !equations::dense_is_cheap(eqs, &rows) && (linear.is_ok() || plain) {
-        let j = match linear {
-            Ok(j) => j,
-            Err(_) => equations::sparse_jacobians(eqs, &rows, selection).map_err(no_state_space)?,
-        };
-        let ss =
-            equations::evaluate_sparse(eqs, &j, params, &x0, &u0, 0.0).map_err(no_state_space)?;
+    // Without algebraic loops, a large model is linearised sparse, its mass-matrix rows included.
+    if !equations::dense_is_cheap(eqs, &rows) && (linear.is_ok() || eqs.tear_blocks.is_empty()) {
+        let ss = match linear {
+            Ok(j) => equations::evaluate_sparse(eqs, &j, params, &x0, &u0, 0.0),
+            Err(_) => equations::linearise_sparse(eqs, &rows, selection, (params, &x0, &u0, 0.0)),
+        }
+        .map_err(no_state_space)?;
         return Ok(if args.sparse {
             sparse::numeric_triplets(&ss)
         } else {

@@ -91,7 +91,8 @@ pub use print::{expr_latex, expr_text, to_json, to_latex, to_text};
 pub use sensitivity::{PointJacobians, Rows, Sensitivity};
 pub use sparse_linear::{
     ModelRows, NumericSparse, SparseJacobians, SparseMatrix, SparseNumericStateSpace,
-    dense_is_cheap, evaluate_sparse, sparse_jacobians, sparse_linear_state_space, state_selection,
+    dense_is_cheap, evaluate_sparse, linearise_sparse, sparse_jacobians, sparse_linear_state_space,
+    state_selection,
 };
 pub(crate) use tear::block_jacobian;
 pub use tear::{LoopFailure, TearBlock, residual_scale, solve_all};

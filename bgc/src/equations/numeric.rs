@@ -6,9 +6,11 @@
 
 use super::dense::{self, Mat};
 use super::linear::{LinearError, NumericStateSpace, check_len as check};
+use super::sparse_linear::{NumericSparse, SparseNumericStateSpace};
 use super::symbols::{self, Sym, SymExt};
 use super::{Equations, MassBlock};
 use crate::symbolic::{Expr, Node};
+use std::collections::BTreeSet;
 
 /// Evaluates `e`, naming `what` in errors.
 fn value_of(
@@ -60,6 +62,142 @@ fn solve_block(block: &MassBlock, m: &Mat, rhs: &Mat) -> Result<Mat, LinearError
     dense::solve(m, rhs).ok_or_else(|| LinearError::SingularMass {
         element: block.element.clone(),
     })
+}
+
+/// [`correct_mass_rows`] on a sparse state space: each block's rows get `M⁻¹ (∂F/∂x − (∂M/∂x) ẋ_B)` and
+/// `M⁻¹ ∂F/∂u` in the columns where those rows or the entries of `M` have any, the same numbers as the dense
+/// correction gives there (it is zero in the other columns), so that the cost follows the blocks and their
+/// entries, not the square of the model.
+pub(crate) fn correct_mass_rows_sparse(
+    eqs: &Equations,
+    value: &dyn Fn(Sym) -> Option<f64>,
+    ss: &mut SparseNumericStateSpace,
+) -> Result<(), LinearError> {
+    let n = ss.a.rows;
+    let mut a_rows = by_rows(&ss.a);
+    let mut b_rows = by_rows(&ss.b);
+    for block in eqs.mass.iter().filter(|b| b.states.iter().all(|&j| j < n)) {
+        let m = mass_at(eqs, block, value)?;
+        let mut forces = Vec::with_capacity(block.states.len());
+        for &j in &block.states {
+            let what = || format!("the rate of `{}`", eqs.sym_name(Sym::State(j)));
+            let f = eqs
+                .f
+                .get(j)
+                .cloned()
+                .flatten()
+                .ok_or_else(|| LinearError::Incomplete { what: what() })?;
+            forces.push(vec![value_of(eqs, &f, &what, value)?]);
+        }
+        let xb: Vec<f64> = solve_block(block, &m, &forces)?
+            .into_iter()
+            .map(|r| r.first().copied().unwrap_or(0.0))
+            .collect();
+        // The states each entry of M reads, and the columns the block's rows fill.
+        let reads: Vec<Vec<Vec<usize>>> = block
+            .matrix
+            .iter()
+            .map(|row| row.iter().map(|mij| states_in(mij, n)).collect())
+            .collect();
+        let mut xcols: BTreeSet<usize> = reads.iter().flatten().flatten().copied().collect();
+        let mut ucols: BTreeSet<usize> = BTreeSet::new();
+        for &row in &block.states {
+            xcols.extend(a_rows.get(row).into_iter().flatten().map(|(c, _)| *c));
+            ucols.extend(b_rows.get(row).into_iter().flatten().map(|(c, _)| *c));
+        }
+        let xcols: Vec<usize> = xcols.into_iter().collect();
+        let ucols: Vec<usize> = ucols.into_iter().collect();
+        let place = |cols: &[usize], c: usize| cols.binary_search(&c).ok();
+        let mut rhs: Mat = vec![vec![0.0; xcols.len() + ucols.len()]; block.states.len()];
+        for (&row, r) in block.states.iter().zip(rhs.iter_mut()) {
+            for (c, v) in a_rows.get(row).into_iter().flatten() {
+                if let Some(k) = place(&xcols, *c) {
+                    r[k] = *v;
+                }
+            }
+            for (c, v) in b_rows.get(row).into_iter().flatten() {
+                if let Some(k) = place(&ucols, *c) {
+                    r[xcols.len() + k] = *v;
+                }
+            }
+        }
+        for (i, (mrow, rrow)) in block.matrix.iter().zip(rhs.iter_mut()).enumerate() {
+            for (j, (mij, xj)) in mrow.iter().zip(&xb).enumerate() {
+                for &k in &reads[i][j] {
+                    let d = symbols::diff(mij, Sym::State(k)).map_err(
+                        |symbols::NotDifferentiable(f)| LinearError::NotDifferentiable {
+                            what: format!("M_{}[{},{}]", block.element, i + 1, j + 1),
+                            func: f.name(),
+                        },
+                    )?;
+                    let what = || format!("∂M_{}[{},{}]/∂x", block.element, i + 1, j + 1);
+                    if let Some(slot) = place(&xcols, k).and_then(|p| rrow.get_mut(p)) {
+                        *slot -= value_of(eqs, &d, &what, value)? * xj;
+                    }
+                }
+            }
+        }
+        let sol = solve_block(block, &m, &rhs)?;
+        for (&row, srow) in block.states.iter().zip(&sol) {
+            if let Some(p) = srow.iter().position(|v| !v.is_finite()) {
+                let what = match p.checked_sub(xcols.len()) {
+                    None => format!("A[{row}][{}]", xcols[p]),
+                    Some(k) => format!("B[{row}][{}]", ucols[k]),
+                };
+                return Err(LinearError::NonFinite { what });
+            }
+            let (x, u) = srow.split_at(xcols.len());
+            let non_zero = |cols: &[usize], vals: &[f64]| -> Vec<(usize, f64)> {
+                cols.iter()
+                    .copied()
+                    .zip(vals.iter().copied())
+                    .filter(|(_, v)| *v != 0.0)
+                    .collect()
+            };
+            if let Some(slot) = a_rows.get_mut(row) {
+                *slot = non_zero(&xcols, x);
+            }
+            if let Some(slot) = b_rows.get_mut(row) {
+                *slot = non_zero(&ucols, u);
+            }
+        }
+    }
+    ss.a.entries = from_rows(a_rows);
+    ss.b.entries = from_rows(b_rows);
+    Ok(())
+}
+
+/// The entries of a sparse matrix by row, each row in column order.
+fn by_rows(m: &NumericSparse) -> Vec<Vec<(usize, f64)>> {
+    let mut rows = vec![Vec::new(); m.rows];
+    for &(r, c, v) in &m.entries {
+        if let Some(row) = rows.get_mut(r) {
+            row.push((c, v));
+        }
+    }
+    rows.iter_mut().for_each(|row| row.sort_by_key(|(c, _)| *c));
+    rows
+}
+
+fn from_rows(rows: Vec<Vec<(usize, f64)>>) -> Vec<(usize, usize, f64)> {
+    rows.into_iter()
+        .enumerate()
+        .flat_map(|(r, row)| row.into_iter().map(move |(c, v)| (r, c, v)))
+        .collect()
+}
+
+/// The selected states (below `n`) an expression reads, in increasing order.
+fn states_in(e: &Expr, n: usize) -> Vec<usize> {
+    let mut out: Vec<usize> = e
+        .syms()
+        .into_iter()
+        .filter_map(|s| match s {
+            Sym::State(k) if k < n => Some(k),
+            _ => None,
+        })
+        .collect();
+    out.sort_unstable();
+    out
 }
 
 impl Equations {

@@ -8,8 +8,9 @@
 //! linearity on those entries.
 //!
 //! Both give the errors of their dense counterparts in [`super::linear`] (in the same order and with the same
-//! texts). Models with nonlinear algebraic loops or I-fields (whose state spaces need the implicit function theorem
-//! or the symbolic elimination of a mass matrix) are small: they take the dense path and are converted.
+//! texts). [`linearise_sparse`] linearises a model with mass-matrix rows at a point, each block solved with its own
+//! `M` there; models with nonlinear algebraic loops (whose state spaces need the implicit function theorem) take
+//! the dense path and are converted.
 
 use super::Equations;
 use super::linear::{self, LinearError, StateSelection};
@@ -406,6 +407,34 @@ pub struct SparseNumericStateSpace {
 }
 
 impl SparseNumericStateSpace {
+    /// The non-zero entries of a dense state space.
+    pub fn from_dense(ss: &linear::NumericStateSpace) -> SparseNumericStateSpace {
+        let sparse = |m: &[Vec<f64>], cols: usize| NumericSparse {
+            rows: m.len(),
+            cols,
+            entries: m
+                .iter()
+                .enumerate()
+                .flat_map(|(r, row)| {
+                    row.iter()
+                        .enumerate()
+                        .filter(|(_, v)| **v != 0.0)
+                        .map(move |(c, v)| (r, c, *v))
+                })
+                .collect(),
+        };
+        let (n, m) = (ss.states.len(), ss.inputs.len());
+        SparseNumericStateSpace {
+            states: ss.states.clone(),
+            inputs: ss.inputs.clone(),
+            outputs: ss.outputs.clone(),
+            a: sparse(&ss.a, n),
+            b: sparse(&ss.b, m),
+            c: sparse(&ss.c, n),
+            d: sparse(&ss.d, m),
+        }
+    }
+
     pub fn to_dense(&self) -> linear::NumericStateSpace {
         linear::NumericStateSpace {
             states: self.states.clone(),
@@ -417,6 +446,28 @@ impl SparseNumericStateSpace {
             d: self.d.to_dense(),
         }
     }
+}
+
+/// The linearisation of any model without algebraic loops at `(x0, u0, t0)`, sparse: the Jacobians of
+/// [`sparse_jacobians`] evaluated there, and the rows of mass-matrix blocks (I-fields, the velocity states of
+/// configuration-dependent dependent storage) turned into those of the rates. The numbers are those of
+/// [`linear::linearise`]; a model with algebraic loops (whose linearisation needs the implicit function theorem)
+/// takes that dense path and is converted.
+pub fn linearise_sparse(
+    eqs: &Equations,
+    rows: &ModelRows,
+    selection: StateSelection,
+    (params, x0, u0, t0): (&[f64], &[f64], &[f64], f64),
+) -> Result<SparseNumericStateSpace, LinearError> {
+    if !eqs.tear_blocks.is_empty() {
+        let dense = linear::linearise(eqs, selection, params, x0, u0, t0)?;
+        return Ok(SparseNumericStateSpace::from_dense(&dense));
+    }
+    let j = sparse_jacobians(eqs, rows, selection)?;
+    let mut ss = evaluate_sparse(eqs, &j, params, x0, u0, t0)?;
+    let value = |s: Sym| super::numeric::point(s, params, x0, u0, t0);
+    super::numeric::correct_mass_rows_sparse(eqs, &value, &mut ss)?;
+    Ok(ss)
 }
 
 /// Evaluates sparse Jacobians at parameter values, operating point `x0`, `u0` and time `t0` (the counterpart of

@@ -56,11 +56,27 @@ fn temporary_beside(target: &Path) -> PathBuf {
 mod tests {
     use super::write_whole;
 
-    fn scratch(name: &str) -> std::path::PathBuf {
+    /// A fresh directory of the test's own, removed with everything in it when the test ends (passed or not).
+    struct Scratch(std::path::PathBuf);
+
+    impl Drop for Scratch {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+
+    impl std::ops::Deref for Scratch {
+        type Target = std::path::Path;
+        fn deref(&self) -> &std::path::Path {
+            &self.0
+        }
+    }
+
+    fn scratch(name: &str) -> Scratch {
         let dir = std::env::temp_dir().join(format!("bgc-files-{}-{name}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{e}"));
-        dir
+        Scratch(dir)
     }
 
     fn entries(dir: &std::path::Path) -> Vec<String> {

@@ -56,8 +56,11 @@ pub(crate) fn plan(
             .map_err(|e| e.to_string())?;
         // Only the states some entry reads can have a derivative that is not zero: a model of many blocks
         // differentiates each by its own few states, not by all of them.
-        let read: std::collections::BTreeSet<Symbol> =
-            matrix.iter().flatten().flat_map(Expr::free_symbols).collect();
+        let read: std::collections::BTreeSet<Symbol> = matrix
+            .iter()
+            .flatten()
+            .flat_map(Expr::free_symbols)
+            .collect();
         let mut derivatives = Vec::new();
         for (k, s) in states.iter().enumerate().filter(|(_, s)| read.contains(s)) {
             let d: Vec<Vec<Expr>> = matrix

@@ -64,6 +64,30 @@ fn solve_block(block: &MassBlock, m: &Mat, rhs: &Mat) -> Result<Mat, LinearError
     })
 }
 
+/// `ẋ_B = M⁻¹ F` of one block at the point, `m` being its `M` there.
+fn block_rates(
+    eqs: &Equations,
+    block: &MassBlock,
+    m: &Mat,
+    value: &dyn Fn(Sym) -> Option<f64>,
+) -> Result<Vec<f64>, LinearError> {
+    let mut forces = Vec::with_capacity(block.states.len());
+    for &j in &block.states {
+        let what = || format!("the rate of `{}`", eqs.sym_name(Sym::State(j)));
+        let f = eqs
+            .f
+            .get(j)
+            .cloned()
+            .flatten()
+            .ok_or_else(|| LinearError::Incomplete { what: what() })?;
+        forces.push(vec![value_of(eqs, &f, &what, value)?]);
+    }
+    Ok(solve_block(block, m, &forces)?
+        .into_iter()
+        .map(|r| r.first().copied().unwrap_or(0.0))
+        .collect())
+}
+
 /// [`correct_mass_rows`] on a sparse state space: each block's rows get `M⁻¹ (∂F/∂x − (∂M/∂x) ẋ_B)` and
 /// `M⁻¹ ∂F/∂u` in the columns where those rows or the entries of `M` have any, the same numbers as the dense
 /// correction gives there (it is zero in the other columns), so that the cost follows the blocks and their
@@ -78,21 +102,7 @@ pub(crate) fn correct_mass_rows_sparse(
     let mut b_rows = by_rows(&ss.b);
     for block in eqs.mass.iter().filter(|b| b.states.iter().all(|&j| j < n)) {
         let m = mass_at(eqs, block, value)?;
-        let mut forces = Vec::with_capacity(block.states.len());
-        for &j in &block.states {
-            let what = || format!("the rate of `{}`", eqs.sym_name(Sym::State(j)));
-            let f = eqs
-                .f
-                .get(j)
-                .cloned()
-                .flatten()
-                .ok_or_else(|| LinearError::Incomplete { what: what() })?;
-            forces.push(vec![value_of(eqs, &f, &what, value)?]);
-        }
-        let xb: Vec<f64> = solve_block(block, &m, &forces)?
-            .into_iter()
-            .map(|r| r.first().copied().unwrap_or(0.0))
-            .collect();
+        let xb = block_rates(eqs, block, &m, value)?;
         // The states each entry of M reads, and the columns the block's rows fill.
         let reads: Vec<Vec<Vec<usize>>> = block
             .matrix
@@ -406,21 +416,7 @@ pub(crate) fn correct_mass_rows(
         }
         let m = mass_at(eqs, block, value)?;
         // ẋ_B = M⁻¹ F at the point.
-        let mut forces = Vec::with_capacity(block.states.len());
-        for &j in &block.states {
-            let what = || format!("the rate of `{}`", eqs.sym_name(Sym::State(j)));
-            let f = eqs
-                .f
-                .get(j)
-                .cloned()
-                .flatten()
-                .ok_or_else(|| LinearError::Incomplete { what: what() })?;
-            forces.push(vec![value_of(eqs, &f, &what, value)?]);
-        }
-        let xb: Vec<f64> = solve_block(block, &m, &forces)?
-            .into_iter()
-            .map(|r| r.first().copied().unwrap_or(0.0))
-            .collect();
+        let xb = block_rates(eqs, block, &m, value)?;
         // Columns of ∂F/∂x − (∂M/∂x_k) ẋ_B, then of ∂F/∂u.
         let empty = Vec::new();
         let mut rhs: Mat = block

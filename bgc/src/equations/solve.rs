@@ -281,15 +281,10 @@ pub(crate) type SparseRow = std::collections::BTreeMap<usize, Expr>;
 /// Symbolic Gaussian elimination of `a x = b`; pivots on numeric entries first, then on any structurally non-zero
 /// entry. `None` when a column has no non-zero pivot.
 pub(crate) fn gauss(a: &mut [Vec<Expr>], b: &mut [Expr]) -> Option<Vec<Expr>> {
-    let rows = a
-        .iter()
-        .map(|row| {
-            row.iter()
-                .enumerate()
-                .filter(|(_, e)| !e.is_zero())
-                .map(|(c, e)| (c, e.clone()))
-                .collect()
-        })
+    let rows = super::sparse_linear::SparseMatrix::from_dense(a, b.len())
+        .entries
+        .into_iter()
+        .map(|row| row.into_iter().collect())
         .collect();
     gauss_sparse(rows, b.to_vec())
 }

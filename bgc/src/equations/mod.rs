@@ -60,6 +60,7 @@ mod coords;
 mod coords_symbolic;
 mod copies;
 pub(crate) mod dense;
+mod dogleg;
 mod energy;
 mod field;
 mod kinematic;

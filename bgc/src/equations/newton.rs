@@ -103,14 +103,16 @@ fn merit(r: &[f64], w: &[f64]) -> f64 {
 ///
 /// Damped Newton first; for a single equation whose Newton iteration fails, a bracket of a sign change is searched
 /// outward from the start and the root is found inside it ([`bracketed`]), which converges wherever the residual is
-/// continuous and changes sign, however steep it is (a diode's exponential). On failure `z` holds the last
-/// iterate of the damped Newton's method and the error is its failure.
+/// continuous and changes sign, however steep it is (a diode's exponential). For several equations whose Newton
+/// iteration fails, Powell's dogleg method (`equations/dogleg.rs`) starts again from the same point. On failure `z`
+/// holds the last iterate of the damped Newton's method and the error is its failure.
 pub fn solve(
     problem: &mut dyn Problem,
     z: &mut [f64],
     settings: Settings,
 ) -> Result<usize, Failure> {
     let start = z.first().copied();
+    let initial = z.to_vec();
     let failure = match damped(problem, z, settings) {
         Ok(k) => return Ok(k),
         Err(f) => f,
@@ -125,7 +127,18 @@ pub fn solve(
             }
             None => Err(failure),
         },
-        _ => Err(failure),
+        // Several equations: the dogleg method from the same start, which follows a curved valley of the
+        // residual where the line search creeps; its failure is reported as the damped method's.
+        _ => {
+            let mut again = initial.clone();
+            match super::dogleg::solve(problem, &mut again, settings) {
+                Some(evaluations) => {
+                    z[..again.len()].copy_from_slice(&again);
+                    Ok(failure.iterations + evaluations)
+                }
+                None => Err(failure),
+            }
+        }
     }
 }
 
@@ -251,6 +264,16 @@ fn bracket(problem: &mut dyn Problem, start: Point) -> Option<(Point, Point, usi
 }
 
 /// Damped Newton's method (the module docs); `z` holds the last iterate.
+/// The damped Newton iteration alone, without the fallbacks of [`solve`].
+#[cfg(test)]
+pub(super) fn damped_for_tests(
+    problem: &mut dyn Problem,
+    z: &mut [f64],
+    settings: Settings,
+) -> Result<usize, Failure> {
+    damped(problem, z, settings)
+}
+
 fn damped(problem: &mut dyn Problem, z: &mut [f64], settings: Settings) -> Result<usize, Failure> {
     let n = problem.size().min(z.len());
     let z = &mut z[..n];
@@ -324,7 +347,7 @@ fn damped(problem: &mut dyn Problem, z: &mut [f64], settings: Settings) -> Resul
 
 /// Solves `a x = b` in place (`a` row-major `n × n`, overwritten; `b` becomes `x`). False when a pivot is zero or
 /// below `1e-14` times the largest entry of its column before elimination.
-fn lu_solve(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
+pub(super) fn lu_solve(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
     if a.len() < n * n || b.len() < n {
         return false;
     }

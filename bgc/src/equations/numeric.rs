@@ -64,6 +64,30 @@ fn solve_block(block: &MassBlock, m: &Mat, rhs: &Mat) -> Result<Mat, LinearError
     })
 }
 
+/// `∂M_ij/∂x_k` of a block at the point.
+fn mass_slope(
+    eqs: &Equations,
+    block: &MassBlock,
+    (i, j): (usize, usize),
+    k: usize,
+    value: &dyn Fn(Sym) -> Option<f64>,
+) -> Result<f64, LinearError> {
+    let mij = block
+        .matrix
+        .get(i)
+        .and_then(|row| row.get(j))
+        .cloned()
+        .unwrap_or_else(Expr::zero);
+    let d = symbols::diff(&mij, Sym::State(k)).map_err(|symbols::NotDifferentiable(f)| {
+        LinearError::NotDifferentiable {
+            what: format!("M_{}[{},{}]", block.element, i + 1, j + 1),
+            func: f.name(),
+        }
+    })?;
+    let what = || format!("∂M_{}[{},{}]/∂x", block.element, i + 1, j + 1);
+    value_of(eqs, &d, &what, value)
+}
+
 /// `ẋ_B = M⁻¹ F` of one block at the point, `m` being its `M` there.
 fn block_rates(
     eqs: &Equations,
@@ -131,18 +155,11 @@ pub(crate) fn correct_mass_rows_sparse(
                 }
             }
         }
-        for (i, (mrow, rrow)) in block.matrix.iter().zip(rhs.iter_mut()).enumerate() {
-            for (j, (mij, xj)) in mrow.iter().zip(&xb).enumerate() {
-                for &k in &reads[i][j] {
-                    let d = symbols::diff(mij, Sym::State(k)).map_err(
-                        |symbols::NotDifferentiable(f)| LinearError::NotDifferentiable {
-                            what: format!("M_{}[{},{}]", block.element, i + 1, j + 1),
-                            func: f.name(),
-                        },
-                    )?;
-                    let what = || format!("∂M_{}[{},{}]/∂x", block.element, i + 1, j + 1);
+        for (i, (row_reads, rrow)) in reads.iter().zip(rhs.iter_mut()).enumerate() {
+            for (j, (entry_reads, xj)) in row_reads.iter().zip(&xb).enumerate() {
+                for &k in entry_reads {
                     if let Some(slot) = place(&xcols, k).and_then(|p| rrow.get_mut(p)) {
-                        *slot -= value_of(eqs, &d, &what, value)? * xj;
+                        *slot -= mass_slope(eqs, block, (i, j), k, value)? * xj;
                     }
                 }
             }
@@ -434,14 +451,7 @@ pub(crate) fn correct_mass_rows(
                     if !mij.contains(Sym::State(k)) {
                         continue;
                     }
-                    let d = symbols::diff(mij, Sym::State(k)).map_err(
-                        |symbols::NotDifferentiable(f)| LinearError::NotDifferentiable {
-                            what: format!("M_{}[{},{}]", block.element, i + 1, j + 1),
-                            func: f.name(),
-                        },
-                    )?;
-                    let what = || format!("∂M_{}[{},{}]/∂x", block.element, i + 1, j + 1);
-                    *slot -= value_of(eqs, &d, &what, value)? * xj;
+                    *slot -= mass_slope(eqs, block, (i, j), k, value)? * xj;
                 }
             }
         }

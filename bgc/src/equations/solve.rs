@@ -11,6 +11,7 @@
 
 use super::symbols::{self, Sym, SymExt, div, mul};
 use crate::symbolic::{Expr, Node};
+use petgraph::unionfind::UnionFind;
 use std::collections::BTreeSet;
 
 /// Why the rates could not be solved.
@@ -46,25 +47,9 @@ pub(crate) fn solve_rates_with(
     let mut g: Vec<Vec<(usize, Expr)>> = Vec::with_capacity(n);
     let mut f0 = Vec::with_capacity(n);
     for (i, fi) in f.iter().enumerate() {
-        let mut read: Vec<(usize, usize)> = fi
-            .syms()
-            .into_iter()
-            .filter_map(|s| match s {
-                Sym::StateDot(j) => coupled.binary_search(&j).ok().map(|k| (k, j)),
-                _ => None,
-            })
-            .collect();
-        read.sort_unstable();
-        let mut row = Vec::with_capacity(read.len());
-        for (k, j) in read {
-            let d = symbols::diff(fi, Sym::StateDot(j))
-                .map_err(|_| SolveError::NotDifferentiable(i))?;
-            if d.any_sym(&is_rate) {
-                return Err(SolveError::Nonlinear(i));
-            }
-            row.push((k, d));
-        }
-        g.push(row);
+        g.push(rate_derivatives(fi, i, &|j| {
+            coupled.binary_search(&j).ok()
+        })?);
         f0.push(symbols::subst(fi, &mut |s| is_rate(s).then(Expr::zero)));
     }
     // The coupled block: (I - G_cc) ẋ_c = F0_c, by rows of its entries that are not zero.
@@ -174,22 +159,8 @@ pub(crate) fn mass_form(f: &[Expr], implicit_rows: &[bool]) -> Result<MassForm, 
                 Expr::zero()
             }
         };
-        let mut read: Vec<(usize, usize)> = f[i]
-            .syms()
-            .into_iter()
-            .filter_map(|s| match s {
-                Sym::StateDot(j) => place.get(j).copied().flatten().map(|c| (c, j)),
-                _ => None,
-            })
-            .collect();
-        read.sort_unstable();
-        let mut row: Vec<(usize, Expr)> = Vec::with_capacity(read.len() + 1);
-        for (c, j) in read {
-            let d = symbols::diff(&f[i], Sym::StateDot(j))
-                .map_err(|_| SolveError::NotDifferentiable(i))?;
-            if d.any_sym(&is_rate) {
-                return Err(SolveError::Nonlinear(i));
-            }
+        let mut row: Vec<(usize, Expr)> = Vec::new();
+        for (c, d) in rate_derivatives(&f[i], i, &|j| place.get(j).copied().flatten())? {
             // −d term by term, so that `M + m` prints as such rather than `-(-M - m)`.
             let minus_d = match d.node() {
                 Node::Add(terms) => symbols::add(terms.iter().cloned().map(symbols::neg).collect()),
@@ -229,31 +200,47 @@ pub(crate) fn mass_form(f: &[Expr], implicit_rows: &[bool]) -> Result<MassForm, 
     Ok((f, blocks))
 }
 
+/// `(column, ∂f/∂ẋ_j)` for each state rate `ẋ_j` that `f` (row `i`) reads and `column` places, by column; the
+/// rates it does not read give zero. Errors when `f` cannot be differentiated or is not linear in the rates.
+fn rate_derivatives(
+    f: &Expr,
+    i: usize,
+    column: &dyn Fn(usize) -> Option<usize>,
+) -> Result<Vec<(usize, Expr)>, SolveError> {
+    let mut read: Vec<(usize, usize)> = f
+        .syms()
+        .into_iter()
+        .filter_map(|s| match s {
+            Sym::StateDot(j) => column(j).map(|c| (c, j)),
+            _ => None,
+        })
+        .collect();
+    read.sort_unstable();
+    let mut row = Vec::with_capacity(read.len());
+    for (c, j) in read {
+        let d = symbols::diff(f, Sym::StateDot(j)).map_err(|_| SolveError::NotDifferentiable(i))?;
+        if d.any_sym(&|s| matches!(s, Sym::StateDot(_))) {
+            return Err(SolveError::Nonlinear(i));
+        }
+        row.push((c, d));
+    }
+    Ok(row)
+}
+
 /// The places of the rows that the entries couple, directly or through other rows: each group in increasing
 /// order, the groups by their first place.
 fn coupled_blocks(entries: &[Vec<(usize, Expr)>]) -> Vec<Vec<usize>> {
     let n = entries.len();
-    let mut parent: Vec<usize> = (0..n).collect();
-    fn root(parent: &mut [usize], mut v: usize) -> usize {
-        while parent[v] != v {
-            parent[v] = parent[parent[v]];
-            v = parent[v];
-        }
-        v
-    }
+    let mut sets = UnionFind::<usize>::new(n);
     for (a, row) in entries.iter().enumerate() {
-        for &(b, _) in row {
-            if b < n {
-                let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
-                parent[ra.max(rb)] = ra.min(rb);
-            }
+        for &(b, _) in row.iter().filter(|(b, _)| *b < n) {
+            sets.union(a, b);
         }
     }
     let mut group_of: Vec<Option<usize>> = vec![None; n];
     let mut groups: Vec<Vec<usize>> = Vec::new();
     for v in 0..n {
-        let r = root(&mut parent, v);
-        let g = *group_of[r].get_or_insert_with(|| {
+        let g = *group_of[sets.find_mut(v)].get_or_insert_with(|| {
             groups.push(Vec::new());
             groups.len() - 1
         });

@@ -24,6 +24,36 @@ pub struct Integrator {
     pub h: f64,
     pub rtol: f64,
     pub atol: f64,
+    /// Work space kept between steps, so that a step allocates nothing.
+    work: Work,
+}
+
+/// The buffers of one extrapolated step.
+struct Work {
+    /// `I − (h/n)·J`, row-major, decomposed in place.
+    matrix: Vec<f64>,
+    /// The row interchanges of the decomposition.
+    pivots: Vec<usize>,
+    f0: Vec<f64>,
+    f: Vec<f64>,
+    y: Vec<f64>,
+    /// The extrapolation table: row `j` holds `j + 1` states.
+    table: Vec<Vec<f64>>,
+    best: Vec<f64>,
+}
+
+impl Work {
+    fn new() -> Work {
+        Work {
+            matrix: vec![0.0; NX * NX],
+            pivots: vec![0; NX],
+            f0: vec![0.0; NX],
+            f: vec![0.0; NX],
+            y: vec![0.0; NX],
+            table: (0..K).map(|j| vec![0.0; (j + 1) * NX]).collect(),
+            best: vec![0.0; NX],
+        }
+    }
 }
 
 impl Integrator {
@@ -32,6 +62,7 @@ impl Integrator {
             h: 0.0,
             rtol,
             atol: rtol * 1e-3,
+            work: Work::new(),
         }
     }
 
@@ -59,8 +90,8 @@ impl Integrator {
             let last = t1 - t <= self.h * 1.000_001;
             let h = if last { t1 - t } else { self.h };
             match self.try_step(p, t, h, x, u) {
-                Some((x_new, err)) if err <= 1.0 => {
-                    x.copy_from_slice(&x_new);
+                Some(err) if err <= 1.0 => {
+                    x.copy_from_slice(&self.work.best);
                     t = if last { t1 } else { t + h };
                     let grow = (0.9 * err.max(1e-10).powf(-1.0 / K as f64)).clamp(0.2, 4.0);
                     // The shortened last step says nothing about the step the dynamics allow.
@@ -68,7 +99,7 @@ impl Integrator {
                         self.h = h * grow;
                     }
                 }
-                Some((_, err)) => {
+                Some(err) => {
                     self.h = h * (0.9 * err.powf(-1.0 / K as f64)).clamp(0.1, 0.9);
                 }
                 None => self.h = h * 0.25,
@@ -83,57 +114,48 @@ impl Integrator {
         Ok(())
     }
 
-    /// One extrapolated step: the new state and its error norm, or `None` when a matrix is singular or a value
-    /// is not finite.
-    fn try_step(
-        &self,
-        p: &Params,
-        t: f64,
-        h: f64,
-        x: &[f64],
-        u: &[f64],
-    ) -> Option<(Vec<f64>, f64)> {
+    /// One extrapolated step: leaves the new state in `work.best` and returns its error norm, or `None` when a
+    /// matrix is singular or a value is not finite.
+    fn try_step(&mut self, p: &Params, t: f64, h: f64, x: &[f64], u: &[f64]) -> Option<f64> {
         let jac = plant::jac_x(p, t, x, u);
-        let mut f0 = vec![0.0; NX];
-        plant::rhs(p, t, x, u, &mut f0);
-        let mut table: Vec<Vec<f64>> = Vec::with_capacity(K);
-        let mut f = vec![0.0; NX];
+        let w = &mut self.work;
+        plant::rhs(p, t, x, u, &mut w.f0);
         for j in 0..K {
             let n = j + 1;
             let hs = h / n as f64;
-            // A matrix of dynamic size: nalgebra decomposes fixed sizes only up to 127.
-            let lu = nalgebra::DMatrix::from_fn(NX, NX, |r, c| {
-                f64::from(u8::from(r == c)) - jac[(r, c)] * hs
-            })
-            .lu();
-            let mut y = x.to_vec();
+            for r in 0..NX {
+                for c in 0..NX {
+                    w.matrix[r * NX + c] = f64::from(u8::from(r == c)) - jac[(r, c)] * hs;
+                }
+            }
+            decompose(&mut w.matrix, &mut w.pivots)?;
+            w.y.copy_from_slice(x);
             for i in 0..n {
                 if i == 0 {
-                    f.copy_from_slice(&f0);
+                    w.f.copy_from_slice(&w.f0);
                 } else {
-                    plant::rhs(p, t + i as f64 * hs, &y, u, &mut f);
+                    plant::rhs(p, t + i as f64 * hs, &w.y, u, &mut w.f);
                 }
-                let rhs = nalgebra::DVector::from_iterator(NX, f.iter().map(|v| v * hs));
-                let delta = lu.solve(&rhs)?;
-                for (yk, d) in y.iter_mut().zip(delta.iter()) {
+                w.f.iter_mut().for_each(|v| *v *= hs);
+                solve(&w.matrix, &w.pivots, &mut w.f);
+                for (yk, d) in w.y.iter_mut().zip(&w.f) {
                     *yk += d;
                 }
             }
-            // Aitken–Neville: row j of the table from row j − 1, in place.
-            let mut row = y;
+            // Aitken–Neville: row j of the table from row j − 1.
+            let (done, rest) = w.table.split_at_mut(j);
+            let row = &mut rest[0];
+            row[..NX].copy_from_slice(&w.y);
             for k in 1..=j {
                 let ratio = n as f64 / (n - k) as f64 - 1.0;
-                let next: Vec<f64> = (0..NX)
-                    .map(|i| {
-                        let a = row[(k - 1) * NX + i];
-                        a + (a - table[j - 1][(k - 1) * NX + i]) / ratio
-                    })
-                    .collect();
-                row.extend(next);
+                let previous = &done[j - 1][(k - 1) * NX..k * NX];
+                for i in 0..NX {
+                    let a = row[(k - 1) * NX + i];
+                    row[k * NX + i] = a + (a - previous[i]) / ratio;
+                }
             }
-            table.push(row);
         }
-        let last = &table[K - 1];
+        let last = &w.table[K - 1];
         let best = &last[(K - 1) * NX..K * NX];
         let second = &last[(K - 2) * NX..(K - 1) * NX];
         let mut sum = 0.0;
@@ -143,6 +165,55 @@ impl Integrator {
             sum += e * e;
         }
         let err = (sum / NX.max(1) as f64).sqrt();
-        (err.is_finite() && best.iter().all(|v| v.is_finite())).then(|| (best.to_vec(), err))
+        w.best.copy_from_slice(best);
+        (err.is_finite() && best.iter().all(|v| v.is_finite())).then_some(err)
+    }
+}
+
+/// LU decomposition with partial pivoting of the row-major `NX x NX` matrix `a`, in place (`L` below the diagonal
+/// with a unit diagonal, `U` on and above). `None` when a pivot is zero or not finite.
+fn decompose(a: &mut [f64], pivots: &mut [usize]) -> Option<()> {
+    for k in 0..NX {
+        let (mut best, mut size) = (k, a[k * NX + k].abs());
+        for r in k + 1..NX {
+            if a[r * NX + k].abs() > size {
+                (best, size) = (r, a[r * NX + k].abs());
+            }
+        }
+        if size == 0.0 || !size.is_finite() {
+            return None;
+        }
+        pivots[k] = best;
+        if best != k {
+            for c in 0..NX {
+                a.swap(k * NX + c, best * NX + c);
+            }
+        }
+        let pivot = a[k * NX + k];
+        for r in k + 1..NX {
+            let factor = a[r * NX + k] / pivot;
+            a[r * NX + k] = factor;
+            if factor != 0.0 {
+                for c in k + 1..NX {
+                    a[r * NX + c] -= factor * a[k * NX + c];
+                }
+            }
+        }
+    }
+    Some(())
+}
+
+/// Solves `A z = b` in place in `b`, with `A` decomposed by `decompose`.
+fn solve(a: &[f64], pivots: &[usize], b: &mut [f64]) {
+    for k in 0..NX {
+        b.swap(k, pivots[k]);
+    }
+    for r in 1..NX {
+        let sum: f64 = (0..r).map(|c| a[r * NX + c] * b[c]).sum();
+        b[r] -= sum;
+    }
+    for r in (0..NX).rev() {
+        let sum: f64 = (r + 1..NX).map(|c| a[r * NX + c] * b[c]).sum();
+        b[r] = (b[r] - sum) / a[r * NX + r];
     }
 }

@@ -125,7 +125,11 @@ impl Equations {
 }
 
 /// The tear variables (names) that the selected rates or the outputs hold, and where the first one is.
-fn implicit_in(eqs: &Equations, f: &[Expr], h: &[Expr]) -> Option<(String, String, String)> {
+pub(super) fn implicit_in(
+    eqs: &Equations,
+    f: &[Expr],
+    h: &[Expr],
+) -> Option<(String, String, String)> {
     let tear = |e: &Expr| {
         let mut found = None;
         e.for_each_sym(&mut |s| {
@@ -157,7 +161,7 @@ fn implicit_in(eqs: &Equations, f: &[Expr], h: &[Expr]) -> Option<(String, Strin
 }
 
 /// The selected rates and all outputs, explicit, checked for use of left-out states.
-fn selected(
+pub(super) fn selected(
     eqs: &Equations,
     selection: StateSelection,
 ) -> Result<(Vec<Expr>, Vec<Expr>), LinearError> {
@@ -521,7 +525,7 @@ pub fn linearise(
         check_len("parameter", eqs.params.len(), params.len())?;
         check_len("state", f.len(), x0.len())?;
         check_len("input", eqs.inputs.len(), u0.len())?;
-        return super::tear::linearise_implicit(eqs, &f, &h, params, x0, u0, t0);
+        return super::implicit_linear::linearise(eqs, (&f, &h), (params, x0, u0, t0));
     }
     let j = jacobians(eqs, selection)?;
     let mut ss = evaluate_at(eqs, &j, params, x0, u0, t0)?;

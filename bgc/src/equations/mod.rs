@@ -63,6 +63,7 @@ pub(crate) mod dense;
 mod dogleg;
 mod energy;
 mod field;
+mod implicit_linear;
 mod kinematic;
 mod linear;
 mod naming;

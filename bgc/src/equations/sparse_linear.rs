@@ -451,8 +451,8 @@ impl SparseNumericStateSpace {
 /// The linearisation of any model without algebraic loops at `(x0, u0, t0)`, sparse: the Jacobians of
 /// [`sparse_jacobians`] evaluated there, and the rows of mass-matrix blocks (I-fields, the velocity states of
 /// configuration-dependent dependent storage) turned into those of the rates. The numbers are those of
-/// [`linear::linearise`]; a model with algebraic loops (whose linearisation needs the implicit function theorem)
-/// takes that dense path and is converted.
+/// [`linear::linearise`]; a model whose rates or outputs read the tears of algebraic loops is linearised by the
+/// implicit function theorem, sparse as well.
 pub fn linearise_sparse(
     eqs: &Equations,
     rows: &ModelRows,
@@ -460,8 +460,10 @@ pub fn linearise_sparse(
     (params, x0, u0, t0): (&[f64], &[f64], &[f64], f64),
 ) -> Result<SparseNumericStateSpace, LinearError> {
     if !eqs.tear_blocks.is_empty() {
-        let dense = linear::linearise(eqs, selection, params, x0, u0, t0)?;
-        return Ok(SparseNumericStateSpace::from_dense(&dense));
+        let (f, h) = linear::selected(eqs, selection)?;
+        if linear::implicit_in(eqs, &f, &h).is_some() {
+            return super::implicit_linear::linearise_sparse(eqs, (&f, &h), (params, x0, u0, t0));
+        }
     }
     let j = sparse_jacobians(eqs, rows, selection)?;
     let mut ss = evaluate_sparse(eqs, &j, params, x0, u0, t0)?;

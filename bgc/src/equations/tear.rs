@@ -19,8 +19,6 @@
 //! `B = ∂f/∂u + ∂f/∂z dz/du`, and the same for `C`, `D` ([`super::linearise`]).
 
 use super::Equations;
-use super::dense::{self, Mat};
-use super::linear::{LinearError, NumericStateSpace};
 use super::newton::{self, Failure, Problem, Settings};
 use super::symbols::{self, Sym, SymExt};
 use crate::symbolic::{Expr, Node};
@@ -194,127 +192,6 @@ pub fn solve_all(
         solved.extend(block.tears.iter().copied().zip(z));
     }
     Ok(solved)
-}
-
-/// The linearisation at `(x0, u0, t0)` of the selected rates `f` and outputs `h` (explicit in states, inputs,
-/// parameters, `t` and tears) of a model with tear blocks, by the implicit function theorem.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn linearise_implicit(
-    eqs: &Equations,
-    f: &[Expr],
-    h: &[Expr],
-    params: &[f64],
-    x0: &[f64],
-    u0: &[f64],
-    t0: f64,
-) -> Result<NumericStateSpace, LinearError> {
-    let n = f.len();
-    for block in &eqs.tear_blocks {
-        for (r, name) in block.residuals.iter().zip(&block.names) {
-            for j in n..eqs.states.len() {
-                if r.contains(Sym::State(j)) {
-                    return Err(LinearError::NeedsIntegratedState {
-                        what: format!("the algebraic loop for `{name}`"),
-                        state: eqs.sym_name(Sym::State(j)),
-                    });
-                }
-            }
-        }
-    }
-    let base = |s: Sym| match s {
-        Sym::Param(i) => params.get(i).copied(),
-        Sym::State(i) if i < n => x0.get(i).copied(),
-        Sym::Input(i) => u0.get(i).copied(),
-        Sym::Time => Some(t0),
-        _ => None,
-    };
-    let tears = solve_all(eqs, &base).map_err(|e| LinearError::LoopNotSolved {
-        tears: e.tear_list(),
-        reason: e.failure.kind.describe(),
-        residual: e.failure.residual,
-    })?;
-    let value = |s: Sym| match s {
-        Sym::Tear(_) => tears.iter().find(|(t, _)| *t == s).map(|(_, v)| *v),
-        other => base(other),
-    };
-    let zs: Vec<Sym> = tears.iter().map(|(t, _)| *t).collect();
-    let xs: Vec<Sym> = (0..n).map(Sym::State).collect();
-    let us: Vec<Sym> = (0..eqs.inputs.len()).map(Sym::Input).collect();
-    let residuals: Vec<Expr> = eqs
-        .tear_blocks
-        .iter()
-        .flat_map(|b| b.residuals.iter().cloned())
-        .collect();
-    let names = zs
-        .iter()
-        .map(|&z| eqs.sym_name(z))
-        .collect::<Vec<_>>()
-        .join("`, `");
-    let numeric = |rows: &[Expr], vars: &[Sym], what: &str| -> Result<Mat, LinearError> {
-        rows.iter()
-            .map(|e| {
-                vars.iter()
-                    .map(|&v| {
-                        let d =
-                            symbols::diff(e, v).map_err(|symbols::NotDifferentiable(func)| {
-                                LinearError::NotDifferentiable {
-                                    what: what.to_string(),
-                                    func: func.name(),
-                                }
-                            })?;
-                        let x = symbols::eval(&d, &value).map_err(|err| match err {
-                            symbols::EvalError::Unbound(s) => LinearError::Unbound {
-                                what: what.to_string(),
-                                symbol: eqs.sym_name(s),
-                            },
-                            symbols::EvalError::Foreign(func) => LinearError::Unbound {
-                                what: what.to_string(),
-                                symbol: func,
-                            },
-                        })?;
-                        if x.is_finite() {
-                            Ok(x)
-                        } else {
-                            Err(LinearError::NonFinite {
-                                what: what.to_string(),
-                            })
-                        }
-                    })
-                    .collect()
-            })
-            .collect()
-    };
-    let loop_what = format!("the algebraic loop for `{names}`");
-    let rz = numeric(&residuals, &zs, &loop_what)?;
-    let mut rxu = numeric(&residuals, &[xs.clone(), us.clone()].concat(), &loop_what)?;
-    rxu.iter_mut().flatten().for_each(|v| *v = -*v);
-    // [dz/dx, dz/du] = −(∂r/∂z)⁻¹ [∂r/∂x, ∂r/∂u]
-    let dz = dense::solve(&rz, &rxu).ok_or(LinearError::SingularLoop { tears: names })?;
-    let total = |rows: &[Expr], what: &str| -> Result<(Mat, Mat), LinearError> {
-        let direct = numeric(rows, &[xs.clone(), us.clone()].concat(), what)?;
-        let through = dense::mul(&numeric(rows, &zs, what)?, &dz);
-        let sum: Mat = direct
-            .iter()
-            .zip(&through)
-            .map(|(a, b)| a.iter().zip(b).map(|(a, b)| a + b).collect())
-            .collect();
-        let split = |row: &Vec<f64>| {
-            let (x, u) = row.split_at(n.min(row.len()));
-            (x.to_vec(), u.to_vec())
-        };
-        Ok(sum.iter().map(split).unzip())
-    };
-    let (a, b) = total(f, "f")?;
-    let (c, d) = total(h, "h")?;
-    Ok(NumericStateSpace {
-        states: (0..n).map(|i| eqs.sym_name(Sym::State(i))).collect(),
-        inputs: eqs.inputs.clone(),
-        outputs: eqs.outputs.iter().map(|o| o.name.clone()).collect(),
-        a,
-        b,
-        c,
-        d,
-    })
 }
 
 #[cfg(test)]

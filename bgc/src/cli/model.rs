@@ -217,8 +217,8 @@ fn energy_coords(
         return symbolic_json(eqs, &j, &fixed);
     }
     let no_state_space = |e: LinearError| format!("no state space: {e}");
-    // Without algebraic loops, a large model is linearised sparse, its mass-matrix rows included.
-    if !equations::dense_is_cheap(eqs, &rows) && (linear.is_ok() || eqs.tear_blocks.is_empty()) {
+    // A large model is linearised sparse, its mass-matrix rows and algebraic loops included.
+    if !equations::dense_is_cheap(eqs, &rows) {
         let ss = match linear {
             Ok(j) => equations::evaluate_sparse(eqs, &j, params, &x0, &u0, 0.0),
             Err(_) => equations::linearise_sparse(eqs, &rows, selection, (params, &x0, &u0, 0.0)),

@@ -129,3 +129,103 @@ fn the_generated_solve_loops_solves_the_steep_diode_loop() {
         assert!((rate - z).abs() <= 1e-12 * z, "u = {u}: {line}");
     }
 }
+
+/// Two diode loops side by side: a module with two tears, so that the generated solvers of blocks of two are
+/// emitted and can be driven directly.
+fn two_diode_loops() -> String {
+    let text = std::fs::read_to_string(corpus("diode_rc.bg")).unwrap_or_else(|e| panic!("{e}"));
+    let start = text.find("    Se source").unwrap_or_default();
+    let end = text.find("    output i").unwrap_or_default();
+    let second = text[start..end]
+        .replace("source", "source2")
+        .replace("loop_current", "loop_current2")
+        .replace("series", "series2")
+        .replace("diode", "diode2")
+        .replace("cap ", "cap2 ")
+        .replace("cap;", "cap2;");
+    text.replacen("    output i", &format!("{second}    output i"), 1)
+}
+
+/// The block of two tears on which damped Newton's method creeps (the loop of cubic resistors through modulated
+/// transformers of bgc's property test, seed 8169226994125556156; the same system as `CubicLoop` in
+/// `equations::dogleg`), driven through the generated `bgc_damped` and `bgc_newton`.
+const CUBIC_MAIN: &str = r#"
+#[allow(dead_code, unused_imports, clippy::all)]
+mod model {
+    include!("two.module");
+
+    pub fn cubic(z: &Tears) -> LoopEval<2> {
+        let (n1, n2, n3, v0, k0, v1, k1) = (1.395, 1.2925, 0.7, 1.725, 0.2295, 2.02, 0.254);
+        let (v2, v3, v4, l0) = (1.23, 1.6825, 2.24, 2.2975);
+        let (q, w, u0, u1): (f64, f64, f64, f64) =
+            (0.21291896135803667, -0.528186186553325, 0.13311726524149825, 0.9393400554106819);
+        let (e, f) = (z[0], z[1]);
+        let l = l0 * (0.3 * w.cos() + 1.0);
+        let m = 1.0 + 0.3 * q.cos();
+        let s = n2 * f - l * (n1 * f * m + e / v1 + k1 * e.powi(3) - u1) + u0;
+        let a = (v3 + v4) * s / (n3 * n3);
+        let x = n1 * e * m - n2 * a - q / v2;
+        let (mut r, mut scale, mut j) = (SVector::zeros(), SVector::zeros(), SMatrix::zeros());
+        r[0] = l * a - e;
+        r[1] = x / v0 + k0 * x.powi(3) - f;
+        scale[0] = (l * a).abs() + e.abs();
+        scale[1] = (x / v0).abs() + (k0 * x.powi(3)).abs() + f.abs();
+        let (ds_de, ds_df) = (-l * (1.0 / v1 + 3.0 * k1 * e * e), n2 - l * n1 * m);
+        let c = (v3 + v4) / (n3 * n3);
+        let (dx_de, dx_df) = (n1 * m - n2 * c * ds_de, -n2 * c * ds_df);
+        let g = 1.0 / v0 + 3.0 * k0 * x * x;
+        j[(0, 0)] = l * c * ds_de - 1.0;
+        j[(0, 1)] = l * c * ds_df;
+        j[(1, 0)] = g * dx_de;
+        j[(1, 1)] = g * dx_df - 1.0;
+        (r, scale, j)
+    }
+
+    pub fn run() {
+        let mut z = Tears::zeros();
+        match bgc_damped(&mut z, 0, 0, &cubic) {
+            Ok(()) => println!("damped solved"),
+            Err(e) => println!("damped {:?}", e.kind),
+        }
+        let mut z = Tears::zeros();
+        match bgc_newton(&mut z, 0, 0, cubic) {
+            Ok(()) => {
+                let (r, s, _) = cubic(&z);
+                let within = r[0].abs() <= LOOP_RTOL * s[0] && r[1].abs() <= LOOP_RTOL * s[1];
+                println!("{} {} {within}", z[0], z[1]);
+            }
+            Err(e) => println!("error {e}"),
+        }
+    }
+}
+
+fn main() {
+    model::run();
+}
+"#;
+
+/// The generated `bgc_newton` falls back on Powell's dogleg method for a block of several tears, as the
+/// compiler's evaluation does: on a block where damped Newton's method fails it finds the root that
+/// `scipy.optimize.root(r, [0, 0], method="hybr")` finds, [0.61577178, 0.45092652].
+#[test]
+fn the_generated_solver_solves_a_block_where_damped_newton_creeps() {
+    let dir = scratch("dogleg-loops");
+    let code = generate_text(
+        "two.bg",
+        &two_diode_loops(),
+        bgc::codegen::rust::Options { runtime: false },
+    );
+    assert!(code.contains("pub const N_TEARS: usize = 2;"), "{code}");
+    let printed = build_and_run(&dir, "two", &code, CUBIC_MAIN, LIBM_STD);
+    let _ = std::fs::remove_dir_all(&dir);
+    let lines: Vec<&str> = printed.lines().collect();
+    assert_eq!(lines.first(), Some(&"damped IterationLimit"), "{printed}");
+    let fields: Vec<&str> = lines.get(1).map_or(vec![], |l| l.split(' ').collect());
+    let value = |k: usize| fields.get(k).and_then(|f| f.parse::<f64>().ok());
+    assert!(
+        value(0).is_some_and(|e| (e - 0.615_771_78).abs() < 1e-8)
+            && value(1).is_some_and(|f| (f - 0.450_926_52).abs() < 1e-8)
+            && fields.get(2) == Some(&"true"),
+        "{printed}"
+    );
+}

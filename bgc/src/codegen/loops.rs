@@ -11,7 +11,8 @@
 //!   until the Armijo test on `Σ (r_i/w_i)²` passes, and the block has converged when `|r_i| ≤ 10⁻¹² s_i` for every
 //!   residual, `s_i` being the sum of the magnitudes of its terms ([`crate::equations::residual_scale`]), after at
 //!   least one step; at most 100 iterations. A block of one tear whose Newton iteration fails is solved in a
-//!   bracket of a sign change searched outward from the start, as [`crate::equations::newton::bracketed`] does;
+//!   bracket of a sign change searched outward from the start, as [`crate::equations::newton::bracketed`] does; a
+//!   block of several by Powell's dogleg method ([`super::loops_dogleg`]), as the compiler's own evaluation does;
 //! - every function that needs the tears (`rhs_into`, `outputs_into`, the Jacobians, the energy functions) starts
 //!   with `let z = loop_values(p, t, x, u);`, which is `solve_loops` with all NaN when it fails: the values are then
 //!   NaN, never silently wrong. Callers that need to know why call `solve_loops`.
@@ -110,7 +111,8 @@ pub(crate) const NEWTON_FN: &str = "
 pub type LoopEval<const B: usize> = (SVector<f64, B>, SVector<f64, B>, SMatrix<f64, B, B>);
 
 /// Solves the block of `B` tears starting at `first` in `z`, from the values in `z`: damped
-/// Newton's method, and for a single tear where it fails, a root in a bracket of a sign change.
+/// Newton's method; where it fails, for a single tear a root in a bracket of a sign change, for
+/// several Powell's dogleg method.
 fn bgc_newton<const B: usize>(
     z: &mut Tears,
     first: usize,
@@ -122,14 +124,20 @@ fn bgc_newton<const B: usize>(
         Ok(()) => return Ok(()),
         Err(e) => e,
     };
-    let bracketed = if B == 1 && start[first].is_finite() {
-        bgc_bracketed(&start, first, &eval)
+    let fallback = if B == 1 && start[first].is_finite() {
+        bgc_bracketed(&start, first, &eval).map(|root| {
+            let mut solved = start;
+            solved[first] = root;
+            solved
+        })
+    } else if B > 1 {
+        bgc_dogleg(&start, first, &eval)
     } else {
         None
     };
-    match bracketed {
-        Some(root) => {
-            z[first] = root;
+    match fallback {
+        Some(solved) => {
+            *z = solved;
             Ok(())
         }
         None => Err(failure),

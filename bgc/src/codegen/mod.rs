@@ -21,6 +21,7 @@ pub(crate) mod emit;
 mod format;
 mod layout;
 mod loops;
+mod loops_dogleg;
 pub(crate) mod mass;
 mod names;
 pub mod rust;

@@ -552,6 +552,7 @@ impl<'a> Writer<'a> {
         }
         if self.plan.loops.is_some() {
             solvers.push_str(super::loops::NEWTON_FN);
+            solvers.push_str(super::loops_dogleg::DOGLEG_FN);
         }
         // With the runtime, its re-exports: the user's crate then needs neither nalgebra nor libm, nor to match
         // their versions (a second nalgebra makes every signature "a different `Matrix`").

@@ -359,3 +359,70 @@ fn the_sparse_linearisation_of_mass_matrix_rows_is_the_dense_one() {
         }
     }
 }
+
+/// The simulation's Jacobian of mass-matrix rows is that of the rates, not of the generalised forces: every entry
+/// equals central differences of the simulated rhs (which solves `M ẋ_B = F`), for the cart-pole of MTFs, the
+/// cart-pole as an I-field and forty levers, at three points each. The levers' Jacobian stays sparse: each
+/// lever's rows read its own two states only.
+#[test]
+fn the_simulations_jacobian_of_mass_matrix_rows_equals_differences_of_the_rates() {
+    let models = [
+        fixture("fields/cart_pole_mtf"),
+        fixture("fields/cart_pole_field"),
+        from_text("levers", levers(40)),
+    ];
+    for eqs in &models {
+        let signal = Signal::parse("0.7*sin(3*t)").unwrap_or_else(|e| panic!("{e}"));
+        let (system, _) =
+            System::new(eqs, eqs.default_params(), vec![signal]).unwrap_or_else(|e| panic!("{e}"));
+        let pattern = system.jacobian_pattern().expect("a symbolic Jacobian");
+        let n = eqs.states.len();
+        if eqs.model == "levers" {
+            // Per lever: the angle's rate (the modulus times the velocity) and the velocity's rate each read the
+            // lever's angle and velocity, and nothing of the other levers.
+            assert_eq!(pattern.iter().filter(|(r, _)| *r < n).count(), 4 * 40);
+        }
+        let mut stack = Vec::new();
+        for seed in 0..3 {
+            let t = 0.2 + 0.3 * seed as f64;
+            let mut u = Vec::new();
+            system.inputs_at(t, &mut u);
+            let mut y: Vec<f64> = (0..n)
+                .map(|i| 0.4 * ((3 * i + seed) % 7) as f64 - 1.1)
+                .collect();
+            y.extend([0.0, 0.0]);
+            let mut values = vec![0.0; pattern.len()];
+            system
+                .jacobian_values(&y, &u, t, &mut values, &mut stack)
+                .expect("a symbolic Jacobian");
+            let mut jac = vec![vec![0.0; n]; n];
+            for (&(r, c), v) in pattern.iter().zip(&values) {
+                if r < n {
+                    jac[r][c] = *v;
+                }
+            }
+            let h = 1e-6;
+            for c in 0..n {
+                let (mut up, mut down) = (y.clone(), y.clone());
+                up[c] += h;
+                down[c] -= h;
+                let (mut fu, mut fd) = (vec![0.0; n + 2], vec![0.0; n + 2]);
+                system
+                    .rhs(&up, &mut u, t, &mut fu, &mut stack)
+                    .expect("rhs");
+                system
+                    .rhs(&down, &mut u, t, &mut fd, &mut stack)
+                    .expect("rhs");
+                for r in 0..n {
+                    let want = (fu[r] - fd[r]) / (2.0 * h);
+                    assert!(
+                        (jac[r][c] - want).abs() < 1e-6 * (1.0 + want.abs()),
+                        "{}: d rate {r} / d state {c} at {y:?}: {} vs {want}",
+                        eqs.model,
+                        jac[r][c]
+                    );
+                }
+            }
+        }
+    }
+}

@@ -38,6 +38,7 @@ pub mod input;
 pub mod input_rate;
 #[cfg(feature = "cli")]
 pub mod integrate;
+mod jacobian;
 pub mod newton;
 pub mod program;
 pub mod samples;
@@ -46,9 +47,9 @@ mod sparse_ode;
 
 use crate::equations::symbols::{self, Sym, SymExt, add};
 use crate::equations::{EnergyKind, Equations, block_jacobian, residual_scale};
-use crate::ir::Func;
-use crate::symbolic::{Expr, Node, Symbol, WIDE_ROW};
+use crate::symbolic::Expr;
 use input::Signal;
+use jacobian::{Jacobian, MassRows};
 use newton::{BlockPrograms, Loops};
 use program::{CompileError, Layout, Program, Values};
 
@@ -137,9 +138,9 @@ pub struct System {
     input_rates: Vec<Signal>,
     /// `f_i` for the model states, then the dissipated and the supplied power.
     rates: Vec<Program>,
-    /// Nonzero entries `(row, column, ∂rate_row/∂x_column)` of the Jacobian of `rates`; `None` when a rate uses
-    /// a function without a derivative (the Jacobian is then taken by finite differences).
-    jacobian: Option<Vec<(usize, usize, Program)>>,
+    /// The Jacobian of the rates (with the mass blocks' rows solved); `None` when a rate uses a function without
+    /// a derivative or the model has algebraic loops (the Jacobian is then taken by finite differences).
+    jacobian: Option<Jacobian>,
     outputs_h: Vec<Program>,
     stored: Program,
     /// The terms of `stored`, by element.
@@ -246,10 +247,17 @@ impl System {
             .map(|(e, what)| compile(e, what))
             .collect::<Result<Vec<_>, _>>()?;
         let loops = compile_loops(eqs, 2 * n_inputs, &compile)?;
-        // The symbolic Jacobian is that of `F` in the mass-matrix rows, not of the rates, and does not see the
-        // loops' unknowns move: leave both to finite differences.
-        let jacobian = if loops.is_empty() && !eqs.has_mass() {
-            symbolic_jacobian(&rate_exprs, n, &compile)
+        // The symbolic Jacobian does not see the loops' unknowns move: leave loops to finite differences.
+        let mass_rows: Vec<MassRows<'_>> = eqs
+            .mass
+            .iter()
+            .map(|b| MassRows {
+                states: &b.states,
+                matrix: b.matrix.iter().flatten().collect(),
+            })
+            .collect();
+        let jacobian = if loops.is_empty() {
+            Jacobian::new(&rate_exprs, n, &mass_rows, &compile)
         } else {
             None
         };
@@ -461,22 +469,20 @@ impl System {
         jv: &mut [f64],
         stack: &mut Vec<f64>,
     ) -> Option<()> {
-        let entries = self.jacobian.as_ref()?;
-        let vals = self.values(y, u, t);
+        let jacobian = self.jacobian.as_ref()?;
         jv.iter_mut().for_each(|x| *x = 0.0);
-        for (r, c, p) in entries {
-            if let (Some(out), Some(vc)) = (jv.get_mut(*r), v.get(*c)) {
-                *out += p.eval(&vals, stack) * vc;
+        jacobian.for_each(&self.values(y, u, t), &self.rates, stack, |r, c, value| {
+            if let (Some(out), Some(vc)) = (jv.get_mut(r), v.get(c)) {
+                *out += value * vc;
             }
-        }
+        });
         Some(())
     }
 
     /// The positions `(row, column)` of the symbolic Jacobian's entries over the model states, row by row (the
     /// energy quadratures' rows last); `None` when it has no symbolic form (see [`System::jacobian_times`]).
     pub fn jacobian_pattern(&self) -> Option<Vec<(usize, usize)>> {
-        let entries = self.jacobian.as_ref()?;
-        Some(entries.iter().map(|(r, c, _)| (*r, *c)).collect())
+        Some(self.jacobian.as_ref()?.pattern())
     }
 
     /// The values of the Jacobian's first `out.len()` entries at `(y, u, t)`, in the order of
@@ -489,11 +495,13 @@ impl System {
         out: &mut [f64],
         stack: &mut Vec<f64>,
     ) -> Option<()> {
-        let entries = self.jacobian.as_ref()?;
-        let vals = self.values(y, u, t);
-        for (slot, (_, _, p)) in out.iter_mut().zip(entries) {
-            *slot = p.eval(&vals, stack);
-        }
+        let jacobian = self.jacobian.as_ref()?;
+        let mut slots = out.iter_mut();
+        jacobian.for_each(&self.values(y, u, t), &self.rates, stack, |_, _, value| {
+            if let Some(slot) = slots.next() {
+                *slot = value;
+            }
+        });
         Some(())
     }
 
@@ -620,58 +628,6 @@ fn compile_loops(
         k += block.tears.len();
     }
     Ok(loops)
-}
-
-/// The nonzero entries of `∂rate/∂x` over the model states (the quadrature states enter no rate).
-///
-/// A sum is differentiated term by term, each term only by the states it reads: the dissipated power sums a term
-/// per resistor, and differentiating the whole sum by every state it reads would be quadratic in the model.
-fn symbolic_jacobian(
-    rates: &[(Expr, String)],
-    n: usize,
-    compile: &dyn Fn(&Expr, &str) -> Result<Program, SimError>,
-) -> Option<Vec<(usize, usize, Program)>> {
-    let mut entries = Vec::new();
-    for (r, (e, what)) in rates.iter().enumerate() {
-        let terms = match e.node() {
-            Node::Add(terms) => terms.as_slice(),
-            _ => std::slice::from_ref(e),
-        };
-        let mut parts: std::collections::BTreeMap<usize, Vec<Expr>> = Default::default();
-        for term in terms {
-            let read = states_read(term, n);
-            if read.len() > WIDE_ROW {
-                // A term that reads many states (a long sum held whole): its gradient in one walk.
-                for (c, d) in read.iter().zip(state_gradient(term, &read)?) {
-                    parts.entry(*c).or_default().push(d);
-                }
-                continue;
-            }
-            for c in read {
-                let d = symbols::diff(term, Sym::State(c)).ok()?;
-                parts.entry(c).or_default().push(d);
-            }
-        }
-        for (c, part) in parts {
-            let d = add(part);
-            if !d.is_zero() {
-                entries.push((r, c, compile(&d, what).ok()?));
-            }
-        }
-    }
-    Some(entries)
-}
-
-/// `∂e/∂x_c` for each state `c` of `read` (those `e` reads), in one walk of `e`; `None` when `e` reads one of them
-/// under `min` or `max` (not differentiable), as [`symbols::diff`] refuses it.
-fn state_gradient(e: &Expr, read: &[usize]) -> Option<Vec<Expr>> {
-    let vars: Vec<Symbol> = read.iter().map(|&c| Sym::State(c).symbol()).collect();
-    if let Some((_, under)) = e.symbols_under_calls(&[Func::Min, Func::Max])
-        && vars.iter().any(|v| under.contains(v))
-    {
-        return None;
-    }
-    Some(e.gradient(&vars))
 }
 
 /// The model states (below `n`) that `e` reads, each once.

@@ -1,0 +1,277 @@
+//! The symbolic Jacobian `∂rate/∂x` of a compiled system, mass-matrix rows included.
+//!
+//! A rate is differentiated term by term, each term only by the states it reads ([`symbolic`]). The rows of a mass
+//! block (an I-field, inertias coupled through a varying modulus) hold the generalised forces `F` of
+//! `M(q) ẋ_B = F`, so their entries are those of the rates only after the block is solved at the point:
+//!
+//! ```text
+//! ∂ẋ_B/∂x_c = M⁻¹ (∂F/∂x_c − (∂M/∂x_c) ẋ_B)
+//! ```
+//!
+//! in the columns `c` where `∂F` or `M` has an entry. Each block is solved with its own `M`, so a model of many
+//! separate mechanisms keeps a sparse Jacobian (before, such models took finite differences of the whole rhs, one
+//! column at a time, and a dense factorisation).
+
+use super::program::{Program, Values};
+use super::{SimError, states_read};
+use crate::equations::dense::{self, Mat};
+use crate::equations::symbols::{self, Sym, add};
+use crate::ir::Func;
+use crate::symbolic::{Expr, Node, Symbol, WIDE_ROW};
+use std::collections::BTreeMap;
+
+/// Where an entry's value comes from.
+#[derive(Clone, Debug)]
+enum Source {
+    /// A rate's derivative, compiled.
+    Direct(Program),
+    /// Row `row` of mass block `block`, at its `column`-th column.
+    Block {
+        block: usize,
+        row: usize,
+        column: usize,
+    },
+}
+
+/// The rows of one mass block.
+#[derive(Clone, Debug)]
+struct BlockRows {
+    /// The block's states, in the order of its matrix.
+    states: Vec<usize>,
+    /// `M` row-major.
+    matrix: Vec<Program>,
+    /// The columns of its rows: those where `∂F` or `M` has an entry, increasing.
+    columns: Vec<usize>,
+    /// Per row of the block: `(column index, ∂F_row/∂x_column)`.
+    force: Vec<Vec<(usize, Program)>>,
+    /// `(column index, i, j, ∂M_ij/∂x_column)`.
+    slopes: Vec<(usize, usize, usize, Program)>,
+}
+
+/// The compiled Jacobian of the rates over the model states.
+#[derive(Clone, Debug)]
+pub(super) struct Jacobian {
+    /// `(row, column, source)`, row by row.
+    entries: Vec<(usize, usize, Source)>,
+    blocks: Vec<BlockRows>,
+}
+
+/// One mass block for [`Jacobian::new`]: its states and `M` row-major, as expressions.
+pub(super) struct MassRows<'a> {
+    pub states: &'a [usize],
+    pub matrix: Vec<&'a Expr>,
+}
+
+impl Jacobian {
+    /// The Jacobian of `rates` over the `n` model states, with the rows of `mass` solved; `None` when a rate or
+    /// a mass entry uses a function without a derivative (the caller then takes finite differences).
+    pub(super) fn new(
+        rates: &[(Expr, String)],
+        n: usize,
+        mass: &[MassRows<'_>],
+        compile: &dyn Fn(&Expr, &str) -> Result<Program, SimError>,
+    ) -> Option<Jacobian> {
+        let mut direct: Vec<Vec<(usize, Program)>> = vec![Vec::new(); rates.len()];
+        for (r, c, p) in symbolic(rates, n, compile)? {
+            direct[r].push((c, p));
+        }
+        let mut block_of: BTreeMap<usize, (usize, usize)> = BTreeMap::new();
+        let mut blocks = Vec::with_capacity(mass.len());
+        for (b, rows) in mass.iter().enumerate() {
+            let block = BlockRows::new(rows, &mut direct, n, compile)?;
+            for (i, &s) in rows.states.iter().enumerate() {
+                block_of.insert(s, (b, i));
+            }
+            blocks.push(block);
+        }
+        let mut entries = Vec::new();
+        for (r, row) in direct.into_iter().enumerate() {
+            match block_of.get(&r) {
+                Some(&(block, i)) => {
+                    let columns = &blocks[block].columns;
+                    entries.extend(columns.iter().enumerate().map(|(column, &c)| {
+                        let source = Source::Block {
+                            block,
+                            row: i,
+                            column,
+                        };
+                        (r, c, source)
+                    }));
+                }
+                None => entries.extend(row.into_iter().map(|(c, p)| (r, c, Source::Direct(p)))),
+            }
+        }
+        Some(Jacobian { entries, blocks })
+    }
+
+    /// The positions `(row, column)` of the entries, row by row.
+    pub(super) fn pattern(&self) -> Vec<(usize, usize)> {
+        self.entries.iter().map(|(r, c, _)| (*r, *c)).collect()
+    }
+
+    /// Calls `each(row, column, value)` for every entry at the point (all NaN in the rows of a block whose `M`
+    /// is singular there); `rates` evaluates the generalised forces of the block rows.
+    pub(super) fn for_each(
+        &self,
+        values: &Values<'_>,
+        rates: &[Program],
+        stack: &mut Vec<f64>,
+        mut each: impl FnMut(usize, usize, f64),
+    ) {
+        let solved: Vec<Mat> = self
+            .blocks
+            .iter()
+            .map(|b| b.solve(values, rates, stack))
+            .collect();
+        for (r, c, source) in &self.entries {
+            let v = match source {
+                Source::Direct(p) => p.eval(values, stack),
+                Source::Block { block, row, column } => solved
+                    .get(*block)
+                    .and_then(|m| m.get(*row))
+                    .and_then(|row| row.get(*column))
+                    .copied()
+                    .unwrap_or(f64::NAN),
+            };
+            each(*r, *c, v);
+        }
+    }
+}
+
+impl BlockRows {
+    /// Takes the block's rows out of `direct` (the entries of `∂F`) and differentiates `M`.
+    fn new(
+        rows: &MassRows<'_>,
+        direct: &mut [Vec<(usize, Program)>],
+        n: usize,
+        compile: &dyn Fn(&Expr, &str) -> Result<Program, SimError>,
+    ) -> Option<BlockRows> {
+        let size = rows.states.len();
+        let what = "the mass matrix";
+        let forces: Vec<Vec<(usize, Program)>> = rows
+            .states
+            .iter()
+            .map(|&s| direct.get_mut(s).map(std::mem::take).unwrap_or_default())
+            .collect();
+        let mut slopes_by_state = Vec::new();
+        for (k, e) in rows.matrix.iter().enumerate() {
+            for c in states_read(e, n) {
+                let d = symbols::diff(e, Sym::State(c)).ok()?;
+                if !d.is_zero() {
+                    slopes_by_state.push((c, k / size, k % size, compile(&d, what).ok()?));
+                }
+            }
+        }
+        let mut columns: Vec<usize> = forces
+            .iter()
+            .flatten()
+            .map(|(c, _)| *c)
+            .chain(slopes_by_state.iter().map(|(c, ..)| *c))
+            .collect();
+        columns.sort_unstable();
+        columns.dedup();
+        let index = |c: usize| columns.binary_search(&c).unwrap_or_default();
+        let force = forces
+            .into_iter()
+            .map(|row| row.into_iter().map(|(c, p)| (index(c), p)).collect())
+            .collect();
+        let slopes = slopes_by_state
+            .into_iter()
+            .map(|(c, i, j, p)| (index(c), i, j, p))
+            .collect();
+        let matrix = rows
+            .matrix
+            .iter()
+            .map(|e| compile(e, what).ok())
+            .collect::<Option<_>>()?;
+        Some(BlockRows {
+            states: rows.states.to_vec(),
+            matrix,
+            columns,
+            force,
+            slopes,
+        })
+    }
+
+    /// The block's rows of `∂ẋ/∂x` over its columns at the point: `M⁻¹ (∂F − (∂M/∂x_c) ẋ_B)`; NaN when `M` is
+    /// singular.
+    fn solve(&self, values: &Values<'_>, rates: &[Program], stack: &mut Vec<f64>) -> Mat {
+        let size = self.states.len();
+        let m: Mat = self
+            .matrix
+            .chunks(size.max(1))
+            .map(|row| row.iter().map(|p| p.eval(values, stack)).collect())
+            .collect();
+        let forces: Mat = self
+            .states
+            .iter()
+            .map(|&s| vec![rates.get(s).map_or(f64::NAN, |p| p.eval(values, stack))])
+            .collect();
+        let nan = || vec![vec![f64::NAN; self.columns.len()]; size];
+        let Some(rates_b) = dense::solve(&m, &forces) else {
+            return nan();
+        };
+        let mut rhs = vec![vec![0.0; self.columns.len()]; size];
+        for (i, row) in self.force.iter().enumerate() {
+            for (c, p) in row {
+                rhs[i][*c] = p.eval(values, stack);
+            }
+        }
+        for (c, i, j, p) in &self.slopes {
+            rhs[*i][*c] -= p.eval(values, stack) * rates_b[*j][0];
+        }
+        dense::solve(&m, &rhs).unwrap_or_else(nan)
+    }
+}
+
+/// The nonzero entries of `∂rate/∂x` over the model states (the quadrature states enter no rate).
+///
+/// A sum is differentiated term by term, each term only by the states it reads: the dissipated power sums a term
+/// per resistor, and differentiating the whole sum by every state it reads would be quadratic in the model.
+fn symbolic(
+    rates: &[(Expr, String)],
+    n: usize,
+    compile: &dyn Fn(&Expr, &str) -> Result<Program, SimError>,
+) -> Option<Vec<(usize, usize, Program)>> {
+    let mut entries = Vec::new();
+    for (r, (e, what)) in rates.iter().enumerate() {
+        let terms = match e.node() {
+            Node::Add(terms) => terms.as_slice(),
+            _ => std::slice::from_ref(e),
+        };
+        let mut parts: BTreeMap<usize, Vec<Expr>> = Default::default();
+        for term in terms {
+            let read = states_read(term, n);
+            if read.len() > WIDE_ROW {
+                // A term that reads many states (a long sum held whole): its gradient in one walk.
+                for (c, d) in read.iter().zip(state_gradient(term, &read)?) {
+                    parts.entry(*c).or_default().push(d);
+                }
+                continue;
+            }
+            for c in read {
+                let d = symbols::diff(term, Sym::State(c)).ok()?;
+                parts.entry(c).or_default().push(d);
+            }
+        }
+        for (c, part) in parts {
+            let d = add(part);
+            if !d.is_zero() {
+                entries.push((r, c, compile(&d, what).ok()?));
+            }
+        }
+    }
+    Some(entries)
+}
+
+/// `∂e/∂x_c` for each state `c` of `read` (those `e` reads), in one walk of `e`; `None` when `e` reads one of them
+/// under `min` or `max` (not differentiable), as [`symbols::diff`] refuses it.
+fn state_gradient(e: &Expr, read: &[usize]) -> Option<Vec<Expr>> {
+    let vars: Vec<Symbol> = read.iter().map(|&c| Sym::State(c).symbol()).collect();
+    if let Some((_, under)) = e.symbols_under_calls(&[Func::Min, Func::Max])
+        && vars.iter().any(|v| under.contains(v))
+    {
+        return None;
+    }
+    Some(e.gradient(&vars))
+}

@@ -268,7 +268,7 @@ fn capacitor_behind_a_modulated_gyrator_is_regular_where_the_modulus_vanishes() 
 
 /// `n` levers side by side, lever `k`: `Se tau -> 1 a_k {I J, R b} -> MTF m_k -> 1 o_k {I J}` with the modulus
 /// `n_k = 1 + 0.5 cos θ_k`, `θ_k = ∫ f(a_k)`.
-fn levers(n: usize) -> String {
+pub(crate) fn levers(n: usize) -> String {
     let mut s = String::from(
         "model levers {\n    domain rotational;\n    param J = 1 [kg m^2];\n    param b = 0.1 [N m s/rad];\n    input tau [N m];\n",
     );

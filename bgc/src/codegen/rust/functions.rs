@@ -541,100 +541,6 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         self.parts(stem, statements, out, cached, prologue)
     }
 
-    /// Whether `∂f/∂x` also gets its sparse form: when a `JacX` takes more than
-    /// [`super::model::MAX_CONSTANT_JACOBIAN_BYTES`] (a thread's stack holds few of them) and every entry is an
-    /// expression of its own (no loop or mass-matrix correction writes to the matrix as a whole).
-    fn wants_sparse_jac_x(&self) -> bool {
-        let n = self.plan.states.len();
-        n.saturating_mul(n).saturating_mul(8) > super::model::MAX_CONSTANT_JACOBIAN_BYTES
-            && self.shared_lets("jac_x_into").is_empty()
-            && self.plan.loops.is_none()
-            && self.plan.mass.is_empty()
-    }
-
-    /// `JAC_X_NNZ`, `JAC_X_ROWS`, `JAC_X_COLS` and `jac_x_sparse_into`: the entries of `∂f/∂x` that are not
-    /// identically zero, column by column, without an `N_STATES × N_STATES` matrix.
-    fn sparse_jac_x(
-        &mut self,
-        m: &SparseMatrix,
-        rows: &[String],
-        cols: &[String],
-        row_prefix: &str,
-    ) {
-        // Column by column.
-        let mut entries: Vec<(usize, usize, &Expr)> =
-            m.iter().filter(|(_, c, _)| *c < cols.len()).collect();
-        entries.sort_by_key(|&(r, c, _)| (c, r));
-        self.out.push('\n');
-        self.doc(
-            0,
-            "The number of entries of `∂f/∂x` that are not identically zero.",
-        );
-        self.out.push_str(&format!(
-            "pub const JAC_X_NNZ: usize = {};\n",
-            entries.len()
-        ));
-        for (konst, what, pick) in [("JAC_X_ROWS", "row", 0usize), ("JAC_X_COLS", "column", 1)] {
-            let list: Vec<String> = entries
-                .iter()
-                .map(|&(r, c, _)| if pick == 0 { r } else { c }.to_string())
-                .collect();
-            self.out.push('\n');
-            self.doc(
-                0,
-                &format!("The {what} of each entry of `jac_x_sparse_into`."),
-            );
-            let head = format!("pub const {konst}: [usize; JAC_X_NNZ] = ");
-            self.out.push_str(&super::super::format::array(
-                &head, &list, ";", 0, self.width,
-            ));
-            self.out.push('\n');
-        }
-        let statements: Vec<Statement> = entries
-            .iter()
-            .enumerate()
-            .map(|(k, &(r, c, e))| Statement {
-                label: entry_label((rows, cols, row_prefix), r, c),
-                expr: e,
-                head: format!("values[{k}] = "),
-                tail: ";".into(),
-            })
-            .collect();
-        let d = if self.splits(statements.len()) {
-            let out = Out {
-                name: "values",
-                ty: "&mut [f64; JAC_X_NNZ]",
-                passed: "values",
-            };
-            self.parts("jac_x_sparse", &statements, out, false, Vec::new())
-        } else {
-            let exprs: Vec<&Expr> = entries.iter().map(|e| e.2).collect();
-            let mut d = self.draft(&exprs);
-            for s in &statements {
-                self.statement(&mut d, &s.label, s.expr, &s.head, &s.tail);
-            }
-            d
-        };
-        let mut args = Self::model_args(d.uses);
-        args.push(Arg::new(
-            "values",
-            "&mut [f64; JAC_X_NNZ]",
-            !entries.is_empty(),
-        ));
-        self.function(Function {
-            doc: "Writes the entries of `∂f/∂x` that are not identically zero into `values`, at the rows \
-                  `JAC_X_ROWS` and columns `JAC_X_COLS`: the Jacobian of a large model without the \
-                  `N_STATES × N_STATES` matrix a `JacX` takes on the stack."
-                .to_string(),
-            name: "jac_x_sparse_into".to_string(),
-            args,
-            ret: String::new(),
-            body: Self::body_text(&d.lines),
-            locals: d.locals,
-            inline: false,
-        });
-    }
-
     fn jacobians(&mut self) {
         let xs: Vec<String> = self
             .plan
@@ -987,7 +893,7 @@ pub(super) fn with_terms_name(name: &str) -> String {
 
 /// The comment naming the entry `(r, c)` of a Jacobian (`∂(d/dt p_mass)/∂q_spring = `): rows and columns named by
 /// `names`, the rows with a prefix.
-fn entry_label(
+pub(super) fn entry_label(
     (rows, cols, row_prefix): (&[String], &[String], &str),
     r: usize,
     c: usize,

@@ -9,8 +9,9 @@
 //!   `get`, `set`; a derived parameter, defined from others in the file, is a method that follows them);
 //! - `rhs`/`rhs_into` (`ẋ = f(t, x, u)`), `outputs`/`outputs_into` (`y = h(t, x, u)`) and the Jacobians
 //!   `jac_x_into`, `jac_u_into`, `output_jac_x_into`, `output_jac_u_into` from symbolic derivatives; when a
-//!   `JacX` takes more than 256 KiB (above 181 states) and no loop or mass matrix corrects it, also the triplets
-//!   `JAC_X_NNZ`, `JAC_X_ROWS`, `JAC_X_COLS` and `jac_x_sparse_into`, which need no `N_STATES²` matrix;
+//!   `JacX` takes more than 256 KiB (above 181 states) and no loop corrects it, also the triplets
+//!   `JAC_X_NNZ`, `JAC_X_ROWS`, `JAC_X_COLS` and `jac_x_sparse_into`, which need no `N_STATES²` matrix (mass blocks'
+//!   rows solved block by block, `sparse_jac.rs`);
 //! - the parameter Jacobians `jac_p_into` (`JacP`, `N_STATES × N_PARAMS`) and `output_jac_p_into` (`OutJacP`,
 //!   `N_OUTPUTS × N_PARAMS`): full matrices, a column per free parameter in `PARAM_NAMES` order, total through the
 //!   derived parameters, with the loops' and mass matrices' contributions as in `jac_x_into`
@@ -62,6 +63,7 @@ mod model;
 mod param_jacobians;
 mod params;
 mod parts;
+mod sparse_jac;
 mod terms;
 
 pub(super) use functions::Draft;

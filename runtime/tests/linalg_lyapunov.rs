@@ -104,8 +104,24 @@ fn diagonalisable_real_case_matches_closed_form() {
     let xd = dlyap(&ad, &qh).unwrap();
     let xc_ref: DMatrix<f64> = &h * xc_diag * &h;
     let xd_ref: DMatrix<f64> = &h * xd_diag * &h;
-    assert!((&xc - xc_ref).amax() < 1e-13);
-    assert!((&xd - xd_ref).amax() < 1e-13);
+    assert!((&xc - &xc_ref).amax() < 1e-13);
+    assert!((&xd - &xd_ref).amax() < 1e-13);
+    // X is linear in Q: Q of any size gives X of that size, where the squares of its entries leave f64 (1e160) or
+    // vanish in it (1e-160). Before, dlyap's residual overflowed there and the solution was refused.
+    for s in [1e-300, 1e-160, 1e160, 1e300] {
+        let qs = &qh * s;
+        let xc = lyap(&ac, &qs).unwrap_or_else(|e| panic!("Q * {s:e}: {e}"));
+        let xd = dlyap(&ad, &qs).unwrap_or_else(|e| panic!("Q * {s:e}: {e}"));
+        assert!((&xc / s - &xc_ref).amax() < 1e-13, "Q * {s:e}: {xc}");
+        assert!((&xd / s - &xd_ref).amax() < 1e-13, "Q * {s:e}: {xd}");
+    }
+    // A solution beyond f64 is an error that says so: X = Q / (1 − 0.99²) ≈ 50 Q.
+    let err = dlyap(
+        &(DMatrix::<f64>::identity(2, 2) * 0.99),
+        &(DMatrix::<f64>::identity(2, 2) * 1e307),
+    )
+    .expect_err("X ≈ 5e308");
+    assert_eq!(err, LyapunovError::Overflow);
 }
 
 #[test]

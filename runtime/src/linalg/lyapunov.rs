@@ -33,6 +33,8 @@ pub enum LyapunovError {
     },
     #[error("relative residual {residual:e} of the solution exceeds {tolerance:e}")]
     Inaccurate { residual: f64, tolerance: f64 },
+    #[error("the solution has entries beyond the range of f64 (about 1.8e308)")]
+    Overflow,
 }
 
 /// Relative residual above which a solution is refused.
@@ -41,6 +43,7 @@ pub(crate) const RESIDUAL_TOLERANCE: f64 = 1e-8;
 /// Solves `A X + X Aᵀ + Q = 0` for symmetric `Q`; the solution is symmetric.
 pub fn lyap(a: &DMatrix<f64>, q: &DMatrix<f64>) -> Result<DMatrix<f64>, LyapunovError> {
     validate(a, q)?;
+    let (q, size) = unit_size(q);
     // A change of the unit of time (a power of two, exact) divides A and Q alike and keeps X: A of unit size, so
     // that the uniqueness test and the residual do not overflow for rates of 1e160 (which were refused as
     // λᵢ + λⱼ = 0).
@@ -62,17 +65,37 @@ pub fn lyap(a: &DMatrix<f64>, q: &DMatrix<f64>) -> Result<DMatrix<f64>, Lyapunov
     })?;
     let residual = frobenius(&(a * &x + &x * a.transpose() + q))
         / (2.0 * frobenius(a) * frobenius(&x) + frobenius(q)).max(f64::MIN_POSITIVE);
-    accept(x, residual)
+    accept(x, residual).and_then(|x| scaled_back(x, size))
 }
 
 /// Solves `A X Aᵀ − X + Q = 0` for symmetric `Q`; the solution is symmetric.
 pub fn dlyap(a: &DMatrix<f64>, q: &DMatrix<f64>) -> Result<DMatrix<f64>, LyapunovError> {
     validate(a, q)?;
+    let (q, size) = unit_size(q);
+    let q = &q;
     let x = solve_symmetric(a, q, Kind::Discrete, 1.0, "λᵢ λⱼ = 1")?;
     let axa = a * &x * a.transpose();
-    let residual =
-        (&axa - &x + q).norm() / (axa.norm() + x.norm() + q.norm()).max(f64::MIN_POSITIVE);
-    accept(x, residual)
+    let residual = frobenius(&(&axa - &x + q))
+        / (frobenius(&axa) + frobenius(&x) + frobenius(q)).max(f64::MIN_POSITIVE);
+    accept(x, residual).and_then(|x| scaled_back(x, size))
+}
+
+/// `Q` divided by a power of two (exact) that brings its largest entry near 1, and that power: `X` is linear in
+/// `Q`, so the equation is solved for `Q / s` and `X` scaled back by `s`, away from overflow (a `Q` of 1e160 has
+/// squares beyond `f64`) and underflow.
+fn unit_size(q: &DMatrix<f64>) -> (DMatrix<f64>, f64) {
+    let s = unit_scale(q.amax());
+    (q / s, s)
+}
+
+/// `x · size`, refused when that is not finite (a solution beyond `f64`).
+fn scaled_back(x: DMatrix<f64>, size: f64) -> Result<DMatrix<f64>, LyapunovError> {
+    let x = x * size;
+    if x.iter().all(|v| v.is_finite()) {
+        Ok(x)
+    } else {
+        Err(LyapunovError::Overflow)
+    }
 }
 
 /// `X` of `A X + X Aᵀ + Q = 0` or `A X Aᵀ − X + Q = 0` through one Schur decomposition of `A` (see the module

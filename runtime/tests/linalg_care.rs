@@ -593,3 +593,30 @@ fn control_far_cheaper_than_the_plant_is_named_ill_conditioned() {
         other => panic!("expected IllConditioned, got {other:?}"),
     }
 }
+
+/// A state weight far below what stabilising the plant costs: `ẋ = [0 1; 4 0.4] x + [0; 1] u` has the poles
+/// 0.2 ± √4.04 (2.20998 unstable, −1.80998 stable). As `Q/R → 0` the gain tends to the minimum-energy one, which
+/// keeps the stable pole and mirrors the unstable one: `A − BK` has the characteristic polynomial
+/// `(s + 1.80998)(s + 2.20998) = s² + 2√4.04 s + 4`, so `K = [8, 0.4 + 2√4.04]` by hand (scipy 1.17.1 gives the
+/// same at `Q = 1e-40 I`). Before, every `Q/R` below about 1e-35 was refused ("the solver did not converge"): the
+/// weight scale balanced `Q` against `G` and left the Hamiltonian's coupling blocks negligible.
+#[test]
+fn a_state_weight_far_below_the_cost_of_stabilising_gives_the_minimum_energy_gain() {
+    let a = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, 4.0, 0.4]);
+    let b = DMatrix::from_row_slice(2, 1, &[0.0, 1.0]);
+    let k_ref = DMatrix::from_row_slice(1, 2, &[8.0, 0.4 + 2.0 * 4.04f64.sqrt()]);
+    for ratio in [1e-20, 1e-40, 1e-100, 1e-200, 1e-300] {
+        let weights = [
+            (DMatrix::identity(2, 2) * ratio, DMatrix::identity(1, 1)),
+            (DMatrix::identity(2, 2), DMatrix::identity(1, 1) / ratio),
+        ];
+        for (q, r) in &weights {
+            let sol = care(&a, &b, q, r).unwrap_or_else(|e| panic!("Q/R = {ratio:e}: {e}"));
+            assert!(
+                max_rel_diff(&sol.k, &k_ref) < 1e-10,
+                "Q/R = {ratio:e}: K = {}",
+                sol.k
+            );
+        }
+    }
+}

@@ -53,6 +53,31 @@ pub fn care_with_cross(
     let p = Problem::new(a, b, q, r, n)?;
     p.check_modes(Domain::Continuous)?;
     let s = Scaled::new(&p);
+    let first = solve_scaled(&p, &s, a, b);
+    // The weight scale balances `Q̃` against `G`, as if `X` were of size √(‖Q‖/‖G‖). A state weight far below
+    // what stabilising the unstable modes costs (`Q` of 1e-40 on an unstable plant) leaves `X` of size ‖Ã‖/‖G‖
+    // instead, and both of the Hamiltonian's coupling blocks negligible: its stable subspace is then lost. Once
+    // more, balanced on the plant's rates.
+    match first {
+        Err(
+            RiccatiError::NoConvergence { .. }
+            | RiccatiError::ClosedLoopUnstable { .. }
+            | RiccatiError::IllConditioned { .. },
+        ) => match s.rebalanced_on_rates() {
+            Some(rates) => solve_scaled(&p, &rates, a, b).or(first),
+            None => first,
+        },
+        other => other,
+    }
+}
+
+/// The CARE of `p` in the scaled coordinates `s`.
+fn solve_scaled(
+    p: &Problem,
+    s: &Scaled,
+    a: &DMatrix<f64>,
+    b: &DMatrix<f64>,
+) -> Result<Riccati, RiccatiError> {
     let nn = p.n;
     // A change of the unit of time (by a power of two, exactly) divides Ã, G and Q̃ alike and keeps X: it brings
     // the Hamiltonian to unit magnitude, so that rates of 1e200 per second neither overflow its iteration nor the

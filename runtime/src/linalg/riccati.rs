@@ -331,6 +331,27 @@ impl Scaled {
         }
     }
 
+    /// The same coordinates with the weight scale `α = ‖Ã‖/‖G‖` (a power of two), when that is larger than the
+    /// one that balances `Q̃` against `G`: the size of `X` where stabilising the unstable modes dominates the
+    /// state weight. `None` otherwise.
+    pub fn rebalanced_on_rates(&self) -> Option<Scaled> {
+        let g_unit = &self.g / self.alpha;
+        let (an, gn) = (frobenius(&self.a), frobenius(&g_unit));
+        if !(an > 0.0 && gn > 0.0 && an.is_finite() && gn.is_finite()) {
+            return None;
+        }
+        let alpha = power_of_two(an / gn);
+        (alpha > self.alpha).then(|| Scaled {
+            q: &self.q * (self.alpha / alpha),
+            r: &self.r * (self.alpha / alpha),
+            g: g_unit * alpha,
+            a: self.a.clone(),
+            b: self.b.clone(),
+            d: self.d.clone(),
+            alpha,
+        })
+    }
+
     /// `X = α D⁻¹ X̃ D⁻¹`.
     pub fn unscale(&self, xs: &DMatrix<f64>) -> DMatrix<f64> {
         let n = xs.nrows();

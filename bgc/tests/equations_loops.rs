@@ -15,9 +15,13 @@ const PARAMS: [f64; 4] = [100.0, 1e-6, 0.05, 1e-3];
 
 fn diode_rc() -> Equations {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/corpus/diode_rc.bg");
-    let text = std::fs::read_to_string(path).expect("corpus file");
+    derived(path, std::fs::read_to_string(path).expect("corpus file"))
+}
+
+/// The equations of the single model of `text`, without errors.
+fn derived(name: &str, text: String) -> Equations {
     let mut sources = SourceMap::new();
-    let root = sources.add(path, text);
+    let root = sources.add(name, text);
     let (models, diags) = lower(&mut sources, root, &mut MemoryLoader::new());
     assert!(diags.iter().all(|d| !d.is_error()), "{diags:?}");
     let (causality, _) = analyse(&models[0]);
@@ -225,14 +229,7 @@ fn cart_pole_behind_a_loop() -> Equations {
          bond cart -> s1; bond s1 -> rs1; bond s1 -> n1; bond n1 -> rp1;\n    \
          bond n1 -> s2; bond s2 -> rs2; bond s2 -> n2; bond n2 -> rp2;\n    output angle",
     );
-    let mut sources = SourceMap::new();
-    let root = sources.add("cart_pole_loop.bg", text);
-    let (models, diags) = lower(&mut sources, root, &mut MemoryLoader::new());
-    assert!(diags.iter().all(|d| !d.is_error()), "{diags:?}");
-    let (causality, _) = analyse(&models[0]);
-    let (eqs, diags) = derive(&models[0], &causality);
-    assert!(diags.iter().all(|d| !d.is_error()), "{diags:?}");
-    eqs
+    derived("cart_pole_loop.bg", text)
 }
 
 /// The rates of the cart-pole behind the loop, by hand: the network's force on the cart is `b v + e`, where the

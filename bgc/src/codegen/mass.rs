@@ -270,18 +270,7 @@ impl Writer<'_> {
                 d.uses.u = true;
                 for (k, dm) in derivatives {
                     let by = self.column_name(columns, *k);
-                    for (i, row) in dm.iter().enumerate() {
-                        for (j, e) in row.iter().enumerate() {
-                            if e.is_zero() {
-                                continue;
-                            }
-                            let label = format!("∂M[{}, {}]/∂{by} = ", i + 1, j + 1);
-                            self.statement(d, &label, e, "let dm = ", ";");
-                            let rate = b.rows.get(j).copied().unwrap_or_default();
-                            d.lines
-                                .push(format!("    rows[({i}, {k})] -= dm * dx[{rate}];"));
-                        }
-                    }
+                    self.slope_correction(d, &b.rows, dm, &by, *k);
                 }
             }
             d.lines.push(format!(
@@ -295,6 +284,27 @@ impl Writer<'_> {
             }
             d.uses.p = true;
             d.uses.x = true;
+        }
+    }
+
+    /// The lines `rows[(i, column)] -= ∂M[i, j]/∂by · dx[j-th row]` of the correction of a block with the rows
+    /// `rows`, for the derivative `dm` of its `M` by the variable `by` of column `column`.
+    pub(super) fn slope_correction(
+        &self,
+        d: &mut Draft,
+        rows: &[usize],
+        dm: &[Vec<Expr>],
+        by: &str,
+        column: usize,
+    ) {
+        for (i, row) in dm.iter().enumerate() {
+            for (j, e) in row.iter().enumerate().filter(|(_, e)| !e.is_zero()) {
+                let label = format!("∂M[{}, {}]/∂{by} = ", i + 1, j + 1);
+                self.statement(d, &label, e, "let dm = ", ";");
+                let rate = rows.get(j).copied().unwrap_or_default();
+                d.lines
+                    .push(format!("    rows[({i}, {column})] -= dm * dx[{rate}];"));
+            }
         }
     }
 

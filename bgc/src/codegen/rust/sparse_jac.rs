@@ -189,16 +189,8 @@ impl Writer<'_> {
             }
             for (c, dm) in &block.derivatives {
                 let k = b.columns.binary_search(c).unwrap_or_default();
-                for (i, row) in dm.iter().enumerate() {
-                    for (j, e) in row.iter().enumerate().filter(|(_, e)| !e.is_zero()) {
-                        let by = self.plan.states.get(*c).map_or("", |s| s.name());
-                        let label = format!("∂M[{}, {}]/∂{by} = ", i + 1, j + 1);
-                        self.statement(&mut d, &label, e, "let dm = ", ";");
-                        let rate = block.rows.get(j).copied().unwrap_or_default();
-                        d.lines
-                            .push(format!("    rows[({i}, {k})] -= dm * dx[{rate}];"));
-                    }
-                }
+                let by = self.plan.states.get(*c).map_or("", |s| s.name());
+                self.slope_correction(&mut d, &block.rows, dm, by, k);
             }
             d.lines.push(format!(
                 "    let solved = bgc_solve(mass_{}(p, x), rows);",

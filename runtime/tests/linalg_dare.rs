@@ -240,3 +240,28 @@ fn a_slow_shrinking_open_loop_keeps_its_small_gain() {
         }
     }
 }
+
+/// A state weight far below what stabilising the plant costs: `A = [1 0.1; 0.4 1.04]` has the eigenvalues
+/// `1.02 ± √0.0404` (1.22100 unstable, 0.81900 stable, their product `det A = 1`). As `Q/R → 0` the gain tends to the
+/// minimum-energy one, which mirrors the unstable eigenvalue into the unit circle: `A − BK` (`B = [0; 0.1]`) has the
+/// double eigenvalue `μ = 1.02 − √0.0404`, so trace `2.04 − 0.1 k₂ = 2μ` and determinant `1 − 0.1 k₂ + 0.01 k₁ = μ²`
+/// give `K = [8.08 − 4√0.0404, 20√0.0404]` by hand (scipy 1.17.1: `[7.27600995, 4.01995025]` at `Q = 1e-40 I`).
+/// Before, `Q/R` below about 1e-15 was refused: the doubling iterates left f64.
+#[test]
+fn a_state_weight_far_below_the_cost_of_stabilising_gives_the_minimum_energy_gain() {
+    let a = DMatrix::from_row_slice(2, 2, &[1.0, 0.1, 0.4, 1.04]);
+    let b = DMatrix::from_row_slice(2, 1, &[0.0, 0.1]);
+    let root = 0.0404f64.sqrt();
+    let k_ref = DMatrix::from_row_slice(1, 2, &[8.08 - 4.0 * root, 20.0 * root]);
+    for ratio in [1e-16, 1e-40, 1e-100, 1e-200, 1e-300] {
+        let weights = [
+            (DMatrix::identity(2, 2) * ratio, DMatrix::identity(1, 1)),
+            (DMatrix::identity(2, 2), DMatrix::identity(1, 1) / ratio),
+        ];
+        for (q, r) in &weights {
+            let sol = dare(&a, &b, q, r).unwrap_or_else(|e| panic!("Q/R = {ratio:e}: {e}"));
+            let err = (&sol.k - &k_ref).amax() / k_ref.amax();
+            assert!(err < 1e-10, "Q/R = {ratio:e}: K = {}", sol.k);
+        }
+    }
+}

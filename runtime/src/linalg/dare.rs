@@ -15,6 +15,8 @@ use super::riccati::{
 const MAX_DOUBLING_STEPS: usize = 100;
 /// Hewer steps at most.
 const MAX_HEWER_STEPS: usize = 30;
+/// `‖G̃‖ δ` of the heavier state weight `Q̃ + δI` whose doubling starts the refinement when the doubling of `Q̃` fails.
+const REGULARISATION: f64 = 1e-8;
 
 /// Solves `AᵀXA − X − AᵀXB(R + BᵀXB)⁻¹BᵀXA + Q = 0` for the stabilising solution `X = Xᵀ ≥ 0` (all eigenvalues
 /// of `A − BK`, `K = (R + BᵀXB)⁻¹BᵀXA`, inside the unit circle).
@@ -29,8 +31,9 @@ const MAX_HEWER_STEPS: usize = 30;
 /// `A₀ = Ã, G₀ = BR⁻¹Bᵀ, H₀ = Q̃`; with `W = I + GₖHₖ`:
 /// `Aₖ₊₁ = Aₖ W⁻¹ Aₖ`, `Gₖ₊₁ = Gₖ + Aₖ W⁻¹ Gₖ Aₖᵀ`, `Hₖ₊₁ = Hₖ + Aₖᵀ Hₖ W⁻¹ Aₖ`,
 ///
-/// where `Hₖ → X` quadratically; then Hewer's (Newton's) refinement in correction form
-/// `(Ã − BK)ᵀ Δ (Ã − BK) − Δ + Res(X) = 0`, `X ← X + Δ`, while the residual decreases. The relative residual
+/// where `Hₖ → X` quadratically (when the iterates leave f64 for a state weight far below the plant's rates, the
+/// doubling of `Q̃ + δI` gives the start instead, `‖G‖ δ = 1e-8`); then Hewer's (Newton's) refinement in correction
+/// form `(Ã − BK)ᵀ Δ (Ã − BK) − Δ + Res(X) = 0`, `X ← X + Δ`, while the residual decreases. The relative residual
 /// `‖Res(X)‖ / (‖ÃᵀXÃ‖ + ‖X‖ + ‖ÃᵀXB(R + BᵀXB)⁻¹BᵀXÃ‖ + ‖Q̃‖)` must be below
 /// [`crate::linalg::riccati::RICCATI_TOLERANCE`] and `A − BK` stable, else an error is returned.
 pub fn dare(
@@ -53,17 +56,72 @@ pub fn dare_with_cross(
     let p = Problem::new(a, b, q, r, n)?;
     p.check_modes(Domain::Discrete)?;
     let s = Scaled::new(&p);
+    let out_of_range =
+        |doubling| overflowed(&p, Domain::Discrete, "the doubling iterates", doubling);
+    let (xs, doubling, identity_lost) = match sda(&p, &s, &s.q) {
+        Ok(found) => found,
+        // A state weight far below the plant's rates (Q/R of 1e-16 on an unstable plant): the iterates grow as
+        // Ã^(2^k) before the weak coupling GₖHₖ acts, and leave f64. The doubling of a slightly heavier weight gives
+        // a stabilising start, and Hewer's refinement below, on the true weight, converges from any stabilising
+        // start.
+        Err(
+            first @ (RiccatiError::OutOfRange { .. }
+            | RiccatiError::NoConvergence { .. }
+            | RiccatiError::IllConditioned { .. }),
+        ) => {
+            let nn = p.n;
+            let heavier = &s.q
+                + DMatrix::<f64>::identity(nn, nn)
+                    * (REGULARISATION / frobenius(&s.g).max(f64::MIN_POSITIVE));
+            sda(&p, &s, &heavier).map_err(|_| first)?
+        }
+        Err(e) => return Err(e),
+    };
+    finite_solution(&xs, doubling)?;
+
+    // Hewer refinement in the scaled coordinates: (Ã − BK)ᵀ Δ (Ã − BK) − Δ + Res(X) = 0.
+    let evaluate = |x: &DMatrix<f64>| Evaluation::new(&s.a, &s.b, &s.q, &s.r, x);
+    let Some(eval) = evaluate(&xs) else {
+        return Err(p.diagnose(Domain::Discrete, f64::INFINITY, doubling));
+    };
+    let hewer = |_: &DMatrix<f64>, eval: &Evaluation| {
+        dlyap(&(&s.a - &s.b * &eval.gain).transpose(), &eval.residual).ok()
+    };
+    let (xs, steps) = refine(xs, eval, MAX_HEWER_STEPS, hewer, evaluate);
+
+    let x = s.unscale(&xs);
+    finite_solution(&x, doubling + steps)?;
+    let Some(orig) = Evaluation::new(&p.a, &p.b, &p.q, &p.r, &x) else {
+        return Err(RiccatiError::Singular { what: "R + BᵀXB" });
+    };
+    p.check_residual(Domain::Discrete, orig.relative, doubling + steps)
+        .map_err(|e| match e {
+            RiccatiError::NoConvergence { .. } if identity_lost => out_of_range(doubling + steps),
+            e => e,
+        })?;
+    // K for the original (cross-weighted) problem: (R + BᵀXB)⁻¹(BᵀXA + Nᵀ).
+    let k = gain(&p.b, &p.r, &x, a, Some(&p.n_t))
+        .ok_or(RiccatiError::Singular { what: "R + BᵀXB" })?;
+    stabilising_solution(Domain::Discrete, a, b, x, k, orig.relative, steps)
+}
+
+/// The structure-preserving doubling from `H₀ = q` in the scaled coordinates `s`: `X`, the number of doubling
+/// steps, and whether some `I + GₖHₖ` lost its identity to rounding.
+fn sda(
+    p: &Problem,
+    s: &Scaled,
+    q: &DMatrix<f64>,
+) -> Result<(DMatrix<f64>, usize, bool), RiccatiError> {
     let nn = p.n;
     let identity = DMatrix::<f64>::identity(nn, nn);
-
-    let (mut ak, mut gk, mut hk) = (s.a.clone(), s.g.clone(), s.q.clone());
+    let (mut ak, mut gk, mut hk) = (s.a.clone(), s.g.clone(), q.clone());
     let mut doubling = 0;
     let mut converged = false;
     // Whether some `I + GₖHₖ` had entries beyond 1/ε: its identity was lost to rounding, so a solution that then
     // fails its residual check failed for range, not for a property of the data.
     let mut identity_lost = false;
     let out_of_range =
-        |doubling| overflowed(&p, Domain::Discrete, "the doubling iterates", doubling);
+        |doubling| overflowed(p, Domain::Discrete, "the doubling iterates", doubling);
     while doubling < MAX_DOUBLING_STEPS {
         doubling += 1;
         let pivot = &identity + &gk * &hk;
@@ -103,33 +161,7 @@ pub fn dare_with_cross(
             p.diagnose(Domain::Discrete, f64::INFINITY, doubling)
         });
     }
-    let xs = hk;
-    finite_solution(&xs, doubling)?;
-
-    // Hewer refinement in the scaled coordinates: (Ã − BK)ᵀ Δ (Ã − BK) − Δ + Res(X) = 0.
-    let evaluate = |x: &DMatrix<f64>| Evaluation::new(&s.a, &s.b, &s.q, &s.r, x);
-    let Some(eval) = evaluate(&xs) else {
-        return Err(p.diagnose(Domain::Discrete, f64::INFINITY, doubling));
-    };
-    let hewer = |_: &DMatrix<f64>, eval: &Evaluation| {
-        dlyap(&(&s.a - &s.b * &eval.gain).transpose(), &eval.residual).ok()
-    };
-    let (xs, steps) = refine(xs, eval, MAX_HEWER_STEPS, hewer, evaluate);
-
-    let x = s.unscale(&xs);
-    finite_solution(&x, doubling + steps)?;
-    let Some(orig) = Evaluation::new(&p.a, &p.b, &p.q, &p.r, &x) else {
-        return Err(RiccatiError::Singular { what: "R + BᵀXB" });
-    };
-    p.check_residual(Domain::Discrete, orig.relative, doubling + steps)
-        .map_err(|e| match e {
-            RiccatiError::NoConvergence { .. } if identity_lost => out_of_range(doubling + steps),
-            e => e,
-        })?;
-    // K for the original (cross-weighted) problem: (R + BᵀXB)⁻¹(BᵀXA + Nᵀ).
-    let k = gain(&p.b, &p.r, &x, a, Some(&p.n_t))
-        .ok_or(RiccatiError::Singular { what: "R + BᵀXB" })?;
-    stabilising_solution(Domain::Discrete, a, b, x, k, orig.relative, steps)
+    Ok((hk, doubling, identity_lost))
 }
 
 /// `K = (R + BᵀXB)⁻¹(BᵀXA + Nᵀ)`, multiplied as `(((R + BᵀXB)⁻¹Bᵀ)X)A`: the solve first, then two products of

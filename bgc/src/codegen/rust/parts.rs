@@ -98,17 +98,23 @@ impl Writer<'_> {
             passed.push(out.passed);
             main.lines
                 .push(format!("    {name}({});", passed.join(", ")));
-            let function = Function {
-                doc: format!("Part {} of {count} of the statements of `{stem}`.", k + 1),
-                name,
-                args,
-                ret: String::new(),
-                body: Self::body_text(&d.lines),
-                locals: d.locals,
-                inline: false,
-            };
-            self.write_function(function, Some("#[inline(never)]"), "fn");
+            let doc = format!("Part {} of {count} of the statements of `{stem}`.", k + 1);
+            self.private_part(doc, name, args, d);
         }
         main
+    }
+
+    /// Writes the draft `d` as a private `#[inline(never)]` function `name(args)` without a result.
+    pub(super) fn private_part(&mut self, doc: String, name: String, args: Vec<Arg>, d: Draft) {
+        let function = Function {
+            doc,
+            name,
+            args,
+            ret: String::new(),
+            body: Self::body_text(&d.lines),
+            locals: d.locals,
+            inline: false,
+        };
+        self.write_function(function, Some("#[inline(never)]"), "fn");
     }
 }

@@ -209,16 +209,9 @@ impl Writer<'_> {
             Arg::new("dx", "&State", true),
             Arg::new("values", "&mut [f64; JAC_X_NNZ]", true),
         ];
-        let function = Function {
-            doc: format!("The rows of mass blocks of `jac_x_sparse_into` (see `{name}`'s caller)."),
-            name: name.to_string(),
-            args,
-            ret: String::new(),
-            body: Self::body_text(&d.lines),
-            locals: d.locals,
-            inline: false,
-        };
-        self.write_function(function, Some("#[inline(never)]"), "fn");
+        let doc =
+            format!("The rows of mass blocks of `jac_x_sparse_into` (see `{name}`'s caller).");
+        self.private_part(doc, name.to_string(), args, d);
     }
 }
 

@@ -609,3 +609,21 @@ fn times_at_the_ends_of_the_range_are_written_with_an_exponent() {
         );
     }
 }
+
+/// A mass matrix that is singular where the run is (the cart-pole I-field with a massless bob: `M = [[2, 0],
+/// [0, 0]]`) is named as the cause, with its element and the time, rather than a non-finite derivative of one of
+/// its states.
+#[test]
+fn a_singular_mass_matrix_stops_the_run_naming_its_element() {
+    let path = repo("bgc/tests/fixtures/fields/cart_pole_field.bg");
+    let (code, out, err) = bgc(&["simulate", &path, "--t-end", "1", "--param", "m=0"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(out.starts_with("t [s],"), "{out}");
+    assert!(
+        err.contains("error: the mass matrix of `body` is singular at t = 0.0"),
+        "{err}"
+    );
+    // With the bob's mass the same run completes.
+    let (code, _, err) = bgc(&["simulate", &path, "--t-end", "1"]);
+    assert_eq!(code, 0, "{err}");
+}

@@ -15,7 +15,7 @@
 //! budget, the segment goes on with TR-BDF2 (A- and L-stable) from the last accepted step, and
 //! [`run_streaming_noted`] returns a note that says so.
 
-use std::cell::{Cell, RefCell};
+use std::cell::RefCell;
 use std::ops::ControlFlow;
 
 use diffsol::error::{DiffsolError, OdeSolverError};
@@ -432,7 +432,7 @@ fn segment_once(
     let t_max = if last { f64::INFINITY } else { just_before(b) };
     // The inputs' vector keeps the loops' last solution in its tear slots, from which the next solve starts.
     let scratch = RefCell::new((warm.to_vec(), Vec::new(), vec![0.0; dim], vec![0.0; dim]));
-    let bad: Cell<Option<(f64, usize)>> = Cell::new(None);
+    let bad: RefCell<Option<FirstBad>> = RefCell::new(None);
     // The latest failure of the algebraic loops' solve at a finite state, reported if the solver then gives up (it
     // may recover from a failed trial step; evaluations at the non-finite states a failed step leads to are
     // consequences, not causes).
@@ -450,10 +450,14 @@ fn segment_once(
         let mut s = scratch.borrow_mut();
         let (u, stack, _, _) = &mut *s;
         evaluate(y, u, t, dy, stack);
-        if bad.get().is_none()
-            && let Some(i) = dy.iter().position(|v| !v.is_finite())
+        if bad.borrow().is_none()
+            && let Some(index) = dy.iter().position(|v| !v.is_finite())
         {
-            bad.set(Some((t, i)));
+            *bad.borrow_mut() = Some(FirstBad {
+                time: t,
+                index,
+                y: y.to_vec(),
+            });
         }
     };
     let jac = |y: &[f64], _p: &[f64], t: f64, v: &[f64], jv: &mut [f64]| {
@@ -578,9 +582,17 @@ const STIFF_FOR_EXPLICIT: &str =
 const SMOOTHER_LAW: &str = "a law with a near-discontinuity, such as a friction regularised over a tiny velocity, \
                             or a fast forcing: smooth the law, loosen the tolerances or shorten the run";
 
+/// The first evaluation whose derivative was not finite: its time, the state whose derivative it was, and the
+/// point.
+struct FirstBad {
+    time: f64,
+    index: usize,
+    y: Vec<f64>,
+}
+
 struct Drive<'c> {
     system: &'c System,
-    bad: &'c Cell<Option<(f64, usize)>>,
+    bad: &'c RefCell<Option<FirstBad>>,
     loop_failure: &'c RefCell<Option<SimError>>,
     from: f64,
     to: f64,
@@ -632,14 +644,20 @@ impl Drive<'_> {
         }
     }
 
-    /// The derivative of state `i` was not finite at `time`: because an input signal was not, when one was.
-    fn non_finite_derivative(&self, time: f64, i: usize) -> SimError {
-        self.system
-            .non_finite_input(time)
-            .unwrap_or_else(|| SimError::NonFiniteDerivative {
-                time,
-                state: self.name(i),
-            })
+    /// The first derivative that was not finite: because an input signal was not, or a mass matrix was singular
+    /// there, when one was.
+    fn non_finite_derivative(&self, bad: &FirstBad) -> SimError {
+        let time = bad.time;
+        if let Some(input) = self.system.non_finite_input(time) {
+            return input;
+        }
+        if let Some(element) = self.system.singular_mass(&bad.y, time, bad.index) {
+            return SimError::SingularMass { time, element };
+        }
+        SimError::NonFiniteDerivative {
+            time,
+            state: self.name(bad.index),
+        }
     }
 
     /// A solver error, attributed to the model when its algebraic loops could not be solved or it had returned a
@@ -648,8 +666,8 @@ impl Drive<'_> {
         if let Some(loop_error) = self.loop_failure.borrow().clone() {
             return loop_error;
         }
-        match self.bad.get() {
-            Some((time, i)) => self.non_finite_derivative(time, i),
+        match &*self.bad.borrow() {
+            Some(bad) => self.non_finite_derivative(bad),
             None => solver_error(time, e),
         }
     }
@@ -692,8 +710,8 @@ impl Drive<'_> {
                 if let Some(loop_error) = self.loop_failure.borrow().clone() {
                     return Err(loop_error);
                 }
-                return Err(match self.bad.get() {
-                    Some((time, i)) => self.non_finite_derivative(time, i),
+                return Err(match &*self.bad.borrow() {
+                    Some(bad) => self.non_finite_derivative(bad),
                     None => SimError::NonFiniteState {
                         time: t_now,
                         state: self.name(i),

@@ -80,6 +80,11 @@ pub enum SimError {
     NonFiniteStart { what: String },
     #[error("the derivative of `{state}` became non-finite at t = {time:?}")]
     NonFiniteDerivative { time: f64, state: String },
+    /// The rates of a mass block have no solution: its `M` is singular (or not finite) at the state reached.
+    #[error(
+        "the mass matrix of `{element}` is singular at t = {time:?}, so the rates of its flow states have no solution there; check the inertias (a zero or negative mass) or the configuration reached"
+    )]
+    SingularMass { time: f64, element: String },
     /// The model's values became non-finite because an input signal is (`1/0`, `sqrt(t - 1)` before t = 1).
     #[error("the {what} is {value:?} at t = {time:?}")]
     NonFiniteInput { time: f64, what: String, value: f64 },
@@ -148,6 +153,8 @@ pub struct System {
     /// The I-fields' mass blocks: the states whose rates solve `M ẋ_B = F` (their `rates` give `F`), and `M`
     /// row-major.
     mass: Vec<(Vec<usize>, Vec<Program>)>,
+    /// The element (or junctions) each mass block is named after, in the order of `mass`.
+    mass_names: Vec<String>,
     /// The nonlinear algebraic loops, solved before every evaluation.
     loops: Loops,
     /// The length of the programs' input vector `[u, u̇, z]`.
@@ -274,6 +281,7 @@ impl System {
             }
             mass.push((b.states.clone(), m));
         }
+        let mass_names = eqs.mass.iter().map(|b| b.element.clone()).collect();
         let mut outputs_h = Vec::with_capacity(eqs.outputs.len());
         for o in &eqs.outputs {
             let what = format!("output `{}`", o.name);
@@ -305,6 +313,7 @@ impl System {
             stored: compile(&stored, "the stored energy")?,
             stored_terms,
             mass,
+            mass_names,
             loops,
             ext_len,
         };
@@ -456,6 +465,31 @@ impl System {
             }
         }
         Ok(())
+    }
+
+    /// The mass block of state `index` when its `M` is singular or not finite at the extended state `y` and time
+    /// `t`: the element it is named after.
+    pub fn singular_mass(&self, y: &[f64], t: f64, index: usize) -> Option<String> {
+        let (k, (states, programs)) = self
+            .mass
+            .iter()
+            .enumerate()
+            .find(|(_, (states, _))| states.contains(&index))?;
+        let mut u = Vec::new();
+        self.inputs_at(t, &mut u);
+        let mut stack = Vec::new();
+        if self.solve_loops(y, &mut u, t, &mut stack).is_err() {
+            return None;
+        }
+        let v = self.values(y, &u, t);
+        let n = states.len();
+        let m: Vec<Vec<f64>> = programs
+            .chunks(n.max(1))
+            .map(|row| row.iter().map(|p| p.eval(&v, &mut stack)).collect())
+            .collect();
+        let singular = m.iter().flatten().any(|x| !x.is_finite())
+            || crate::equations::dense::solve(&m, &vec![vec![1.0]; n]).is_none();
+        singular.then(|| self.mass_names.get(k).cloned().unwrap_or_default())
     }
 
     /// `J v` for the Jacobian `J = ∂rhs/∂y`; `None` when it has no symbolic form (a rate uses a function without a

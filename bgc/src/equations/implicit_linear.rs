@@ -66,23 +66,7 @@ impl Point<'_> {
                 func: func.name(),
             }
         })?;
-        let x = symbols::eval(&d, self.value).map_err(|err| match err {
-            symbols::EvalError::Unbound(s) => LinearError::Unbound {
-                what: what.to_string(),
-                symbol: self.eqs.sym_name(s),
-            },
-            symbols::EvalError::Foreign(func) => LinearError::Unbound {
-                what: what.to_string(),
-                symbol: func,
-            },
-        })?;
-        if x.is_finite() {
-            Ok(x)
-        } else {
-            Err(LinearError::NonFinite {
-                what: what.to_string(),
-            })
-        }
+        numeric::value_of(self.eqs, &d, &|| what.to_string(), self.value)
     }
 }
 

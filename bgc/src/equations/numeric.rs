@@ -13,7 +13,7 @@ use crate::symbolic::{Expr, Node};
 use std::collections::BTreeSet;
 
 /// Evaluates `e`, naming `what` in errors.
-fn value_of(
+pub(super) fn value_of(
     eqs: &Equations,
     e: &Expr,
     what: &dyn Fn() -> String,
@@ -131,7 +131,7 @@ pub(crate) fn correct_mass_rows_sparse(
         let reads: Vec<Vec<Vec<usize>>> = block
             .matrix
             .iter()
-            .map(|row| row.iter().map(|mij| states_in(mij, n)).collect())
+            .map(|row| row.iter().map(|mij| symbols::states_read(mij, n)).collect())
             .collect();
         let mut xcols: BTreeSet<usize> = reads.iter().flatten().flatten().copied().collect();
         let mut ucols: BTreeSet<usize> = BTreeSet::new();
@@ -211,20 +211,6 @@ fn from_rows(rows: Vec<Vec<(usize, f64)>>) -> Vec<(usize, usize, f64)> {
         .enumerate()
         .flat_map(|(r, row)| row.into_iter().map(move |(c, v)| (r, c, v)))
         .collect()
-}
-
-/// The selected states (below `n`) an expression reads, in increasing order.
-fn states_in(e: &Expr, n: usize) -> Vec<usize> {
-    let mut out: Vec<usize> = e
-        .syms()
-        .into_iter()
-        .filter_map(|s| match s {
-            Sym::State(k) if k < n => Some(k),
-            _ => None,
-        })
-        .collect();
-    out.sort_unstable();
-    out
 }
 
 impl Equations {

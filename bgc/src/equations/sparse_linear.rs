@@ -9,8 +9,8 @@
 //!
 //! Both give the errors of their dense counterparts in [`super::linear`] (in the same order and with the same
 //! texts). [`linearise_sparse`] linearises a model with mass-matrix rows at a point, each block solved with its own
-//! `M` there; models with nonlinear algebraic loops (whose state spaces need the implicit function theorem) take
-//! the dense path and are converted.
+//! `M` there, and a model with nonlinear algebraic loops by the implicit function theorem
+//! ([`super::implicit_linear`]), sparse as well.
 
 use super::Equations;
 use super::linear::{self, LinearError, StateSelection};
@@ -448,7 +448,7 @@ impl SparseNumericStateSpace {
     }
 }
 
-/// The linearisation of any model without algebraic loops at `(x0, u0, t0)`, sparse: the Jacobians of
+/// The linearisation of any model at `(x0, u0, t0)`, sparse: the Jacobians of
 /// [`sparse_jacobians`] evaluated there, and the rows of mass-matrix blocks (I-fields, the velocity states of
 /// configuration-dependent dependent storage) turned into those of the rates. The numbers are those of
 /// [`linear::linearise`]; a model whose rates or outputs read the tears of algebraic loops is linearised by the

@@ -542,6 +542,20 @@ fn flat_terms(e: &Expr, coeff: f64, out: &mut Vec<Expr>) {
     }
 }
 
+/// The states below `n` that `e` reads, each once, in increasing order.
+pub fn states_read(e: &Expr, n: usize) -> Vec<usize> {
+    let mut out: Vec<usize> = e
+        .syms()
+        .into_iter()
+        .filter_map(|s| match s {
+            Sym::State(k) if k < n => Some(k),
+            _ => None,
+        })
+        .collect();
+    out.sort_unstable();
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

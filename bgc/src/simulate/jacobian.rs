@@ -13,9 +13,10 @@
 //! column at a time, and a dense factorisation).
 
 use super::program::{Program, Values};
-use super::{SimError, states_read};
+use super::{MassPrograms, SimError};
+use crate::equations::MassBlock;
 use crate::equations::dense::{self, Mat};
-use crate::equations::symbols::{self, Sym, add};
+use crate::equations::symbols::{self, Sym, add, states_read};
 use crate::ir::Func;
 use crate::symbolic::{Expr, Node, Symbol, WIDE_ROW};
 use std::collections::BTreeMap;
@@ -33,13 +34,9 @@ enum Source {
     },
 }
 
-/// The rows of one mass block.
+/// The rows of one mass block (the system's block of the same index supplies its states and `M`).
 #[derive(Clone, Debug)]
 struct BlockRows {
-    /// The block's states, in the order of its matrix.
-    states: Vec<usize>,
-    /// `M` row-major.
-    matrix: Vec<Program>,
     /// The columns of its rows: those where `∂F` or `M` has an entry, increasing.
     columns: Vec<usize>,
     /// Per row of the block: `(column index, ∂F_row/∂x_column)`.
@@ -56,19 +53,13 @@ pub(super) struct Jacobian {
     blocks: Vec<BlockRows>,
 }
 
-/// One mass block for [`Jacobian::new`]: its states and `M` row-major, as expressions.
-pub(super) struct MassRows<'a> {
-    pub states: &'a [usize],
-    pub matrix: Vec<&'a Expr>,
-}
-
 impl Jacobian {
     /// The Jacobian of `rates` over the `n` model states, with the rows of `mass` solved; `None` when a rate or
     /// a mass entry uses a function without a derivative (the caller then takes finite differences).
     pub(super) fn new(
         rates: &[(Expr, String)],
         n: usize,
-        mass: &[MassRows<'_>],
+        mass: &[MassBlock],
         compile: &dyn Fn(&Expr, &str) -> Result<Program, SimError>,
     ) -> Option<Jacobian> {
         let mut direct: Vec<Vec<(usize, Program)>> = vec![Vec::new(); rates.len()];
@@ -110,18 +101,20 @@ impl Jacobian {
     }
 
     /// Calls `each(row, column, value)` for every entry at the point (all NaN in the rows of a block whose `M`
-    /// is singular there); `rates` evaluates the generalised forces of the block rows.
+    /// is singular there); `rates` evaluates the generalised forces of the block rows, `mass` the blocks (those
+    /// [`Jacobian::new`] was given, compiled, in the same order).
     pub(super) fn for_each(
         &self,
         values: &Values<'_>,
-        rates: &[Program],
+        (rates, mass): (&[Program], &[MassPrograms]),
         stack: &mut Vec<f64>,
         mut each: impl FnMut(usize, usize, f64),
     ) {
         let solved: Vec<Mat> = self
             .blocks
             .iter()
-            .map(|b| b.solve(values, rates, stack))
+            .zip(mass)
+            .map(|(b, block)| b.solve(block, values, rates, stack))
             .collect();
         for (r, c, source) in &self.entries {
             let v = match source {
@@ -141,7 +134,7 @@ impl Jacobian {
 impl BlockRows {
     /// Takes the block's rows out of `direct` (the entries of `∂F`) and differentiates `M`.
     fn new(
-        rows: &MassRows<'_>,
+        rows: &MassBlock,
         direct: &mut [Vec<(usize, Program)>],
         n: usize,
         compile: &dyn Fn(&Expr, &str) -> Result<Program, SimError>,
@@ -154,7 +147,7 @@ impl BlockRows {
             .map(|&s| direct.get_mut(s).map(std::mem::take).unwrap_or_default())
             .collect();
         let mut slopes_by_state = Vec::new();
-        for (k, e) in rows.matrix.iter().enumerate() {
+        for (k, e) in rows.matrix.iter().flatten().enumerate() {
             for c in states_read(e, n) {
                 let d = symbols::diff(e, Sym::State(c)).ok()?;
                 if !d.is_zero() {
@@ -179,14 +172,7 @@ impl BlockRows {
             .into_iter()
             .map(|(c, i, j, p)| (index(c), i, j, p))
             .collect();
-        let matrix = rows
-            .matrix
-            .iter()
-            .map(|e| compile(e, what).ok())
-            .collect::<Option<_>>()?;
         Some(BlockRows {
-            states: rows.states.to_vec(),
-            matrix,
             columns,
             force,
             slopes,
@@ -195,14 +181,16 @@ impl BlockRows {
 
     /// The block's rows of `∂ẋ/∂x` over its columns at the point: `M⁻¹ (∂F − (∂M/∂x_c) ẋ_B)`; NaN when `M` is
     /// singular.
-    fn solve(&self, values: &Values<'_>, rates: &[Program], stack: &mut Vec<f64>) -> Mat {
-        let size = self.states.len();
-        let m: Mat = self
-            .matrix
-            .chunks(size.max(1))
-            .map(|row| row.iter().map(|p| p.eval(values, stack)).collect())
-            .collect();
-        let forces: Mat = self
+    fn solve(
+        &self,
+        block: &MassPrograms,
+        values: &Values<'_>,
+        rates: &[Program],
+        stack: &mut Vec<f64>,
+    ) -> Mat {
+        let size = block.states.len();
+        let m = block.at(values, stack);
+        let forces: Mat = block
             .states
             .iter()
             .map(|&s| vec![rates.get(s).map_or(f64::NAN, |p| p.eval(values, stack))])

@@ -49,7 +49,7 @@ use crate::equations::symbols::{self, Sym, SymExt, add};
 use crate::equations::{EnergyKind, Equations, block_jacobian, residual_scale};
 use crate::symbolic::Expr;
 use input::Signal;
-use jacobian::{Jacobian, MassRows};
+use jacobian::Jacobian;
 use newton::{BlockPrograms, Loops};
 use program::{CompileError, Layout, Program, Values};
 
@@ -150,15 +150,32 @@ pub struct System {
     stored: Program,
     /// The terms of `stored`, by element.
     stored_terms: Vec<(String, Program)>,
-    /// The I-fields' mass blocks: the states whose rates solve `M ẋ_B = F` (their `rates` give `F`), and `M`
-    /// row-major.
-    mass: Vec<(Vec<usize>, Vec<Program>)>,
-    /// The element (or junctions) each mass block is named after, in the order of `mass`.
-    mass_names: Vec<String>,
+    /// The mass blocks (I-fields, inertias coupled through a varying modulus), in the order of
+    /// [`Equations::mass`].
+    mass: Vec<MassPrograms>,
     /// The nonlinear algebraic loops, solved before every evaluation.
     loops: Loops,
     /// The length of the programs' input vector `[u, u̇, z]`.
     ext_len: usize,
+}
+
+/// One mass block compiled: the states whose rates solve `M ẋ_B = F` (their `rates` give `F`), `M` row-major,
+/// and the element (or junctions) the block is named after.
+#[derive(Clone, Debug)]
+struct MassPrograms {
+    states: Vec<usize>,
+    matrix: Vec<Program>,
+    element: String,
+}
+
+impl MassPrograms {
+    /// `M` at the point.
+    fn at(&self, v: &Values<'_>, stack: &mut Vec<f64>) -> Vec<Vec<f64>> {
+        self.matrix
+            .chunks(self.states.len().max(1))
+            .map(|row| row.iter().map(|p| p.eval(v, stack)).collect())
+            .collect()
+    }
 }
 
 impl System {
@@ -255,33 +272,28 @@ impl System {
             .collect::<Result<Vec<_>, _>>()?;
         let loops = compile_loops(eqs, 2 * n_inputs, &compile)?;
         // The symbolic Jacobian does not see the loops' unknowns move: leave loops to finite differences.
-        let mass_rows: Vec<MassRows<'_>> = eqs
-            .mass
-            .iter()
-            .map(|b| MassRows {
-                states: &b.states,
-                matrix: b.matrix.iter().flatten().collect(),
-            })
-            .collect();
         let jacobian = if loops.is_empty() {
-            Jacobian::new(&rate_exprs, n, &mass_rows, &compile)
+            Jacobian::new(&rate_exprs, n, &eqs.mass, &compile)
         } else {
             None
         };
         let mut mass = Vec::with_capacity(eqs.mass.len());
         for b in &eqs.mass {
-            let mut m = Vec::new();
+            let mut matrix = Vec::new();
             for (i, row) in b.matrix.iter().enumerate() {
                 for (j, e) in row.iter().enumerate() {
-                    m.push(compile(
+                    matrix.push(compile(
                         e,
                         &format!("M_{}[{},{}]", b.element, i + 1, j + 1),
                     )?);
                 }
             }
-            mass.push((b.states.clone(), m));
+            mass.push(MassPrograms {
+                states: b.states.clone(),
+                matrix,
+                element: b.element.clone(),
+            });
         }
-        let mass_names = eqs.mass.iter().map(|b| b.element.clone()).collect();
         let mut outputs_h = Vec::with_capacity(eqs.outputs.len());
         for o in &eqs.outputs {
             let what = format!("output `{}`", o.name);
@@ -313,7 +325,6 @@ impl System {
             stored: compile(&stored, "the stored energy")?,
             stored_terms,
             mass,
-            mass_names,
             loops,
             ext_len,
         };
@@ -442,19 +453,15 @@ impl System {
         for (d, p) in dy.iter_mut().zip(&self.rates) {
             *d = p.eval(&v, stack);
         }
-        for (states, programs) in &self.mass {
-            let n = states.len();
-            let m: Vec<Vec<f64>> = programs
-                .chunks(n.max(1))
-                .map(|row| row.iter().map(|p| p.eval(&v, stack)).collect())
-                .collect();
-            let forces: Vec<Vec<f64>> = states
+        for block in &self.mass {
+            let forces: Vec<Vec<f64>> = block
+                .states
                 .iter()
                 .map(|&j| vec![dy.get(j).copied().unwrap_or(f64::NAN)])
                 .collect();
             // A singular mass matrix leaves non-finite rates, which the integrator reports with the time.
-            let solved = crate::equations::dense::solve(&m, &forces);
-            for (k, &j) in states.iter().enumerate() {
+            let solved = crate::equations::dense::solve(&block.at(&v, stack), &forces);
+            for (k, &j) in block.states.iter().enumerate() {
                 if let Some(d) = dy.get_mut(j) {
                     *d = solved
                         .as_ref()
@@ -470,26 +477,18 @@ impl System {
     /// The mass block of state `index` when its `M` is singular or not finite at the extended state `y` and time
     /// `t`: the element it is named after.
     pub fn singular_mass(&self, y: &[f64], t: f64, index: usize) -> Option<String> {
-        let (k, (states, programs)) = self
-            .mass
-            .iter()
-            .enumerate()
-            .find(|(_, (states, _))| states.contains(&index))?;
+        let block = self.mass.iter().find(|b| b.states.contains(&index))?;
         let mut u = Vec::new();
         self.inputs_at(t, &mut u);
         let mut stack = Vec::new();
         if self.solve_loops(y, &mut u, t, &mut stack).is_err() {
             return None;
         }
-        let v = self.values(y, &u, t);
-        let n = states.len();
-        let m: Vec<Vec<f64>> = programs
-            .chunks(n.max(1))
-            .map(|row| row.iter().map(|p| p.eval(&v, &mut stack)).collect())
-            .collect();
+        let m = block.at(&self.values(y, &u, t), &mut stack);
+        let n = block.states.len();
         let singular = m.iter().flatten().any(|x| !x.is_finite())
             || crate::equations::dense::solve(&m, &vec![vec![1.0]; n]).is_none();
-        singular.then(|| self.mass_names.get(k).cloned().unwrap_or_default())
+        singular.then(|| block.element.clone())
     }
 
     /// `J v` for the Jacobian `J = ∂rhs/∂y`; `None` when it has no symbolic form (a rate uses a function without a
@@ -505,11 +504,16 @@ impl System {
     ) -> Option<()> {
         let jacobian = self.jacobian.as_ref()?;
         jv.iter_mut().for_each(|x| *x = 0.0);
-        jacobian.for_each(&self.values(y, u, t), &self.rates, stack, |r, c, value| {
-            if let (Some(out), Some(vc)) = (jv.get_mut(r), v.get(c)) {
-                *out += value * vc;
-            }
-        });
+        jacobian.for_each(
+            &self.values(y, u, t),
+            (&self.rates, &self.mass),
+            stack,
+            |r, c, value| {
+                if let (Some(out), Some(vc)) = (jv.get_mut(r), v.get(c)) {
+                    *out += value * vc;
+                }
+            },
+        );
         Some(())
     }
 
@@ -531,11 +535,16 @@ impl System {
     ) -> Option<()> {
         let jacobian = self.jacobian.as_ref()?;
         let mut slots = out.iter_mut();
-        jacobian.for_each(&self.values(y, u, t), &self.rates, stack, |_, _, value| {
-            if let Some(slot) = slots.next() {
-                *slot = value;
-            }
-        });
+        jacobian.for_each(
+            &self.values(y, u, t),
+            (&self.rates, &self.mass),
+            stack,
+            |_, _, value| {
+                if let Some(slot) = slots.next() {
+                    *slot = value;
+                }
+            },
+        );
         Some(())
     }
 
@@ -662,13 +671,4 @@ fn compile_loops(
         k += block.tears.len();
     }
     Ok(loops)
-}
-
-/// The model states (below `n`) that `e` reads, each once.
-fn states_read(e: &Expr, n: usize) -> Vec<usize> {
-    let states = e.syms().into_iter().filter_map(|s| match s {
-        Sym::State(c) if c < n => Some(c),
-        _ => None,
-    });
-    states.collect()
 }

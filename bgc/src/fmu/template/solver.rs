@@ -39,7 +39,6 @@ struct Work {
     y: Vec<f64>,
     /// The extrapolation table: row `j` holds `j + 1` states.
     table: Vec<Vec<f64>>,
-    best: Vec<f64>,
 }
 
 impl Work {
@@ -51,8 +50,12 @@ impl Work {
             f: vec![0.0; NX],
             y: vec![0.0; NX],
             table: (0..K).map(|j| vec![0.0; (j + 1) * NX]).collect(),
-            best: vec![0.0; NX],
         }
+    }
+
+    /// The last step's most extrapolated state: the end of the table's last row.
+    fn best(&self) -> &[f64] {
+        &self.table[K - 1][(K - 1) * NX..K * NX]
     }
 }
 
@@ -91,7 +94,7 @@ impl Integrator {
             let h = if last { t1 - t } else { self.h };
             match self.try_step(p, t, h, x, u) {
                 Some(err) if err <= 1.0 => {
-                    x.copy_from_slice(&self.work.best);
+                    x.copy_from_slice(self.work.best());
                     t = if last { t1 } else { t + h };
                     let grow = (0.9 * err.max(1e-10).powf(-1.0 / K as f64)).clamp(0.2, 4.0);
                     // The shortened last step says nothing about the step the dynamics allow.
@@ -114,8 +117,8 @@ impl Integrator {
         Ok(())
     }
 
-    /// One extrapolated step: leaves the new state in `work.best` and returns its error norm, or `None` when a
-    /// matrix is singular or a value is not finite.
+    /// One extrapolated step: leaves the new state at the end of the table (`Work::best`) and returns its error
+    /// norm, or `None` when a matrix is singular or a value is not finite.
     fn try_step(&mut self, p: &Params, t: f64, h: f64, x: &[f64], u: &[f64]) -> Option<f64> {
         let jac = plant::jac_x(p, t, x, u);
         let w = &mut self.work;
@@ -165,7 +168,6 @@ impl Integrator {
             sum += e * e;
         }
         let err = (sum / NX.max(1) as f64).sqrt();
-        w.best.copy_from_slice(best);
         (err.is_finite() && best.iter().all(|v| v.is_finite())).then_some(err)
     }
 }

@@ -301,3 +301,38 @@ fn a_large_model_of_mass_blocks_gets_the_sparse_jacobian_of_its_rates() {
         .unwrap_or(f64::NAN);
     assert!(worst < 1e-6, "{printed}");
 }
+
+/// 50 pairs of coupled coils (constant 2 x 2 inductance matrices, 200 states): their mass blocks need no rates in
+/// `jac_x_sparse_into`, and the module compiles with `-D warnings` (it declared an unused `dx` argument before).
+#[test]
+fn a_large_model_of_constant_mass_blocks_compiles_without_warnings() {
+    let mut text = String::from(
+        "model coils {\n    domain electrical;\n    param L1 = 2 [H];\n    param L2 = 3 [H];\n    param Mu = 1 [H];\n    \
+         param R1 = 5 [Ohm];\n    input u [V];\n",
+    );
+    for k in 0..50 {
+        text += &format!(
+            "    Se s{k} = u;\n    1 a{k};\n    1 b{k};\n    \
+             IF c{k}(2) {{ mass[1, 1] = L1; mass[1, 2] = Mu; mass[2, 2] = L2; }}\n    R r{k} = R1;\n    \
+             R q{k} = R1;\n    bond s{k} -> a{k};\n    bond a{k} -> c{k}[1];\n    bond a{k} -> r{k};\n    \
+             bond b{k} -> c{k}[2];\n    bond b{k} -> q{k};\n"
+        );
+    }
+    text += "}\n";
+    let code = generate_text("coils.bg", &text, Options { runtime: false });
+    assert!(code.contains("pub const N_STATES: usize = 200;"));
+    assert!(
+        code.contains("fn jac_x_sparse_mass_1(p: &Params, x: &State, values"),
+        "{code}"
+    );
+    let dir = scratch("large-coils");
+    crate::codegen_support::rustc::stand_ins(&dir);
+    let compiled = crate::codegen_support::rustc::compile_no_std_with(
+        &dir,
+        "coils",
+        &code,
+        &["-D", "warnings"],
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(compiled.is_ok(), "{compiled:?}");
+}

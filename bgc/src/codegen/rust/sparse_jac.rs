@@ -96,17 +96,26 @@ impl Writer<'_> {
                 "The rows of the mass blocks hold ∂F so far: M (∂ẋ_B) = ∂F − (∂M/∂x_c) ẋ_B, solved with each \
                  block's M.",
             ));
-            d.lines.push("    let mut dx = State::zeros();".into());
-            d.lines.push("    rhs_into(p, t, x, u, &mut dx);".into());
+            // The rates `ẋ_B` enter through the derivatives of `M` only: constant mass matrices need none.
+            let rates = blocks.iter().any(|b| !b.block.derivatives.is_empty());
+            if rates {
+                d.lines.push("    let mut dx = State::zeros();".into());
+                d.lines.push("    rhs_into(p, t, x, u, &mut dx);".into());
+                d.uses.t = true;
+                d.uses.u = true;
+            }
+            let passed = if rates {
+                "p, x, &dx, values"
+            } else {
+                "p, x, values"
+            };
             for (k, chunk) in blocks.chunks(BLOCKS_PER_PART).enumerate() {
                 let name = format!("jac_x_sparse_mass_{}", k + 1);
-                d.lines.push(format!("    {name}(p, x, &dx, values);"));
-                self.mass_part(&name, chunk, &position);
+                d.lines.push(format!("    {name}({passed});"));
+                self.mass_part(&name, chunk, &position, rates);
             }
             d.uses.p = true;
-            d.uses.t = true;
             d.uses.x = true;
-            d.uses.u = true;
         }
         let mut args = Self::model_args(d.uses);
         args.push(Arg::new(
@@ -157,12 +166,14 @@ impl Writer<'_> {
         }
     }
 
-    /// A private function that solves the rows of `chunk`'s blocks in `values`, with the rates `dx` at the point.
+    /// A private function that solves the rows of `chunk`'s blocks in `values`, with the rates `dx` at the point
+    /// when `rates` (some block's `M` varies).
     fn mass_part(
         &mut self,
         name: &str,
         chunk: &[BlockColumns<'_>],
         position: &HashMap<(usize, usize), usize>,
+        rates: bool,
     ) {
         let slopes: Vec<&Expr> = chunk
             .iter()
@@ -203,12 +214,15 @@ impl Writer<'_> {
                 }
             }
         }
-        let args = vec![
+        let mut args = vec![
             Arg::new("p", "&Params", true),
             Arg::new("x", "&State", true),
-            Arg::new("dx", "&State", true),
-            Arg::new("values", "&mut [f64; JAC_X_NNZ]", true),
         ];
+        if rates {
+            let reads = chunk.iter().any(|b| !b.block.derivatives.is_empty());
+            args.push(Arg::new("dx", "&State", reads));
+        }
+        args.push(Arg::new("values", "&mut [f64; JAC_X_NNZ]", true));
         let doc =
             format!("The rows of mass blocks of `jac_x_sparse_into` (see `{name}`'s caller).");
         self.private_part(doc, name.to_string(), args, d);

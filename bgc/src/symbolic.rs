@@ -68,6 +68,7 @@ mod expr;
 mod from_ir;
 mod intern;
 mod linear;
+mod magnitude;
 mod order;
 mod print;
 mod solve;

@@ -21,7 +21,7 @@
 use super::Equations;
 use super::newton::{self, Failure, Problem, Settings};
 use super::symbols::{self, Sym, SymExt};
-use crate::symbolic::{Expr, Node};
+use crate::symbolic::Expr;
 use petgraph::graph::DiGraph;
 
 /// One block of nonlinear algebraic equations solved together: `0 = r(z, x, u, p, t)` for its tear variables `z`.
@@ -71,17 +71,15 @@ pub(crate) fn blocks(implicit: &[(usize, Expr)], name: &dyn Fn(Sym) -> String) -
         .collect()
 }
 
-/// The scale of residual `r` for the convergence test of [`super::newton`]: the sum of the magnitudes of its
-/// terms (`|a| + |b| + |z|` for `r = a + b − z`), plus the magnitude of its own tear `z`. A residual cannot be
-/// computed more accurately than about `ε` times this.
+/// The scale of residual `r` for the convergence test of [`super::newton`]: its magnitude ([`Expr::magnitude`]: the
+/// magnitudes of its terms, and inside a product those of the product's terms, `|a| + |c|·(|d| + |e|) + |z|` for
+/// `r = a + c·(d + e) − z`), plus the magnitude of its own tear `z`. A residual cannot be computed more accurately
+/// than about `ε` times this, however much its terms cancel.
 pub fn residual_scale(r: &Expr, own: Sym) -> Expr {
-    let abs = |e: &Expr| symbols::call(crate::ir::Func::Abs, vec![e.clone()]);
-    let mut terms: Vec<Expr> = match r.node() {
-        Node::Add(ts) => ts.iter().map(abs).collect(),
-        _ => vec![abs(r)],
-    };
-    terms.push(abs(&symbols::leaf(own)));
-    symbols::add(terms)
+    symbols::add(vec![
+        r.magnitude(),
+        symbols::call(crate::ir::Func::Abs, vec![symbols::leaf(own)]),
+    ])
 }
 
 /// A block's residuals evaluated by the tree evaluator, the other symbols' values given.

@@ -1,6 +1,7 @@
 //! The equations stage (`lower` → `causality::analyse` → `equations::derive`, what `bgc equations` runs) on
 //! families of models whose cost must grow with the model, not faster:
-//! - a resistor ladder with chained algebraic loops (`rungs`),
+//! - a resistor ladder with chained algebraic loops (`rungs`), with one resistance for all and with a resistance per
+//!   resistor,
 //! - outputs defined through earlier outputs, `y_i = sin(y_{i-1}·y_{i-1}) + cos(y_{i-1})` (`levels`),
 //! - a chain of modulated transformers with every inertia but one dependent (`n`),
 //! - a gear train of numeric ratios whose efforts each hold the next (`n`),
@@ -23,7 +24,8 @@ use bgc::lower::{MemoryLoader, lower};
 use bgc::span::SourceMap;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use families::{
-    benchmark_chain, gear_train, gyrator_chain, ladder, mtf_chain, output_chain, parallel_pairs,
+    benchmark_chain, gear_train, gyrator_chain, ladder, ladder_distinct, mtf_chain, output_chain,
+    parallel_pairs,
 };
 use std::hint::black_box;
 
@@ -81,7 +83,9 @@ fn family(c: &mut Criterion, name: &str, sizes: &[usize], generate: fn(usize) ->
 }
 
 fn bench(c: &mut Criterion) {
-    family(c, "ladder", &[3, 6, 12], ladder);
+    family(c, "ladder", &[3, 6, 12, 50, 100], ladder);
+    // A resistance per resistor: nested loops past a size are solved as one linear block, not in closed form.
+    family(c, "ladder_distinct", &[6, 12, 24, 48, 96], ladder_distinct);
     family(c, "output_chain", &[6, 12, 24], output_chain);
     // The velocities behind the chain's moduli are found in one walk of the definitions, not one per inertia.
     family(c, "mtf_chain", &[25, 100, 1000], mtf_chain);

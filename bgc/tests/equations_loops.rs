@@ -5,8 +5,8 @@
 use bgc::causality::analyse;
 use bgc::equations::symbols::{self as sym, Sym};
 use bgc::equations::{
-    Equations, LinearError, StateSelection, derive, jacobians, linear_state_space, linearise,
-    numeric_state_space, solve_all, to_json, to_latex, to_text,
+    Equations, LinearError, StateSelection, derive, jacobians, linear_state_space,
+    linear_through_loops, linearise, numeric_state_space, solve_all, to_json, to_latex, to_text,
 };
 use bgc::lower::{MemoryLoader, lower};
 use bgc::span::SourceMap;
@@ -28,6 +28,12 @@ fn derived(name: &str, text: String) -> Equations {
     let (eqs, diags) = derive(&models[0], &causality);
     assert!(diags.iter().all(|d| !d.is_error()), "{diags:?}");
     eqs
+}
+
+/// The diode's loop is solved numerically and is not linear: the state space needs an operating point.
+#[test]
+fn a_nonlinear_loop_is_not_linear_through_its_loops() {
+    assert!(!linear_through_loops(&diode_rc(), StateSelection::Energy));
 }
 
 #[test]

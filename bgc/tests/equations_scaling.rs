@@ -6,7 +6,9 @@ use bgc::causality::analyse;
 use bgc::codegen::explicit_outputs;
 use bgc::diagnostic::Diagnostic;
 use bgc::equations::symbols::{Sym, SymExt};
-use bgc::equations::{Equations, derive, expr_text};
+use bgc::equations::{
+    Equations, StateSelection, derive, expr_text, linear_through_loops, linearise, to_text,
+};
 use bgc::lower::{MemoryLoader, lower};
 use bgc::simulate::System;
 use bgc::simulate::input::Signal;
@@ -14,7 +16,8 @@ use bgc::span::SourceMap;
 use bgc::symbolic::Expr;
 
 use crate::equations_support::families::{
-    gear_train, gyrator_chain, ladder, mtf_chain, output_chain, parallel_pairs,
+    gear_train, gyrator_chain, ladder, ladder_distinct, ladder_distinct_resistances, mtf_chain,
+    output_chain, parallel_pairs,
 };
 
 /// Lowers, analyses and derives one model from source text; any error fails the test.
@@ -86,28 +89,43 @@ fn outputs_through_earlier_outputs_are_the_composition() {
 }
 
 /// The node voltages `V_0 = u, V_1 … V_N = q/c` of the ladder by nodal analysis: at node `k < N`,
-/// `(V_{k−1} − V_k)/r = V_k/(k r) + (V_k − V_{k+1})/r`, a tridiagonal system solved by elimination. Returns the
-/// capacitor's current `(V_{N−1} − V_N)/r − V_N/(N r)` and the source's `(u − V_1)/r`.
+/// `(V_{k−1} − V_k)/r = V_k/(k r) + (V_k − V_{k+1})/r`. Returns the capacitor's current
+/// `(V_{N−1} − V_N)/r − V_N/(N r)` and the source's `(u − V_1)/r`.
 fn ladder_currents(rungs: usize, r: f64, vc: f64, u: f64) -> (f64, f64) {
-    let n = rungs;
-    // Unknowns V_1 … V_{N−1}: row k: −V_{k−1} + (2 + 1/k) V_k − V_{k+1} = 0, known ends moved to the right.
+    let series = vec![r; rungs];
+    let shunt: Vec<f64> = (1..=rungs).map(|k| k as f64 * r).collect();
+    nodal_currents(&series, &shunt, vc, u)
+}
+
+/// Nodal analysis of a ladder with series resistances `ra` and shunt resistances `rb` (rung `k` at index `k − 1`),
+/// `V_0 = u` and `V_N = vc`: at node `k < N`, `(V_{k−1} − V_k)/ra_k = V_k/rb_k + (V_k − V_{k+1})/ra_{k+1}`, a
+/// tridiagonal system solved by elimination. Returns the capacitor's current `(V_{N−1} − V_N)/ra_N − V_N/rb_N` and
+/// the source's `(u − V_1)/ra_1`.
+fn nodal_currents(ra: &[f64], rb: &[f64], vc: f64, u: f64) -> (f64, f64) {
+    let n = ra.len();
+    // Unknowns V_1 … V_{N−1}: row k: −V_{k−1}/ra_k + (1/ra_k + 1/rb_k + 1/ra_{k+1}) V_k − V_{k+1}/ra_{k+1} = 0,
+    // the known ends moved to the right.
     let m = n - 1;
-    let mut diag: Vec<f64> = (1..=m).map(|k| 2.0 + 1.0 / k as f64).collect();
+    let mut diag: Vec<f64> = (0..m)
+        .map(|i| 1.0 / ra[i] + 1.0 / rb[i] + 1.0 / ra[i + 1])
+        .collect();
+    let upper: Vec<f64> = (0..m).map(|i| -1.0 / ra[i + 1]).collect();
     let mut rhs = vec![0.0; m];
-    rhs[0] += u;
-    rhs[m - 1] += vc;
+    rhs[0] += u / ra[0];
+    rhs[m - 1] += vc / ra[m];
     for k in 1..m {
-        let w = -1.0 / diag[k - 1];
-        diag[k] += w;
+        // Row k's sub-diagonal is −1/ra_k, the same conductance as row k − 1's super-diagonal.
+        let w = upper[k - 1] / diag[k - 1];
+        diag[k] -= w * upper[k - 1];
         rhs[k] -= w * rhs[k - 1];
     }
     let mut v = vec![0.0; m];
     v[m - 1] = rhs[m - 1] / diag[m - 1];
     for k in (0..m - 1).rev() {
-        v[k] = (rhs[k] + v[k + 1]) / diag[k];
+        v[k] = (rhs[k] - upper[k] * v[k + 1]) / diag[k];
     }
-    let i_cap = (v[m - 1] - vc) / r - vc / (n as f64 * r);
-    (i_cap, (u - v[0]) / r)
+    let i_cap = (v[m - 1] - vc) / ra[m] - vc / rb[m];
+    (i_cap, (u - v[0]) / ra[0])
 }
 
 /// A ladder whose rungs form a chain of algebraic loops: every solved loop is multiplied out, so the explicit rate
@@ -143,6 +161,63 @@ fn long_ladder_stays_small_and_matches_nodal_analysis() {
     let (i_cap, i_src) = ladder_currents(2, 1.0, 0.6, 1.5);
     assert!((i_cap - (1.5 / 3.0 - 7.0 * 0.6 / 6.0)).abs() < 1e-15);
     assert!((i_src - (2.0 * 1.5 / 3.0 - 0.6 / 3.0)).abs() < 1e-15);
+}
+
+/// A ladder with a resistance per resistor: solved one inside the other, its loops' closed forms grow geometrically
+/// (nothing collects), so past a size the loops are one block of linear equations solved numerically. The
+/// equations stay small, their values are those of nodal analysis, and the model is still linear: its state space
+/// without an operating point is exact.
+#[test]
+fn ladder_with_a_resistance_per_resistor_keeps_its_loops_linear_and_small() {
+    let size = |rungs: usize| to_text(&equations(&ladder_distinct(rungs))).len();
+    let (small, large) = (size(8), size(16));
+    assert!(
+        large < 3 * small,
+        "the equations grow geometrically: {small} bytes at 8 rungs, {large} at 16"
+    );
+    let c = 1e-3;
+    for rungs in [16, 40] {
+        let eqs = equations(&ladder_distinct(rungs));
+        assert!(!eqs.tear_blocks.is_empty(), "{rungs} rungs in closed form");
+        let (ra, rb): (Vec<f64>, Vec<f64>) = (1..=rungs).map(ladder_distinct_resistances).unzip();
+        let p = eqs.default_params();
+        for &(q, u) in &[(0.0, 1.0), (2e-3, -0.5), (-1e-3, 3.0)] {
+            let (i_cap, i_src) = nodal_currents(&ra, &rb, q / c, u);
+            let rates = eqs
+                .rates_at(&p, &[q], &[u], 0.0)
+                .unwrap_or_else(|e| panic!("{e}"));
+            let y = eqs
+                .outputs_at(&p, &[q], &[u], 0.0)
+                .unwrap_or_else(|e| panic!("{e}"));
+            assert!(
+                (rates[0] - i_cap).abs() < 1e-12 * (1.0 + i_cap.abs()),
+                "{rungs} rungs: {rates:?} vs {i_cap}"
+            );
+            assert!(
+                (y[0] - i_src).abs() < 1e-12 * (1.0 + i_src.abs()),
+                "{rungs} rungs: {y:?} vs {i_src}"
+            );
+        }
+        assert!(linear_through_loops(&eqs, StateSelection::Energy));
+        let ss = linearise(&eqs, StateSelection::Energy, &p, &[0.0], &[0.0], 0.0)
+            .unwrap_or_else(|e| panic!("{e}"));
+        // By superposition: A and C from q = 1 (V_N = 1/c) with u = 0, B and D from u = 1 with q = 0.
+        let (a, cc) = nodal_currents(&ra, &rb, 1.0 / c, 0.0);
+        let (b, d) = nodal_currents(&ra, &rb, 0.0, 1.0);
+        for (got, want, what) in [
+            (ss.a[0][0], a, "A"),
+            (ss.b[0][0], b, "B"),
+            (ss.c[0][0], cc, "C"),
+            (ss.d[0][0], d, "D"),
+        ] {
+            // C is tiny for a long ladder: compare against the scale of the currents it is a difference of.
+            let scale = a.abs().max(d.abs());
+            assert!(
+                (got - want).abs() < 1e-12 * scale,
+                "{rungs} rungs: {what} = {got} vs {want}"
+            );
+        }
+    }
 }
 
 /// `y_1 … y_levels` at `q_spring = q` by the recurrence itself.

@@ -46,6 +46,30 @@ pub fn ladder(rungs: usize) -> String {
     s
 }
 
+/// The ladder of [`ladder`] with a parameter of its own for every resistor (`ra<k> = 1 + 0.1 k`, `rb<k> = 2 +
+/// 0.05 k`): nothing collects when its loops are solved one inside the other, so their closed forms grow
+/// geometrically with the rungs.
+pub fn ladder_distinct(rungs: usize) -> String {
+    let mut s = String::from(
+        "model ladder {\n    domain electrical;\n    input u [V];\n    param c = 1e-3 [F];\n    Se src = u;\n    C cap = c;\n",
+    );
+    let mut chain = String::from("src");
+    for k in 1..=rungs {
+        let (ra, rb) = ladder_distinct_resistances(k);
+        s += &format!("    param ra{k} = {ra} [Ohm];\n    param rb{k} = {rb} [Ohm];\n");
+        s += &format!("    1 s{k};\n    R rs{k} = ra{k};\n    0 n{k};\n    R rp{k} = rb{k};\n");
+        s += &format!("    bond s{k} -> rs{k};\n    bond n{k} -> rp{k};\n");
+        chain += &format!(" -> s{k} -> n{k}");
+    }
+    s += &format!("    bond {chain} -> cap;\n    output i1 [A] = f(rs1);\n}}\n");
+    s
+}
+
+/// The series and shunt resistances of rung `k` (from 1) of [`ladder_distinct`].
+pub fn ladder_distinct_resistances(k: usize) -> (f64, f64) {
+    (1.0 + 0.1 * k as f64, 2.0 + 0.05 * k as f64)
+}
+
 /// A mass on a spring with outputs `y_1 = sin((q/q0)²) + cos(q/q0)`, `y_i = sin(y_{i-1}·y_{i-1}) + cos(y_{i-1})`,
 /// `q0 = 1`.
 pub fn output_chain(levels: usize) -> String {

@@ -192,8 +192,10 @@ fn energy_coords(
         ) => Err(e),
         Err(e) => return Err(format!("no state space: {e}")),
     };
+    // A linear model whose loops are solved numerically is linearised at the origin: exactly its state space.
     if let Err(why) = &linear
         && args.at.is_empty()
+        && !equations::linear_through_loops(eqs, selection)
     {
         return Err(format!(
             "the model is not linear ({why}): give an operating point with --at NAME=VALUE,... (states: {}; inputs: \

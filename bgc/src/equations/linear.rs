@@ -61,7 +61,7 @@ pub enum LinearError {
         got: usize,
     },
     #[error(
-        "the model has a nonlinear algebraic loop solved numerically (for `{tears}`): its Jacobians have no closed form; linearise it at an operating point instead"
+        "the model has an algebraic loop solved numerically (for `{tears}`): its Jacobians have no closed form; linearise it at an operating point instead"
     )]
     ImplicitLoop { tears: String },
     #[error(

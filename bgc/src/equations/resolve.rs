@@ -7,9 +7,11 @@
 //!   for afterwards ([`super::solve`]); a `u̇` left in a state rate or an output is an error there.
 //! - An algebraic loop shows up as a variable needed while it is being computed. It is torn there: the inner use
 //!   gets the symbol `Tear(v)`, and when `v = E(Tear(v))` is complete it is solved exactly if `E` is affine in the
-//!   tear (`v = b / (1 - a)` for `E = a·v + b`). Otherwise the loop stays implicit: `v` is the unknown `Tear(v)`
-//!   everywhere and the residual `0 = E(Tear(v)) − Tear(v)` is kept ([`Resolver::implicit_loops`]) for a numeric
-//!   solve ([`super::tear`]). A nonlinear loop through a storage in derivative causality is refused.
+//!   tear (`v = b / (1 - a)` for `E = a·v + b`) and writing that solution into the values computed inside the loop
+//!   costs at most [`REWRITE_BUDGET`]. Otherwise the loop stays implicit: `v` is the unknown `Tear(v)` everywhere
+//!   and the residual `0 = E(Tear(v)) − Tear(v)` is kept ([`Resolver::implicit_loops`]) for a numeric solve
+//!   ([`super::tear`]); an affine loop kept so is a block of linear equations, and the model stays linear
+//!   ([`super::linear_through_loops`]). A nonlinear loop through a storage in derivative causality is refused.
 
 use super::build::{Built, Def};
 use super::symbols::{self, Expander, Sym, SymExt, add, div, mul};
@@ -196,7 +198,7 @@ impl<'a> Resolver<'a> {
         }
         let tear = Sym::Tear(v);
         let Some((a, b)) = symbols::affine_in(&value, tear) else {
-            if value.any_sym(&|s| matches!(s, Sym::StateDot(_) | Sym::InputDot(_))) {
+            if has_rates(&value) {
                 return Err(ResolveError::NonlinearLoop(v));
             }
             let residual = symbols::sub(value, symbols::leaf(tear));
@@ -212,6 +214,14 @@ impl<'a> Resolver<'a> {
         // there. The tear exists only while `v` is being computed, so only the values completed since `v` was opened
         // can hold it (looking through every value at each loop cost the number of loops times the model).
         let since = self.opened_at.get(v).copied().unwrap_or(0);
+        if !has_rates(&value) && self.rewrite_cost(since, tear, &solved) > REWRITE_BUDGET {
+            // Nested loops whose closed forms feed each other (a ladder of resistors with parameters of their own)
+            // grow geometrically when solved one inside the other: the loop stays a linear block, solved
+            // numerically like a nonlinear one (Newton's method takes one exact step on it).
+            let residual = symbols::sub(value, symbols::leaf(tear));
+            self.implicit.push((v, residual));
+            return Ok(symbols::leaf(tear));
+        }
         let expander = &mut self.expander;
         let mut replace = |e: &mut Expr| {
             if e.contains(tear) {
@@ -228,6 +238,23 @@ impl<'a> Resolver<'a> {
         }
         self.implicit.iter_mut().for_each(|(_, r)| replace(r));
         Ok(solved)
+    }
+
+    /// The size, as trees, of what closing the loop of `tear` in closed form writes: every value completed since
+    /// `since` that holds the tear, and the solution `solved` once per such value.
+    fn rewrite_cost(&self, since: usize, tear: Sym, solved: &Expr) -> usize {
+        let mut cost = 0usize;
+        let values = self.completed.get(since..).unwrap_or_default().iter();
+        let held = values
+            .filter_map(|&w| self.cache.get(w).and_then(Option::as_ref))
+            .chain(self.implicit.iter().map(|(_, r)| r))
+            .filter(|e| e.contains(tear));
+        for e in held {
+            cost = cost
+                .saturating_add(e.node_count())
+                .saturating_add(solved.node_count());
+        }
+        cost
     }
 
     /// Undoes a failed computation of `v`: `v` is new again, and so is everything computed inside it that holds
@@ -329,6 +356,17 @@ fn vars_read(e: &Expr) -> Vec<usize> {
 /// form however they are reached, and multiplying out a value this size costs at most this much, so a chain of
 /// values that each hold the next stays linear (only the first few links are this small).
 const COMPACT_TREE: usize = 1024;
+
+/// The most a loop's closed form may write, as trees ([`Resolver::rewrite_cost`]), before the loop is kept as a
+/// block of linear equations instead. Nested loops whose solutions hold each other grow geometrically (a ladder with
+/// a resistance per resistor doubles per rung); with this bound a six-rung ladder is still solved in closed form
+/// and the cost of the rest stays polynomial.
+const REWRITE_BUDGET: usize = 100_000;
+
+/// Whether `e` holds the rate of a state or of an input (a storage in derivative causality on a loop).
+fn has_rates(e: &Expr) -> bool {
+    e.any_sym(&|s| matches!(s, Sym::StateDot(_) | Sym::InputDot(_)))
+}
 
 /// `e` multiplied out when that makes it no larger. A value is copied into every variable that uses it: in a chain
 /// of algebraic loops each rung's solution `b / (1 − a)` holds the previous ones as nested products of sums, which

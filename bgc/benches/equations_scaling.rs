@@ -85,7 +85,12 @@ fn family(c: &mut Criterion, name: &str, sizes: &[usize], generate: fn(usize) ->
 fn bench(c: &mut Criterion) {
     family(c, "ladder", &[3, 6, 12, 50, 100], ladder);
     // A resistance per resistor: nested loops past a size are solved as one linear block, not in closed form.
-    family(c, "ladder_distinct", &[6, 12, 24, 48, 96], ladder_distinct);
+    family(
+        c,
+        "ladder_distinct",
+        &[6, 12, 24, 48, 96, 384],
+        ladder_distinct,
+    );
     family(c, "output_chain", &[6, 12, 24], output_chain);
     // The velocities behind the chain's moduli are found in one walk of the definitions, not one per inertia.
     family(c, "mtf_chain", &[25, 100, 1000], mtf_chain);

@@ -214,7 +214,7 @@ impl<'a> Resolver<'a> {
         // there. The tear exists only while `v` is being computed, so only the values completed since `v` was opened
         // can hold it (looking through every value at each loop cost the number of loops times the model).
         let since = self.opened_at.get(v).copied().unwrap_or(0);
-        if !has_rates(&value) && self.rewrite_cost(since, tear, &solved) > REWRITE_BUDGET {
+        if !has_rates(&value) && !self.closed_form_affordable(since, tear, &solved) {
             // Nested loops whose closed forms feed each other (a ladder of resistors with parameters of their own)
             // grow geometrically when solved one inside the other: the loop stays a linear block, solved
             // numerically like a nonlinear one (Newton's method takes one exact step on it).
@@ -240,21 +240,28 @@ impl<'a> Resolver<'a> {
         Ok(solved)
     }
 
-    /// The size, as trees, of what closing the loop of `tear` in closed form writes: every value completed since
-    /// `since` that holds the tear, and the solution `solved` once per such value.
-    fn rewrite_cost(&self, since: usize, tear: Sym, solved: &Expr) -> usize {
-        let mut cost = 0usize;
+    /// Whether closing the loop of `tear` in closed form costs at most [`REWRITE_BUDGET`], as trees: the values
+    /// completed since `since` and the implicit loops' residuals are read (each walk costs at most its tree), and
+    /// those that hold the tear are written again with the solution `solved` in them. Counting stops at the budget,
+    /// so the check itself costs no more than it.
+    fn closed_form_affordable(&self, since: usize, tear: Sym, solved: &Expr) -> bool {
         let values = self.completed.get(since..).unwrap_or_default().iter();
-        let held = values
+        let read = values
             .filter_map(|&w| self.cache.get(w).and_then(Option::as_ref))
-            .chain(self.implicit.iter().map(|(_, r)| r))
-            .filter(|e| e.contains(tear));
-        for e in held {
-            cost = cost
-                .saturating_add(e.node_count())
-                .saturating_add(solved.node_count());
+            .chain(self.implicit.iter().map(|(_, r)| r));
+        let mut cost = 0usize;
+        for e in read {
+            cost = cost.saturating_add(e.node_count());
+            if cost > REWRITE_BUDGET {
+                return false;
+            }
+            if e.contains(tear) {
+                cost = cost
+                    .saturating_add(e.node_count())
+                    .saturating_add(solved.node_count());
+            }
         }
-        cost
+        cost <= REWRITE_BUDGET
     }
 
     /// Undoes a failed computation of `v`: `v` is new again, and so is everything computed inside it that holds
@@ -357,10 +364,10 @@ fn vars_read(e: &Expr) -> Vec<usize> {
 /// values that each hold the next stays linear (only the first few links are this small).
 const COMPACT_TREE: usize = 1024;
 
-/// The most a loop's closed form may write, as trees ([`Resolver::rewrite_cost`]), before the loop is kept as a
+/// The most a loop's closed form may cost, as trees ([`Resolver::closed_form_affordable`]), before the loop is kept as a
 /// block of linear equations instead. Nested loops whose solutions hold each other grow geometrically (a ladder with
-/// a resistance per resistor doubles per rung); with this bound a six-rung ladder is still solved in closed form
-/// and the cost of the rest stays polynomial.
+/// a resistance per resistor doubles per rung); with this bound a four-rung one keeps its closed form, a longer one
+/// has its outer rungs' loops in one linear block, and the cost stays polynomial.
 const REWRITE_BUDGET: usize = 100_000;
 
 /// Whether `e` holds the rate of a state or of an input (a storage in derivative causality on a loop).

@@ -23,6 +23,7 @@ use super::newton::{self, Failure, Problem, Settings};
 use super::symbols::{self, Sym, SymExt};
 use crate::symbolic::Expr;
 use petgraph::graph::DiGraph;
+use std::collections::HashMap;
 
 /// One block of nonlinear algebraic equations solved together: `0 = r(z, x, u, p, t)` for its tear variables `z`.
 #[derive(Clone, Debug, PartialEq)]
@@ -42,11 +43,19 @@ pub(crate) fn blocks(implicit: &[(usize, Expr)], name: &dyn Fn(Sym) -> String) -
     // components in reverse topological order of the edges, that is each block after the blocks it refers to.
     let mut graph = DiGraph::<usize, ()>::new();
     let nodes: Vec<_> = (0..implicit.len()).map(|k| graph.add_node(k)).collect();
+    let loop_of: HashMap<Sym, usize> = implicit
+        .iter()
+        .enumerate()
+        .map(|(j, (w, _))| (Sym::Tear(*w), j))
+        .collect();
+    // Each residual's tears in one walk (not one walk per loop: a ladder has hundreds).
     for (i, (_, r)) in implicit.iter().enumerate() {
-        for (j, (w, _)) in implicit.iter().enumerate() {
-            if r.contains(Sym::Tear(*w))
-                && let (Some(&a), Some(&b)) = (nodes.get(i), nodes.get(j))
-            {
+        for j in r
+            .syms()
+            .into_iter()
+            .filter_map(|s| loop_of.get(&s).copied())
+        {
+            if let (Some(&a), Some(&b)) = (nodes.get(i), nodes.get(j)) {
                 graph.add_edge(a, b, ());
             }
         }

@@ -114,7 +114,7 @@ fn many_errors_on_one_long_line_give_a_short_report() {
     assert!(run.stderr.len() < 200_000, "{}", run.transcript());
     assert!(
         run.stderr.contains(
-            "only the first 100 diagnostics are shown; 15899 more not shown (15899 errors"
+            "only the 100 most severe diagnostics are shown; 15899 more not shown (15899 errors"
         ),
         "{}",
         run.transcript()

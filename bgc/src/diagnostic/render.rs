@@ -31,7 +31,8 @@ pub fn to_text(sources: &SourceMap, diags: &[Diagnostic], color: bool) -> String
     }
     let config = term::Config::default();
     let mut out = String::new();
-    for d in diags.iter().take(MAX_SHOWN) {
+    let (shown_diags, rest) = most_severe(diags);
+    for d in shown_diags {
         let mut excerpts = Excerpts::new(&files, &originals);
         let cs_diag = to_codespan(d, &mut excerpts);
         let mut buf: Vec<u8> = Vec::new();
@@ -54,14 +55,39 @@ pub fn to_text(sources: &SourceMap, diags: &[Diagnostic], color: bool) -> String
             ));
         }
     }
-    if let Some(rest) = diags.get(MAX_SHOWN..).filter(|r| !r.is_empty()) {
-        out.push_str(&omitted_line(rest));
+    if !rest.is_empty() {
+        out.push_str(&omitted_line(&rest));
     }
     out
 }
 
+/// The diagnostics to render and those left out: all of them when there are at most [`MAX_SHOWN`], otherwise the
+/// [`MAX_SHOWN`] most severe (errors, then warnings, then notes, each in the order given), rendered in the order
+/// given. An error after a hundred notes (a long ladder's arbitrary causalities) is shown, not counted.
+fn most_severe(diags: &[Diagnostic]) -> (Vec<&Diagnostic>, Vec<&Diagnostic>) {
+    if diags.len() <= MAX_SHOWN {
+        return (diags.iter().collect(), Vec::new());
+    }
+    let rank = |s: Severity| match s {
+        Severity::Error => 0,
+        Severity::Warning => 1,
+        Severity::Note => 2,
+    };
+    let mut by_severity: Vec<usize> = (0..diags.len()).collect();
+    by_severity.sort_by_key(|&i| (rank(diags[i].severity), i));
+    let mut chosen = vec![false; diags.len()];
+    for &i in by_severity.iter().take(MAX_SHOWN) {
+        chosen[i] = true;
+    }
+    let (shown, rest): (Vec<_>, Vec<_>) = diags.iter().zip(chosen).partition(|(_, c)| *c);
+    (
+        shown.into_iter().map(|(d, _)| d).collect(),
+        rest.into_iter().map(|(d, _)| d).collect(),
+    )
+}
+
 /// The closing line for the diagnostics not rendered.
-fn omitted_line(rest: &[Diagnostic]) -> String {
+fn omitted_line(rest: &[&Diagnostic]) -> String {
     let count = |s: Severity| rest.iter().filter(|d| d.severity == s).count();
     let (errors, warnings, notes) = (
         count(Severity::Error),
@@ -70,7 +96,7 @@ fn omitted_line(rest: &[Diagnostic]) -> String {
     );
     let plural = |n: usize, word: &str| format!("{n} {word}{}", if n == 1 { "" } else { "s" });
     format!(
-        "note: only the first {MAX_SHOWN} diagnostics are shown; {} more not shown ({}, {}, {})\n",
+        "note: only the {MAX_SHOWN} most severe diagnostics are shown; {} more not shown ({}, {}, {})\n",
         rest.len(),
         plural(errors, "error"),
         plural(warnings, "warning"),
@@ -178,4 +204,31 @@ pub fn to_json_value(sources: &SourceMap, diags: &[Diagnostic]) -> serde_json::V
         })
         .collect();
     serde_json::to_value(items).unwrap_or(serde_json::Value::Null)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_error_after_more_notes_than_are_shown_is_shown() {
+        let mut diags: Vec<Diagnostic> = (0..150)
+            .map(|k| Diagnostic::note_diag("BG0530", format!("choice {k}")))
+            .collect();
+        diags.insert(120, Diagnostic::warning("BG0520", "a loop"));
+        diags.push(Diagnostic::error("BG0701", "too many tears"));
+        let text = to_text(&SourceMap::new(), &diags, false);
+        assert!(text.contains("error[BG0701]: too many tears"), "{text}");
+        assert!(text.contains("warning[BG0520]: a loop"), "{text}");
+        // The notes kept are the first 98, in their order, before the warning and the error.
+        assert!(
+            text.contains("choice 97\n") && !text.contains("choice 98\n"),
+            "{text}"
+        );
+        let (warning, error) = (text.find("a loop"), text.find("too many tears"));
+        assert!(text.find("choice 97") < warning && warning < error);
+        assert!(text.ends_with(
+            "note: only the 100 most severe diagnostics are shown; 52 more not shown (0 errors, 0 warnings, 52 notes)\n"
+        ));
+    }
 }

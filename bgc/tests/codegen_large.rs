@@ -336,3 +336,30 @@ fn a_large_model_of_constant_mass_blocks_compiles_without_warnings() {
     let _ = std::fs::remove_dir_all(&dir);
     assert!(compiled.is_ok(), "{compiled:?}");
 }
+
+/// Loops with more tears than generated code keeps on its stack are refused with the reason and the way out, not
+/// generated into matrices that overflow it (a ladder of 190 rungs with a resistance per resistor has 188).
+#[test]
+fn loops_with_more_tears_than_the_stack_takes_are_refused_with_the_reason() {
+    let text = crate::equations_support::families::ladder_distinct(190);
+    let mut sources = bgc::span::SourceMap::new();
+    let id = sources.add("ladder.bg", text.as_str());
+    let diags = match bgc::codegen::compile(&mut sources, id, &mut bgc::lower::MemoryLoader::new())
+    {
+        Ok(_) => panic!("generated"),
+        Err(diags) => diags,
+    };
+    let errors: Vec<String> = diags
+        .iter()
+        .filter(|d| d.is_error())
+        .map(|d| d.message.clone())
+        .collect();
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    for part in ["188 tear variables", "at most 181 tears", "bgc simulate"] {
+        assert!(errors[0].contains(part), "{part}: {}", errors[0]);
+    }
+    // Below the bound the loops are generated.
+    let small = crate::equations_support::families::ladder_distinct(40);
+    let id = sources.add("small.bg", small.as_str());
+    assert!(bgc::codegen::compile(&mut sources, id, &mut bgc::lower::MemoryLoader::new()).is_ok());
+}

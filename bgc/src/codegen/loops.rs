@@ -27,6 +27,10 @@ use crate::equations::{Equations, ParamChain, residual_scale};
 use crate::symbolic::{Expr, Symbol};
 use std::fmt::Write;
 
+/// The most tear variables generated code takes: `∂r/∂z` of all loops is an `N_TEARS × N_TEARS` matrix on the
+/// stack, 256 KiB at 181 tears, the bound that large models' `JacX` keeps.
+const MAX_TEARS: usize = 181;
+
 /// One block of the loops for the generator.
 #[derive(Clone, Debug)]
 pub(crate) struct LoopBlockPlan {
@@ -64,6 +68,13 @@ pub(crate) fn plan(
 ) -> Result<Option<LoopPlan>, String> {
     if eqs.tear_blocks.is_empty() {
         return Ok(None);
+    }
+    let count: usize = eqs.tear_blocks.iter().map(|b| b.tears.len()).sum();
+    if count > MAX_TEARS {
+        let kib = count * count * 8 / 1024;
+        return Err(format!(
+            "its algebraic loops have {count} tear variables: the generated Newton iteration and Jacobians keep              {count} × {count} matrices ({kib} KiB each) on the stack, more than the 256 KiB generated code allows              (at most {MAX_TEARS} tears); a storage element on a loop (a parasitic compliance or inertia) removes its              tear, and `bgc simulate` runs the model as it is"
+        ));
     }
     let convert = |e: &Expr| to_symbolic(eqs, e).map_err(|e| e.to_string());
     let mut tears = Vec::new();

@@ -358,6 +358,7 @@ fn loops_with_more_tears_than_the_stack_takes_are_refused_with_the_reason() {
     for part in ["188 tear variables", "at most 181 tears", "bgc simulate"] {
         assert!(errors[0].contains(part), "{part}: {}", errors[0]);
     }
+    assert!(!errors[0].contains("  "), "{}", errors[0]);
     // Below the bound the loops are generated.
     let small = crate::equations_support::families::ladder_distinct(40);
     let id = sources.add("small.bg", small.as_str());

@@ -73,7 +73,10 @@ pub(crate) fn plan(
     if count > MAX_TEARS {
         let kib = count * count * 8 / 1024;
         return Err(format!(
-            "its algebraic loops have {count} tear variables: the generated Newton iteration and Jacobians keep              {count} × {count} matrices ({kib} KiB each) on the stack, more than the 256 KiB generated code allows              (at most {MAX_TEARS} tears); a storage element on a loop (a parasitic compliance or inertia) removes its              tear, and `bgc simulate` runs the model as it is"
+            "its algebraic loops have {count} tear variables: the generated Newton iteration and Jacobians keep \
+             {count} × {count} matrices ({kib} KiB each) on the stack, more than the 256 KiB generated code \
+             allows (at most {MAX_TEARS} tears); a storage element on a loop (a parasitic compliance or \
+             inertia) removes its tear, and `bgc simulate` runs the model as it is"
         ));
     }
     let convert = |e: &Expr| to_symbolic(eqs, e).map_err(|e| e.to_string());

@@ -7,7 +7,8 @@ use bgc::codegen::explicit_outputs;
 use bgc::diagnostic::Diagnostic;
 use bgc::equations::symbols::{Sym, SymExt};
 use bgc::equations::{
-    Equations, StateSelection, derive, expr_text, linear_through_loops, linearise, to_text,
+    Equations, LinearError, StateSelection, derive, expr_text, linear_through_loops, linearise,
+    time_in_loops, to_text,
 };
 use bgc::lower::{MemoryLoader, lower};
 use bgc::simulate::System;
@@ -218,6 +219,30 @@ fn ladder_with_a_resistance_per_resistor_keeps_its_loops_linear_and_small() {
             );
         }
     }
+}
+
+/// A signal of time on loops kept as a linear block is refused by name, as it is in a rate: the state space has no
+/// column for it (it would vanish from A and B).
+#[test]
+fn a_signal_of_time_on_a_linear_block_of_loops_is_refused_by_name() {
+    let text = ladder_distinct(12).replace(
+        "    Se src = u;",
+        "    param V0 = 1 [V];\n    param w = 50 [rad/s];\n    Se src = u + V0*sin(w*t);",
+    );
+    let eqs = equations(&text);
+    assert!(!eqs.tear_blocks.is_empty());
+    assert!(!linear_through_loops(&eqs, StateSelection::Energy));
+    match time_in_loops(&eqs) {
+        Some(e @ LinearError::TimeDependent { .. }) => {
+            let msg = e.to_string();
+            assert!(
+                msg.contains("`src`") && msg.contains("algebraic loop"),
+                "{msg}"
+            );
+        }
+        other => panic!("expected a refusal naming `src`, got {other:?}"),
+    }
+    assert!(time_in_loops(&equations(&ladder_distinct(12))).is_none());
 }
 
 /// `y_1 … y_levels` at `q_spring = q` by the recurrence itself.

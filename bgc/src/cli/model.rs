@@ -192,7 +192,14 @@ fn energy_coords(
         ) => Err(e),
         Err(e) => return Err(format!("no state space: {e}")),
     };
-    // A linear model whose loops are solved numerically is linearised at the origin: exactly its state space.
+    // A linear model whose loops are solved numerically is linearised at the origin: exactly its state space. A
+    // signal of time on such a loop is refused as it is in a rate.
+    if linear.is_err()
+        && args.at.is_empty()
+        && let Some(e) = equations::time_in_loops(eqs)
+    {
+        return Err(format!("no state space: {e}"));
+    }
     if let Err(why) = &linear
         && args.at.is_empty()
         && !equations::linear_through_loops(eqs, selection)

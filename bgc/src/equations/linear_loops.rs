@@ -7,7 +7,7 @@
 //! so the implicit-function linearisation at any point, the origin included, is its exact state space.
 
 use super::Equations;
-use super::linear::{StateSelection, selected};
+use super::linear::{LinearError, StateSelection, selected, time_elements_text};
 use super::symbols::{self, Sym, SymExt};
 use crate::symbolic::Expr;
 use std::collections::BTreeSet;
@@ -66,4 +66,18 @@ fn linear_in_unknowns(e: &Expr) -> bool {
         .iter()
         .all(|&s| symbols::diff(e, s).is_ok_and(|d| !d.any_sym(&unknown)));
     constant_slopes && symbols::subst(e, &mut |s| unknown(s).then(Expr::zero)).is_zero()
+}
+
+/// The error for a model whose numerically solved loops read a signal of time (`Se mains = V0*sin(w*t);` on a
+/// loop): like a rate that reads one, it has no state space `ẋ = A x + B u` ([`LinearError::TimeDependent`]).
+/// `None` when no loop residual reads `t`.
+pub fn time_in_loops(eqs: &Equations) -> Option<LinearError> {
+    let block = eqs
+        .tear_blocks
+        .iter()
+        .find(|b| b.residuals.iter().any(|r| r.contains(Sym::Time)))?;
+    Some(LinearError::TimeDependent {
+        what: format!("the algebraic loop for `{}`", block.names.join("`, `")),
+        elements: time_elements_text(eqs),
+    })
 }

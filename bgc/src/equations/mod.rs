@@ -89,7 +89,7 @@ pub use linear::{
     Jacobians, LinearError, NumericStateSpace, StateSelection, SymbolicStateSpace, evaluate_at,
     jacobians, linear_state_space, linearise, numeric_state_space,
 };
-pub use linear_loops::linear_through_loops;
+pub use linear_loops::{linear_through_loops, time_in_loops};
 pub use param_chain::ParamChain;
 pub use print::{expr_latex, expr_text, to_json, to_latex, to_text};
 pub use sensitivity::{PointJacobians, Rows, Sensitivity};

@@ -338,9 +338,10 @@ fn a_large_model_of_constant_mass_blocks_compiles_without_warnings() {
 }
 
 /// Loops with more tears than generated code keeps on its stack are refused with the reason and the way out, not
-/// generated into matrices that overflow it (a ladder of 190 rungs with a resistance per resistor has 188).
+/// generated into matrices that overflow it (a ladder of 190 rungs with a resistance per resistor has 188); a
+/// smaller linear block is generated, with a warning that the module has no `state_space`.
 #[test]
-fn loops_with_more_tears_than_the_stack_takes_are_refused_with_the_reason() {
+fn generated_loops_are_bounded_and_a_linear_block_is_noted() {
     let text = crate::equations_support::families::ladder_distinct(190);
     let mut sources = bgc::span::SourceMap::new();
     let id = sources.add("ladder.bg", text.as_str());
@@ -359,8 +360,26 @@ fn loops_with_more_tears_than_the_stack_takes_are_refused_with_the_reason() {
         assert!(errors[0].contains(part), "{part}: {}", errors[0]);
     }
     assert!(!errors[0].contains("  "), "{}", errors[0]);
-    // Below the bound the loops are generated.
+    // Below the bound the loops are generated; the model is linear but has no symbolic state space, and a warning
+    // says that the module has no `state_space` and where A, B, C, D are instead.
     let small = crate::equations_support::families::ladder_distinct(40);
     let id = sources.add("small.bg", small.as_str());
-    assert!(bgc::codegen::compile(&mut sources, id, &mut bgc::lower::MemoryLoader::new()).is_ok());
+    let compiled = bgc::codegen::compile(&mut sources, id, &mut bgc::lower::MemoryLoader::new())
+        .unwrap_or_else(|d| panic!("{d:?}"));
+    let notes: Vec<&str> = compiled
+        .warnings
+        .iter()
+        .filter(|d| d.code.0 == "BG0702")
+        .map(|d| d.message.as_str())
+        .collect();
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert!(notes[0].contains("no `state_space`"), "{}", notes[0]);
+    // A ladder of four rungs keeps its loops in closed form and has its state space.
+    let closed = crate::equations_support::families::ladder_distinct(4);
+    let id = sources.add("closed.bg", closed.as_str());
+    let compiled = bgc::codegen::compile(&mut sources, id, &mut bgc::lower::MemoryLoader::new())
+        .unwrap_or_else(|d| panic!("{d:?}"));
+    assert!(compiled.warnings.iter().all(|d| d.code.0 != "BG0702"));
+    let module = bgc::codegen::rust::generate(&compiled, "closed.bg");
+    assert!(module.contains("pub fn state_space("), "no state_space");
 }

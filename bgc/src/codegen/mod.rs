@@ -15,6 +15,7 @@
 //! |---|---|
 //! | BG0700 | the file declares no `model` (components alone generate nothing) |
 //! | BG0701 | equations that cannot be generated (incomplete, or an expression with no value in code) |
+//! | BG0702 | warning: a linear model whose loops are solved numerically gets no `state_space` (its Jacobians at the origin are `A, B, C, D`) |
 
 mod adapter;
 pub(crate) mod emit;
@@ -41,6 +42,7 @@ use crate::span::{FileId, SourceMap};
 pub mod codes {
     pub const NO_MODEL: &str = "BG0700";
     pub const NOT_GENERATABLE: &str = "BG0701";
+    pub const NO_STATE_SPACE: &str = "BG0702";
 }
 
 /// One model with its derived equations.
@@ -108,6 +110,11 @@ pub fn compile(
                 return Err(diags);
             }
         };
+        if plan.linear_ss.is_err()
+            && crate::equations::linear_through_loops(&equations, plan.linear_selection)
+        {
+            diags.push(no_state_space_note(&model, &equations));
+        }
         compiled.push(CompiledModel {
             model,
             equations,
@@ -119,6 +126,26 @@ pub fn compile(
         warnings: diags,
         hash: input_hash(sources),
     })
+}
+
+/// The warning for a linear model whose loops are a block solved numerically: it has no symbolic state space, so
+/// the module has no `state_space`, and a crate that used one would otherwise stop compiling without a reason. A
+/// warning, not a note, so that it is among the diagnostics shown after a long ladder's hundreds of notes.
+fn no_state_space_note(model: &ir::Model, eqs: &crate::equations::Equations) -> Diagnostic {
+    let tears: usize = eqs.tear_blocks.iter().map(|b| b.tears.len()).sum();
+    Diagnostic::warning(
+        codes::NO_STATE_SPACE,
+        format!(
+            "`{}` is linear, but {tears} of its algebraic loops are solved numerically: the generated code has no \
+             `state_space`",
+            model.name
+        ),
+    )
+    .with_primary(model.spans.model, "this model")
+    .with_help(
+        "`jac_x_into`, `jac_u_into`, `output_jac_x_into` and `output_jac_u_into` at the origin (x = 0, u = 0) hold \
+         its A, B, C and D; `bgc statespace` prints them",
+    )
 }
 
 /// FNV-1a (64 bit) of every file of `sources`: each file's name, a zero byte, its text, a zero byte, in load order.

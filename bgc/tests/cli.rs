@@ -258,6 +258,21 @@ fn fmt_refuses_a_file_with_syntax_errors_and_leaves_it_alone() {
 }
 
 /// `bgc rust FILE` prints exactly what the build-script API writes for the same file.
+/// `bgc rust` prints the model's warnings and notes on standard error, as `bgc fmu` and the build script give them
+/// (the diode's algebraic loop, BG0520), and the module alone on standard output.
+#[test]
+fn rust_command_prints_the_warnings_on_standard_error() {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/corpus/diode_rc.bg");
+    let run = bgc(&fixtures_dir(), &["rust", &model.display().to_string()]);
+    assert_eq!(run.status, 0, "{}", run.transcript());
+    assert!(
+        run.stderr.contains("warning[BG0520]"),
+        "{}",
+        run.transcript()
+    );
+    assert!(!run.stdout.contains("BG0520"), "{}", run.transcript());
+}
+
 #[test]
 fn rust_command_prints_what_the_build_script_generates() {
     let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/back_support.bg");

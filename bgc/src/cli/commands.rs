@@ -374,6 +374,11 @@ pub fn rust(path: &Path, runtime: bool, color: bool) -> Status {
     }
     match bgc::codegen::compile(&mut sources, id, &mut loader) {
         Ok(compiled) => {
+            // The warnings and notes on standard error, as `bgc fmu` and the build script give them.
+            let findings = render::to_text(&sources, &compiled.warnings, color);
+            if !findings.is_empty() {
+                stderr(&findings);
+            }
             // Named as `bgc::build` names it, so that both print the same text.
             let cwd = std::env::current_dir().ok();
             let name = match is_stdin(path) {

@@ -129,6 +129,34 @@ fn nodal_currents(ra: &[f64], rb: &[f64], vc: f64, u: f64) -> (f64, f64) {
     (i_cap, (u - v[0]) / ra[0])
 }
 
+/// The ladder's rate (the capacitor's current) and output (the source's) at three points `(q, u)`, against
+/// `currents(q/c, u) = (i_cap, i_src)` of nodal analysis, to 1e-12; `what` names the ladder in a failure.
+fn assert_nodal_values(
+    eqs: &Equations,
+    c: f64,
+    what: &str,
+    currents: &dyn Fn(f64, f64) -> (f64, f64),
+) {
+    let p = eqs.default_params();
+    for &(q, u) in &[(0.0, 1.0), (2e-3, -0.5), (-1e-3, 3.0)] {
+        let (i_cap, i_src) = currents(q / c, u);
+        let rates = eqs
+            .rates_at(&p, &[q], &[u], 0.0)
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            (rates[0] - i_cap).abs() < 1e-12 * (1.0 + i_cap.abs()),
+            "{what}: {rates:?} vs {i_cap}"
+        );
+        let y = eqs
+            .outputs_at(&p, &[q], &[u], 0.0)
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            (y[0] - i_src).abs() < 1e-12 * (1.0 + i_src.abs()),
+            "{what}: {y:?} vs {i_src}"
+        );
+    }
+}
+
 /// A ladder whose rungs form a chain of algebraic loops: every solved loop is multiplied out, so the explicit rate
 /// stays a few terms in `q_cap` and `u` (nested, it grows about fivefold per rung), with the values of nodal
 /// analysis.
@@ -136,28 +164,13 @@ fn nodal_currents(ra: &[f64], rb: &[f64], vc: f64, u: f64) -> (f64, f64) {
 fn long_ladder_stays_small_and_matches_nodal_analysis() {
     let rungs = 12;
     let eqs = equations(&ladder(rungs));
-    let p = eqs.default_params();
     let (r, c) = (1.0, 1e-3);
     let rate = eqs.f[0].as_ref().unwrap_or_else(|| panic!("no rate"));
     let text = expr_text(&eqs, rate);
     assert!(text.len() < 100, "{text}");
-    for &(q, u) in &[(0.0, 1.0), (2e-3, -0.5), (-1e-3, 3.0)] {
-        let (i_cap, i_src) = ladder_currents(rungs, r, q / c, u);
-        let rates = eqs
-            .rates_at(&p, &[q], &[u], 0.0)
-            .unwrap_or_else(|e| panic!("{e}"));
-        assert!(
-            (rates[0] - i_cap).abs() < 1e-12 * (1.0 + i_cap.abs()),
-            "{rates:?} vs {i_cap}"
-        );
-        let y = eqs
-            .outputs_at(&p, &[q], &[u], 0.0)
-            .unwrap_or_else(|e| panic!("{e}"));
-        assert!(
-            (y[0] - i_src).abs() < 1e-12 * (1.0 + i_src.abs()),
-            "{y:?} vs {i_src}"
-        );
-    }
+    assert_nodal_values(&eqs, c, &format!("{rungs} rungs"), &|vc, u| {
+        ladder_currents(rungs, r, vc, u)
+    });
     // The nodal analysis itself, on the two-rung ladder derived by hand above.
     let (i_cap, i_src) = ladder_currents(2, 1.0, 0.6, 1.5);
     assert!((i_cap - (1.5 / 3.0 - 7.0 * 0.6 / 6.0)).abs() < 1e-15);
@@ -181,24 +194,10 @@ fn ladder_with_a_resistance_per_resistor_keeps_its_loops_linear_and_small() {
         let eqs = equations(&ladder_distinct(rungs));
         assert!(!eqs.tear_blocks.is_empty(), "{rungs} rungs in closed form");
         let (ra, rb): (Vec<f64>, Vec<f64>) = (1..=rungs).map(ladder_distinct_resistances).unzip();
+        assert_nodal_values(&eqs, c, &format!("{rungs} rungs"), &|vc, u| {
+            nodal_currents(&ra, &rb, vc, u)
+        });
         let p = eqs.default_params();
-        for &(q, u) in &[(0.0, 1.0), (2e-3, -0.5), (-1e-3, 3.0)] {
-            let (i_cap, i_src) = nodal_currents(&ra, &rb, q / c, u);
-            let rates = eqs
-                .rates_at(&p, &[q], &[u], 0.0)
-                .unwrap_or_else(|e| panic!("{e}"));
-            let y = eqs
-                .outputs_at(&p, &[q], &[u], 0.0)
-                .unwrap_or_else(|e| panic!("{e}"));
-            assert!(
-                (rates[0] - i_cap).abs() < 1e-12 * (1.0 + i_cap.abs()),
-                "{rungs} rungs: {rates:?} vs {i_cap}"
-            );
-            assert!(
-                (y[0] - i_src).abs() < 1e-12 * (1.0 + i_src.abs()),
-                "{rungs} rungs: {y:?} vs {i_src}"
-            );
-        }
         assert!(linear_through_loops(&eqs, StateSelection::Energy));
         let ss = linearise(&eqs, StateSelection::Energy, &p, &[0.0], &[0.0], 0.0)
             .unwrap_or_else(|e| panic!("{e}"));

@@ -192,24 +192,22 @@ fn energy_coords(
         ) => Err(e),
         Err(e) => return Err(format!("no state space: {e}")),
     };
-    // A linear model whose loops are solved numerically is linearised at the origin: exactly its state space. A
-    // signal of time on such a loop is refused as it is in a rate.
-    if linear.is_err()
-        && args.at.is_empty()
-        && let Some(e) = equations::time_in_loops(eqs)
-    {
-        return Err(format!("no state space: {e}"));
-    }
+    // Without a point: a signal of time on numerically solved loops is refused as it is in a rate, and a linear
+    // model whose loops are solved numerically is linearised at the origin, exactly its state space.
     if let Err(why) = &linear
         && args.at.is_empty()
-        && !equations::linear_through_loops(eqs, selection)
     {
-        return Err(format!(
-            "the model is not linear ({why}): give an operating point with --at NAME=VALUE,... (states: {}; inputs: \
-             {}; those not given are 0)",
-            name_list(&state_names),
-            name_list(&eqs.inputs)
-        ));
+        if let Some(e) = equations::time_in_loops(eqs) {
+            return Err(format!("no state space: {e}"));
+        }
+        if !equations::linear_through_loops(eqs, selection) {
+            return Err(format!(
+                "the model is not linear ({why}): give an operating point with --at NAME=VALUE,... (states: {}; \
+                 inputs: {}; those not given are 0)",
+                name_list(&state_names),
+                name_list(&eqs.inputs)
+            ));
+        }
     }
     let fixed = fixed_params(eqs, args.params, params);
     if args.symbolic {

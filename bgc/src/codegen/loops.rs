@@ -22,14 +22,14 @@
 //! `u` and for the outputs). `∂r/∂z` of all blocks together is block-triangular and is solved by `bgc_solve`.
 
 use super::adapter::to_symbolic;
-use super::rust::{Draft, Writer};
+use super::rust::{Draft, MAX_CONSTANT_JACOBIAN_BYTES, Writer};
 use crate::equations::{Equations, ParamChain, residual_scale};
 use crate::symbolic::{Expr, Symbol};
 use std::fmt::Write;
 
 /// The most tear variables generated code takes: `∂r/∂z` of all loops is an `N_TEARS × N_TEARS` matrix on the
-/// stack, 256 KiB at 181 tears, the bound that large models' `JacX` keeps.
-const MAX_TEARS: usize = 181;
+/// stack, held to the bound of a dense `JacX` ([`MAX_CONSTANT_JACOBIAN_BYTES`], 181 tears).
+const MAX_TEARS: usize = (MAX_CONSTANT_JACOBIAN_BYTES / 8).isqrt();
 
 /// One block of the loops for the generator.
 #[derive(Clone, Debug)]
@@ -71,10 +71,10 @@ pub(crate) fn plan(
     }
     let count: usize = eqs.tear_blocks.iter().map(|b| b.tears.len()).sum();
     if count > MAX_TEARS {
-        let kib = count * count * 8 / 1024;
+        let (kib, bound) = (count * count * 8 / 1024, MAX_CONSTANT_JACOBIAN_BYTES / 1024);
         return Err(format!(
             "its algebraic loops have {count} tear variables: the generated Newton iteration and Jacobians keep \
-             {count} × {count} matrices ({kib} KiB each) on the stack, more than the 256 KiB generated code \
+             {count} × {count} matrices ({kib} KiB each) on the stack, more than the {bound} KiB generated code \
              allows (at most {MAX_TEARS} tears); a storage element on a loop (a parasitic compliance or \
              inertia) removes its tear, and `bgc simulate` runs the model as it is"
         ));

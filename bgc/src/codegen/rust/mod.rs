@@ -60,6 +60,7 @@
 mod calls;
 mod functions;
 mod model;
+pub(in crate::codegen) use model::MAX_CONSTANT_JACOBIAN_BYTES;
 mod param_jacobians;
 mod params;
 mod parts;

@@ -35,7 +35,6 @@ use super::expr::{Expr, Node, Symbol};
 use super::order::cmp_factors;
 use crate::ir::Func;
 use std::ops;
-use std::sync::OnceLock;
 
 impl Expr {
     /// A numeric constant.
@@ -43,16 +42,14 @@ impl Expr {
         Expr::from_canonical(Node::Const(value))
     }
 
-    /// `0`, interned once per process: dense matrices of mostly zeros take it millions of times.
+    /// `0` (a small constant: interned once per process).
     pub fn zero() -> Expr {
-        static ZERO: OnceLock<Expr> = OnceLock::new();
-        ZERO.get_or_init(|| Expr::constant(0.0)).clone()
+        Expr::constant(0.0)
     }
 
-    /// `1`, interned once per process.
+    /// `1` (a small constant: interned once per process).
     pub fn one() -> Expr {
-        static ONE: OnceLock<Expr> = OnceLock::new();
-        ONE.get_or_init(|| Expr::constant(1.0)).clone()
+        Expr::constant(1.0)
     }
 
     /// A bare symbol.

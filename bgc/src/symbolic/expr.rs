@@ -14,7 +14,7 @@ use super::intern::intern;
 use crate::ir::Func;
 use std::fmt;
 use std::hash::{Hash, Hasher};
-use std::sync::Arc;
+use std::sync::{Arc, LazyLock};
 
 /// What a symbol stands for. The declaration order is the sort order, so in a product parameters come before
 /// inputs, time and states (`k*q_spring`, not `q_spring*k`).
@@ -57,7 +57,7 @@ impl Symbol {
     /// The symbol numbered `index` among those of `kind`, without a name (it prints as `kind#index`, so its user
     /// prints it with its own names, e.g. through [`crate::symbolic::to_text_with`]).
     pub fn indexed(kind: SymbolKind, index: usize) -> Symbol {
-        static EMPTY: std::sync::LazyLock<Arc<str>> = std::sync::LazyLock::new(|| Arc::from(""));
+        static EMPTY: LazyLock<Arc<str>> = LazyLock::new(|| Arc::from(""));
         Symbol {
             kind,
             name: EMPTY.clone(),
@@ -165,9 +165,16 @@ impl Expr {
     /// constructors call this.
     pub(super) fn from_canonical(node: Node) -> Expr {
         let node = match node {
-            Node::Const(c) => Node::Const(normalize_const(c)),
+            Node::Const(c) => match small_constant(c) {
+                Some(e) => return e,
+                None => Node::Const(normalize_const(c)),
+            },
             other => other,
         };
+        Expr::intern(node)
+    }
+
+    fn intern(node: Node) -> Expr {
         let hash = structural_hash(&node);
         let mut tree_size = 1u64;
         node.for_each_child(|c| tree_size = tree_size.saturating_add(c.0.tree_size));
@@ -273,6 +280,27 @@ fn normalize_const(c: f64) -> f64 {
     } else {
         c
     }
+}
+
+/// The multiples of ½ from −[`SMALL_CONSTANT_MAX`] to [`SMALL_CONSTANT_MAX`], interned once per process: the
+/// signs, `2` of `q²/2` and `−1` of every division are built millions of times in a large model, and taking them
+/// from here spares each a lock and a table probe.
+const SMALL_CONSTANT_MAX: f64 = 8.0;
+
+fn small_constant(c: f64) -> Option<Expr> {
+    static TABLE: LazyLock<Vec<Expr>> = LazyLock::new(|| {
+        let halves = (4.0 * SMALL_CONSTANT_MAX) as i32;
+        (0..=halves)
+            .map(|k| Expr::intern(Node::Const(f64::from(k - halves / 2) / 2.0)))
+            .collect()
+    });
+    let twice = 2.0 * c;
+    // `-0.0` is `0.0` here, as `normalize_const` makes it.
+    if twice.fract() != 0.0 || c.abs() > SMALL_CONSTANT_MAX {
+        return None;
+    }
+    let index = (twice + 2.0 * SMALL_CONSTANT_MAX) as usize;
+    TABLE.get(index).cloned()
 }
 
 fn structural_hash(node: &Node) -> u64 {

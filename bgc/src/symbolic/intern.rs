@@ -116,14 +116,19 @@ impl Shard {
     }
 }
 
-static TABLE: LazyLock<[Mutex<Shard>; SHARDS]> =
-    LazyLock::new(|| std::array::from_fn(|_| Mutex::new(Shard::default())));
+/// A shard's lock and table header on cache lines of their own: two threads interning in neighbouring shards at
+/// once would otherwise pass one line back and forth on every lock and unlock.
+#[repr(align(128))]
+struct Padded(Mutex<Shard>);
+
+static TABLE: LazyLock<[Padded; SHARDS]> =
+    LazyLock::new(|| std::array::from_fn(|_| Padded(Mutex::new(Shard::default()))));
 
 /// The one node equal to `node` (whose structural hash is `hash`), built now if it did not exist.
 pub(super) fn intern(node: Node, hash: u64, tree_size: u64) -> Arc<Inner> {
     // The shard from bits the shard's table does not use: it indexes by the low bits and tags each entry with the
     // top seven.
-    let shard = &TABLE[(hash >> 32) as usize % SHARDS];
+    let shard = &TABLE[(hash >> 32) as usize % SHARDS].0;
     // A panic cannot leave a shard inconsistent (each update is one map operation), so a poisoned lock is usable.
     let mut guard = shard.lock().unwrap_or_else(PoisonError::into_inner);
     let (found, candidate) = guard.find_or_insert(hash, node, tree_size);

@@ -32,9 +32,40 @@ pub(crate) fn join<A: Send, B>(
     })
 }
 
+/// Below this many items, [`map_halves`] maps on the calling thread: starting a thread costs more than the work.
+const PARALLEL_ITEMS: usize = 4096;
+
+/// `items.iter().map(f)`, in order, the first half on a helper thread when there are many items. For passes that
+/// handle each element of a large model on its own (the definitions of each node, the text of each equation).
+pub(crate) fn map_halves<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
+    if items.len() < PARALLEL_ITEMS {
+        return items.iter().map(&f).collect();
+    }
+    let (first, second) = items.split_at(items.len() / 2);
+    let (mut out, rest) = join(
+        || first.iter().map(&f).collect::<Vec<R>>(),
+        || second.iter().map(&f).collect::<Vec<R>>(),
+    );
+    out.extend(rest);
+    out
+}
+
 #[cfg(test)]
 mod tests {
-    use super::join;
+    use super::{PARALLEL_ITEMS, join, map_halves};
+
+    #[test]
+    fn halves_are_mapped_in_order_on_both_sides_of_the_threshold() {
+        for n in [0, 7, PARALLEL_ITEMS, 3 * PARALLEL_ITEMS + 1] {
+            let items: Vec<usize> = (0..n).collect();
+            let mapped = map_halves(&items, |&k| 2 * k + 1);
+            assert_eq!(
+                mapped,
+                (0..n).map(|k| 2 * k + 1).collect::<Vec<_>>(),
+                "{n} items"
+            );
+        }
+    }
 
     #[test]
     fn both_results_come_back_in_their_places() {

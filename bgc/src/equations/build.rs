@@ -547,8 +547,11 @@ pub(crate) fn build(
             Err(ConvertError::Unsupported(what)) => diags.push(node_error(model, s.node, codes::UNSUPPORTED, format!("cannot write the equations of `{}`: {what}", w.name))),
         }
     }
-    for node in model.graph.node_indices() {
-        let result = node_defs(model, causality, ctx, node);
+    let nodes: Vec<NodeIndex> = model.graph.node_indices().collect();
+    let shared: &Ctx = ctx;
+    let results =
+        crate::concurrent::map_halves(&nodes, |&node| node_defs(model, causality, shared, node));
+    for (&node, result) in nodes.iter().zip(results) {
         match result {
             Ok(list) => {
                 for (var, def) in list {

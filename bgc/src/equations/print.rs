@@ -8,7 +8,8 @@
 use super::build::{Built, Def};
 use super::naming::UniqueNames;
 use super::symbols::{self, Sym, SymExt};
-use super::{Equations, Intermediate, StateKind};
+use super::{Equations, Intermediate, StateKind, StateSpec};
+use crate::concurrent::map_halves;
 use crate::symbolic::{Expr, Symbol, to_latex_with, to_text_with};
 use serde_json::{Value, json};
 use std::collections::HashMap;
@@ -234,13 +235,17 @@ fn mass_row(eqs: &Equations, i: usize) -> Option<(&super::MassBlock, usize)> {
 pub fn to_text(eqs: &Equations) -> String {
     let mut out = format!("model {}\n", eqs.model);
     out.push_str("states:\n");
-    for (i, (s, r)) in eqs.states.iter().zip(&eqs.rates).enumerate() {
+    // The lines of a large model's long lists are formatted on two threads (see `map_halves`).
+    let rows: Vec<(usize, (&StateSpec, &Expr))> =
+        eqs.states.iter().zip(&eqs.rates).enumerate().collect();
+    let lines = map_halves(&rows, |&(i, (s, r))| {
         let lhs = match mass_row(eqs, i) {
             Some((b, k)) => format!("[M_{} d/dt f_{}]_{}", b.element, b.element, k + 1),
             None => format!("d/dt {}", s.name),
         };
-        out.push_str(&format!("  {lhs} = {}\n", expr_text(eqs, r)));
-    }
+        format!("  {lhs} = {}\n", expr_text(eqs, r))
+    });
+    lines.iter().for_each(|l| out.push_str(l));
     for b in &eqs.mass {
         out.push_str(&format!(
             "mass matrix M_{} (symmetric), f_{} = [{}]:\n",
@@ -265,14 +270,15 @@ pub fn to_text(eqs: &Equations) -> String {
         }
     }
     out.push_str("intermediates:\n");
-    for i in &eqs.intermediates {
+    let lines = map_halves(&eqs.intermediates, |i| {
         let v = expr_text(eqs, &i.value);
         if i.derivative {
-            out.push_str(&format!("  {} = d/dt({v})\n", i.name));
+            format!("  {} = d/dt({v})\n", i.name)
         } else {
-            out.push_str(&format!("  {} = {v}\n", i.name));
+            format!("  {} = {v}\n", i.name)
         }
-    }
+    });
+    lines.iter().for_each(|l| out.push_str(l));
     if !eqs.loops.is_empty() {
         out.push_str(&format!(
             "  (algebraic loop, solved exactly for: {})\n",
@@ -305,13 +311,15 @@ pub fn to_text(eqs: &Equations) -> String {
             let value = expr_named(eqs, value, Style::Text, &names);
             out.push_str(&format!("  where {name} = {value}\n"));
         }
-        for (t, value) in eqs.energy.iter().zip(&values) {
+        let terms: Vec<_> = eqs.energy.iter().zip(&values).collect();
+        let lines = map_halves(&terms, |(t, value)| {
             let value = value.as_ref().map_or_else(
                 || NOT_COMPUTED.to_string(),
                 |v| expr_named(eqs, v, Style::Text, &names),
             );
-            out.push_str(&format!("  {} {} = {value}\n", t.kind.name(), t.element));
-        }
+            format!("  {} {} = {value}\n", t.kind.name(), t.element)
+        });
+        lines.iter().for_each(|l| out.push_str(l));
     }
     out
 }

@@ -64,6 +64,7 @@ pub(in crate::codegen) use model::MAX_CONSTANT_JACOBIAN_BYTES;
 mod param_jacobians;
 mod params;
 mod parts;
+mod scopes;
 mod sparse_jac;
 mod terms;
 
@@ -530,7 +531,8 @@ impl<'a> Writer<'a> {
         self.out.push_str(&sig);
         self.out.push('\n');
         if !f.body.is_empty() {
-            self.out.push_str(&f.body);
+            self.out
+                .push_str(&scopes::flatten_lets(&f.body, "    ", self.width));
             self.out.push_str("}\n");
         }
     }

@@ -272,7 +272,8 @@ impl Writer<'_> {
         }
         self.out
             .push_str("    pub fn at(p: &Params) -> ParamTerms {\n");
-        self.out.push_str(&body);
+        self.out
+            .push_str(&super::scopes::flatten_lets(&body, "        ", self.width));
         self.out.push_str("    }\n}\n");
     }
 }

@@ -1,7 +1,7 @@
 //! Generates the model modules from the `.bg` files: the exoskeleton models into `$OUT_DIR`, and, with the
-//! feature `corpus` (this crate's tests turn it on), the compiler's test corpus into `$OUT_DIR/corpus`, checked
-//! by the tests against the compiler's own evaluation. A normal build leaves the test models (and their
-//! intended warnings) out.
+//! feature `corpus` (this crate's tests turn it on), the compiler's test corpus and this crate's test models into
+//! `$OUT_DIR/corpus`, checked by the tests against the compiler's own evaluation and against hand derivations. A
+//! normal build leaves the test models (and their intended warnings) out.
 
 use std::path::PathBuf;
 
@@ -29,6 +29,9 @@ const CORPUS: &[&str] = &[
     "two_tank",
 ];
 
+/// Test models of this crate (`tests/models`), generated with the corpus.
+const TEST_MODELS: &[&str] = &["ladder_loops"];
+
 fn main() -> Result<(), bgc::build::Error> {
     bgc::build::compile(MODELS)?;
     if std::env::var_os("CARGO_FEATURE_CORPUS").is_none() {
@@ -38,6 +41,11 @@ fn main() -> Result<(), bgc::build::Error> {
     let corpus: Vec<String> = CORPUS
         .iter()
         .map(|name| format!("../bgc/tests/corpus/{name}.bg"))
+        .chain(
+            TEST_MODELS
+                .iter()
+                .map(|name| format!("tests/models/{name}.bg")),
+        )
         .collect();
     bgc::build::Config::new()
         .out_dir(out_dir.join("corpus"))

@@ -339,9 +339,10 @@ fn a_large_model_of_constant_mass_blocks_compiles_without_warnings() {
 
 /// Loops with more tears than generated code keeps on its stack are refused with the reason and the way out, not
 /// generated into matrices that overflow it (a ladder of 190 rungs with a resistance per resistor has 188); a
-/// smaller linear block is generated, with a warning that the module has no `state_space`.
+/// smaller linear block is generated, and its module's `state_space` evaluates the Jacobians unless `A` is too
+/// large for that, which a warning says.
 #[test]
-fn generated_loops_are_bounded_and_a_linear_block_is_noted() {
+fn generated_loops_are_bounded_and_a_linear_block_has_its_state_space() {
     let text = crate::equations_support::families::ladder_distinct(190);
     let mut sources = bgc::span::SourceMap::new();
     let id = sources.add("ladder.bg", text.as_str());
@@ -360,10 +361,26 @@ fn generated_loops_are_bounded_and_a_linear_block_is_noted() {
         assert!(errors[0].contains(part), "{part}: {}", errors[0]);
     }
     assert!(!errors[0].contains("  "), "{}", errors[0]);
-    // Below the bound the loops are generated; the model is linear but has no symbolic state space, and a warning
-    // says that the module has no `state_space` and where A, B, C, D are instead.
+    // Below the bound the loops are generated; the model is linear but has no symbolic state space, so its
+    // `state_space` evaluates its Jacobians at the origin (models/tests/loops.rs checks the numbers).
     let small = crate::equations_support::families::ladder_distinct(40);
     let id = sources.add("small.bg", small.as_str());
+    let compiled = bgc::codegen::compile(&mut sources, id, &mut bgc::lower::MemoryLoader::new())
+        .unwrap_or_else(|d| panic!("{d:?}"));
+    assert!(compiled.warnings.iter().all(|d| d.code.0 != "BG0702"));
+    let module = bgc::codegen::rust::generate(&compiled, "small.bg");
+    assert!(module.contains("pub fn state_space(p: &Params) -> EnergyStateSpace {\n"));
+    assert!(module.contains("    jac_x_into(p, 0.0, &x, &u, &mut jx);\n"));
+    // With 182 more states (a resistor and a capacitor each) `A` would pass 256 KiB: no `state_space`, and a
+    // warning that says so and where `A, B, C, D` are.
+    let branches: String = (1..=182)
+        .map(|k| format!("    0 j{k};\n    C c{k} = c;\n    R r{k} = ra1;\n    bond j{k} -> c{k};\n    bond j{k} -> r{k};\n"))
+        .collect();
+    let Some(body) = small.strip_suffix("}\n") else {
+        panic!("the ladder's text ends with its model's brace")
+    };
+    let large = format!("{body}{branches}}}\n");
+    let id = sources.add("large.bg", large.as_str());
     let compiled = bgc::codegen::compile(&mut sources, id, &mut bgc::lower::MemoryLoader::new())
         .unwrap_or_else(|d| panic!("{d:?}"));
     let notes: Vec<&str> = compiled
@@ -373,7 +390,13 @@ fn generated_loops_are_bounded_and_a_linear_block_is_noted() {
         .map(|d| d.message.as_str())
         .collect();
     assert_eq!(notes.len(), 1, "{notes:?}");
+    assert!(notes[0].contains("more than 181 states"), "{}", notes[0]);
     assert!(notes[0].contains("no `state_space`"), "{}", notes[0]);
+    let module = bgc::codegen::rust::generate(&compiled, "large.bg");
+    assert!(
+        !module.contains("pub fn state_space("),
+        "a state_space of 183 states"
+    );
     // A ladder of four rungs keeps its loops in closed form and has its state space.
     let closed = crate::equations_support::families::ladder_distinct(4);
     let id = sources.add("closed.bg", closed.as_str());

@@ -1,5 +1,6 @@
-//! The compiler's test corpus (`bgc/tests/corpus/*.bg`), generated like the models so that the tests of this crate
-//! check the generated code of every corpus model. Not part of the public API.
+//! The compiler's test corpus (`bgc/tests/corpus/*.bg`) and this crate's test models (`tests/models/*.bg`),
+//! generated like the models so that the tests of this crate check the generated code of every corpus model. Not
+//! part of the public API.
 
 macro_rules! corpus {
     ($($name:ident),* $(,)?) => {
@@ -24,4 +25,6 @@ corpus!(
     resistive_network,
     series_rlc,
     two_tank,
+    // This crate's test models (`tests/models`).
+    ladder_loops,
 );

@@ -37,6 +37,7 @@ agreement! {
     resistive_network: corpus::resistive_network => "bgc/tests/corpus/resistive_network.bg",
     series_rlc: corpus::series_rlc => "bgc/tests/corpus/series_rlc.bg",
     two_tank: corpus::two_tank => "bgc/tests/corpus/two_tank.bg",
+    ladder_loops: corpus::ladder_loops => "models/tests/models/ladder_loops.bg",
 }
 
 /// The diode's nonlinear loop, solved by the generated Newton iteration. The charge is drawn from ±1 mC so that the

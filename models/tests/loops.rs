@@ -99,3 +99,68 @@ fn a_loop_without_a_finite_solution_is_an_error_and_nan() {
 fn support_equations() -> bgc::equations::Equations {
     support::equations_of("bgc/tests/corpus/diode_rc.bg")
 }
+
+/// The ladder of `tests/models/ladder_loops.bg` by nodal analysis: node voltages `v_1 … v_8` with `v_0 = u` at the
+/// source and `v_8 = q/c` across the capacitor; Kirchhoff's current law at nodes 1 … 7,
+/// `(v_{k−1} − v_k)/ra_k = v_k/rb_k + (v_k − v_{k+1})/ra_{k+1}`; the capacitor takes what rung 8 leaves,
+/// `q̇ = (v_7 − v_8)/ra_8 − v_8/rb_8`, and the output is the current into the ladder, `i_1 = (u − v_1)/ra_1`.
+/// Returns `(q̇, i_1)`.
+fn ladder_by_nodes(p: &bgc_models::corpus::ladder_loops::Params, u: f64, q: f64) -> (f64, f64) {
+    use bgc_models::corpus::ladder_loops as l;
+    let get = |name: &str| {
+        l::PARAM_NAMES
+            .iter()
+            .position(|n| *n == name)
+            .and_then(|i| p.get(i))
+            .unwrap_or_else(|| panic!("no parameter {name}"))
+    };
+    let (ra, rb): (Vec<f64>, Vec<f64>) = (1..=8)
+        .map(|k| (get(&format!("ra{k}")), get(&format!("rb{k}"))))
+        .unzip();
+    let v8 = q / get("c");
+    // Unknowns v_1 … v_7; row k − 1 is node k's balance.
+    let mut g = nalgebra::DMatrix::<f64>::zeros(7, 7);
+    let mut rhs = nalgebra::DVector::<f64>::zeros(7);
+    for k in 1..=7 {
+        let (into, out) = (1.0 / ra[k - 1], 1.0 / ra[k]);
+        g[(k - 1, k - 1)] = into + 1.0 / rb[k - 1] + out;
+        if k > 1 {
+            g[(k - 1, k - 2)] = -into;
+        } else {
+            rhs[0] += into * u;
+        }
+        if k < 7 {
+            g[(k - 1, k)] = -out;
+        } else {
+            rhs[6] += out * v8;
+        }
+    }
+    let v = g.lu().solve(&rhs).unwrap_or_else(|| panic!("singular"));
+    let q_dot = (v[6] - v8) / ra[7] - v8 / rb[7];
+    (q_dot, (u - v[0]) / ra[0])
+}
+
+/// A linear model whose algebraic loops are solved numerically (no symbolic state space) has a generated
+/// `state_space`: its Jacobians through the loops, which are `A, B, C, D` by nodal analysis.
+#[test]
+fn a_linear_ladder_solved_numerically_has_its_state_space() {
+    use bgc_models::corpus::ladder_loops as l;
+    // The ladder's loops are a numeric block (else the module would not compile: `N_TEARS` exists only then).
+    assert_eq!(l::TEAR_NAMES.len(), l::N_TEARS);
+    assert_eq!(l::N_TEARS, 4);
+    let p = l::Params::default();
+    let (a, b, c, d) = l::state_space(&p);
+    let (a_ref, c_ref) = ladder_by_nodes(&p, 0.0, 1.0);
+    let (b_ref, d_ref) = ladder_by_nodes(&p, 1.0, 0.0);
+    for (name, got, want) in [
+        ("A", a[(0, 0)], a_ref),
+        ("B", b[(0, 0)], b_ref),
+        ("C", c[(0, 0)], c_ref),
+        ("D", d[(0, 0)], d_ref),
+    ] {
+        assert!(
+            (got - want).abs() <= 1e-12 * want.abs(),
+            "{name}: generated {got}, nodal analysis {want}"
+        );
+    }
+}

@@ -15,7 +15,7 @@
 //! |---|---|
 //! | BG0700 | the file declares no `model` (components alone generate nothing) |
 //! | BG0701 | equations that cannot be generated (incomplete, or an expression with no value in code) |
-//! | BG0702 | warning: a linear model whose loops are solved numerically gets no `state_space` (its Jacobians at the origin are `A, B, C, D`) |
+//! | BG0702 | warning: a linear model whose loops are solved numerically and which has more than 181 states gets no `state_space` |
 
 mod adapter;
 pub(crate) mod emit;
@@ -111,6 +111,7 @@ pub fn compile(
             }
         };
         if plan.linear_ss.is_err()
+            && !rust::state_space_through_loops(&equations, &plan)
             && crate::equations::linear_through_loops(&equations, plan.linear_selection)
         {
             diags.push(no_state_space_note(&model, &equations));
@@ -128,23 +129,24 @@ pub fn compile(
     })
 }
 
-/// The warning for a linear model whose loops are a block solved numerically: it has no symbolic state space, so
-/// the module has no `state_space`, and a crate that used one would otherwise stop compiling without a reason. A
-/// warning, not a note, so that it is among the diagnostics shown after a long ladder's hundreds of notes.
+/// The warning for a linear model whose loops are a block solved numerically and whose `A` is too large for the
+/// `state_space` that evaluates its Jacobians: it has no symbolic state space either, so the module has no
+/// `state_space`, and a crate that used one would otherwise stop compiling without a reason. A warning, not a note,
+/// so that it is among the diagnostics shown after a long ladder's hundreds of notes.
 fn no_state_space_note(model: &ir::Model, eqs: &crate::equations::Equations) -> Diagnostic {
     let tears: usize = eqs.tear_blocks.iter().map(|b| b.tears.len()).sum();
     Diagnostic::warning(
         codes::NO_STATE_SPACE,
         format!(
-            "`{}` is linear, but {tears} of its algebraic loops are solved numerically: the generated code has no \
-             `state_space`",
+            "`{}` is linear, but {tears} of its algebraic loops are solved numerically and it has more than 181 \
+             states: the generated code has no `state_space`",
             model.name
         ),
     )
     .with_primary(model.spans.model, "this model")
     .with_help(
-        "`jac_x_into`, `jac_u_into`, `output_jac_x_into` and `output_jac_u_into` at the origin (x = 0, u = 0) hold \
-         its A, B, C and D; `bgc statespace` prints them",
+        "`bgc statespace` prints its A, B, C and D (`--sparse` as triplets); with at most 181 states the module's \
+         `state_space` evaluates its Jacobians at the origin",
     )
 }
 

@@ -109,7 +109,7 @@ pub fn generated_modules(runtime: bool) -> Vec<(String, String)> {
     let root = workspace();
     let options = rust::Options { runtime };
     let mut files: Vec<PathBuf> = Vec::new();
-    for dir in ["models", "bgc/tests/corpus"] {
+    for dir in ["models", "models/tests/models", "bgc/tests/corpus"] {
         let mut entries: Vec<PathBuf> = std::fs::read_dir(root.join(dir))
             .unwrap_or_else(|e| panic!("{dir}: {e}"))
             .filter_map(|e| e.ok().map(|e| e.path()))

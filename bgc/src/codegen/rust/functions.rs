@@ -739,6 +739,9 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         };
         match &self.plan.linear_ss {
             Ok(ss) => self.state_space_fn(("state_space", ty), size, &ss.clone(), states),
+            Err(_) if state_space_through_loops(&self.m.equations, self.plan) => {
+                self.state_space_at_origin(ty, size, states);
+            }
             Err(why) => {
                 self.out.push('\n');
                 self.note(0, &format!("No `state_space`: {}.", comment(why)));
@@ -768,6 +771,59 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             }
             None => {}
         }
+    }
+
+    /// `state_space` of a linear model whose algebraic loops are solved numerically: it has no symbolic `A, B, C,
+    /// D`, but its Jacobians, which take the loops' implicit derivatives, are constant and are `A, B, C, D`. They
+    /// are taken at the origin, where the loops' residuals are linear in the tears (so the same at any point).
+    fn state_space_at_origin(&mut self, ty: &str, size: &str, doc: &str) {
+        self.out.push('\n');
+        self.doc(
+            0,
+            &format!("`A, B, C, D` of `ẋ = A x + B u`, `y = C x + D u` {doc}."),
+        );
+        self.out.push_str(&format!(
+            "pub type {ty} = (\n    SMatrix<f64, {size}, {size}>,\n    SMatrix<f64, {size}, N_INPUTS>,\n    \
+             SMatrix<f64, N_OUTPUTS, {size}>,\n    SMatrix<f64, N_OUTPUTS, N_INPUTS>,\n);\n"
+        ));
+        self.out.push('\n');
+        self.doc(
+            0,
+            &format!(
+                "The linear state space {doc}, at the parameters `p`. The model's algebraic loops are solved \
+                 numerically, so these are its Jacobians `jac_x_into`, `jac_u_into`, `output_jac_x_into` and \
+                 `output_jac_u_into` at the origin, which are exact for this linear model; all NaN when the \
+                 loops are singular at `p`."
+            ),
+        );
+        // The energy states are the first ones: their block of the full Jacobians, copied entry by entry (the
+        // generated code uses nothing of `nalgebra` beyond `zeros` and indexing).
+        let states = self.plan.states.len();
+        let selected = match self.plan.linear_selection {
+            StateSelection::Energy => self.m.equations.energy_states,
+            StateSelection::All => states,
+        };
+        let blocks = if selected == states {
+            "    (jx, ju, hx, hu)\n".to_string()
+        } else {
+            let inputs = !self.plan.inputs.is_empty();
+            let outputs = !output_names(&self.m.equations).is_empty();
+            energy_block(size, selected > 0, inputs, outputs)
+        };
+        self.out.push_str(&format!(
+            "pub fn state_space(p: &Params) -> {ty} {{
+    let (x, u) = (State::zeros(), Inputs::zeros());
+    let mut jx = JacX::zeros();
+    jac_x_into(p, 0.0, &x, &u, &mut jx);
+    let mut ju = JacU::zeros();
+    jac_u_into(p, 0.0, &x, &u, &mut ju);
+    let mut hx = OutJacX::zeros();
+    output_jac_x_into(p, 0.0, &x, &u, &mut hx);
+    let mut hu = OutJacU::zeros();
+    output_jac_u_into(p, 0.0, &x, &u, &mut hu);
+{blocks}}}
+"
+        ));
     }
 
     /// `stored_energy`, `dissipated_power` and `supplied_power`: one `let` per element, then their sum.
@@ -903,4 +959,45 @@ pub(super) fn entry_label(
         rows.get(r).map_or("", String::as_str),
         cols.get(c).map_or("", String::as_str)
     )
+}
+
+/// Whether the module's `state_space` comes from its Jacobians at the origin: a linear model whose algebraic loops
+/// are solved numerically has no symbolic `A, B, C, D`, and gets one when its `JacX` fits (at most 181 states, as a
+/// dense `state_space` does).
+pub(in crate::codegen) fn state_space_through_loops(
+    eqs: &crate::equations::Equations,
+    plan: &super::super::emit::Plan,
+) -> bool {
+    let n = plan.states.len();
+    plan.linear_ss.is_err()
+        && n.saturating_mul(n).saturating_mul(8) <= super::model::MAX_CONSTANT_JACOBIAN_BYTES
+        && crate::equations::linear_through_loops(eqs, plan.linear_selection)
+}
+
+/// The statements that copy the first `size` states' block of `jx`, `ju` and `hx` into `a`, `b` and `c` and return
+/// `(a, b, c, hu)`; no loop over an empty range (a lint), so none without `states`, `inputs` or `outputs`.
+fn energy_block(size: &str, states: bool, inputs: bool, outputs: bool) -> String {
+    let binding = |written: bool| if written { "let mut" } else { "let" };
+    let mut s = format!(
+        "    {} a = SMatrix::<f64, {size}, {size}>::zeros();\n    {} b = SMatrix::<f64, {size}, N_INPUTS>::zeros();\n    \
+         {} c = SMatrix::<f64, N_OUTPUTS, {size}>::zeros();\n",
+        binding(states),
+        binding(states && inputs),
+        binding(states && outputs),
+    );
+    if states {
+        s += &format!(
+            "    for i in 0..{size} {{\n        for j in 0..{size} {{\n            a[(i, j)] = jx[(i, j)];\n        }}\n"
+        );
+        if inputs {
+            s += "        for j in 0..N_INPUTS {\n            b[(i, j)] = ju[(i, j)];\n        }\n";
+        }
+        s += "    }\n";
+        if outputs {
+            s += &format!(
+                "    for i in 0..N_OUTPUTS {{\n        for j in 0..{size} {{\n            c[(i, j)] = hx[(i, j)];\n        }}\n    }}\n"
+            );
+        }
+    }
+    s + "    (a, b, c, hu)\n"
 }

@@ -20,7 +20,9 @@
 //!   states, where `A` takes more than 256 KiB, `state_space_entries(&Params, &mut dyn FnMut(char, usize, usize,
 //!   f64))` instead, which passes each entry that is not identically zero and declares no matrix): in the energy
 //!   states (type `EnergyStateSpace`), or, when the outputs or rates read an integrated flow (`var`), in all states,
-//!   energy states then integrated flows (type `FullStateSpace`); and, when the model declares coordinates,
+//!   energy states then integrated flows (type `FullStateSpace`); a linear model whose algebraic loops are solved
+//!   numerically has no symbolic one, and its `state_space` (up to 181 states) evaluates the Jacobians at the
+//!   origin, which are its `A, B, C, D`; and, when the model declares coordinates,
 //!   `state_space_declared` (type `DeclaredStateSpace`, sizes `N_COORDS`, names `COORD_NAMES`);
 //! - `stored_energy`, `dissipated_power`, `supplied_power` when every term has a closed form;
 //! - for a model with nonlinear algebraic loops, `N_TEARS`, `TEAR_NAMES`, `Tears`, `LoopFailure`, `LoopError` and
@@ -60,6 +62,7 @@
 mod calls;
 mod functions;
 mod model;
+pub(in crate::codegen) use functions::state_space_through_loops;
 pub(in crate::codegen) use model::MAX_CONSTANT_JACOBIAN_BYTES;
 mod param_jacobians;
 mod params;

@@ -600,15 +600,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             self.state_space_entries(name, ss, doc);
             return;
         }
-        self.out.push('\n');
-        self.doc(
-            0,
-            &format!("`A, B, C, D` of `ẋ = A x + B u`, `y = C x + D u` {doc}."),
-        );
-        self.out.push_str(&format!(
-            "pub type {ty} = (\n    SMatrix<f64, {size}, {size}>,\n    SMatrix<f64, {size}, N_INPUTS>,\n    \
-             SMatrix<f64, N_OUTPUTS, {size}>,\n    SMatrix<f64, N_OUTPUTS, N_INPUTS>,\n);\n"
-        ));
+        self.state_space_type(ty, size, doc);
         let matrices = [
             ("a", &ss.a, size, size),
             ("b", &ss.b, size, "N_INPUTS"),
@@ -773,10 +765,8 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         }
     }
 
-    /// `state_space` of a linear model whose algebraic loops are solved numerically: it has no symbolic `A, B, C,
-    /// D`, but its Jacobians, which take the loops' implicit derivatives, are constant and are `A, B, C, D`. They
-    /// are taken at the origin, where the loops' residuals are linear in the tears (so the same at any point).
-    fn state_space_at_origin(&mut self, ty: &str, size: &str, doc: &str) {
+    /// The type `{ty}` of `(A, B, C, D)` in `size` states.
+    fn state_space_type(&mut self, ty: &str, size: &str, doc: &str) {
         self.out.push('\n');
         self.doc(
             0,
@@ -786,6 +776,13 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             "pub type {ty} = (\n    SMatrix<f64, {size}, {size}>,\n    SMatrix<f64, {size}, N_INPUTS>,\n    \
              SMatrix<f64, N_OUTPUTS, {size}>,\n    SMatrix<f64, N_OUTPUTS, N_INPUTS>,\n);\n"
         ));
+    }
+
+    /// `state_space` of a linear model whose algebraic loops are solved numerically: it has no symbolic `A, B, C,
+    /// D`, but its Jacobians, which take the loops' implicit derivatives, are constant and are `A, B, C, D`. They
+    /// are taken at the origin, where the loops' residuals are linear in the tears (so the same at any point).
+    fn state_space_at_origin(&mut self, ty: &str, size: &str, doc: &str) {
+        self.state_space_type(ty, size, doc);
         self.out.push('\n');
         self.doc(
             0,

@@ -26,5 +26,6 @@ corpus!(
     series_rlc,
     two_tank,
     // This crate's test models (`tests/models`).
+    ladder_closed,
     ladder_loops,
 );

@@ -37,6 +37,7 @@ agreement! {
     resistive_network: corpus::resistive_network => "bgc/tests/corpus/resistive_network.bg",
     series_rlc: corpus::series_rlc => "bgc/tests/corpus/series_rlc.bg",
     two_tank: corpus::two_tank => "bgc/tests/corpus/two_tank.bg",
+    ladder_closed: corpus::ladder_closed => "models/tests/models/ladder_closed.bg",
     ladder_loops: corpus::ladder_loops => "models/tests/models/ladder_loops.bg",
 }
 
@@ -79,6 +80,7 @@ state_space! {
     resistive_network_state_space: corpus::resistive_network => "bgc/tests/corpus/resistive_network.bg",
     series_rlc_state_space: corpus::series_rlc => "bgc/tests/corpus/series_rlc.bg",
     two_tank_state_space: corpus::two_tank => "bgc/tests/corpus/two_tank.bg",
+    ladder_closed_state_space: corpus::ladder_closed => "models/tests/models/ladder_closed.bg",
 }
 
 #[test]

@@ -68,6 +68,8 @@ power_balance! {
     two_tank: corpus::two_tank,
     pendulum_rig: bgc_models::pendulum_rig,
     walking_leg: bgc_models::walking_leg,
+    ladder_closed: corpus::ladder_closed,
+    ladder_loops: corpus::ladder_loops,
 }
 
 /// The back-support model supplies power through a flow source whose power needs `d omega_h/dt`, so it has no

@@ -56,8 +56,9 @@ pub(crate) struct Plan {
     /// parameters ([`ParamChain`]); partial at fixed tears, and the mass-matrix rows hold `∂F/∂p`, as in `dfdx`.
     pub dfdp: Vec<Vec<Expr>>,
     pub dhdp: Vec<Vec<Expr>>,
-    /// For each Jacobian function (`jac_x_into`, ..., `output_jac_p_into`), the shared subexpressions its
-    /// entries are written over ([`super::shared`]): empty unless an entry would print as a huge tree.
+    /// For each Jacobian function (`jac_x_into`, ..., `output_jac_p_into`), energy function (`stored_energy`,
+    /// `dissipated_power`, `supplied_power`) and `state_space`, the shared subexpressions its entries are written
+    /// over ([`super::shared`]): empty unless an entry would print as a huge tree.
     pub shared: BTreeMap<&'static str, Lets>,
     /// `A, B, C, D` in the energy states, or (when the rates or outputs read an integrated flow) in all states,
     /// or why there is none.
@@ -137,6 +138,15 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
     );
     p.shared.insert("jac_p_into", params.dfdp_shared);
     p.shared.insert("output_jac_p_into", params.dhdp_shared);
+    // Entries of `A, B, C, D` that would print as huge trees (nested loops solved in closed form) are written over
+    // `let`s of their shared subexpressions too.
+    let mut linear_ss = linear_ss;
+    if let Ok(ss) = &mut linear_ss {
+        let entries = [&mut ss.a, &mut ss.b, &mut ss.c, &mut ss.d]
+            .into_iter()
+            .flat_map(sparse_entries);
+        p.shared.insert("state_space", share("ss_", entries));
+    }
     Ok(Plan {
         loops,
         mass,
@@ -228,12 +238,12 @@ impl PointPlan {
                 .map_err(|e| e.to_string())
                 .and_then(|j| state_space(eqs, j.states, &j.dfdx, &j.dfdu, &j.dhdx, &j.dhdu))
         });
-        let energy = energy_terms(eqs);
+        let mut energy = energy_terms(eqs);
         let mut dfdx = SparseMatrix::jacobian(f, states);
         let mut dfdu = SparseMatrix::jacobian(f, inputs);
         let mut dhdx = SparseMatrix::jacobian(h, states);
         let mut dhdu = SparseMatrix::jacobian(h, inputs);
-        let shared = BTreeMap::from([
+        let mut shared = BTreeMap::from([
             (
                 "jac_x_into",
                 share("dfdx_", sparse_entries(&mut dfdx).into_iter()),
@@ -251,6 +261,18 @@ impl PointPlan {
                 share("dhdu_", sparse_entries(&mut dhdu).into_iter()),
             ),
         ]);
+        // Energy terms that would print as huge trees (the powers of the resistors of nested loops solved in
+        // closed form) are written over `let`s of their shared subexpressions, as the Jacobians' entries are.
+        for (kind, terms) in &mut energy {
+            if let Ok(terms) = terms {
+                let (function, prefix) = match kind {
+                    EnergyKind::Stored => ("stored_energy", "stored_"),
+                    EnergyKind::Dissipated => ("dissipated_power", "dissipated_"),
+                    EnergyKind::Supplied => ("supplied_power", "supplied_"),
+                };
+                shared.insert(function, share(prefix, terms.iter_mut().map(|(_, e)| e)));
+            }
+        }
         PointPlan {
             rhs,
             outputs,

@@ -1,4 +1,5 @@
-//! Named shared subexpressions for Jacobian entries that would print as huge trees.
+//! Named shared subexpressions for entries (of Jacobians, state spaces and energy terms) that would print as huge
+//! trees.
 //!
 //! The engine stores a subexpression used in many places once, but printed code repeats it at every use: the
 //! derivative of a chain of outputs `yᵢ = sin(yᵢ₋₁²) + cos(yᵢ₋₁)` is a DAG of a few nodes per level and a tree

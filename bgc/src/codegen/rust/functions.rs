@@ -607,12 +607,15 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             ("c", &ss.c, "N_OUTPUTS", size),
             ("d", &ss.d, "N_OUTPUTS", "N_INPUTS"),
         ];
+        let shared = self.shared_lets(name);
         let all: Vec<&Expr> = matrices
             .iter()
             .flat_map(|m| m.1.iter().map(|(_, _, e)| e))
+            .chain(shared.iter().map(|(_, v)| v))
             .collect();
         // Entries are free of states, inputs and time: the draft binds nothing.
         let mut d = self.draft(&all);
+        self.shared_statements(&mut d, shared);
         for (var, m, rows, cols) in matrices {
             let mutable = if m.iter().any(|(_, _, e)| !e.is_zero()) {
                 "mut "
@@ -681,7 +684,9 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         }
         let function = format!("{name}_entries");
         let ty = "&mut dyn FnMut(char, usize, usize, f64)";
-        let d = if self.splits(statements.len()) {
+        // Entries written over shared `let`s stay in one function, as the Jacobians' entries do.
+        let shared = self.shared_lets(name);
+        let d = if shared.is_empty() && self.splits(statements.len()) {
             let out = Out {
                 name: "entry",
                 ty,
@@ -689,8 +694,13 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             };
             self.parts(&function, &statements, out, false, Vec::new())
         } else {
-            let exprs: Vec<&Expr> = statements.iter().map(|s| s.expr).collect();
+            let exprs: Vec<&Expr> = statements
+                .iter()
+                .map(|s| s.expr)
+                .chain(shared.iter().map(|(_, v)| v))
+                .collect();
             let mut d = self.draft(&exprs);
+            self.shared_statements(&mut d, shared);
             for s in &statements {
                 self.statement(&mut d, &s.label, s.expr, &s.head, &s.tail);
             }
@@ -853,13 +863,17 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
                     continue;
                 }
             };
-            if self.splits(terms.len()) {
+            // Terms written over shared `let`s stay in one function, as the Jacobians' entries do.
+            let shared = self.shared_lets(name);
+            if shared.is_empty() && self.splits(terms.len()) {
                 self.energy_in_parts(name, doc, &terms);
                 continue;
             }
-            let exprs: Vec<&Expr> = terms.iter().map(|t| &t.1).collect();
+            let mut exprs: Vec<&Expr> = terms.iter().map(|t| &t.1).collect();
+            exprs.extend(shared.iter().map(|(_, v)| v));
             let mut d = self.draft(&exprs);
             self.solve_tears(&mut d, &exprs);
+            self.shared_statements(&mut d, shared);
             match terms.as_slice() {
                 [] => d.lines.push("    0.0".into()),
                 [(element, e)] => self.statement(&mut d, &format!("{element}: "), e, "", ""),

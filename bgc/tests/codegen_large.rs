@@ -337,6 +337,26 @@ fn a_large_model_of_constant_mass_blocks_compiles_without_warnings() {
     assert!(compiled.is_ok(), "{compiled:?}");
 }
 
+/// The code generation of `text` (named `name`), or its diagnostics.
+fn compile(
+    name: &str,
+    text: &str,
+) -> Result<bgc::codegen::CompiledFile, Vec<bgc::diagnostic::Diagnostic>> {
+    let mut sources = bgc::span::SourceMap::new();
+    let id = sources.add(name, text);
+    bgc::codegen::compile(&mut sources, id, &mut bgc::lower::MemoryLoader::new())
+}
+
+/// The messages of the BG0702 warnings of `compiled`.
+fn no_state_space_warnings(compiled: &bgc::codegen::CompiledFile) -> Vec<&str> {
+    compiled
+        .warnings
+        .iter()
+        .filter(|d| d.code.0 == "BG0702")
+        .map(|d| d.message.as_str())
+        .collect()
+}
+
 /// Loops with more tears than generated code keeps on its stack are refused with the reason and the way out, not
 /// generated into matrices that overflow it (a ladder of 190 rungs with a resistance per resistor has 188); a
 /// smaller linear block is generated, and its module's `state_space` evaluates the Jacobians unless `A` is too
@@ -344,12 +364,8 @@ fn a_large_model_of_constant_mass_blocks_compiles_without_warnings() {
 #[test]
 fn generated_loops_are_bounded_and_a_linear_block_has_its_state_space() {
     let text = crate::equations_support::families::ladder_distinct(190);
-    let mut sources = bgc::span::SourceMap::new();
-    let id = sources.add("ladder.bg", text.as_str());
-    let diags = match bgc::codegen::compile(&mut sources, id, &mut bgc::lower::MemoryLoader::new())
-    {
-        Ok(_) => panic!("generated"),
-        Err(diags) => diags,
+    let Err(diags) = compile("ladder.bg", &text) else {
+        panic!("generated")
     };
     let errors: Vec<String> = diags
         .iter()
@@ -364,10 +380,8 @@ fn generated_loops_are_bounded_and_a_linear_block_has_its_state_space() {
     // Below the bound the loops are generated; the model is linear but has no symbolic state space, so its
     // `state_space` evaluates its Jacobians at the origin (models/tests/loops.rs checks the numbers).
     let small = crate::equations_support::families::ladder_distinct(40);
-    let id = sources.add("small.bg", small.as_str());
-    let compiled = bgc::codegen::compile(&mut sources, id, &mut bgc::lower::MemoryLoader::new())
-        .unwrap_or_else(|d| panic!("{d:?}"));
-    assert!(compiled.warnings.iter().all(|d| d.code.0 != "BG0702"));
+    let compiled = compile("small.bg", &small).unwrap_or_else(|d| panic!("{d:?}"));
+    assert!(no_state_space_warnings(&compiled).is_empty());
     let module = bgc::codegen::rust::generate(&compiled, "small.bg");
     assert!(module.contains("pub fn state_space(p: &Params) -> EnergyStateSpace {\n"));
     assert!(module.contains("    jac_x_into(p, 0.0, &x, &u, &mut jx);\n"));
@@ -380,15 +394,8 @@ fn generated_loops_are_bounded_and_a_linear_block_has_its_state_space() {
         panic!("the ladder's text ends with its model's brace")
     };
     let large = format!("{body}{branches}}}\n");
-    let id = sources.add("large.bg", large.as_str());
-    let compiled = bgc::codegen::compile(&mut sources, id, &mut bgc::lower::MemoryLoader::new())
-        .unwrap_or_else(|d| panic!("{d:?}"));
-    let notes: Vec<&str> = compiled
-        .warnings
-        .iter()
-        .filter(|d| d.code.0 == "BG0702")
-        .map(|d| d.message.as_str())
-        .collect();
+    let compiled = compile("large.bg", &large).unwrap_or_else(|d| panic!("{d:?}"));
+    let notes = no_state_space_warnings(&compiled);
     assert_eq!(notes.len(), 1, "{notes:?}");
     assert!(notes[0].contains("more than 181 states"), "{}", notes[0]);
     assert!(notes[0].contains("no `state_space`"), "{}", notes[0]);
@@ -399,10 +406,8 @@ fn generated_loops_are_bounded_and_a_linear_block_has_its_state_space() {
     );
     // A ladder of four rungs keeps its loops in closed form and has its state space.
     let closed = crate::equations_support::families::ladder_distinct(4);
-    let id = sources.add("closed.bg", closed.as_str());
-    let compiled = bgc::codegen::compile(&mut sources, id, &mut bgc::lower::MemoryLoader::new())
-        .unwrap_or_else(|d| panic!("{d:?}"));
-    assert!(compiled.warnings.iter().all(|d| d.code.0 != "BG0702"));
+    let compiled = compile("closed.bg", &closed).unwrap_or_else(|d| panic!("{d:?}"));
+    assert!(no_state_space_warnings(&compiled).is_empty());
     let module = bgc::codegen::rust::generate(&compiled, "closed.bg");
     assert!(module.contains("pub fn state_space("), "no state_space");
     // Its closed forms nest: the entries of `A, B, C, D` and the resistors' powers are written over `let`s of their

@@ -65,6 +65,9 @@ pub(crate) struct Plan {
     pub linear_ss: Result<StateSpace, String>,
     /// The states of `linear_ss`.
     pub linear_selection: StateSelection,
+    /// No symbolic `linear_ss`, but a linear model whose algebraic loops are solved numerically
+    /// ([`crate::equations::linear_through_loops`]): its Jacobians are its `A, B, C, D`.
+    pub linear_through_loops: bool,
     /// `A, B, C, D` in the declared coordinates (`None`: the model declares none), or why there is none.
     pub declared_ss: Option<Result<StateSpace, String>>,
     /// Stored energy, dissipated and supplied power: the terms `(element, value)`, or the elements without a closed
@@ -161,6 +164,8 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
         inputs,
         rhs: p.rhs,
         outputs: p.outputs,
+        linear_through_loops: linear_ss.is_err()
+            && crate::equations::linear_through_loops(eqs, linear_selection),
         linear_ss,
         linear_selection,
         declared_ss: p.declared_ss,

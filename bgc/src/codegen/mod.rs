@@ -110,10 +110,7 @@ pub fn compile(
                 return Err(diags);
             }
         };
-        if plan.linear_ss.is_err()
-            && !rust::state_space_through_loops(&equations, &plan)
-            && crate::equations::linear_through_loops(&equations, plan.linear_selection)
-        {
+        if plan.linear_through_loops && !rust::state_space_through_loops(&plan) {
             diags.push(no_state_space_note(&model, &equations));
         }
         compiled.push(CompiledModel {

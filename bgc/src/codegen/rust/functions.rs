@@ -596,7 +596,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
 
     fn state_space_fn(&mut self, (name, ty): (&str, &str), size: &str, ss: &StateSpace, doc: &str) {
         let n = ss.states.len();
-        if n.saturating_mul(n).saturating_mul(8) > super::model::MAX_CONSTANT_JACOBIAN_BYTES {
+        if !super::model::square_fits(n) {
             self.state_space_entries(name, ss, doc);
             return;
         }
@@ -741,7 +741,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
         };
         match &self.plan.linear_ss {
             Ok(ss) => self.state_space_fn(("state_space", ty), size, &ss.clone(), states),
-            Err(_) if state_space_through_loops(&self.m.equations, self.plan) => {
+            Err(_) if state_space_through_loops(self.plan) => {
                 self.state_space_at_origin(ty, size, states);
             }
             Err(why) => {
@@ -975,14 +975,8 @@ pub(super) fn entry_label(
 /// Whether the module's `state_space` comes from its Jacobians at the origin: a linear model whose algebraic loops
 /// are solved numerically has no symbolic `A, B, C, D`, and gets one when its `JacX` fits (at most 181 states, as a
 /// dense `state_space` does).
-pub(in crate::codegen) fn state_space_through_loops(
-    eqs: &crate::equations::Equations,
-    plan: &super::super::emit::Plan,
-) -> bool {
-    let n = plan.states.len();
-    plan.linear_ss.is_err()
-        && n.saturating_mul(n).saturating_mul(8) <= super::model::MAX_CONSTANT_JACOBIAN_BYTES
-        && crate::equations::linear_through_loops(eqs, plan.linear_selection)
+pub(in crate::codegen) fn state_space_through_loops(plan: &super::super::emit::Plan) -> bool {
+    plan.linear_through_loops && super::model::square_fits(plan.states.len())
 }
 
 /// The statements that copy the first `size` states' block of `jx`, `ju` and `hx` into `a`, `b` and `c` and return

@@ -27,8 +27,7 @@ impl Writer<'_> {
     /// [`super::model::MAX_CONSTANT_JACOBIAN_BYTES`] (a thread's stack holds few of them) and every entry is an
     /// expression of its own or a mass block's (no loop correction writes to the matrix as a whole).
     pub(super) fn wants_sparse_jac_x(&self) -> bool {
-        let n = self.plan.states.len();
-        n.saturating_mul(n).saturating_mul(8) > super::model::MAX_CONSTANT_JACOBIAN_BYTES
+        !super::model::square_fits(self.plan.states.len())
             && self.shared_lets("jac_x_into").is_empty()
             && self.plan.loops.is_none()
     }

@@ -98,8 +98,32 @@ fn star(n: usize) -> String {
     let mut s = String::from(
         "model star {\n    domain translational;\n    input u [N];\n    Se src = u;\n    1 j;\n    I m = 1;\n    bond src -> j -> m;\n",
     );
+    s += &springs(n);
+    s + "}\n"
+}
+
+/// The `n - 1` springs of [`star`] on its junction `j`.
+fn springs(n: usize) -> String {
+    let mut s = String::new();
     for k in 1..n {
         s += &format!("    C c{k} = 1;\n    bond j -> c{k};\n");
+    }
+    s
+}
+
+/// `loops` diode loops (one tear variable and one state each, as `corpus/diode_rc.bg`) beside a star of
+/// `states - loops` states: `states` in all.
+fn loops_and_star(loops: usize, states: usize) -> String {
+    let mut s = String::from(
+        "model star {\n    domain electrical;\n    input u [V];\n    param I_s = 1e-6 [A];\n    param V_t = 0.05 [V];\n    \
+         Se src = u;\n    1 j;\n    I m = 1;\n    bond src -> j -> m;\n",
+    );
+    s += &springs(states - loops);
+    for k in 1..=loops {
+        s += &format!(
+            "    Se s{k} = u;\n    1 l{k};\n    R r{k} = 100;\n    R d{k} {{ f = I_s * (exp(e / V_t) - 1); }}\n    \
+             C v{k} = 1e-3;\n    bond s{k} -> l{k} -> r{k}, d{k}, v{k};\n"
+        );
     }
     s + "}\n"
 }
@@ -112,17 +136,34 @@ fn package(text: String) -> Result<bgc::fmu::Sources, String> {
     package_sources(&compiled, None, Version::Fmi2, "star.bg")
 }
 
-/// The FMU's solver holds the dense state Jacobian on the importer's stack, at most 256 KiB: a model of 181
-/// states is packaged (its solver's LU is of dynamic size, since nalgebra decomposes fixed sizes only up to 127,
-/// and a model of 131 states did not compile), one of 182 is refused with the reason and what to use instead.
+/// The FMU's solver keeps the dense state Jacobian and its LU decomposition on the heap: a model of 4,096 states
+/// is packaged (256 MiB of them), one of 4,097 refused with the reason and what to use instead. Models of more
+/// than 181 states were refused while the Jacobian was on the importer's stack.
 #[test]
-fn a_model_of_more_than_181_states_is_refused_with_its_reason() {
-    let sources = package(star(181)).unwrap_or_else(|e| panic!("{e}"));
+fn a_model_of_more_than_4096_states_is_refused_with_its_reason() {
+    let sources = package(star(4096)).unwrap_or_else(|e| panic!("{e}"));
     assert!(sources.description.contains("<ModelVariables>"));
-    let Err(err) = package(star(182)) else {
-        panic!("a model of 182 states was packaged")
+    let Err(err) = package(star(4097)) else {
+        panic!("a model of 4,097 states was packaged")
     };
-    assert!(err.contains("model `star` has 182 states"), "{err}");
-    assert!(err.contains("at most 181 states"), "{err}");
+    assert!(err.contains("model `star` has 4097 states"), "{err}");
+    assert!(err.contains("(256 MiB)"), "{err}");
+    assert!(err.contains("at most 4096 states"), "{err}");
     assert!(err.contains("bgc simulate"), "{err}");
+}
+
+/// The generated Jacobians of a model with algebraic loops keep `∂r/∂x` (tears × states) on the stack: 20 tears
+/// by 1,638 states (262,080 bytes) are packaged, 20 by 1,639 (262,240 bytes, over 256 KiB) refused.
+#[test]
+fn loops_whose_jacobian_matrices_exceed_256_kib_are_refused() {
+    package(loops_and_star(20, 1638)).unwrap_or_else(|e| panic!("{e}"));
+    let Err(err) = package(loops_and_star(20, 1639)) else {
+        panic!("20 tears by 1,639 states were packaged")
+    };
+    assert!(err.contains("model `star` has 1639 states"), "{err}");
+    assert!(
+        err.contains("the algebraic loops' tear variables by the states (256 KiB)"),
+        "{err}"
+    );
+    assert!(err.contains("more than the 256 KiB"), "{err}");
 }

@@ -1,9 +1,11 @@
 //! FMUs of `bgc fmu` (FMI 2.0 and 3.0) in FMPy, a real importer, and FMI 2.0 Co-Simulation also in the Open
 //! Simulation Platform's libcosim, a second one: `fmpy validate` accepts the FMU of every model in `models/`, and
 //! the simulations of the back-support plant, the walking leg (mass matrix), the diode loop (nonlinear
-//! algebraic loop), a voltage divider (no states) and a mass on 149 springs (150 states), through Model Exchange (FMPy's CVode) and Co-Simulation (the FMU's own integrator), give the
+//! algebraic loop), a voltage divider (no states), a mass on 149 springs (150 states) and a chain of 200 masses
+//! (400 states), through Model Exchange (FMPy's CVode) and Co-Simulation (the FMU's own integrator), give the
 //! outputs of `bgc simulate` to 1e-6 of each output's range; the directional derivatives equal central
 //! differences of the derivatives and outputs, and every dependency they show is listed in `ModelStructure`.
+//! FMPy runs on a worker thread of 1 MiB of stack (`fmpy_driver.py`), as importers run FMUs.
 
 use crate::fmu_support::{
     Scenario, bgc_simulate, compare, fmpy_jacobian, fmpy_simulate, fmu, libcosim_simulate,
@@ -63,6 +65,19 @@ const NO_STATES: Scenario = Scenario {
 /// (`Const<151>: ToTypenum` in its solver's LU); the solver's LU is of dynamic size now.
 const WIDE: Scenario = Scenario {
     model: "bgc/tests/fmu_support/wide_star.bg",
+    t_end: 0.5,
+    dt: 5e-3,
+    inputs: &[("u", "step(0.1)")],
+    rows: &[&[0.0, 0.0], &[0.1, 0.0], &[0.1, 1.0], &[0.5, 1.0]],
+    x0: &[],
+    jumps: &[0.1],
+};
+
+/// 400 states, a state Jacobian of 1.25 MiB: the FMU's solver and its directional derivatives held it on the
+/// stack, which a 1 MiB worker thread (the driver runs FMPy on one) does not have, and `bgc fmu` refused models of
+/// more than 181 states; both keep it on the heap now.
+const LONG_CHAIN: Scenario = Scenario {
+    model: "bgc/tests/fmu_support/long_chain.bg",
     t_end: 0.5,
     dt: 5e-3,
     inputs: &[("u", "step(0.1)")],
@@ -173,6 +188,12 @@ fn diode_loop_fmu_follows_bgc_simulate() {
 #[test]
 fn a_model_of_150_states_follows_bgc_simulate() {
     agrees(&WIDE, 2);
+}
+
+#[test]
+fn a_model_of_400_states_follows_bgc_simulate_on_a_worker_thread() {
+    agrees(&LONG_CHAIN, 2);
+    jacobian_matches_differences(&LONG_CHAIN, 2);
 }
 
 #[test]

@@ -79,6 +79,23 @@ pub(crate) struct Plan {
     pub mass: Vec<super::mass::MassPlan>,
 }
 
+impl Plan {
+    /// The bytes (and what its rows are) of the largest matrix that the generated Jacobian functions keep on the stack besides the one
+    /// they fill: the loops' `∂r/∂x` and `∂f/∂z` (tears × states, [`super::loops`]) and each mass block's rows
+    /// (rows × states, [`super::mass`]). A caller that keeps `JacX` itself off the stack (an FMU's solver) is
+    /// bound by this.
+    pub(crate) fn jacobian_stack_matrix(&self) -> (usize, &'static str) {
+        let n = self.states.len() * std::mem::size_of::<f64>();
+        let tears = self.loops.as_ref().map_or(0, |l| l.tears.len());
+        let block = self.mass.iter().map(|b| b.rows.len()).max().unwrap_or(0);
+        if tears >= block {
+            (tears * n, "the algebraic loops' tear variables")
+        } else {
+            (block * n, "a mass block's rows")
+        }
+    }
+}
+
 fn convert_all(eqs: &Equations, es: &[Expr]) -> Result<Vec<Expr>, AdaptError> {
     es.iter().map(|e| to_symbolic(eqs, e)).collect()
 }

@@ -5,7 +5,7 @@ use super::Version;
 use super::description::{Header, model_description};
 use super::structure::dependencies;
 use super::variables::variables;
-use crate::codegen::{CompiledFile, Fnv1a, rust};
+use crate::codegen::{CompiledFile, CompiledModel, Fnv1a, rust};
 
 /// The files of an FMU's crate and what its description says.
 #[derive(Clone, Debug)]
@@ -43,10 +43,13 @@ const TEMPLATE: [(&str, &str); 9] = [
     ("src/fmi3.rs", include_str!("template/fmi3.rs")),
 ];
 
-/// The most states an FMU takes: its solver and its directional derivatives hold `N_STATES x N_STATES` Jacobians
-/// on the importing tool's stack, each at most 256 KiB (181² · 8 bytes) here, the bound the generated code keeps
-/// its dense Jacobians within.
-const MAX_STATES: usize = 181;
+/// The most states an FMU takes: its Co-Simulation solver holds the dense state Jacobian and its LU decomposition
+/// on the heap (2 · N² · 8 bytes, 256 MiB at 4,096 states) and decomposes it at every step (N³/3 flops).
+const MAX_STATES: usize = 4096;
+
+/// The most bytes of a matrix that the generated Jacobian functions may keep on the importing tool's stack (the
+/// loops' tears × states, a mass block's rows × states): 256 KiB, the bound of the generated code's dense matrices.
+const MAX_STACK_MATRIX_BYTES: usize = 256 * 1024;
 
 /// The crate of model `model` of `file` (the only one when `None`) for FMI `version`; `source_name` names the file
 /// in the generated module's header.
@@ -70,15 +73,7 @@ pub fn package_sources(
             format!("has no model `{name}`; it declares {}", names.join(", "))
         })?,
     };
-    let states = chosen.equations.states.len();
-    if states > MAX_STATES {
-        return Err(format!(
-            "model `{}` has {states} states: an FMU's solver holds the {states} x {states} state Jacobian on the \
-             stack of the importing tool's thread, so `bgc fmu` exports models of at most {MAX_STATES} states (a \
-             Jacobian of 256 KiB); simulate it with `bgc simulate`, or generate its Rust module with `bgc rust`",
-            chosen.model.name
-        ));
-    }
+    check_size(chosen)?;
     let identifier = identifier(&chosen.model.name);
     let guid = guid(file.hash, &chosen.model.name, version);
     let vars = variables(chosen);
@@ -125,6 +120,32 @@ pub fn package_sources(
         description,
         files,
     })
+}
+
+/// Refuses a model too large for an FMU: more than [`MAX_STATES`] states, or Jacobian functions that keep more
+/// than [`MAX_STACK_MATRIX_BYTES`] in one matrix on the importer's stack.
+fn check_size(chosen: &CompiledModel) -> Result<(), String> {
+    let name = &chosen.model.name;
+    let states = chosen.equations.states.len();
+    if states > MAX_STATES {
+        let mib = states * states * 8 * 2 / (1024 * 1024);
+        return Err(format!(
+            "model `{name}` has {states} states: an FMU's Co-Simulation solver holds the {states} x {states} state \
+             Jacobian and its LU decomposition ({mib} MiB) and decomposes it at every step, so `bgc fmu` exports \
+             models of at most {MAX_STATES} states; simulate it with `bgc simulate`, or generate its Rust module \
+             with `bgc rust`"
+        ));
+    }
+    let (bytes, rows) = chosen.plan.jacobian_stack_matrix();
+    if bytes > MAX_STACK_MATRIX_BYTES {
+        let (kib, bound) = (bytes / 1024, MAX_STACK_MATRIX_BYTES / 1024);
+        return Err(format!(
+            "model `{name}` has {states} states: its Jacobian functions keep a matrix of {rows} by the states \
+             ({kib} KiB) on the stack of the importing tool's thread, more than the {bound} KiB an FMU allows; \
+             simulate it with `bgc simulate`, or generate its Rust module with `bgc rust`"
+        ));
+    }
+    Ok(())
 }
 
 /// The manifest: the library as a `cdylib`, with the crates the generated module needs (the versions bgc's own

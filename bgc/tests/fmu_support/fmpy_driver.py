@@ -2,16 +2,16 @@
 bgc/tests/fmu_fmpy.rs).
 
 simulate FMU KIND STOP DT RTOL SCENARIO.json
-    Simulates with FMPy's simulate_fmu (KIND ModelExchange: CVode; CoSimulation: the FMU's own integrator) and
-    prints CSV: `time` and the outputs, every number in Python's round-trip form. SCENARIO holds
+    On a worker thread of 1 MiB of stack, simulates with FMPy's simulate_fmu (KIND ModelExchange: CVode;
+    CoSimulation: the FMU's own integrator) and prints CSV: `time` and the outputs, every number in Python's round-trip form. SCENARIO holds
     {"inputs": [names], "rows": [[t, values...], ...], "start": {name: value}}; a step is two rows at one time.
 
 libcosim FMU STOP DT SCENARIO.json
     The same with the Open Simulation Platform's libcosim (FMI 2.0 Co-Simulation), a second importer.
 
 jacobian FMU SCENARIO.json
-    Instantiates the Model Exchange interface (FMI 2.0 or 3.0), sets the states and inputs of SCENARIO ("start" and the first row)
-    and prints JSON {"dd": ..., "fd": ...}: for each state and input (columns), the directional derivatives of
+    On a worker thread of 1 MiB of stack, instantiates the Model Exchange interface (FMI 2.0 or 3.0), sets the
+    states and inputs of SCENARIO ("start" and the first row) and prints JSON {"dd": ..., "fd": ...}: for each state and input (columns), the directional derivatives of
     the state derivatives and outputs (rows) from fmi2GetDirectionalDerivative, and the same by central
     differences of fmi2GetDerivatives and fmi2GetReal; and, as column indices, the dependencies ModelStructure
     lists for each row (null where it lists none, meaning every state and input).
@@ -21,6 +21,7 @@ import atexit
 import json
 import shutil
 import sys
+import threading
 
 import numpy as np
 from fmpy import extract, read_model_description, simulate_fmu
@@ -33,6 +34,26 @@ def unzipped(fmu):
     directory = extract(fmu)
     atexit.register(shutil.rmtree, directory, ignore_errors=True)
     return directory
+
+
+def on_worker_thread(function, *args):
+    """Runs `function(*args)` on a thread of 1 MiB of stack, as importers run FMUs on worker threads (the main
+    thread's 8 MiB would hide an FMU that keeps a large Jacobian on the stack), and re-raises what it raised."""
+    threading.stack_size(1 << 20)
+    outcome = {}
+
+    def run():
+        try:
+            outcome["value"] = function(*args)
+        except BaseException as e:  # noqa: BLE001 (re-raised on the calling thread)
+            outcome["error"] = e
+
+    worker = threading.Thread(target=run)
+    worker.start()
+    worker.join()
+    if "error" in outcome:
+        raise outcome["error"]
+    return outcome.get("value")
 
 
 def scenario(path):
@@ -325,7 +346,7 @@ def libcosim(fmu, stop, dt, path):
 
 if __name__ == "__main__":
     if sys.argv[1] == "simulate":
-        simulate(*sys.argv[2:8])
+        on_worker_thread(simulate, *sys.argv[2:8])
     elif sys.argv[1] == "interface":
         interface(sys.argv[2])
     elif sys.argv[1] == "libcosim":
@@ -333,4 +354,4 @@ if __name__ == "__main__":
     elif sys.argv[1] == "interface3":
         interface3(sys.argv[2])
     else:
-        jacobian(*sys.argv[2:4])
+        on_worker_thread(jacobian, *sys.argv[2:4])

@@ -3,6 +3,7 @@
 //! state derivatives, each in the generated module's order.
 
 use crate::model as m;
+use nalgebra::SMatrix;
 
 pub const NX: usize = m::N_STATES;
 pub const NU: usize = m::N_INPUTS;
@@ -69,18 +70,24 @@ pub fn outputs(p: &Params, t: f64, x: &[f64], u: &[f64], y: &mut [f64]) {
     y.copy_from_slice(out.as_slice());
 }
 
-/// `∂f/∂x` (fixed size, for the solver's LU decomposition).
-pub fn jac_x(p: &Params, t: f64, x: &[f64], u: &[f64]) -> m::JacX {
-    let mut jac = m::JacX::zeros();
-    m::jac_x_into(p, t, &state(x), &inputs(u), &mut jac);
-    jac
+/// An `R × C` matrix of zeros on the heap. The Jacobians of a model of a few hundred states do not fit the stack
+/// of the importing tool's thread, and `Box::new(SMatrix::zeros())` would build the matrix on the stack first.
+pub fn zeroed_matrix<const R: usize, const C: usize>() -> Box<SMatrix<f64, R, C>> {
+    // SAFETY: an `SMatrix<f64, R, C>` is an array of `R · C` `f64` (nalgebra's `ArrayStorage` in a `repr(C)`
+    // `Matrix`), and all-zero bits are the `f64` 0.0.
+    unsafe { Box::<SMatrix<f64, R, C>>::new_zeroed().assume_init() }
+}
+
+/// Writes `∂f/∂x` into `jac` (for the solver's LU decomposition).
+pub fn jac_x_into(p: &Params, t: f64, x: &[f64], u: &[f64], jac: &mut m::JacX) {
+    m::jac_x_into(p, t, &state(x), &inputs(u), jac);
 }
 
 /// The Jacobian of `(ẋ, y)` with respect to `(x, u)`: rows ẋ then y, columns x then u, column-major.
 pub fn full_jacobian(p: &Params, t: f64, x: &[f64], u: &[f64]) -> Vec<f64> {
     let (xs, us) = (state(x), inputs(u));
-    let (mut fx, mut fu) = (m::JacX::zeros(), m::JacU::zeros());
-    let (mut hx, mut hu) = (m::OutJacX::zeros(), m::OutJacU::zeros());
+    let (mut fx, mut fu) = (zeroed_matrix::<NX, NX>(), zeroed_matrix::<NX, NU>());
+    let (mut hx, mut hu) = (zeroed_matrix::<NY, NX>(), zeroed_matrix::<NY, NU>());
     m::jac_x_into(p, t, &xs, &us, &mut fx);
     m::jac_u_into(p, t, &xs, &us, &mut fu);
     m::output_jac_x_into(p, t, &xs, &us, &mut hx);

@@ -8,6 +8,7 @@
 //! instead of resolving them, which an explicit method would have to. The difference of the two last entries of
 //! the table's diagonal estimates the local error; the step size follows it.
 
+use crate::model as m;
 use crate::plant::{self, NX, Params};
 
 /// Substep counts 1..=K: order K.
@@ -30,6 +31,8 @@ pub struct Integrator {
 
 /// The buffers of one extrapolated step.
 struct Work {
+    /// `∂f/∂x` at the start of the step (on the heap: a large model's does not fit a thread's stack).
+    jac: Box<m::JacX>,
     /// `I − (h/n)·J`, row-major, decomposed in place.
     matrix: Vec<f64>,
     /// The row interchanges of the decomposition.
@@ -44,6 +47,7 @@ struct Work {
 impl Work {
     fn new() -> Work {
         Work {
+            jac: plant::zeroed_matrix(),
             matrix: vec![0.0; NX * NX],
             pivots: vec![0; NX],
             f0: vec![0.0; NX],
@@ -120,15 +124,15 @@ impl Integrator {
     /// One extrapolated step: leaves the new state at the end of the table (`Work::best`) and returns its error
     /// norm, or `None` when a matrix is singular or a value is not finite.
     fn try_step(&mut self, p: &Params, t: f64, h: f64, x: &[f64], u: &[f64]) -> Option<f64> {
-        let jac = plant::jac_x(p, t, x, u);
         let w = &mut self.work;
+        plant::jac_x_into(p, t, x, u, &mut w.jac);
         plant::rhs(p, t, x, u, &mut w.f0);
         for j in 0..K {
             let n = j + 1;
             let hs = h / n as f64;
             for r in 0..NX {
                 for c in 0..NX {
-                    w.matrix[r * NX + c] = f64::from(u8::from(r == c)) - jac[(r, c)] * hs;
+                    w.matrix[r * NX + c] = f64::from(u8::from(r == c)) - w.jac[(r, c)] * hs;
                 }
             }
             decompose(&mut w.matrix, &mut w.pivots)?;

@@ -360,7 +360,7 @@ fn no_state_space_warnings(compiled: &bgc::codegen::CompiledFile) -> Vec<&str> {
 /// Loops with more tears than generated code keeps on its stack are refused with the reason and the way out, not
 /// generated into matrices that overflow it (a ladder of 190 rungs with a resistance per resistor has 188); a
 /// smaller linear block is generated, and its module's `state_space` evaluates the Jacobians unless `A` is too
-/// large for that, which a warning says.
+/// large for that, which a warning says; the loops' correction of the Jacobians holds only the states it reaches.
 #[test]
 fn generated_loops_are_bounded_and_a_linear_block_has_its_state_space() {
     let text = crate::equations_support::families::ladder_distinct(190);
@@ -403,6 +403,19 @@ fn generated_loops_are_bounded_and_a_linear_block_has_its_state_space() {
     assert!(
         !module.contains("pub fn state_space("),
         "a state_space of 183 states"
+    );
+    // The loops' correction of `∂f/∂x` is taken where it can be, at the capacitor the ladder drives: its
+    // matrices are tears by that one state, not by all 183 (`rows × cols × N_TEARS` multiplications per call).
+    for shape in [
+        "    const LOOP_ROWS: [usize; 1] = [0];\n",
+        "    let mut rv = SMatrix::<f64, N_TEARS, 1>::zeros();\n",
+        "    let mut gz = SMatrix::<f64, 1, N_TEARS>::zeros();\n",
+    ] {
+        assert!(module.contains(shape), "no `{}`", shape.trim());
+    }
+    assert!(
+        !module.contains("N_TEARS, N_STATES>"),
+        "tears by all states"
     );
     // A ladder of four rungs keeps its loops in closed form and has its state space.
     let closed = crate::equations_support::families::ladder_distinct(4);

@@ -80,18 +80,34 @@ pub(crate) struct Plan {
 }
 
 impl Plan {
-    /// The bytes (and what its rows are) of the largest matrix that the generated Jacobian functions keep on the stack besides the one
-    /// they fill: the loops' `∂r/∂x` and `∂f/∂z` (tears × states, [`super::loops`]) and each mass block's rows
-    /// (rows × states, [`super::mass`]). A caller that keeps `JacX` itself off the stack (an FMU's solver) is
-    /// bound by this.
+    /// The bytes (and what its rows are) of the largest matrix that the generated Jacobian functions of the states
+    /// and inputs keep on the stack besides the one they fill: the loops' `∂r/∂z`, and `∂r/∂v` and `∂g/∂z` at the
+    /// columns and rows where the loops' correction can be ([`super::loops::correction_support`]), and each mass
+    /// block's rows by the states ([`super::mass`]). A caller that keeps `JacX` itself off the stack (an FMU's
+    /// solver) is bound by this.
     pub(crate) fn jacobian_stack_matrix(&self) -> (usize, &'static str) {
-        let n = self.states.len() * std::mem::size_of::<f64>();
-        let tears = self.loops.as_ref().map_or(0, |l| l.tears.len());
-        let block = self.mass.iter().map(|b| b.rows.len()).max().unwrap_or(0);
-        if tears >= block {
-            (tears * n, "the algebraic loops' tear variables")
+        let f64s = std::mem::size_of::<f64>();
+        let block = self.mass.iter().map(|b| b.rows.len()).max().unwrap_or(0) * self.states.len();
+        let loops = self.loops.as_ref().map_or(0, |l| {
+            let tears = l.tears.len();
+            let pairs = [
+                (&l.dfdz, &l.drdx),
+                (&l.dfdz, &l.drdu),
+                (&l.dhdz, &l.drdx),
+                (&l.dhdz, &l.drdu),
+            ];
+            pairs
+                .iter()
+                .map(|(g_z, r_v)| {
+                    let (rows, cols) = super::loops::correction_support(g_z, r_v);
+                    tears * rows.len().max(cols.len())
+                })
+                .fold(tears * tears, usize::max)
+        });
+        if loops >= block {
+            (loops * f64s, "the algebraic loops' tear variables")
         } else {
-            (block * n, "a mass block's rows")
+            (block * f64s, "a mass block's rows")
         }
     }
 }

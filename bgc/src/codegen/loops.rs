@@ -666,7 +666,8 @@ fn loop_values(p: &Params, t: f64, x: &State, u: &Inputs) -> Tears {
         let Some(lp) = &self.plan.loops else {
             return Vec::new();
         };
-        if !needs_correction(g_z, r_v) {
+        let (rows, cols) = correction_support(g_z, r_v);
+        if rows.is_empty() || cols.is_empty() {
             return Vec::new();
         }
         lp.drdz
@@ -679,59 +680,83 @@ fn loop_values(p: &Params, t: f64, x: &State, u: &Inputs) -> Tears {
             .collect()
     }
 
-    /// The lines that add `∂g/∂z dz/dv` to `jac` (`rows × cols`), `dz/dv = −(∂r/∂z)⁻¹ ∂r/∂v`.
-    pub(super) fn loop_correction(
-        &self,
-        d: &mut Draft,
-        g_z: &[Vec<Expr>],
-        r_v: &[Vec<Expr>],
-        (rows, cols): (&str, &str),
-    ) {
+    /// The lines that add `∂g/∂z dz/dv` to `jac`, `dz/dv = −(∂r/∂z)⁻¹ ∂r/∂v`, over the rows of
+    /// `∂g/∂z` and the columns of `∂r/∂v` that are not identically zero only ([`correction_support`]): the
+    /// matrices on the stack are `N_TEARS` by those, and the product costs their count times `N_TEARS`, not
+    /// `rows × cols × N_TEARS`.
+    pub(super) fn loop_correction(&self, d: &mut Draft, g_z: &[Vec<Expr>], r_v: &[Vec<Expr>]) {
         let Some(lp) = &self.plan.loops else {
             return;
         };
-        if !needs_correction(g_z, r_v) {
+        let (read_rows, read_cols) = correction_support(g_z, r_v);
+        if read_rows.is_empty() || read_cols.is_empty() {
             return;
         }
         d.lines.extend(self.comment_lines(
-            "Through the algebraic loops (implicit function theorem): dz = −(∂r/∂z)⁻¹ ∂r, jac += (∂/∂z) dz.",
+            "Through the algebraic loops (implicit function theorem): dz = −(∂r/∂z)⁻¹ ∂r, jac += (∂/∂z) dz, \
+             only at the rows that read a tear (`LOOP_ROWS`) and the columns that a residual reads (`LOOP_COLS`).",
         ));
+        let (n_rows, n_cols) = (read_rows.len(), read_cols.len());
+        for (name, list) in [("LOOP_ROWS", &read_rows), ("LOOP_COLS", &read_cols)] {
+            let items: Vec<String> = list.iter().map(usize::to_string).collect();
+            let head = format!("    const {name}: [usize; {}] = ", items.len());
+            d.lines.push(crate::codegen::format::array(
+                &head, &items, ";", 4, self.width,
+            ));
+        }
         d.lines
             .push("    let mut rz = SMatrix::<f64, N_TEARS, N_TEARS>::zeros();".into());
         d.lines.push(format!(
-            "    let mut rv = SMatrix::<f64, N_TEARS, {cols}>::zeros();"
+            "    let mut rv = SMatrix::<f64, N_TEARS, {n_cols}>::zeros();"
         ));
         d.lines.push(format!(
-            "    let mut gz = SMatrix::<f64, {rows}, N_TEARS>::zeros();"
+            "    let mut gz = SMatrix::<f64, {n_rows}, N_TEARS>::zeros();"
         ));
-        let cell = |m: &[Vec<Expr>], var: &str, sign: bool, d: &mut Draft| {
-            for (i, row) in m.iter().enumerate() {
-                for (j, e) in row.iter().enumerate() {
-                    if e.is_zero() {
-                        continue;
-                    }
-                    let value = if sign { -e } else { e.clone() };
-                    self.statement(
-                        d,
-                        &format!("{var}[{i}, {j}] = "),
-                        &value,
-                        &format!("{var}[({i}, {j})] = "),
-                        ";",
-                    );
-                }
+        let mut cell = |var: &str, i: usize, j: usize, e: &Expr, sign: bool| {
+            if e.is_zero() {
+                return;
             }
+            let value = if sign { -e } else { e.clone() };
+            self.statement(
+                d,
+                &format!("{var}[{i}, {j}] = "),
+                &value,
+                &format!("{var}[({i}, {j})] = "),
+                ";",
+            );
         };
-        cell(&lp.drdz, "rz", false, d);
-        cell(r_v, "rv", true, d);
-        cell(g_z, "gz", false, d);
+        for (i, row) in lp.drdz.iter().enumerate() {
+            for (j, e) in row.iter().enumerate() {
+                cell("rz", i, j, e, false);
+            }
+        }
+        for (k, row) in r_v.iter().enumerate() {
+            for (j, &col) in read_cols.iter().enumerate() {
+                cell("rv", k, j, &row[col], true);
+            }
+        }
+        for (i, &row) in read_rows.iter().enumerate() {
+            for (k, e) in g_z[row].iter().enumerate() {
+                cell("gz", i, k, e, false);
+            }
+        }
         d.lines.push("    let dz = bgc_solve(rz, rv);".into());
-        d.lines.push(format!(
-            "    for row in 0..{rows} {{\n        for col in 0..{cols} {{\n            for k in 0..N_TEARS {{\n                jac[(row, col)] += gz[(row, k)] * dz[(k, col)];\n            }}\n        }}\n    }}"
-        ));
+        d.lines.push(
+            "    for (i, &row) in LOOP_ROWS.iter().enumerate() {\n        for (j, &col) in LOOP_COLS.iter().enumerate() {\n            for k in 0..N_TEARS {\n                jac[(row, col)] += gz[(i, k)] * dz[(k, j)];\n            }\n        }\n    }"
+                .into(),
+        );
     }
 }
 
-/// The correction is zero when `∂g/∂z` or `∂r/∂v` is.
-fn needs_correction(g_z: &[Vec<Expr>], r_v: &[Vec<Expr>]) -> bool {
-    g_z.iter().flatten().any(|e| !e.is_zero()) && r_v.iter().flatten().any(|e| !e.is_zero())
+/// The rows of `∂g/∂z` and the columns of `∂r/∂v` that are not identically zero: where the loops' correction of
+/// a Jacobian can be (it is zero when either list is empty).
+pub(crate) fn correction_support(g_z: &[Vec<Expr>], r_v: &[Vec<Expr>]) -> (Vec<usize>, Vec<usize>) {
+    let rows = (0..g_z.len())
+        .filter(|&i| g_z[i].iter().any(|e| !e.is_zero()))
+        .collect();
+    let width = r_v.first().map_or(0, Vec::len);
+    let cols = (0..width)
+        .filter(|&j| r_v.iter().any(|r| r.get(j).is_some_and(|e| !e.is_zero())))
+        .collect();
+    (rows, cols)
 }

@@ -140,8 +140,8 @@ fn check_size(chosen: &CompiledModel) -> Result<(), String> {
     if bytes > MAX_STACK_MATRIX_BYTES {
         let (kib, bound) = (bytes / 1024, MAX_STACK_MATRIX_BYTES / 1024);
         return Err(format!(
-            "model `{name}` has {states} states: its Jacobian functions keep a matrix of {rows} by the states \
-             ({kib} KiB) on the stack of the importing tool's thread, more than the {bound} KiB an FMU allows; \
+            "model `{name}` has {states} states: its Jacobian functions keep a matrix of {rows} by states, \
+             inputs or outputs ({kib} KiB) on the stack of the importing tool's thread, more than the {bound} KiB an FMU allows; \
              simulate it with `bgc simulate`, or generate its Rust module with `bgc rust`"
         ));
     }

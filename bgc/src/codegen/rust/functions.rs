@@ -427,12 +427,12 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             );
         }
         let plan = self.plan;
-        let (g_z, r_v, size) = match (name, &plan.loops) {
-            ("jac_x_into", Some(l)) => (&l.dfdz[..], &l.drdx[..], ("N_STATES", "N_STATES")),
-            ("jac_u_into", Some(l)) => (&l.dfdz[..], &l.drdu[..], ("N_STATES", "N_INPUTS")),
-            ("output_jac_x_into", Some(l)) => (&l.dhdz[..], &l.drdx[..], ("N_OUTPUTS", "N_STATES")),
-            ("output_jac_u_into", Some(l)) => (&l.dhdz[..], &l.drdu[..], ("N_OUTPUTS", "N_INPUTS")),
-            _ => (&[][..], &[][..], ("", "")),
+        let (g_z, r_v) = match (name, &plan.loops) {
+            ("jac_x_into", Some(l)) => (&l.dfdz[..], &l.drdx[..]),
+            ("jac_u_into", Some(l)) => (&l.dfdz[..], &l.drdu[..]),
+            ("output_jac_x_into", Some(l)) => (&l.dhdz[..], &l.drdx[..]),
+            ("output_jac_u_into", Some(l)) => (&l.dhdz[..], &l.drdu[..]),
+            _ => (&[][..], &[][..]),
         };
         let correction = self.loop_correction_exprs(g_z, r_v);
         nonzero.extend(correction.iter());
@@ -449,7 +449,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             self.solve_tears(&mut d, &nonzero);
             self.shared_statements(&mut d, shared);
             self.matrix_entries(&mut d, m.iter(), (rows, cols, row_prefix));
-            self.loop_correction(&mut d, g_z, r_v, size);
+            self.loop_correction(&mut d, g_z, r_v);
             match name {
                 "jac_x_into" => self.mass_solve_in_jacobian(&mut d, MassColumns::States),
                 // Without inputs `∂f/∂u` has no columns to solve for (and an empty loop fails `clippy`).

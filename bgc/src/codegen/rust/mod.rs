@@ -305,7 +305,7 @@ pub(in crate::codegen) struct Writer<'a> {
     /// Rust name of every parameter (a field, or the method of a derived parameter), in parameter order.
     all_fields: Vec<String>,
     /// The columns of a line.
-    width: usize,
+    pub(in crate::codegen) width: usize,
     /// The Jacobians whose bodies read neither `t`, `x` nor `u` (those of a linear model): `Model` computes them
     /// once per parameter set.
     constant_jacobians: Vec<model::ConstantJacobian>,

@@ -98,8 +98,7 @@ pub type OutJacP = SMatrix<f64, N_OUTPUTS, N_PARAMS>;
         self.solve_tears(&mut d, &needed);
         self.shared_statements(&mut d, shared);
         self.matrix_entries(&mut d, entries, (rows, cols, row_prefix));
-        let size = if mass { "N_STATES" } else { "N_OUTPUTS" };
-        self.loop_correction(&mut d, g_z, r_p, (size, "N_PARAMS"));
+        self.loop_correction(&mut d, g_z, r_p);
         if solve_mass {
             self.mass_solve_in_jacobian(&mut d, MassColumns::Params);
         }

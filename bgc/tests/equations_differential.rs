@@ -15,7 +15,8 @@
 //! `RF` with a constant symmetric matrix on random junctions (an `IF`: `e = s M f`; a `CF`: `s e = K f`; an `RF`:
 //! `e = R f`, with each port's flow counted into the field); structures that give storages in
 //! derivative causality and resistive loops occur. Cases that bgc rightly refuses (an output that needs an input's
-//! derivative, causal conflicts) are skipped.
+//! derivative, causal conflicts) are skipped. A linear graph whose loops bgc keeps as a block solved numerically
+//! (larger graphs, `LARGE`) is compared through its linearisation at the origin.
 
 // Index loops read like the textbook elimination and matrix products they implement.
 #![allow(clippy::needless_range_loop)]
@@ -23,7 +24,9 @@
 use crate::equations_support;
 
 use bgc::causality::analyse;
-use bgc::equations::{StateSelection, derive, numeric_state_space};
+use bgc::equations::{
+    StateSelection, derive, linear_through_loops, linearise, numeric_state_space,
+};
 use bgc::ir::Model;
 use bgc::syntax::ast::ElementKind as K;
 use equations_support::*;
@@ -32,11 +35,34 @@ use petgraph::graph::NodeIndex;
 use petgraph::visit::EdgeRef;
 use proptest::prelude::*;
 
+/// The sizes of the random graphs: up to `junctions + 1` junctions, `ports + 1` one-ports besides the two sources,
+/// and `closing - 1` bonds that close loops in the junction structure.
+#[derive(Clone, Copy)]
+struct Sizes {
+    junctions: u64,
+    ports: u64,
+    closing: u64,
+}
+
+/// The graphs the property test draws: small enough for their loops to be solved in closed form.
+const SMALL: Sizes = Sizes {
+    junctions: 3,
+    ports: 4,
+    closing: 3,
+};
+
+/// Larger graphs, among which some keep their resistive loops as a linear block solved numerically.
+const LARGE: Sizes = Sizes {
+    junctions: 12,
+    ports: 14,
+    closing: 8,
+};
+
 /// The one-ports of the model, with their kind, for the outputs.
-fn random_model(seed: u64) -> (Model, Vec<(String, K)>) {
+fn random_model(seed: u64, sizes: Sizes) -> (Model, Vec<(String, K)>) {
     let mut g = Gen(seed);
     let mut b = Builder::new("random");
-    let junctions: Vec<_> = (0..2 + g.below(3))
+    let junctions: Vec<_> = (0..2 + g.below(sizes.junctions))
         .map(|k| {
             let kind = if g.coin() { K::Zero } else { K::One };
             b.junction(kind, &format!("j{k}"))
@@ -71,7 +97,7 @@ fn random_model(seed: u64) -> (Model, Vec<(String, K)>) {
         }
     }
     let mut ports = Vec::new();
-    let count = 2 + g.below(4);
+    let count = 2 + g.below(sizes.ports);
     for k in 0..count {
         let kind = [K::C, K::I, K::R][g.below(3) as usize];
         let value = b.param(&format!("v{k}"), g.value());
@@ -90,7 +116,7 @@ fn random_model(seed: u64) -> (Model, Vec<(String, K)>) {
         ports.push((name, kind));
     }
     // Loops in the junction structure: bonds (or TFs and GYs) between junctions the tree already joins.
-    for k in 0..g.below(3) {
+    for k in 0..g.below(sizes.closing) {
         let x = junctions[g.below(junctions.len() as u64) as usize];
         let y = junctions[g.below(junctions.len() as u64) as usize];
         if x == y {
@@ -434,23 +460,40 @@ fn state_space_transfer(ss: &bgc::equations::NumericStateSpace, s: Cx) -> Option
     Some(out)
 }
 
-fn compare(seed: u64) -> Result<bool, TestCaseError> {
-    let (model, _) = random_model(seed);
+/// How a graph was compared: not at all (a case bgc rightly refuses), through bgc's state space, or through the
+/// linearisation of a linear model whose loops are a block solved numerically (exactly its state space).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Compared {
+    No,
+    StateSpace,
+    ThroughLoops,
+}
+
+fn compare(seed: u64, sizes: Sizes) -> Result<Compared, TestCaseError> {
+    let (model, _) = random_model(seed, sizes);
     let (causality, _) = analyse(&model);
     if !causality.consistent {
-        return Ok(false);
+        return Ok(Compared::No);
     }
     let (eqs, diags) = derive(&model, &causality);
     if bgc::diagnostic::has_errors(&diags) {
-        return Ok(false);
+        return Ok(Compared::No);
     }
     let params = eqs.default_params();
-    let Ok(ss) = numeric_state_space(&eqs, StateSelection::Energy, &params) else {
-        return Ok(false);
+    let (ss, how) = match numeric_state_space(&eqs, StateSelection::Energy, &params) {
+        Ok(ss) => (ss, Compared::StateSpace),
+        Err(_) if linear_through_loops(&eqs, StateSelection::Energy) => {
+            let n = eqs.state_count(StateSelection::Energy);
+            let (x0, u0) = (vec![0.0; n], vec![0.0; eqs.inputs.len()]);
+            let ss = linearise(&eqs, StateSelection::Energy, &params, &x0, &u0, 0.0)
+                .map_err(|e| TestCaseError::fail(format!("seed {seed}: {e}")))?;
+            (ss, Compared::ThroughLoops)
+        }
+        Err(_) => return Ok(Compared::No),
     };
     for s in [Cx(0.3, 1.1), Cx(-0.2, 2.7), Cx(1.5, -0.4)] {
         let Some(want) = descriptor_transfer(&model, &params, s) else {
-            return Ok(false);
+            return Ok(Compared::No);
         };
         let got =
             state_space_transfer(&ss, s).ok_or_else(|| TestCaseError::fail("sI - A singular"))?;
@@ -465,7 +508,7 @@ fn compare(seed: u64) -> Result<bool, TestCaseError> {
             }
         }
     }
-    Ok(true)
+    Ok(how)
 }
 
 proptest! {
@@ -473,7 +516,7 @@ proptest! {
 
     #[test]
     fn linear_graphs_match_the_descriptor_formulation(seed in any::<u64>()) {
-        compare(seed)?;
+        compare(seed, SMALL)?;
     }
 }
 
@@ -483,9 +526,9 @@ proptest! {
 fn most_random_graphs_are_compared() {
     let (mut compared, mut loops, mut fields) = (0, 0, [0; 3]);
     for seed in 0..256u64 {
-        if compare(seed).unwrap_or_else(|e| panic!("{e}")) {
+        if compare(seed, SMALL).unwrap_or_else(|e| panic!("{e}")) != Compared::No {
             compared += 1;
-            let model = random_model(seed).0;
+            let model = random_model(seed, SMALL).0;
             loops += usize::from(has_junction_loop(&model));
             for (count, kind) in fields.iter_mut().zip([K::IF, K::CF, K::RF]) {
                 *count += model
@@ -508,4 +551,19 @@ fn most_random_graphs_are_compared() {
         fields.iter().all(|&n| n >= 3),
         "compared graphs with an IF, a CF, an RF: {fields:?}"
     );
+}
+
+/// Larger graphs whose resistive loops bgc keeps as a linear block solved numerically: their state space, from
+/// the Jacobians at the origin through the block, matches the descriptor formulation. These are the 14 such
+/// graphs among seeds 5,000 to 24,999 of the large generator (2,973 of those 20,000 graphs were compared, none
+/// differed); the property test's small graphs never need a block.
+#[test]
+fn linear_loop_blocks_match_the_descriptor_formulation() {
+    let seeds = [
+        7112, 7466, 7543, 8088, 9911, 11992, 14395, 15363, 17253, 17472, 20734, 21135, 22500, 24881,
+    ];
+    for seed in seeds {
+        let how = compare(seed, LARGE).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(how, Compared::ThroughLoops, "seed {seed}");
+    }
 }

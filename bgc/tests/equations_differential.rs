@@ -35,29 +35,6 @@ use petgraph::graph::NodeIndex;
 use petgraph::visit::EdgeRef;
 use proptest::prelude::*;
 
-/// The sizes of the random graphs: up to `junctions + 1` junctions, `ports + 1` one-ports besides the two sources,
-/// and `closing - 1` bonds that close loops in the junction structure.
-#[derive(Clone, Copy)]
-struct Sizes {
-    junctions: u64,
-    ports: u64,
-    closing: u64,
-}
-
-/// The graphs the property test draws: small enough for their loops to be solved in closed form.
-const SMALL: Sizes = Sizes {
-    junctions: 3,
-    ports: 4,
-    closing: 3,
-};
-
-/// Larger graphs, among which some keep their resistive loops as a linear block solved numerically.
-const LARGE: Sizes = Sizes {
-    junctions: 12,
-    ports: 14,
-    closing: 8,
-};
-
 /// The one-ports of the model, with their kind, for the outputs.
 fn random_model(seed: u64, sizes: Sizes) -> (Model, Vec<(String, K)>) {
     let mut g = Gen(seed);

@@ -101,11 +101,11 @@ fn wave(g: &mut Gen, storages: &[(NodeIndex, K)], w: &Expr) -> Expr {
     }
 }
 
-fn random_model(seed: u64, rewrite: &Rewrite) -> Model {
+fn random_model(seed: u64, sizes: Sizes, rewrite: &Rewrite) -> Model {
     let mut g = Gen(seed);
     let mut b = Builder::new("modulated");
     let w = b.input("w");
-    let junctions: Vec<NodeIndex> = (0..2 + g.below(3))
+    let junctions: Vec<NodeIndex> = (0..2 + g.below(sizes.junctions))
         .map(|k| {
             let kind = if g.coin() { K::Zero } else { K::One };
             b.junction(kind, &format!("j{k}"))
@@ -136,7 +136,7 @@ fn random_model(seed: u64, rewrite: &Rewrite) -> Model {
     }
     let mut one_ports = Vec::new();
     let mut storages = Vec::new();
-    for k in 0..2 + g.below(4) {
+    for k in 0..2 + g.below(sizes.ports) {
         let kind = [K::C, K::I, K::R][g.below(3) as usize];
         let node = b.node(kind, &format!("x{k}"), Relation::Junction);
         b.model.graph[node].relation = one_port_law(&mut b, &mut g, (kind, node, k), rewrite);
@@ -172,7 +172,7 @@ fn random_model(seed: u64, rewrite: &Rewrite) -> Model {
         b.model.graph[node].relation = Relation::Modulus(mul(n, add(c(1.0), mul(c(0.3), wave))));
     }
     // Loops in the junction structure: bonds and two-ports between junctions the tree already joins.
-    for k in 0..g.below(3) {
+    for k in 0..g.below(sizes.closing) {
         let x = junctions[g.below(junctions.len() as u64) as usize];
         let y = junctions[g.below(junctions.len() as u64) as usize];
         if x == y {
@@ -264,12 +264,12 @@ struct Case {
 
 /// The model of a seed with every R's cubic law in the form its causality needs and linear laws on its storages in
 /// derivative causality.
-fn model_and_causality(seed: u64) -> (Model, bgc::causality::Causality) {
+fn model_and_causality(seed: u64, sizes: Sizes) -> (Model, bgc::causality::Causality) {
     let mut rewrite = Rewrite::default();
     let mut round = 0;
     loop {
         round += 1;
-        let model = random_model(seed, &rewrite);
+        let model = random_model(seed, sizes, &rewrite);
         let (causality, _) = analyse(&model);
         let turn: Vec<NodeIndex> = causality.inverted_laws.iter().map(|l| l.0).collect();
         let cubic = |n: &NodeIndex| matches!(model.graph[*n].relation, Relation::Laws(_));
@@ -291,14 +291,17 @@ fn model_and_causality(seed: u64) -> (Model, bgc::causality::Causality) {
 
 /// The graphs of up to eight draws from `seed` that bgc accepts (the others mostly need an input's derivative,
 /// `BG0602`, `BG0604`).
-fn prepare(seed: u64) -> impl Iterator<Item = Case> {
+fn prepare(seed: u64, sizes: Sizes) -> impl Iterator<Item = Case> {
     (0..8u64).filter_map(move |draw| {
-        prepare_graph(seed.wrapping_add(draw.wrapping_mul(0x9E37_79B9_7F4A_7C15)))
+        prepare_graph(
+            seed.wrapping_add(draw.wrapping_mul(0x9E37_79B9_7F4A_7C15)),
+            sizes,
+        )
     })
 }
 
-fn prepare_graph(seed: u64) -> Option<Case> {
-    let (model, causality) = model_and_causality(seed);
+fn prepare_graph(seed: u64, sizes: Sizes) -> Option<Case> {
+    let (model, causality) = model_and_causality(seed, sizes);
     if !causality.consistent {
         return None;
     }
@@ -376,7 +379,7 @@ fn check(case: &Case, flip: Flip) -> Result<(), Mismatch> {
 /// else whether the compared graph has a storage in derivative causality and whether it has a loop in its junction
 /// structure.
 fn compare(seed: u64) -> Result<Option<(bool, bool)>, String> {
-    for case in prepare(seed) {
+    for case in prepare(seed, SMALL) {
         match check(&case, Flip::Nothing) {
             Ok(()) => {
                 let dependent = !case.dependent.is_empty();
@@ -426,7 +429,7 @@ fn most_modulated_graphs_are_compared() {
 #[test]
 fn a_flipped_sign_in_the_reference_is_caught() {
     let cases: Vec<Case> = (0..64u64)
-        .flat_map(|seed| prepare(seed).take(2))
+        .flat_map(|seed| prepare(seed, SMALL).take(2))
         .filter(|case| check(case, Flip::Nothing).is_ok())
         .collect();
     for flip in FLIPS {
@@ -440,5 +443,31 @@ fn a_flipped_sign_in_the_reference_is_caught() {
             derivative.any(|c| caught(&c)),
             "{flip:?} in the reference went unnoticed in every graph with derivative causality"
         );
+    }
+}
+
+/// The larger graphs swept for [`a_loop_with_a_cubed_cancelling_sum_is_solved_to_its_root`].
+const SWEPT: Sizes = Sizes {
+    junctions: 10,
+    ports: 12,
+    closing: 6,
+};
+
+/// A larger graph (seed 1696 of the generator at [`SWEPT`] sizes) whose nonlinear loop has a residual with the cube of a
+/// cancelling sum: the convergence test's scale counted that sum's error cubed (5e11 at the first point), so
+/// Newton's method stopped at a residual of -0.027 and the rates were off by 1e-3. Of 3,000 such graphs (seeds
+/// 300 to 3,299, 2,558 compared, 337 with loops solved numerically) it was the one that differed; seeds 3,300 to
+/// 9,299 (5,098 compared, 626 with such loops) differ nowhere.
+#[test]
+fn a_loop_with_a_cubed_cancelling_sum_is_solved_to_its_root() {
+    let Some(case) = prepare(1696, SWEPT).next() else {
+        panic!("seed 1696 gives no graph bgc accepts")
+    };
+    assert!(
+        !case.eqs.tear_blocks.is_empty(),
+        "no loop solved numerically"
+    );
+    if let Err(e) = check(&case, Flip::Nothing) {
+        panic!("{e:?}");
     }
 }

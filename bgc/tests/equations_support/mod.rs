@@ -342,6 +342,29 @@ pub fn solve(mut a: Vec<Vec<Cx>>, mut b: Vec<Cx>) -> Option<Vec<Cx>> {
     Some(x)
 }
 
+/// The sizes of the differential tests' random graphs: up to `junctions + 1` junctions, `ports + 1` one-ports besides the two sources,
+/// and `closing - 1` bonds that close loops in the junction structure.
+#[derive(Clone, Copy)]
+pub struct Sizes {
+    pub junctions: u64,
+    pub ports: u64,
+    pub closing: u64,
+}
+
+/// The graphs the property test draws: small enough for their loops to be solved in closed form.
+pub const SMALL: Sizes = Sizes {
+    junctions: 3,
+    ports: 4,
+    closing: 3,
+};
+
+/// Larger graphs, among which some keep their resistive loops as a block solved numerically.
+pub const LARGE: Sizes = Sizes {
+    junctions: 12,
+    ports: 14,
+    closing: 8,
+};
+
 /// A small deterministic generator driven by proptest's seed.
 pub struct Gen(pub u64);
 impl Gen {

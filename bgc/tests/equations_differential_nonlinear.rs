@@ -559,7 +559,9 @@ fn energy_terms_balance_power_along_the_motion() {
             Err(why) => panic!("seed {seed}: {why}"),
         }
     }
-    eprintln!("{compared} graphs compared, {derivative} with derivative causality, {loops} with loops");
+    eprintln!(
+        "{compared} graphs compared, {derivative} with derivative causality, {loops} with loops"
+    );
     assert!(compared >= 250, "only {compared} graphs compared");
     assert!(
         derivative >= 50,

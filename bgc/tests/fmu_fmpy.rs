@@ -75,15 +75,10 @@ const WIDE: Scenario = Scenario {
 
 /// 400 states, a state Jacobian of 1.25 MiB: the FMU's solver and its directional derivatives held it on the
 /// stack, which a 1 MiB worker thread (the driver runs FMPy on one) does not have, and `bgc fmu` refused models of
-/// more than 181 states; both keep it on the heap now.
+/// more than 181 states; both keep it on the heap now. The same input and run as `WIDE`.
 const LONG_CHAIN: Scenario = Scenario {
     model: "bgc/tests/fmu_support/long_chain.bg",
-    t_end: 0.5,
-    dt: 5e-3,
-    inputs: &[("u", "step(0.1)")],
-    rows: &[&[0.0, 0.0], &[0.1, 0.0], &[0.1, 1.0], &[0.5, 1.0]],
-    x0: &[],
-    jumps: &[0.1],
+    ..WIDE
 };
 
 /// The required agreement with `bgc simulate`, relative to each output's range.

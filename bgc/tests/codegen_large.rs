@@ -5,7 +5,7 @@
 
 use crate::codegen_support::rustc::build_and_run;
 use crate::codegen_support::{generate_text, scratch};
-use crate::equations_support::families::benchmark_chain;
+use crate::equations_support::families::{self, benchmark_chain};
 use crate::loops_globalised::LIBM_STD;
 use bgc::codegen::rust::Options;
 
@@ -431,4 +431,31 @@ fn generated_loops_are_bounded_and_a_linear_block_has_its_state_space() {
     }
     let lines = module.lines().count();
     assert!(lines < 3_500, "{lines} lines");
+}
+
+/// Loops whose tears reach many states: the generated Jacobians keep `rv`, `gz` and `dz` of tears by those states on
+/// the stack, and above 256 KiB a warning says so and what to do (30 tears by 1,110 states: 260 KiB); 30 tears by
+/// 1,080 states (253 KiB) compile without it.
+#[test]
+fn jacobian_matrices_above_256_kib_on_the_stack_are_a_warning() {
+    let warnings = |text: &str| -> Vec<String> {
+        let compiled = compile("loops.bg", text).unwrap_or_else(|d| panic!("{d:?}"));
+        compiled
+            .warnings
+            .iter()
+            .filter(|d| d.code.0 == "BG0703")
+            .map(|d| format!("{} / {}", d.message, d.help.clone().unwrap_or_default()))
+            .collect()
+    };
+    let large = warnings(&families::loops_in_series(30, 37));
+    assert_eq!(large.len(), 1, "{large:?}");
+    for part in [
+        "the generated Jacobian functions of `star` keep a matrix of the algebraic loops' tear variables",
+        "(260 KiB) on the stack",
+        "std::thread::Builder::stack_size",
+        "`bgc fmu` refuses",
+    ] {
+        assert!(large[0].contains(part), "{part}: {}", large[0]);
+    }
+    assert!(warnings(&families::loops_in_series(30, 36)).is_empty());
 }

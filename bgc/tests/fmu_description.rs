@@ -10,6 +10,7 @@
 //! `tau_h = k_eh q_c + d_eh (ω_sext − ω_h)` on omega_h, p_sensor_out and q_coupling_spring (17 25 26), whatever
 //! the values of the parameters (d_eh is 0 by default, and still a dependency).
 
+use crate::equations_support::families;
 use bgc::build::FsLoader;
 use bgc::fmu::{Version, package_sources};
 use bgc::span::SourceMap;
@@ -104,24 +105,6 @@ fn star(n: usize) -> String {
     s + "}\n"
 }
 
-/// `loops` diode loops (one tear variable each, as `corpus/diode_rc.bg`), each with `caps` capacitors in series:
-/// every capacitor's rate reads its loop's tear, and every loop's residual reads its capacitors' charges.
-fn loops_in_series(loops: usize, caps: usize) -> String {
-    let mut s = String::from(
-        "model star {\n    domain electrical;\n    input u [V];\n    param I_s = 1e-6 [A];\n    param V_t = 0.05 [V];\n",
-    );
-    for k in 1..=loops {
-        s += &format!(
-            "    Se s{k} = u;\n    1 l{k};\n    R r{k} = 100;\n    R d{k} {{ f = I_s * (exp(e / V_t) - 1); }}\n    \
-             bond s{k} -> l{k} -> r{k}, d{k};\n"
-        );
-        for c in 1..=caps {
-            s += &format!("    C c{k}_{c} = 1e-3;\n    bond l{k} -> c{k}_{c};\n");
-        }
-    }
-    s + "}\n"
-}
-
 fn package(text: String) -> Result<bgc::fmu::Sources, String> {
     let mut sources = SourceMap::new();
     let root = sources.add("star.bg", text);
@@ -151,8 +134,8 @@ fn a_model_of_more_than_4096_states_is_refused_with_its_reason() {
 /// packaged, 30 by 1,110 (266,400 bytes, over 256 KiB) refused.
 #[test]
 fn loops_whose_jacobian_matrices_exceed_256_kib_are_refused() {
-    package(loops_in_series(30, 36)).unwrap_or_else(|e| panic!("{e}"));
-    let Err(err) = package(loops_in_series(30, 37)) else {
+    package(families::loops_in_series(30, 36)).unwrap_or_else(|e| panic!("{e}"));
+    let Err(err) = package(families::loops_in_series(30, 37)) else {
         panic!("30 tears by 1,110 states were packaged")
     };
     assert!(err.contains("model `star` has 1110 states"), "{err}");

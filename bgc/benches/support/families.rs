@@ -149,3 +149,21 @@ pub fn parallel_pairs(n: usize) -> String {
     }
     s + "}\n"
 }
+
+/// `loops` diode loops (one tear variable each, as `bgc/tests/corpus/diode_rc.bg`), each with `caps` capacitors in series:
+/// every capacitor's rate reads its loop's tear, and every loop's residual reads its capacitors' charges.
+pub fn loops_in_series(loops: usize, caps: usize) -> String {
+    let mut s = String::from(
+        "model star {\n    domain electrical;\n    input u [V];\n    param I_s = 1e-6 [A];\n    param V_t = 0.05 [V];\n",
+    );
+    for k in 1..=loops {
+        s += &format!(
+            "    Se s{k} = u;\n    1 l{k};\n    R r{k} = 100;\n    R d{k} {{ f = I_s * (exp(e / V_t) - 1); }}\n    \
+             bond s{k} -> l{k} -> r{k}, d{k};\n"
+        );
+        for c in 1..=caps {
+            s += &format!("    C c{k}_{c} = 1e-3;\n    bond l{k} -> c{k}_{c};\n");
+        }
+    }
+    s + "}\n"
+}

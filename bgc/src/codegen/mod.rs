@@ -16,6 +16,7 @@
 //! | BG0700 | the file declares no `model` (components alone generate nothing) |
 //! | BG0701 | equations that cannot be generated (incomplete, or an expression with no value in code) |
 //! | BG0702 | warning: a linear model whose loops are solved numerically and which has more than 181 states gets no `state_space` |
+//! | BG0703 | warning: the generated Jacobians keep a matrix of more than 256 KiB on the stack (loops' tears or a mass block's rows by the states they reach) |
 
 mod adapter;
 pub(crate) mod emit;
@@ -43,6 +44,7 @@ pub mod codes {
     pub const NO_MODEL: &str = "BG0700";
     pub const NOT_GENERATABLE: &str = "BG0701";
     pub const NO_STATE_SPACE: &str = "BG0702";
+    pub const LARGE_STACK_MATRIX: &str = "BG0703";
 }
 
 /// One model with its derived equations.
@@ -113,6 +115,9 @@ pub fn compile(
         if plan.linear_through_loops && !rust::state_space_through_loops(&plan) {
             diags.push(no_state_space_note(&model, &equations));
         }
+        if let Some(d) = large_stack_matrix_warning(&model, &plan) {
+            diags.push(d);
+        }
         compiled.push(CompiledModel {
             model,
             equations,
@@ -144,6 +149,32 @@ fn no_state_space_note(model: &ir::Model, eqs: &crate::equations::Equations) -> 
     .with_help(
         "`bgc statespace` prints its A, B, C and D (`--sparse` as triplets); with at most 181 states the module's \
          `state_space` evaluates its Jacobians at the origin",
+    )
+}
+
+/// The warning for generated Jacobian functions that keep a matrix larger than the generated code's bound for
+/// dense matrices on the stack ([`rust::MAX_CONSTANT_JACOBIAN_BYTES`]): they still compute, but a thread with a
+/// small stack (2 MiB for a spawned thread, less in a debug build, which keeps copies) overflows in them.
+fn large_stack_matrix_warning(model: &ir::Model, plan: &emit::Plan) -> Option<Diagnostic> {
+    let (bytes, rows) = plan.jacobian_stack_matrix();
+    if bytes <= rust::MAX_CONSTANT_JACOBIAN_BYTES {
+        return None;
+    }
+    let kib = bytes / 1024;
+    Some(
+        Diagnostic::warning(
+            codes::LARGE_STACK_MATRIX,
+            format!(
+                "the generated Jacobian functions of `{}` keep a matrix of {rows} by states, inputs or outputs \
+                 ({kib} KiB) on the stack",
+                model.name
+            ),
+        )
+        .with_primary(model.spans.model, "this model")
+        .with_help(format!(
+            "call `jac_x_into` and the other Jacobians on a thread with a stack well above {kib} KiB \
+             (`std::thread::Builder::stack_size`); `bgc fmu` refuses such a model"
+        )),
     )
 }
 

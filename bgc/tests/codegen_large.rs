@@ -347,14 +347,19 @@ fn compile(
     bgc::codegen::compile(&mut sources, id, &mut bgc::lower::MemoryLoader::new())
 }
 
-/// The messages of the BG0702 warnings of `compiled`.
-fn no_state_space_warnings(compiled: &bgc::codegen::CompiledFile) -> Vec<&str> {
+/// The warnings of code `code` in `compiled`: each message, then its help.
+fn warnings_of(compiled: &bgc::codegen::CompiledFile, code: &str) -> Vec<String> {
     compiled
         .warnings
         .iter()
-        .filter(|d| d.code.0 == "BG0702")
-        .map(|d| d.message.as_str())
+        .filter(|d| d.code.0 == code)
+        .map(|d| format!("{} / {}", d.message, d.help.clone().unwrap_or_default()))
         .collect()
+}
+
+/// The BG0702 warnings of `compiled`.
+fn no_state_space_warnings(compiled: &bgc::codegen::CompiledFile) -> Vec<String> {
+    warnings_of(compiled, "BG0702")
 }
 
 /// Loops with more tears than generated code keeps on its stack are refused with the reason and the way out, not
@@ -438,14 +443,9 @@ fn generated_loops_are_bounded_and_a_linear_block_has_its_state_space() {
 /// 1,080 states (253 KiB) compile without it.
 #[test]
 fn jacobian_matrices_above_256_kib_on_the_stack_are_a_warning() {
-    let warnings = |text: &str| -> Vec<String> {
+    let warnings = |text: &str| {
         let compiled = compile("loops.bg", text).unwrap_or_else(|d| panic!("{d:?}"));
-        compiled
-            .warnings
-            .iter()
-            .filter(|d| d.code.0 == "BG0703")
-            .map(|d| format!("{} / {}", d.message, d.help.clone().unwrap_or_default()))
-            .collect()
+        warnings_of(&compiled, "BG0703")
     };
     let large = warnings(&families::loops_in_series(30, 37));
     assert_eq!(large.len(), 1, "{large:?}");

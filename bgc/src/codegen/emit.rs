@@ -81,11 +81,12 @@ pub(crate) struct Plan {
 
 impl Plan {
     /// The bytes (and what its rows are) of the largest matrix that the generated Jacobian functions of the states
-    /// and inputs keep on the stack besides the one they fill: the loops' `∂r/∂z`, and `∂r/∂v` and `∂g/∂z` at the
-    /// columns and rows where the loops' correction can be ([`super::loops::correction_support`]), and each mass
-    /// block's rows by the states ([`super::mass`]). A caller that keeps `JacX` itself off the stack (an FMU's
-    /// solver) is bound by this.
-    pub(crate) fn jacobian_stack_matrix(&self) -> (usize, &'static str) {
+    /// and inputs keep on the stack besides the one they fill, when it exceeds the generated code's bound for dense
+    /// matrices ([`super::rust::MAX_CONSTANT_JACOBIAN_BYTES`]): the loops' `∂r/∂z`, and `∂r/∂v` and `∂g/∂z` at
+    /// the columns and rows where the loops' correction can be ([`super::loops::correction_support`]), and each
+    /// mass block's rows by the states ([`super::mass`]). Warned about by `compile` (BG0703) and refused by an FMU,
+    /// whose solver keeps `JacX` itself off the stack.
+    pub(crate) fn oversized_stack_matrix(&self) -> Option<(usize, &'static str)> {
         let f64s = std::mem::size_of::<f64>();
         let block = self.mass.iter().map(|b| b.rows.len()).max().unwrap_or(0) * self.states.len();
         let loops = self.loops.as_ref().map_or(0, |l| {
@@ -104,11 +105,12 @@ impl Plan {
                 })
                 .fold(tears * tears, usize::max)
         });
-        if loops >= block {
+        let (bytes, rows) = if loops >= block {
             (loops * f64s, "the algebraic loops' tear variables")
         } else {
             (block * f64s, "a mass block's rows")
-        }
+        };
+        (bytes > super::rust::MAX_CONSTANT_JACOBIAN_BYTES).then_some((bytes, rows))
     }
 }
 

@@ -156,10 +156,7 @@ fn no_state_space_note(model: &ir::Model, eqs: &crate::equations::Equations) -> 
 /// dense matrices on the stack ([`rust::MAX_CONSTANT_JACOBIAN_BYTES`]): they still compute, but a thread with a
 /// small stack (2 MiB for a spawned thread, less in a debug build, which keeps copies) overflows in them.
 fn large_stack_matrix_warning(model: &ir::Model, plan: &emit::Plan) -> Option<Diagnostic> {
-    let (bytes, rows) = plan.jacobian_stack_matrix();
-    if bytes <= rust::MAX_CONSTANT_JACOBIAN_BYTES {
-        return None;
-    }
+    let (bytes, rows) = plan.oversized_stack_matrix()?;
     let kib = bytes / 1024;
     Some(
         Diagnostic::warning(

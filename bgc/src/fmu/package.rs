@@ -47,10 +47,6 @@ const TEMPLATE: [(&str, &str); 9] = [
 /// on the heap (2 · N² · 8 bytes, 256 MiB at 4,096 states) and decomposes it at every step (N³/3 flops).
 const MAX_STATES: usize = 4096;
 
-/// The most bytes of a matrix that the generated Jacobian functions may keep on the importing tool's stack (the
-/// loops' tears × states, a mass block's rows × states): 256 KiB, the bound of the generated code's dense matrices.
-const MAX_STACK_MATRIX_BYTES: usize = 256 * 1024;
-
 /// The crate of model `model` of `file` (the only one when `None`) for FMI `version`; `source_name` names the file
 /// in the generated module's header.
 pub fn package_sources(
@@ -122,8 +118,8 @@ pub fn package_sources(
     })
 }
 
-/// Refuses a model too large for an FMU: more than [`MAX_STATES`] states, or Jacobian functions that keep more
-/// than [`MAX_STACK_MATRIX_BYTES`] in one matrix on the importer's stack.
+/// Refuses a model too large for an FMU: more than [`MAX_STATES`] states, or Jacobian functions that keep a matrix
+/// larger than the generated code's bound on the importer's stack (`Plan::oversized_stack_matrix`).
 fn check_size(chosen: &CompiledModel) -> Result<(), String> {
     let name = &chosen.model.name;
     let states = chosen.equations.states.len();
@@ -136,9 +132,8 @@ fn check_size(chosen: &CompiledModel) -> Result<(), String> {
              with `bgc rust`"
         ));
     }
-    let (bytes, rows) = chosen.plan.jacobian_stack_matrix();
-    if bytes > MAX_STACK_MATRIX_BYTES {
-        let (kib, bound) = (bytes / 1024, MAX_STACK_MATRIX_BYTES / 1024);
+    if let Some((bytes, rows)) = chosen.plan.oversized_stack_matrix() {
+        let (kib, bound) = (bytes / 1024, rust::MAX_CONSTANT_JACOBIAN_BYTES / 1024);
         return Err(format!(
             "model `{name}` has {states} states: its Jacobian functions keep a matrix of {rows} by states, \
              inputs or outputs ({kib} KiB) on the stack of the importing tool's thread, more than the {bound} KiB an FMU allows; \

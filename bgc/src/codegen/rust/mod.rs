@@ -63,7 +63,7 @@ mod calls;
 mod functions;
 mod model;
 pub(in crate::codegen) use functions::state_space_through_loops;
-pub(in crate::codegen) use model::MAX_CONSTANT_JACOBIAN_BYTES;
+pub(crate) use model::MAX_CONSTANT_JACOBIAN_BYTES;
 mod param_jacobians;
 mod params;
 mod parts;

@@ -12,7 +12,7 @@ use super::Writer;
 use std::fmt::Write;
 
 /// The most bytes of constant Jacobians a `Model` holds (256 KiB: a `JacX` of 181 states).
-pub(in crate::codegen) const MAX_CONSTANT_JACOBIAN_BYTES: usize = 256 * 1024;
+pub(crate) const MAX_CONSTANT_JACOBIAN_BYTES: usize = 256 * 1024;
 
 /// Whether an `n × n` matrix of `f64` fits in [`MAX_CONSTANT_JACOBIAN_BYTES`] (up to 181 states): the bound of every
 /// square matrix generated code declares (`JacX`, the state space's `A`).

@@ -12,6 +12,7 @@
 //! when `s` does not depend on `r` (its constraint is kinematic, as for an inertia tied to another through
 //! transformers); a case where it does is not compared.
 
+use super::fields::{self, port_bond};
 use super::{Case, Flip, Point};
 use crate::equations_support::*;
 
@@ -37,11 +38,28 @@ fn own(model: &Model, n: NodeIndex, flip: Flip) -> Option<(usize, f64)> {
 /// The effort or the flow unknown of a bond.
 type BondVar = fn(usize) -> usize;
 
+/// The value of a storage's energy variable at a point: a one-port's (`port` None), a field port's displacement or
+/// an `IF` port's flow (`velocity`).
+#[derive(Clone, Copy)]
+struct Given {
+    node: NodeIndex,
+    port: Option<u32>,
+    velocity: bool,
+    value: f64,
+}
+
+fn given(states: &[Given], node: NodeIndex, port: Option<u32>, velocity: bool) -> Option<f64> {
+    let found = states
+        .iter()
+        .find(|s| (s.node, s.port, s.velocity) == (node, port, velocity));
+    Some(found?.value)
+}
+
 /// A point and the bond unknowns `z` (`z[2b]` the effort, `z[2b + 1]` the flow of bond `b`).
 struct At<'a> {
     model: &'a Model,
     params: &'a [f64],
-    states: &'a [(NodeIndex, f64)],
+    states: &'a [Given],
     u: &'a [f64],
     t: f64,
     z: &'a [f64],
@@ -56,7 +74,18 @@ impl At<'_> {
             Expr::Time => self.t,
             Expr::Param(i) => *self.params.get(*i)?,
             Expr::Input(i) => *self.u.get(*i)?,
-            Expr::Displacement(n) | Expr::Momentum(n) => self.states.iter().find(|s| s.0 == *n)?.1,
+            Expr::Displacement(n) | Expr::Momentum(n) => given(self.states, *n, None, false)?,
+            Expr::FieldPort { node, var, port } => match var {
+                PortVar::Displacement => given(self.states, *node, Some(*port), false)?,
+                PortVar::Effort => self.z[2 * port_bond(self.model, *node, *port)?.0],
+                PortVar::Flow => {
+                    let (b, sign) = port_bond(self.model, *node, *port)?;
+                    sign * self.z[2 * b + 1]
+                }
+                PortVar::Momentum => return None,
+            },
+            Expr::Effort(Target::Bond(b)) => self.z[2 * b.index()],
+            Expr::Flow(Target::Bond(b)) => self.z[2 * b.index() + 1],
             Expr::Effort(Target::Node(n)) => self.z[2 * own(self.model, *n, self.flip)?.0],
             Expr::Flow(Target::Node(n)) => {
                 let (b, sign) = own(self.model, *n, self.flip)?;
@@ -131,11 +160,11 @@ impl At<'_> {
                     rows.push(own_flow()? - sign * self.eval(x)?)
                 }
                 (K::C, Relation::Linear(c)) => {
-                    let q = self.states.iter().find(|s| s.0 == n)?.1;
+                    let q = given(self.states, n, None, false)?;
                     rows.push(own_effort()? - sign * q / self.eval(c)?);
                 }
                 (K::I, Relation::Linear(m)) => {
-                    let p = self.states.iter().find(|s| s.0 == n)?.1;
+                    let p = given(self.states, n, None, false)?;
                     rows.push(own_flow()? - sign * p / self.eval(m)?);
                 }
                 (K::R, Relation::Linear(r)) => {
@@ -159,6 +188,25 @@ impl At<'_> {
                     } else {
                         rows.push(z[ef(i)] - sign * m * z[fl(o)]);
                         rows.push(z[ef(o)] - m * z[fl(i)]);
+                    }
+                }
+                (K::CF | K::RF, Relation::Laws(laws)) => {
+                    for law in laws {
+                        let (b, so) = port_bond(self.model, n, law.port)?;
+                        let lhs = match law.lhs {
+                            PortVar::Effort => z[ef(b)],
+                            PortVar::Flow => so * z[fl(b)],
+                            _ => return None,
+                        };
+                        rows.push(lhs - sign * self.eval(&law.rhs)?);
+                    }
+                }
+                // An `IF`'s port flows are its velocity states; its efforts are set by the rest of the graph.
+                (K::IF, Relation::MassMatrix { n: ports, .. }) => {
+                    for k in 0..*ports {
+                        let (b, so) = port_bond(self.model, n, k)?;
+                        let v = given(self.states, n, Some(k), true)?;
+                        rows.push(so * z[fl(b)] - sign * v);
                     }
                 }
                 _ => return None,
@@ -232,19 +280,27 @@ impl Static<'_> {
     }
 
     /// The node of every storage with its energy variable: the given states `x`, then the unknowns `s`.
-    fn states(&self, x: &[f64], s: &[f64]) -> Option<Vec<(NodeIndex, f64)>> {
-        let given = self.case.eqs.states.iter().zip(x);
-        let given = given.map(|(spec, &v)| Some((spec.node?, v)));
-        let unknown = self
-            .case
-            .dependent
-            .iter()
-            .zip(s)
-            .map(|(&n, &v)| Some((n, v)));
-        given.chain(unknown).collect()
+    fn states(&self, x: &[f64], s: &[f64]) -> Option<Vec<Given>> {
+        let known = self.case.eqs.states.iter().zip(x).map(|(spec, &value)| {
+            Some(Given {
+                node: spec.node?,
+                port: spec.port,
+                velocity: spec.kind == StateKind::Velocity,
+                value,
+            })
+        });
+        let unknown = self.case.dependent.iter().zip(s).map(|(&node, &value)| {
+            Some(Given {
+                node,
+                port: None,
+                velocity: false,
+                value,
+            })
+        });
+        known.chain(unknown).collect()
     }
 
-    fn at<'b>(&'b self, states: &'b [(NodeIndex, f64)], t: f64, z: &'b [f64]) -> At<'b> {
+    fn at<'b>(&'b self, states: &'b [Given], t: f64, z: &'b [f64]) -> At<'b> {
         At {
             model: &self.case.model,
             params: &self.case.params,
@@ -286,11 +342,59 @@ impl Static<'_> {
         let at = self.at(&states, t, z);
         let specs = self.case.eqs.states.iter();
         specs
-            .map(|spec| match spec.kind {
-                StateKind::Displacement | StateKind::Momentum => Self::rate(&at, spec.node?),
+            .map(|spec| match (spec.kind, spec.port) {
+                (StateKind::Displacement | StateKind::Momentum, None) => {
+                    Self::rate(&at, spec.node?)
+                }
+                (StateKind::Displacement, Some(k)) => at.eval(&Expr::FieldPort {
+                    node: spec.node?,
+                    var: PortVar::Flow,
+                    port: k,
+                }),
+                (StateKind::Velocity, Some(k)) => Self::accelerations(&at, spec.node?)?
+                    .get(k as usize)
+                    .copied(),
                 _ => None,
             })
             .collect()
+    }
+
+    /// The rates of an `IF`'s port flows at `at`, from its definition (see `fields.rs`).
+    fn accelerations(at: &At, node: NodeIndex) -> Option<Vec<f64>> {
+        let Relation::MassMatrix { n, entries } = &at.model.graph[node].relation else {
+            return None;
+        };
+        let ports = 0..*n;
+        let q: Vec<f64> = ports
+            .clone()
+            .map(|k| given(at.states, node, Some(k), false))
+            .collect::<Option<_>>()?;
+        let v: Vec<f64> = ports
+            .clone()
+            .map(|k| given(at.states, node, Some(k), true))
+            .collect::<Option<_>>()?;
+        let e: Vec<f64> = ports
+            .map(|k| Some(at.z[2 * port_bond(at.model, node, k)?.0]))
+            .collect::<Option<_>>()?;
+        let mass = |shifted: &[f64]| -> Option<Vec<f64>> {
+            let states: Vec<Given> = at
+                .states
+                .iter()
+                .map(|s| match s.port {
+                    Some(k) if s.node == node && !s.velocity => Given {
+                        value: shifted[k as usize],
+                        ..*s
+                    },
+                    _ => *s,
+                })
+                .collect();
+            let at = At {
+                states: &states,
+                ..*at
+            };
+            entries.iter().map(|m| at.eval(m)).collect()
+        };
+        fields::accelerations(&mass, &q, &v, &e)
     }
 
     /// `∂s/∂v` along a direction of `(x, t)`, by central differences at steps `h` and `h/2`, extrapolated.

@@ -36,6 +36,7 @@ mod equations_back_support;
 mod equations_corpus;
 mod equations_derivative;
 mod equations_differential;
+mod equations_differential_kinematic;
 mod equations_differential_nonlinear;
 mod equations_energy_laws;
 mod equations_fields;

@@ -6,7 +6,7 @@
 //! and coupled laws, or an `RF` with coupled cubic laws in the effort or the flow form. The reference treats an `IF`
 //! from its definition alone: the port efforts are `e = d/dt(M(q) f) - ∂T/∂q` with `T = f' M(q) f / 2`, so
 //! `M ḟ = e - Σ_l (∂M/∂q_l) f_l f + ½ (f' (∂M/∂q_k) f)_k`, with `∂M/∂q` by extrapolated central differences of
-//! `M` as written; nothing of bgc's Lagrange terms is used.
+//! `M` as written (`equations_support/lagrange.rs`); nothing of bgc's Lagrange terms is used.
 
 use crate::equations_support::*;
 
@@ -104,62 +104,4 @@ pub(super) fn port_bond(model: &Model, n: NodeIndex, k: u32) -> Option<(usize, f
     let out = model.graph.edges_directed(n, Direction::Outgoing);
     let b = out.into_iter().find(|b| b.weight().from_port == k)?;
     Some((b.id().index(), -1.0))
-}
-
-/// `M ḟ = e - c(q, f)` solved for `ḟ`: `mass(q)` evaluates the inertia matrix (row-major) at displacements `q`,
-/// `e` are the port efforts and `v` the port flows.
-pub(super) fn accelerations(
-    mass: &dyn Fn(&[f64]) -> Option<Vec<f64>>,
-    q: &[f64],
-    v: &[f64],
-    e: &[f64],
-) -> Option<Vec<f64>> {
-    let n = q.len();
-    let at = |l: usize, h: f64| {
-        let mut shifted = q.to_vec();
-        shifted[l] += h;
-        mass(&shifted)
-    };
-    let central = |l: usize, h: f64| -> Option<Vec<f64>> {
-        let (plus, minus) = (at(l, h)?, at(l, -h)?);
-        Some(
-            plus.iter()
-                .zip(&minus)
-                .map(|(a, b)| (a - b) / (2.0 * h))
-                .collect(),
-        )
-    };
-    // `dm[l][i * n + j]` = ∂M_ij/∂q_l, Richardson-extrapolated (error of order h⁴).
-    let dm: Vec<Vec<f64>> = (0..n)
-        .map(|l| {
-            let (coarse, fine) = (central(l, 1e-3)?, central(l, 5e-4)?);
-            Some(
-                coarse
-                    .iter()
-                    .zip(&fine)
-                    .map(|(c, f)| (4.0 * f - c) / 3.0)
-                    .collect(),
-            )
-        })
-        .collect::<Option<_>>()?;
-    let quadratic = |m: &[f64]| -> f64 {
-        (0..n)
-            .flat_map(|i| (0..n).map(move |j| (i, j)))
-            .map(|(i, j)| m[i * n + j] * v[i] * v[j])
-            .sum()
-    };
-    let rhs: Vec<Cx> = (0..n)
-        .map(|k| {
-            let changing: f64 = (0..n)
-                .flat_map(|l| (0..n).map(move |j| (l, j)))
-                .map(|(l, j)| dm[l][k * n + j] * v[l] * v[j])
-                .sum();
-            Cx::re(e[k] - changing + 0.5 * quadratic(&dm[k]))
-        })
-        .collect();
-    let m = mass(q)?;
-    let rows = (0..n)
-        .map(|i| (0..n).map(|j| Cx::re(m[i * n + j])).collect())
-        .collect();
-    Some(solve(rows, rhs)?.iter().map(|a| a.0).collect())
 }

@@ -12,8 +12,9 @@
 //! when `s` does not depend on `r` (its constraint is kinematic, as for an inertia tied to another through
 //! transformers); a case where it does is not compared.
 
-use super::fields::{self, port_bond};
+use super::fields::port_bond;
 use super::{Case, Flip, Point};
+use crate::equations_support::lagrange;
 use crate::equations_support::*;
 
 use bgc::equations::StateKind;
@@ -394,7 +395,7 @@ impl Static<'_> {
             };
             entries.iter().map(|m| at.eval(m)).collect()
         };
-        fields::accelerations(&mass, &q, &v, &e)
+        lagrange::accelerations(&mass, &q, &v, &e)
     }
 
     /// `∂s/∂v` along a direction of `(x, t)`, by central differences at steps `h` and `h/2`, extrapolated.

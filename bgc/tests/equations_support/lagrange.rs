@@ -1,0 +1,62 @@
+//! Lagrange's equations for an inertia matrix given as a function of the configuration, the independent
+//! reference of the differential tests for multiport inertias and for mechanisms of modulated transformers.
+
+use super::{Cx, solve};
+
+/// `M ḟ = e - c(q, f)` solved for `ḟ`: `mass(q)` evaluates the inertia matrix (row-major) at displacements `q`,
+/// `e` are the port efforts and `v` the port flows.
+pub fn accelerations(
+    mass: &dyn Fn(&[f64]) -> Option<Vec<f64>>,
+    q: &[f64],
+    v: &[f64],
+    e: &[f64],
+) -> Option<Vec<f64>> {
+    let n = q.len();
+    let at = |l: usize, h: f64| {
+        let mut shifted = q.to_vec();
+        shifted[l] += h;
+        mass(&shifted)
+    };
+    let central = |l: usize, h: f64| -> Option<Vec<f64>> {
+        let (plus, minus) = (at(l, h)?, at(l, -h)?);
+        Some(
+            plus.iter()
+                .zip(&minus)
+                .map(|(a, b)| (a - b) / (2.0 * h))
+                .collect(),
+        )
+    };
+    // `dm[l][i * n + j]` = ∂M_ij/∂q_l, Richardson-extrapolated (error of order h⁴).
+    let dm: Vec<Vec<f64>> = (0..n)
+        .map(|l| {
+            let (coarse, fine) = (central(l, 1e-3)?, central(l, 5e-4)?);
+            Some(
+                coarse
+                    .iter()
+                    .zip(&fine)
+                    .map(|(c, f)| (4.0 * f - c) / 3.0)
+                    .collect(),
+            )
+        })
+        .collect::<Option<_>>()?;
+    let quadratic = |m: &[f64]| -> f64 {
+        (0..n)
+            .flat_map(|i| (0..n).map(move |j| (i, j)))
+            .map(|(i, j)| m[i * n + j] * v[i] * v[j])
+            .sum()
+    };
+    let rhs: Vec<Cx> = (0..n)
+        .map(|k| {
+            let changing: f64 = (0..n)
+                .flat_map(|l| (0..n).map(move |j| (l, j)))
+                .map(|(l, j)| dm[l][k * n + j] * v[l] * v[j])
+                .sum();
+            Cx::re(e[k] - changing + 0.5 * quadratic(&dm[k]))
+        })
+        .collect();
+    let m = mass(q)?;
+    let rows = (0..n)
+        .map(|i| (0..n).map(|j| Cx::re(m[i * n + j])).collect())
+        .collect();
+    Some(solve(rows, rhs)?.iter().map(|a| a.0).collect())
+}

@@ -199,7 +199,7 @@ impl Mechanism {
     }
 }
 
-/// A random mechanism as a bond graph, its description, and the nodes of its coordinates' junctions.
+/// A random mechanism as a bond graph, and its description.
 fn random_mechanism(seed: u64) -> (Model, Mechanism) {
     let mut g = Gen(seed);
     let mut b = Builder::new("mechanism");
@@ -208,99 +208,120 @@ fn random_mechanism(seed: u64) -> (Model, Mechanism) {
     let mut junctions = Vec::new();
     let mut thetas = Vec::new();
     for k in 0..coordinates {
-        let a = b.junction(K::One, &format!("a{k}"));
-        thetas.push(b.var(&format!("th{k}"), f(a)));
-        let u = b.input(&format!("u{k}"));
-        let src = b.node(K::Se, &format!("src{k}"), source(u));
-        b.bond(src, a);
-        let one_port = |b: &mut Builder, g: &mut Gen, kind, name: String| -> f64 {
-            if g.coin() {
-                return 0.0;
-            }
-            let v = g.value();
-            let value = b.param(&format!("v_{name}"), v);
-            let node = b.node(kind, &name, linear(value));
-            hang(b, g, a, node);
-            v
-        };
-        let inertia = one_port(&mut b, &mut g, K::I, format!("ja{k}"));
-        let damping = one_port(&mut b, &mut g, K::R, format!("ra{k}"));
-        mech.coordinates.push((inertia, damping));
+        let (a, theta, description) = add_coordinate(&mut b, &mut g, k);
         junctions.push(a);
+        thetas.push(theta);
+        mech.coordinates.push(description);
     }
     for i in 0..1 + g.below(3) as usize {
-        let body = b.junction(K::One, &format!("b{i}"));
-        let mass = g.value();
-        let value = b.param(&format!("m{i}"), mass);
-        let inertia = b.node(K::I, &format!("mb{i}"), linear(value));
-        hang(&mut b, &mut g, body, inertia);
-        let first = g.below(coordinates as u64) as usize;
-        let mut ks = vec![first];
-        if coordinates > 1 && g.coin() {
-            ks.push((first + 1 + g.below(coordinates as u64 - 1) as usize) % coordinates);
-        }
-        // The body's velocity: one two-port straight to the coordinate, or a 0-junction summing two.
-        let sum = (ks.len() > 1).then(|| {
-            let s = b.junction(K::Zero, &format!("s{i}"));
-            b.bond(body, s);
-            s
-        });
-        let mut terms = Vec::new();
-        for (t, &k) in ks.iter().enumerate() {
-            // Half of the moduli vary with their own coordinate (a position's Jacobian, `x = ∫ n(θ_k) dθ_k`).
-            let l = if g.coin() {
-                k
-            } else {
-                g.below(coordinates as u64) as usize
-            };
-            let shape = [
-                Shape::Constant,
-                Shape::Offset(l),
-                Shape::Sine(l),
-                Shape::Cosine(l),
-            ][g.below(4) as usize];
-            let n = g.value();
-            let modulus = b.param(&format!("n{i}_{t}"), n);
-            let kind = if matches!(shape, Shape::Constant) {
-                K::TF
-            } else {
-                K::MTF
-            };
-            let relation = Relation::Modulus(shape.expr(modulus, &thetas));
-            let two = b.node(kind, &format!("tp{i}_{t}"), relation);
-            b.bond(sum.unwrap_or(body), two);
-            b.bond(two, junctions[k]);
-            terms.push((k, n, shape));
-        }
-        let damping = if g.coin() {
-            let d = g.value();
-            let value = b.param(&format!("d{i}"), d);
-            let r = b.node(K::R, &format!("rb{i}"), linear(value));
-            hang(&mut b, &mut g, body, r);
-            d
-        } else {
-            0.0
-        };
-        let force = g.coin().then(|| {
-            let (w, l) = (g.value() - 1.5, g.below(coordinates as u64) as usize);
-            let amplitude = b.param(&format!("w{i}"), w);
-            let cos = Expr::Call(Func::Cos, vec![thetas[l].clone()]);
-            let value = mul(amplitude, add(c(1.0), mul(c(0.5), cos)));
-            let push = b.node(K::MSe, &format!("push{i}"), source(value));
-            b.bond(push, body);
-            (w, l)
-        });
-        mech.bodies.push(Body {
-            mass,
-            damping,
-            force,
-            terms,
-        });
+        let body = add_body(&mut b, &mut g, i, (&junctions, &thetas));
+        mech.bodies.push(body);
     }
     for (k, &a) in junctions.iter().enumerate() {
         b.output(&format!("v{k}"), f(a));
     }
     (b.finish(), mech)
+}
+
+/// Coordinate `k`: its 1-junction with a source, maybe an inertia and a damper; the junction, `θ_k` and its
+/// `(J_k, b_k)`.
+fn add_coordinate(b: &mut Builder, g: &mut Gen, k: usize) -> (NodeIndex, Expr, (f64, f64)) {
+    let a = b.junction(K::One, &format!("a{k}"));
+    let theta = b.var(&format!("th{k}"), f(a));
+    let u = b.input(&format!("u{k}"));
+    let src = b.node(K::Se, &format!("src{k}"), source(u));
+    b.bond(src, a);
+    let mut one_port = |kind, name: String| -> f64 {
+        if g.coin() {
+            return 0.0;
+        }
+        let v = g.value();
+        let value = b.param(&format!("v_{name}"), v);
+        let node = b.node(kind, &name, linear(value));
+        hang(b, g, a, node);
+        v
+    };
+    let inertia = one_port(K::I, format!("ja{k}"));
+    let damping = one_port(K::R, format!("ra{k}"));
+    (a, theta, (inertia, damping))
+}
+
+/// Body `i`: an inertia on a 1-junction whose velocity is the sum of one or two moduli times coordinates' velocities,
+/// maybe with a damper and a force.
+fn add_body(
+    b: &mut Builder,
+    g: &mut Gen,
+    i: usize,
+    (junctions, thetas): (&[NodeIndex], &[Expr]),
+) -> Body {
+    let coordinates = junctions.len() as u64;
+    let body = b.junction(K::One, &format!("b{i}"));
+    let mass = g.value();
+    let value = b.param(&format!("m{i}"), mass);
+    let inertia = b.node(K::I, &format!("mb{i}"), linear(value));
+    hang(b, g, body, inertia);
+    let first = g.below(coordinates) as usize;
+    let mut ks = vec![first];
+    if coordinates > 1 && g.coin() {
+        ks.push((first + 1 + g.below(coordinates - 1) as usize) % coordinates as usize);
+    }
+    // The body's velocity: one two-port straight to the coordinate, or a 0-junction summing two.
+    let sum = (ks.len() > 1).then(|| {
+        let s = b.junction(K::Zero, &format!("s{i}"));
+        b.bond(body, s);
+        s
+    });
+    let mut terms = Vec::new();
+    for (t, &k) in ks.iter().enumerate() {
+        // Half of the moduli vary with their own coordinate (a position's Jacobian, `x = ∫ n(θ_k) dθ_k`).
+        let l = if g.coin() {
+            k
+        } else {
+            g.below(coordinates) as usize
+        };
+        let shape = [
+            Shape::Constant,
+            Shape::Offset(l),
+            Shape::Sine(l),
+            Shape::Cosine(l),
+        ][g.below(4) as usize];
+        let n = g.value();
+        let modulus = b.param(&format!("n{i}_{t}"), n);
+        let kind = if matches!(shape, Shape::Constant) {
+            K::TF
+        } else {
+            K::MTF
+        };
+        let relation = Relation::Modulus(shape.expr(modulus, thetas));
+        let two = b.node(kind, &format!("tp{i}_{t}"), relation);
+        b.bond(sum.unwrap_or(body), two);
+        b.bond(two, junctions[k]);
+        terms.push((k, n, shape));
+    }
+    let damping = if g.coin() {
+        let d = g.value();
+        let value = b.param(&format!("d{i}"), d);
+        let r = b.node(K::R, &format!("rb{i}"), linear(value));
+        hang(b, g, body, r);
+        d
+    } else {
+        0.0
+    };
+    let force = g.coin().then(|| {
+        let (w, l) = (g.value() - 1.5, g.below(coordinates) as usize);
+        let amplitude = b.param(&format!("w{i}"), w);
+        let cos = Expr::Call(Func::Cos, vec![thetas[l].clone()]);
+        let value = mul(amplitude, add(c(1.0), mul(c(0.5), cos)));
+        let push = b.node(K::MSe, &format!("push{i}"), source(value));
+        b.bond(push, body);
+        (w, l)
+    });
+    Body {
+        mass,
+        damping,
+        force,
+        terms,
+    }
 }
 
 /// A one-port on a junction, its bond drawn either way.

@@ -131,7 +131,7 @@ fn random_model(seed: u64, sizes: Sizes) -> (Model, Vec<(String, K)>) {
 /// be definite), its ports bonded to random junctions in random directions, and the effort and flow of each port's
 /// bond as outputs.
 fn add_field(b: &mut Builder, g: &mut Gen, junctions: &[NodeIndex]) {
-    use bgc::ir::{Expr, Law, PortVar, Relation, Target};
+    use bgc::ir::{Expr, Law, PortVar, Relation};
     let kind = [K::IF, K::CF, K::RF][g.below(3) as usize];
     let node = b.field(kind, "fld", 2);
     let a = b.param("fa", g.value());
@@ -162,16 +162,7 @@ fn add_field(b: &mut Builder, g: &mut Gen, junctions: &[NodeIndex]) {
         K::CF => laws(PortVar::Displacement),
         _ => laws(PortVar::Flow),
     };
-    for k in 0..2 {
-        let j = junctions[g.below(junctions.len() as u64) as usize];
-        let bond = if g.coin() {
-            b.port_bond((j, 0), (node, k))
-        } else {
-            b.port_bond((node, k), (j, 0))
-        };
-        b.output(&format!("e_fld{k}_y"), Expr::Effort(Target::Bond(bond)));
-        b.output(&format!("f_fld{k}_y"), Expr::Flow(Target::Bond(bond)));
-    }
+    bond_field_ports(b, g, node, junctions);
 }
 
 /// The rows of a two-port field at `s`: with `X` its matrix, `v` the own flow of each port (into the field) and

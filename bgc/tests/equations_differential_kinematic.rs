@@ -358,21 +358,11 @@ fn bgc_motion(eqs: &Equations, p: &[f64], x: &[f64], u: &[f64]) -> Option<Motion
         };
         let plus = eqs.outputs_at(p, &shifted(1.0), u, 0.0).ok()?;
         let minus = eqs.outputs_at(p, &shifted(-1.0), u, 0.0).ok()?;
-        Some(
-            plus.iter()
-                .zip(&minus)
-                .map(|(a, b)| (a - b) / (2.0 * h))
-                .collect(),
-        )
+        Some(central_difference(&plus, &minus, h))
     };
     // Steps of at most 1e-3 in any state.
     let h = 1e-3 / (1.0 + rates.iter().fold(0.0f64, |m, r| m.max(r.abs())));
-    let (coarse, fine) = (along(2.0 * h)?, along(h)?);
-    let vdot = coarse
-        .iter()
-        .zip(&fine)
-        .map(|(c, f)| (4.0 * f - c) / 3.0)
-        .collect();
+    let vdot = richardson(&along(2.0 * h)?, &along(h)?);
     let theta = index.iter().map(|&i| x[i]).collect();
     let theta_dot = index.iter().map(|&i| rates[i]).collect();
     Some((theta, v, theta_dot, vdot))

@@ -10,7 +10,7 @@
 
 use crate::equations_support::*;
 
-use bgc::ir::{Expr, Func, Law, Model, PortVar, Relation, Target};
+use bgc::ir::{Expr, Func, Law, Model, PortVar, Relation};
 use bgc::syntax::ast::ElementKind as K;
 use petgraph::Direction;
 use petgraph::graph::NodeIndex;
@@ -83,16 +83,7 @@ pub(super) fn add_field(b: &mut Builder, g: &mut Gen, junctions: &[NodeIndex]) {
         _ if g.coin() => laws(b, g, PortVar::Effort, of(PortVar::Flow)),
         _ => laws(b, g, PortVar::Flow, of(PortVar::Effort)),
     };
-    for k in 0..2 {
-        let j = junctions[g.below(junctions.len() as u64) as usize];
-        let bond = if g.coin() {
-            b.port_bond((j, 0), (node, k))
-        } else {
-            b.port_bond((node, k), (j, 0))
-        };
-        b.output(&format!("e_fld{k}_y"), Expr::Effort(Target::Bond(bond)));
-        b.output(&format!("f_fld{k}_y"), Expr::Flow(Target::Bond(bond)));
-    }
+    bond_field_ports(b, g, node, junctions);
 }
 
 /// The bond on port `k` of a field and the sign of the port's own flow (into the field) relative to the bond's.

@@ -408,22 +408,9 @@ impl Static<'_> {
                 let w = self.solve(&x, t + sign * h * dt, &zero, w)?;
                 Some(w[bonds..].to_vec())
             };
-            let (plus, minus) = (shifted(1.0)?, shifted(-1.0)?);
-            Some(
-                plus.iter()
-                    .zip(&minus)
-                    .map(|(p, m)| (p - m) / (2.0 * h))
-                    .collect(),
-            )
+            Some(central_difference(&shifted(1.0)?, &shifted(-1.0)?, h))
         };
-        let (coarse, fine) = (central(1e-2)?, central(5e-3)?);
-        Some(
-            coarse
-                .iter()
-                .zip(&fine)
-                .map(|(c, f)| (4.0 * f - c) / 3.0)
-                .collect(),
-        )
+        Some(richardson(&central(1e-2)?, &central(5e-3)?))
     }
 
     /// The solution at a point with the storages in derivative causality at their consistent rates.

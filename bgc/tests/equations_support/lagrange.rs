@@ -1,7 +1,7 @@
 //! Lagrange's equations for an inertia matrix given as a function of the configuration, the independent
 //! reference of the differential tests for multiport inertias and for mechanisms of modulated transformers.
 
-use super::{Cx, solve};
+use super::{Cx, central_difference, richardson, solve};
 
 /// `M ḟ = e - c(q, f)` solved for `ḟ`: `mass(q)` evaluates the inertia matrix (row-major) at displacements `q`,
 /// `e` are the port efforts and `v` the port flows.
@@ -17,27 +17,10 @@ pub fn accelerations(
         shifted[l] += h;
         mass(&shifted)
     };
-    let central = |l: usize, h: f64| -> Option<Vec<f64>> {
-        let (plus, minus) = (at(l, h)?, at(l, -h)?);
-        Some(
-            plus.iter()
-                .zip(&minus)
-                .map(|(a, b)| (a - b) / (2.0 * h))
-                .collect(),
-        )
-    };
+    let central = |l: usize, h: f64| Some(central_difference(&at(l, h)?, &at(l, -h)?, h));
     // `dm[l][i * n + j]` = ∂M_ij/∂q_l, Richardson-extrapolated (error of order h⁴).
     let dm: Vec<Vec<f64>> = (0..n)
-        .map(|l| {
-            let (coarse, fine) = (central(l, 1e-3)?, central(l, 5e-4)?);
-            Some(
-                coarse
-                    .iter()
-                    .zip(&fine)
-                    .map(|(c, f)| (4.0 * f - c) / 3.0)
-                    .collect(),
-            )
-        })
+        .map(|l| Some(richardson(&central(l, 1e-3)?, &central(l, 5e-4)?)))
         .collect::<Option<_>>()?;
     let quadratic = |m: &[f64]| -> f64 {
         (0..n)

@@ -263,6 +263,40 @@ pub fn assert_close(what: &str, got: &[Vec<f64>], want: &[Vec<f64>], tol: f64) {
     }
 }
 
+/// `(plus − minus) / 2h`: the central difference of two evaluations at `±h`.
+pub fn central_difference(plus: &[f64], minus: &[f64], h: f64) -> Vec<f64> {
+    plus.iter()
+        .zip(minus)
+        .map(|(p, m)| (p - m) / (2.0 * h))
+        .collect()
+}
+
+/// Richardson's extrapolation of central differences at a step (`coarse`) and at half of it (`fine`): the error
+/// of order `h²` cancels.
+pub fn richardson(coarse: &[f64], fine: &[f64]) -> Vec<f64> {
+    coarse
+        .iter()
+        .zip(fine)
+        .map(|(c, f)| (4.0 * f - c) / 3.0)
+        .collect()
+}
+
+/// The two ports of field `node` bonded to random junctions in random directions, the effort and flow of each
+/// port's bond as outputs `e_fld{k}_y`, `f_fld{k}_y`.
+pub fn bond_field_ports(b: &mut Builder, g: &mut Gen, node: NodeIndex, junctions: &[NodeIndex]) {
+    use bgc::ir::Target;
+    for k in 0..2 {
+        let j = junctions[g.below(junctions.len() as u64) as usize];
+        let bond = if g.coin() {
+            b.port_bond((j, 0), (node, k))
+        } else {
+            b.port_bond((node, k), (j, 0))
+        };
+        b.output(&format!("e_fld{k}_y"), Expr::Effort(Target::Bond(bond)));
+        b.output(&format!("f_fld{k}_y"), Expr::Flow(Target::Bond(bond)));
+    }
+}
+
 /// A deterministic pseudo-random generator (SplitMix64) for parameter values.
 pub struct Rng(pub u64);
 

@@ -296,6 +296,51 @@ model long_laws {
     assert!(lines[start + 1].trim_start().starts_with("//     "));
 }
 
+/// The comment blocks of `code`: each run of `//` lines, their texts joined by spaces.
+fn comment_blocks(code: &str) -> Vec<String> {
+    let mut blocks = vec![String::new()];
+    for l in code.lines().map(str::trim) {
+        let text = l.strip_prefix("// ").filter(|_| !l.starts_with("///"));
+        let Some(block) = blocks.last_mut() else {
+            continue;
+        };
+        match text {
+            Some(text) => {
+                if !block.is_empty() {
+                    block.push(' ');
+                }
+                block.push_str(text.trim());
+            }
+            None if !block.is_empty() => blocks.push(String::new()),
+            None => {}
+        }
+    }
+    blocks
+}
+
+/// An equation that written out as a tree runs to thousands of nodes (a four-rung ladder of distinct resistors, its
+/// loops solved one inside another: the output's expression has 5,458 nodes, 10 kB in a comment) is named by its
+/// size in its comment instead of printed; the equations of a small model are printed whole.
+#[test]
+fn an_equation_too_long_to_read_is_named_by_its_size() {
+    let code = generate(&crate::equations_support::families::ladder_distinct(4));
+    let blocks = comment_blocks(&code);
+    let longest = blocks.iter().map(String::len).max().unwrap_or(0);
+    assert!(longest < 4_000, "a comment block of {longest} bytes");
+    let named = blocks
+        .iter()
+        .find(|b| b.starts_with("i1 = (an expression of "))
+        .unwrap_or_else(|| panic!("no comment names the output's size in\n{code}"));
+    assert!(
+        named.contains(
+            "nodes when written out, not repeated here: `bgc equations` prints it with named"
+        ),
+        "{named}"
+    );
+    // A small model's equations stay in full.
+    assert!(generate(TWO_MODELS).contains("// d/dt q_spring = f_mass"));
+}
+
 #[test]
 fn energy_is_a_sum_of_named_terms_or_a_running_total_for_many_terms() {
     let energy = |code: &str| {

@@ -322,6 +322,12 @@ pub(in crate::codegen) struct Writer<'a> {
     pub(in crate::codegen) out: String,
 }
 
+/// The largest expression, in nodes written out as a tree (shared parts counted each time), that a comment in
+/// the generated code shows: a rate from the symbolic elimination of derivative causality, or from loops solved
+/// in closed form one inside another, can take tens of kilobytes written out (a tree can be far larger than the
+/// shared form the code computes), and a comment that long helps no reader.
+const MAX_COMMENT_NODES: usize = 2_000;
+
 /// Memo of [`Writer::code`] and the text of equation comments, keyed by expression (a node, so lookups are by
 /// identity). Both are pure functions of the expression for one writer. Cleared when full, to bound its memory.
 #[derive(Default)]
@@ -483,8 +489,22 @@ impl<'a> Writer<'a> {
         }
     }
 
-    /// The equation `{label}{e}` (`d/dt x = ...`) as comment lines above a statement of a function body.
+    /// The equation `{label}{e}` (`d/dt x = ...`) as comment lines above a statement of a function body; an
+    /// expression of more than [`MAX_COMMENT_NODES`] nodes written out is named by its size instead.
     fn equation(&self, indent: usize, label: &str, e: &Expr) -> Vec<String> {
+        let nodes = e.node_count();
+        if nodes > MAX_COMMENT_NODES {
+            let size = if nodes == usize::MAX {
+                "too many".to_string()
+            } else {
+                nodes.to_string()
+            };
+            let text = format!(
+                "{label}(an expression of {size} nodes when written out, not repeated here: `bgc equations` \
+                 prints it with named intermediates)"
+            );
+            return format::comment(indent, "//", &text, Wrap::Prose, self.width);
+        }
         let text = {
             let mut printed = self.printed.borrow_mut();
             Printed::get_or(&mut printed.text, e, || crate::symbolic::to_text(e))

@@ -17,11 +17,11 @@
 //! bgc's stored energy must be the description's `½ v' M(θ) v`, and its energy terms must balance power.
 
 use crate::equations_support::lagrange;
+use crate::equations_support::power::{energy_total, power_balance};
 use crate::equations_support::*;
 
 use bgc::causality::analyse;
-use bgc::equations::symbols::{self as sym, Sym};
-use bgc::equations::{EnergyKind, Equations, derive, solve_all};
+use bgc::equations::{EnergyKind, Equations, derive};
 use bgc::ir::{Expr, Func, Model, Relation};
 use bgc::syntax::ast::ElementKind as K;
 use petgraph::graph::NodeIndex;
@@ -150,12 +150,7 @@ impl Mechanism {
                 rhs[k] -= body.mass * row[k] * drift;
             }
         }
-        let m = self.mass_matrix(theta);
-        let rows = (0..n)
-            .map(|i| (0..n).map(|j| Cx::re(m[i * n + j])).collect())
-            .collect();
-        let solved = solve(rows, rhs.into_iter().map(Cx::re).collect())?;
-        Some(solved.iter().map(|a| a.0).collect())
+        lagrange::solve_dense(&self.mass_matrix(theta), rhs)
     }
 
     /// `v̇` by Lagrange's equations for `T(θ, v)` (`∂M/∂θ` by differences): the same as
@@ -368,26 +363,6 @@ fn bgc_motion(eqs: &Equations, p: &[f64], x: &[f64], u: &[f64]) -> Option<Motion
     Some((theta, v, theta_dot, vdot))
 }
 
-/// The total energy term of `kind` at `(x, u)` (the loops solved there); `None` when a term does not evaluate.
-fn energy_at(eqs: &Equations, p: &[f64], kind: EnergyKind, x: &[f64], u: &[f64]) -> Option<f64> {
-    let known = |s: Sym| match s {
-        Sym::Param(i) => p.get(i).copied(),
-        Sym::State(i) => x.get(i).copied(),
-        Sym::Input(i) => u.get(i).copied(),
-        Sym::Time => Some(0.0),
-        _ => None,
-    };
-    let tears = solve_all(eqs, &known).ok()?;
-    let value = |s: Sym| {
-        let torn = tears.iter().find(|(z, _)| *z == s);
-        torn.map(|(_, v)| *v).or_else(|| known(s))
-    };
-    let terms = eqs.energy.iter().filter(|t| t.kind == kind);
-    terms
-        .map(|t| sym::eval(t.value.as_ref()?, &value).ok())
-        .sum()
-}
-
 /// bgc's stored energy at `x` against the description's `T = ½ v' M(θ) v`, and the power balance along bgc's
 /// motion (a central difference of the stored energy along `ẋ`, steps of at most 1e-6) against the supplied minus
 /// the dissipated power.
@@ -398,28 +373,13 @@ fn energy_agrees(
     (theta, v): (&[f64], &[f64]),
 ) -> Result<(), String> {
     let p = eqs.default_params();
-    let at = |kind, x: &[f64]| energy_at(eqs, &p, kind, x, u).ok_or(format!("no {kind:?} energy"));
-    let m = mech.mass_matrix(theta);
-    let n = theta.len();
-    let pairs = (0..n).flat_map(|i| (0..n).map(move |j| (i, j)));
-    let kinetic: f64 = 0.5 * pairs.map(|(i, j)| m[i * n + j] * v[i] * v[j]).sum::<f64>();
-    let stored = at(EnergyKind::Stored, x)?;
+    let kinetic = 0.5 * lagrange::quadratic_form(&mech.mass_matrix(theta), v);
+    let stored =
+        energy_total(eqs, &p, EnergyKind::Stored, (x, u, 0.0)).ok_or("no stored energy")?;
     if (stored - kinetic).abs() > 1e-9 * (1.0 + kinetic.abs()) {
         return Err(format!("stored energy {stored}, T = {kinetic}"));
     }
-    let rates = eqs.rates_at(&p, x, u, 0.0).map_err(|e| e.to_string())?;
-    let h = 1e-6 / (1.0 + rates.iter().fold(0.0f64, |m, r| m.max(r.abs())));
-    let along = |s: f64| -> Vec<f64> { x.iter().zip(&rates).map(|(a, r)| a + s * h * r).collect() };
-    let rate =
-        (at(EnergyKind::Stored, &along(1.0))? - at(EnergyKind::Stored, &along(-1.0))?) / (2.0 * h);
-    let (supplied, dissipated) = (at(EnergyKind::Supplied, x)?, at(EnergyKind::Dissipated, x)?);
-    let size = 1.0 + supplied.abs() + dissipated.abs() + rate.abs();
-    if (rate - (supplied - dissipated)).abs() > 1e-6 * size {
-        return Err(format!(
-            "d/dt stored {rate}, supplied {supplied}, dissipated {dissipated}"
-        ));
-    }
-    Ok(())
+    power_balance(eqs, &p, (x, u, 0.0)).ok_or("no rates or energy terms")?
 }
 
 /// Compares a seed's mechanism at three random states, those where `M` is nearly singular left out: `Ok(false)`

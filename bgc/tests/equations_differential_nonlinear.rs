@@ -31,10 +31,10 @@ mod fields;
 mod reference;
 
 use crate::equations_support;
+use crate::equations_support::power::power_balance;
 
 use bgc::causality::analyse;
-use bgc::equations::symbols::{self as sym, Sym};
-use bgc::equations::{EnergyKind, Equations, derive, solve_all};
+use bgc::equations::{Equations, derive};
 use bgc::ir::{Expr, Func, Law, Model, PortVar, Relation};
 use bgc::simulate::System;
 use bgc::simulate::input::Signal;
@@ -514,66 +514,14 @@ fn derivative_causality_through_a_numerically_solved_loop_matches_the_reference(
     }
 }
 
-/// The total energy term of `kind` of `case` at `(x, u, t)`, the inputs held (`u̇ = 0`) and the loops solved there;
-/// `None` when a term has no closed form or does not evaluate.
-fn energy_at(case: &Case, kind: EnergyKind, (x, u, t): (&[f64], &[f64], f64)) -> Option<f64> {
-    let p = &case.params;
-    let known = |s: Sym| match s {
-        Sym::Param(i) => p.get(i).copied(),
-        Sym::State(i) => x.get(i).copied(),
-        Sym::Input(i) => u.get(i).copied(),
-        Sym::InputDot(_) => Some(0.0),
-        Sym::Time => Some(t),
-        _ => None,
-    };
-    let tears = solve_all(&case.eqs, &known).ok()?;
-    let value = |s: Sym| {
-        tears
-            .iter()
-            .find(|(z, _)| *z == s)
-            .map(|(_, v)| *v)
-            .or_else(|| known(s))
-    };
-    let mut total = 0.0;
-    for term in case.eqs.energy.iter().filter(|term| term.kind == kind) {
-        total += sym::eval(term.value.as_ref()?, &value).ok()?;
-    }
-    Some(total)
-}
-
-/// Whether the energy terms of `case` obey the power balance at each of its points: the rate of the stored energy
-/// along the motion (a central difference along `ẋ`, a step of at most 1e-6 in any state) equals the supplied
-/// minus the dissipated power, to 1e-6 of the powers' size.
+/// Whether the energy terms of `case` obey the power balance at each of its points ([`power_balance`]); false when
+/// a rate or a term does not evaluate at one.
 fn balances_power(case: &Case) -> Result<bool, String> {
     for point in &case.points {
-        let (x, u, t) = (&point.x[..], &point.u[..], point.t);
-        let Ok(rates) = case.eqs.rates_at(&case.params, x, u, t) else {
-            return Ok(false);
-        };
-        let fastest = rates.iter().fold(0.0f64, |m, r| m.max(r.abs()));
-        let h = 1e-6 / (1.0 + fastest);
-        let along = |sign: f64| -> Vec<f64> {
-            x.iter()
-                .zip(&rates)
-                .map(|(a, r)| a + sign * h * r)
-                .collect()
-        };
-        let (ahead, behind) = (along(1.0), along(-1.0));
-        let terms = (
-            energy_at(case, EnergyKind::Stored, (&ahead, u, t)),
-            energy_at(case, EnergyKind::Stored, (&behind, u, t)),
-            energy_at(case, EnergyKind::Supplied, (x, u, t)),
-            energy_at(case, EnergyKind::Dissipated, (x, u, t)),
-        );
-        let (Some(ahead), Some(behind), Some(supplied), Some(dissipated)) = terms else {
-            return Ok(false);
-        };
-        let stored_rate = (ahead - behind) / (2.0 * h);
-        let size = 1.0 + supplied.abs() + dissipated.abs() + stored_rate.abs();
-        if (stored_rate - (supplied - dissipated)).abs() > 1e-6 * size {
-            return Err(format!(
-                "d/dt stored {stored_rate}, supplied {supplied}, dissipated {dissipated} at x = {x:?}"
-            ));
+        let at = (&point.x[..], &point.u[..], point.t);
+        match power_balance(&case.eqs, &case.params, at) {
+            Some(balance) => balance?,
+            None => return Ok(false),
         }
     }
     Ok(true)

@@ -29,9 +29,9 @@ fn cube(x: Expr) -> Expr {
 
 /// `Σ_j r[j] x_j + k x_own³`: one coupled cubic law.
 fn coupled(r: [Expr; 2], x: [Expr; 2], k: Expr, own: usize) -> Expr {
+    let cubed = cube(x[own].clone());
     let [r0, r1] = r;
     let [x0, x1] = x;
-    let cubed = cube([x0.clone(), x1.clone()][own].clone());
     add(add(mul(r0, x0), mul(r1, x1)), mul(k, cubed))
 }
 

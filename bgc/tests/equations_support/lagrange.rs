@@ -22,24 +22,31 @@ pub fn accelerations(
     let dm: Vec<Vec<f64>> = (0..n)
         .map(|l| Some(richardson(&central(l, 1e-3)?, &central(l, 5e-4)?)))
         .collect::<Option<_>>()?;
-    let quadratic = |m: &[f64]| -> f64 {
-        (0..n)
-            .flat_map(|i| (0..n).map(move |j| (i, j)))
-            .map(|(i, j)| m[i * n + j] * v[i] * v[j])
-            .sum()
-    };
-    let rhs: Vec<Cx> = (0..n)
+    let rhs: Vec<f64> = (0..n)
         .map(|k| {
             let changing: f64 = (0..n)
                 .flat_map(|l| (0..n).map(move |j| (l, j)))
                 .map(|(l, j)| dm[l][k * n + j] * v[l] * v[j])
                 .sum();
-            Cx::re(e[k] - changing + 0.5 * quadratic(&dm[k]))
+            e[k] - changing + 0.5 * quadratic_form(&dm[k], v)
         })
         .collect();
-    let m = mass(q)?;
+    solve_dense(&mass(q)?, rhs)
+}
+
+/// `v' M v` for the `n × n` matrix `m` (row-major), `n` the length of `v`.
+pub fn quadratic_form(m: &[f64], v: &[f64]) -> f64 {
+    let n = v.len();
+    let pairs = (0..n).flat_map(|i| (0..n).map(move |j| (i, j)));
+    pairs.map(|(i, j)| m[i * n + j] * v[i] * v[j]).sum()
+}
+
+/// `M x = b` for the `n × n` matrix `m` (row-major), `n` the length of `b`; `None` when `M` is singular.
+pub fn solve_dense(m: &[f64], b: Vec<f64>) -> Option<Vec<f64>> {
+    let n = b.len();
     let rows = (0..n)
         .map(|i| (0..n).map(|j| Cx::re(m[i * n + j])).collect())
         .collect();
-    Some(solve(rows, rhs)?.iter().map(|a| a.0).collect())
+    let x = solve(rows, b.into_iter().map(Cx::re).collect())?;
+    Some(x.iter().map(|a| a.0).collect())
 }

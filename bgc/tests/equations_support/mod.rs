@@ -7,6 +7,7 @@
 #[path = "../../benches/support/families.rs"]
 pub mod families;
 pub mod lagrange;
+pub mod power;
 
 use bgc::ir::{
     Bond, Domain, Expr, Input, Model, Node, Output, Param, Relation, SpanTable, Target, Var,

@@ -58,6 +58,7 @@ mod front_end_props;
 mod hostile_props;
 mod language_examples;
 mod loops_globalised;
+mod loops_ill_conditioned;
 mod loops_warm_start;
 mod lsp_fixes;
 mod lsp_props;

@@ -132,7 +132,7 @@ fn the_generated_solve_loops_solves_the_steep_diode_loop() {
 
 /// Two diode loops side by side: a module with two tears, so that the generated solvers of blocks of two are
 /// emitted and can be driven directly.
-fn two_diode_loops() -> String {
+pub(crate) fn two_diode_loops() -> String {
     let text = std::fs::read_to_string(corpus("diode_rc.bg")).unwrap_or_else(|e| panic!("{e}"));
     let start = text.find("    Se source").unwrap_or_default();
     let end = text.find("    output i").unwrap_or_default();

@@ -9,8 +9,9 @@
 //!   caller's guess, the last solution of a time-stepping caller, and retries from zero when that fails), with the analytic `∂r/∂z` (symbolic derivatives of the
 //!   residuals). It mirrors [`crate::equations::newton`]: the step solves `∂r/∂z Δ = −r`, the damping halves `λ`
 //!   until the Armijo test on `Σ (r_i/w_i)²` passes, and the block has converged when `|r_i| ≤ 10⁻¹² s_i` for every
-//!   residual, `s_i` being the sum of the magnitudes of its terms ([`crate::equations::residual_scale`]), after at
-//!   least one step; at most 100 iterations. A block of one tear whose Newton iteration fails is solved in a
+//!   residual, `s_i` being the sum of the magnitudes of its terms ([`crate::equations::residual_scale`]), and the
+//!   Newton step from the iterate is within `10⁻¹⁰` of each tear or no longer contracts, after at least one step;
+//!   at most 100 iterations. A block of one tear whose Newton iteration fails is solved in a
 //!   bracket of a sign change searched outward from the start, as [`crate::equations::newton::bracketed`] does; a
 //!   block of several by Powell's dogleg method ([`super::loops_dogleg`]), as the compiler's own evaluation does;
 //! - every function that needs the tears (`rhs_into`, `outputs_into`, the Jacobians, the energy functions) starts
@@ -202,9 +203,14 @@ fn bgc_bracketed<const B: usize>(
     if r0.is_nan() {
         return None;
     }
-    // Converged: finite and within the tolerance (an infinite residual only gives a direction).
+    // Converged: finite and within the tolerance (an infinite residual only gives a direction), and
+    // the Newton step from the point within its tolerance.
     let within = |r: f64, s: f64| r.is_finite() && s.is_finite() && libm::fabs(r) <= LOOP_RTOL * s;
-    if within(r0, s0) {
+    let settled = |x: f64, r: f64, s: f64, j: f64| {
+        let step = r / j;
+        within(r, s) && (r == 0.0 || libm::fabs(step) <= LOOP_STEP_RTOL * libm::fabs(x))
+    };
+    if settled(z0, r0, s0, j0) {
         return Some(z0);
     }
     let mut evaluations = 1;
@@ -249,7 +255,7 @@ fn bgc_bracketed<const B: usize>(
     let mut step_before = libm::fabs(hi.0 - lo.0);
     let mut step = step_before;
     while evaluations < LOOP_BRACKET_EVALUATIONS {
-        if within(x.1, x.2) {
+        if settled(x.0, x.1, x.2, x.3) {
             return Some(x.0);
         }
         let newton = if x.1.is_finite() {
@@ -314,6 +320,23 @@ fn bgc_bracketed<const B: usize>(
     }
 }
 
+/// The Newton step's size in units of its tolerance, `LOOP_STEP_RTOL |z_i|` (infinite when it is
+/// not finite or moves a tear at zero).
+fn bgc_step_ratio<const B: usize>(z: &Tears, first: usize, step: &SVector<f64, B>) -> f64 {
+    let mut ratio = 0.0f64;
+    for i in 0..B {
+        if step[i] != 0.0 {
+            let q = libm::fabs(step[i]) / (LOOP_STEP_RTOL * libm::fabs(z[first + i]));
+            ratio = if q.is_nan() {
+                f64::INFINITY
+            } else {
+                ratio.max(q)
+            };
+        }
+    }
+    ratio
+}
+
 /// Damped Newton's method for the block, from the values in `z`.
 fn bgc_damped<const B: usize>(
     z: &mut Tears,
@@ -340,6 +363,9 @@ fn bgc_damped<const B: usize>(
             residual: if B == 0 { 0.0 } else { libm::fabs(r[worst]) },
         }
     };
+    // The step ratio of the last step if it was a full step from an iterate that passed the
+    // residual test.
+    let mut previous = f64::INFINITY;
     for k in 0..=LOOP_MAX_ITERATIONS {
         let mut finite = true;
         let mut converged = true;
@@ -352,28 +378,50 @@ fn bgc_damped<const B: usize>(
         if !finite {
             return Err(fail(LoopFailure::NonFinite, k, &r));
         }
-        if converged && (k > 0 || all_zero) {
+        if k == 0 && all_zero {
             return Ok(());
         }
         if k == LOOP_MAX_ITERATIONS {
             break;
         }
         let mut minus_r = SMatrix::<f64, B, 1>::zeros();
+        let mut jacobian_finite = true;
         for i in 0..B {
             for j in 0..B {
-                if !jz[(i, j)].is_finite() {
-                    return Err(fail(LoopFailure::NonFinite, k, &r));
-                }
+                jacobian_finite &= jz[(i, j)].is_finite();
             }
             minus_r[i] = -r[i];
         }
         let step = bgc_solve(jz, minus_r);
+        let mut solved = jacobian_finite;
+        for i in 0..B {
+            solved &= step[i].is_finite();
+        }
+        if !solved {
+            // A converged iterate where the step cannot be judged (a singular root) stays.
+            if converged && k > 0 {
+                return Ok(());
+            }
+            let kind = if jacobian_finite {
+                LoopFailure::Singular
+            } else {
+                LoopFailure::NonFinite
+            };
+            return Err(fail(kind, k, &r));
+        }
+        // Converged: the residual and the Newton step within their tolerances, or the step no
+        // longer contracting (the rounding floor).
+        let ratio = if converged {
+            bgc_step_ratio(z, first, &step)
+        } else {
+            f64::INFINITY
+        };
+        if converged && k > 0 && (ratio <= 1.0 || ratio >= 0.5 * previous) {
+            return Ok(());
+        }
         let mut weights = SVector::<f64, B>::zeros();
         let mut merit = 0.0;
         for i in 0..B {
-            if !step[i].is_finite() {
-                return Err(fail(LoopFailure::Singular, k, &r));
-            }
             weights[i] = if s[i] > 0.0 { s[i] } else { 1.0 };
             merit += (r[i] / weights[i]) * (r[i] / weights[i]);
         }
@@ -389,7 +437,11 @@ fn bgc_damped<const B: usize>(
             for i in 0..B {
                 merit_trial += (at.0[i] / weights[i]) * (at.0[i] / weights[i]);
             }
-            if merit_trial.is_finite() && merit_trial <= (1.0 - 1e-4 * lambda) * merit {
+            // From a converged iterate the full step: the residual no longer measures the
+            // distance to the root there, the Newton step does.
+            if merit_trial.is_finite()
+                && (converged || merit_trial <= (1.0 - 1e-4 * lambda) * merit)
+            {
                 accepted = Some(at);
                 break;
             }
@@ -397,10 +449,15 @@ fn bgc_damped<const B: usize>(
         }
         match accepted {
             Some(at) => {
+                previous = if converged && lambda == 1.0 {
+                    ratio
+                } else {
+                    f64::INFINITY
+                };
                 *z = trial;
                 (r, s, jz) = at;
             }
-            // At the rounding floor no step decreases the residual: a converged iterate stays.
+            // No step from a converged iterate has finite residuals: it stays.
             None if converged => return Ok(()),
             None => return Err(fail(LoopFailure::NoDescent, k, &r)),
         }
@@ -413,6 +470,9 @@ fn bgc_damped<const B: usize>(
 const ITEMS: &str = "
 /// The residual tolerance of the loops, relative to the magnitudes of each residual's terms.
 pub const LOOP_RTOL: f64 = 1e-12;
+/// The Newton step's tolerance at an iterate whose residuals are within `LOOP_RTOL`, relative to
+/// its tear; a step that no longer contracts (the rounding floor) is accepted too.
+pub const LOOP_STEP_RTOL: f64 = 1e-10;
 
 /// The most Newton iterations per block of the loops.
 pub const LOOP_MAX_ITERATIONS: usize = 100;

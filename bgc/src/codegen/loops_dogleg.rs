@@ -5,8 +5,9 @@
 //! A line search along the Newton direction can creep along a curved valley of `‖r‖²` (a torn loop of cubic
 //! resistors makes the residual of degree 9 in the tears); the dogleg step bends from the steepest-descent step
 //! towards the Newton step inside a trust radius that follows how well the linear model predicted the last step.
-//! The residuals are weighted by their scales at the start, and convergence is the damped method's test,
-//! `|r_i| ≤ LOOP_RTOL · s_i`. Fixed-size values only: no allocation, `core`, `nalgebra` and `libm`.
+//! The residuals are weighted by their scales at the start, and convergence is the damped method's test on
+//! the residual, `|r_i| ≤ LOOP_RTOL · s_i`, and on the Newton step (`bgc_step_ratio`). Fixed-size values
+//! only: no allocation, `core`, `nalgebra` and `libm`.
 
 /// Emitted into the module after [`super::loops::NEWTON_FN`]; needs `bgc_solve` ([`super::mass::SOLVE_FN`]).
 pub(crate) const DOGLEG_FN: &str = "
@@ -48,15 +49,22 @@ fn bgc_dogleg<const B: usize>(
         radius += z[first + i] * z[first + i];
     }
     radius = libm::sqrt(radius).max(1.0);
+    // The step ratio of the last step if it was a full Newton step from an iterate that passed the
+    // residual test, and whether a step was taken.
+    let (mut previous, mut moved) = (f64::INFINITY, false);
     for _ in 0..4 * LOOP_MAX_ITERATIONS {
         // The weighted system: the rows of r and its Jacobian divided by w.
         let mut jw = SMatrix::<f64, B, B>::zeros();
         let mut rw = SVector::<f64, B>::zeros();
+        let mut converged = moved;
+        let mut minus_r = SVector::<f64, B>::zeros();
         for i in 0..B {
             if !r[i].is_finite() || !s[i].is_finite() {
                 return None;
             }
+            converged &= libm::fabs(r[i]) <= LOOP_RTOL * s[i];
             rw[i] = r[i] / w[i];
+            minus_r[i] = -r[i];
             for j in 0..B {
                 if !jz[(i, j)].is_finite() {
                     return None;
@@ -64,7 +72,33 @@ fn bgc_dogleg<const B: usize>(
                 jw[(i, j)] = jz[(i, j)] / w[i];
             }
         }
-        let step = bgc_dogleg_step(&jw, &rw, radius)?;
+        // Converged after a step: the residual and the Newton step from here within their
+        // tolerances, or the step no longer contracting.
+        let mut ratio = f64::INFINITY;
+        if converged {
+            let newton = bgc_solve(jz, minus_r);
+            ratio = bgc_step_ratio(&z, first, &newton);
+            if ratio <= 1.0 || ratio >= 0.5 * previous {
+                return Some(z);
+            }
+            // The full Newton step, as in the damped method.
+            let mut trial = z;
+            for i in 0..B {
+                trial[first + i] = z[first + i] + newton[i];
+            }
+            let at = eval(&trial);
+            let mut finite = true;
+            for i in 0..B {
+                finite &= at.0[i].is_finite() && at.1[i].is_finite();
+            }
+            if finite {
+                z = trial;
+                (r, s, jz) = at;
+                previous = ratio;
+                continue;
+            }
+        }
+        let (step, full) = bgc_dogleg_step(&jw, &rw, radius)?;
         let mut predicted = merit(&r);
         let mut trial = z;
         for i in 0..B {
@@ -77,26 +111,21 @@ fn bgc_dogleg<const B: usize>(
         }
         let at = eval(&trial);
         let actual = merit(&r) - merit(&at.0);
-        let ratio = if predicted > 0.0 {
+        let reduction = if predicted > 0.0 {
             actual / predicted
         } else {
             -1.0
         };
         let length = libm::sqrt(bgc_dot(&step, &step));
-        if ratio.is_finite() && ratio > 1e-4 {
+        if reduction.is_finite() && reduction > 1e-4 {
             z = trial;
             (r, s, jz) = at;
-            let mut converged = true;
-            for i in 0..B {
-                converged &= libm::fabs(r[i]) <= LOOP_RTOL * s[i];
-            }
-            if converged {
-                return Some(z);
-            }
+            previous = if full { ratio } else { f64::INFINITY };
+            moved = true;
         }
-        if !ratio.is_finite() || ratio < 0.25 {
+        if !reduction.is_finite() || reduction < 0.25 {
             radius = length / 4.0;
-        } else if ratio > 0.75 && length >= 0.99 * radius {
+        } else if reduction > 0.75 && length >= 0.99 * radius {
             radius *= 2.0;
         }
         let mut size = 1.0f64;
@@ -110,13 +139,13 @@ fn bgc_dogleg<const B: usize>(
     None
 }
 
-/// The dogleg step within `radius` for the model `r + J p`; `None` when the gradient is zero and
-/// no Newton step exists.
+/// The dogleg step within `radius` for the model `r + J p`, and whether it is the full Newton step;
+/// `None` when the gradient is zero and no Newton step exists.
 fn bgc_dogleg_step<const B: usize>(
     j: &SMatrix<f64, B, B>,
     r: &SVector<f64, B>,
     radius: f64,
-) -> Option<SVector<f64, B>> {
+) -> Option<(SVector<f64, B>, bool)> {
     let mut minus_r = SVector::<f64, B>::zeros();
     for i in 0..B {
         minus_r[i] = -r[i];
@@ -127,7 +156,7 @@ fn bgc_dogleg_step<const B: usize>(
         has_newton &= newton[i].is_finite();
     }
     if has_newton && libm::sqrt(bgc_dot(&newton, &newton)) <= radius {
-        return Some(newton);
+        return Some((newton, true));
     }
     // The gradient g = Jᵀ r of the model's merit at p = 0, and J g.
     let mut g = SVector::<f64, B>::zeros();
@@ -157,7 +186,7 @@ fn bgc_dogleg_step<const B: usize>(
         for i in 0..B {
             cauchy[i] = -g[i] * scale;
         }
-        return Some(cauchy);
+        return Some((cauchy, false));
     }
     // From the Cauchy point towards the Newton point, to the boundary: |c + tau (N - c)| = radius.
     let mut d = SVector::<f64, B>::zeros();
@@ -169,6 +198,6 @@ fn bgc_dogleg_step<const B: usize>(
     for i in 0..B {
         cauchy[i] += tau * d[i];
     }
-    Some(cauchy)
+    Some((cauchy, false))
 }
 ";

@@ -63,6 +63,7 @@ pub const RESERVED: &[&str] = &[
     "LOOP_RTOL",
     "LOOP_MAX_ITERATIONS",
     "LOOP_BRACKET_EVALUATIONS",
+    "LOOP_STEP_RTOL",
     "libm",
     "core",
     "N_STATES",

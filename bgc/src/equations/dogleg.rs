@@ -6,9 +6,9 @@
 //! The dogleg step bends from the steepest-descent (Cauchy) step towards the Newton step inside a radius that
 //! follows how well the linear model predicted the last step, so it turns with the valley. Each residual is divided
 //! by its scale at the start (the same weights throughout, so `‖r/w‖²` is one merit function), and convergence is
-//! the damped method's test, `|r_i| ≤ rtol · s_i`.
+//! the damped method's test on the residual and the Newton step ([`super::newton::StepTest`]).
 
-use super::newton::{Problem, Settings, lu_solve};
+use super::newton::{Problem, Settings, StepTest, lu_solve, step_ratio, within};
 
 /// Steps tried before giving up: the trust region also needs steps to grow and shrink.
 const STEP_FACTOR: usize = 4;
@@ -29,6 +29,7 @@ pub(super) fn solve(problem: &mut dyn Problem, z: &mut [f64], settings: Settings
     let merit =
         |r: &[f64]| -> f64 { r.iter().zip(&w).map(|(r, w)| (r / w).powi(2)).sum::<f64>() / 2.0 };
     let mut radius = x.iter().map(|v| v * v).sum::<f64>().sqrt().max(1.0);
+    let (mut floor, mut moved) = (StepTest::default(), false);
     for k in 1..=settings.max_iterations * STEP_FACTOR {
         if r.iter().chain(&s).any(|v| !v.is_finite()) {
             return None;
@@ -37,30 +38,55 @@ pub(super) fn solve(problem: &mut dyn Problem, z: &mut [f64], settings: Settings
         if jac.iter().any(|v| !v.is_finite()) {
             return None;
         }
+        // Converged after a step: the residual and the Newton step from here within their tolerances.
+        let mut ratio = None;
+        if moved && within(&r, &s, settings.rtol) {
+            let mut newton: Vec<f64> = r.iter().map(|v| -v).collect();
+            if !lu_solve(&mut jac.clone(), &mut newton, n) {
+                // A root where ∂r/∂z is singular: the step cannot be judged.
+                z[..n].copy_from_slice(&x);
+                return Some(k);
+            }
+            let q = step_ratio(&x, &newton);
+            if floor.accepts(q) {
+                z[..n].copy_from_slice(&x);
+                return Some(k);
+            }
+            // The full Newton step, as in the damped method: the residual no longer measures the distance to
+            // the root here.
+            let trial: Vec<f64> = x.iter().zip(&newton).map(|(x, p)| x + p).collect();
+            problem.residual(&trial, &mut r_try, &mut s_try);
+            if r_try.iter().chain(&s_try).all(|v| v.is_finite()) {
+                x = trial;
+                std::mem::swap(&mut r, &mut r_try);
+                std::mem::swap(&mut s, &mut s_try);
+                floor.took(Some(q), true);
+                continue;
+            }
+            ratio = Some(q);
+        }
         // The weighted system: rows of r and J divided by w.
         let rw: Vec<f64> = r.iter().zip(&w).map(|(r, w)| r / w).collect();
         let jw: Vec<f64> = (0..n * n).map(|k| jac[k] / w[k / n]).collect();
-        let step = dogleg_step(&jw, &rw, n, radius)?;
+        let (step, full) = dogleg_step(&jw, &rw, n, radius)?;
         let predicted = merit(&r) - linear_merit(&jw, &rw, &step, n);
         let trial: Vec<f64> = x.iter().zip(&step).map(|(x, p)| x + p).collect();
         problem.residual(&trial, &mut r_try, &mut s_try);
         let actual = merit(&r) - merit(&r_try);
-        let ratio = if predicted > 0.0 {
+        let ratio_of_reduction = if predicted > 0.0 {
             actual / predicted
         } else {
             -1.0
         };
         let length = step.iter().map(|v| v * v).sum::<f64>().sqrt();
-        if ratio.is_finite() && ratio > 1e-4 {
+        if ratio_of_reduction.is_finite() && ratio_of_reduction > 1e-4 {
             x = trial;
             std::mem::swap(&mut r, &mut r_try);
             std::mem::swap(&mut s, &mut s_try);
-            if r.iter().zip(&s).all(|(r, s)| r.abs() <= settings.rtol * s) {
-                z[..n].copy_from_slice(&x);
-                return Some(k);
-            }
+            floor.took(ratio, full);
+            moved = true;
         }
-        radius = match ratio {
+        radius = match ratio_of_reduction {
             q if !q.is_finite() || q < 0.25 => length / 4.0,
             q if q > 0.75 && length >= 0.99 * radius => 2.0 * radius,
             _ => radius,
@@ -84,15 +110,15 @@ fn linear_merit(j: &[f64], r: &[f64], p: &[f64], n: usize) -> f64 {
         / 2.0
 }
 
-/// The dogleg step within `radius` for the model `r + J p` (J row-major `n × n`); `None` when the gradient is zero
-/// and no Newton step exists.
-fn dogleg_step(j: &[f64], r: &[f64], n: usize, radius: f64) -> Option<Vec<f64>> {
+/// The dogleg step within `radius` for the model `r + J p` (J row-major `n × n`), and whether it is the full Newton
+/// step; `None` when the gradient is zero and no Newton step exists.
+fn dogleg_step(j: &[f64], r: &[f64], n: usize, radius: f64) -> Option<(Vec<f64>, bool)> {
     let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
     let mut newton: Vec<f64> = r.iter().map(|v| -v).collect();
     let mut a = j.to_vec();
     let has_newton = lu_solve(&mut a, &mut newton, n);
     if has_newton && norm(&newton) <= radius {
-        return Some(newton);
+        return Some((newton, true));
     }
     // The gradient of ½‖r + J p‖² at p = 0, and the minimiser of the model along it.
     let g: Vec<f64> = (0..n)
@@ -112,7 +138,7 @@ fn dogleg_step(j: &[f64], r: &[f64], n: usize, radius: f64) -> Option<Vec<f64>> 
     let cauchy_length = norm(&cauchy);
     if !has_newton || cauchy_length >= radius {
         let scale = radius / gg.sqrt();
-        return Some(g.iter().map(|v| -v * scale).collect());
+        return Some((g.iter().map(|v| -v * scale).collect(), false));
     }
     // From the Cauchy point towards the Newton point, to the boundary: ‖c + τ (N − c)‖ = radius.
     let d: Vec<f64> = newton.iter().zip(&cauchy).map(|(a, b)| a - b).collect();
@@ -122,7 +148,10 @@ fn dogleg_step(j: &[f64], r: &[f64], n: usize, radius: f64) -> Option<Vec<f64>> 
     );
     let cc = cauchy_length * cauchy_length;
     let tau = (-cd + (cd * cd + dd * (radius * radius - cc)).max(0.0).sqrt()) / dd;
-    Some(cauchy.iter().zip(&d).map(|(c, d)| c + tau * d).collect())
+    Some((
+        cauchy.iter().zip(&d).map(|(c, d)| c + tau * d).collect(),
+        false,
+    ))
 }
 
 #[cfg(test)]

@@ -6,11 +6,18 @@
 //! `φ(z_k + λΔ) ≤ (1 − 10⁻⁴ λ) φ(z_k)` on `φ(z) = Σ (r_i(z)/w_i)²`, the weights `w_i` being the residual scales at
 //! `z_k`. The damping keeps a steep law (a diode's exponential) from throwing the iterate where it overflows.
 //!
-//! Convergence is tested on the residual: `|r_i(z)| ≤ rtol · s_i(z)` for every `i`, where `s_i` is the scale of
-//! residual `i`, the sum of the magnitudes of its terms ([`super::tear::residual_scale`]). The test is free of units
-//! and reachable in floating point (a residual cannot be computed more accurately than `ε · s_i`). It is checked
-//! after at least one Newton step, so a warm start that already passes is polished to the quadratic rate's
-//! accuracy, which keeps finite differences of the solution smooth.
+//! Convergence is tested on the residual and on the Newton step. The residual: `|r_i(z)| ≤ rtol · s_i(z)` for
+//! every `i`, where `s_i` is the scale of residual `i`, the sum of the magnitudes of its terms
+//! ([`super::tear::residual_scale`]); free of units and reachable in floating point (a residual cannot be computed
+//! more accurately than `ε · s_i`). A small residual alone does not bound the error of `z` where `∂r/∂z` is
+//! ill-conditioned (a loop whose gain is near one along some direction: terms of 10⁹ that cancel to a residual of
+//! 10⁻³ can leave the tears 0.1 % from the root), so the Newton step `Δ` from the iterate must be small too:
+//! `|Δ_i| ≤ 10⁻¹⁰ |z_i|` (`step_ratio`), or, where rounding keeps it from getting there (a tear at zero, a
+//! loop so ill-conditioned that the residuals' rounding moves the tears by more), it must have stopped
+//! contracting (`StepTest`). From an iterate that passed the residual test the full Newton step is taken without
+//! the line search (the residual no longer measures the distance to the root there). Both tests are checked after
+//! at least one Newton step, so a warm start that already passes is polished to the quadratic rate's accuracy,
+//! which keeps finite differences of the solution smooth.
 
 // Index loops read like the textbook elimination they implement.
 #![allow(clippy::needless_range_loop)]
@@ -165,9 +172,18 @@ pub fn bracketed(problem: &mut dyn Problem, z0: f64, settings: Settings) -> Opti
     if r0.is_nan() {
         return None;
     }
-    // Converged: finite, and within the tolerance of the scale (an infinite residual is only a direction).
+    // Converged: finite, within the tolerance of the scale (an infinite residual is only a direction), and the
+    // Newton step from the point within its tolerance.
     let within = |r: f64, s: f64| r.is_finite() && s.is_finite() && r.abs() <= settings.rtol * s;
-    if within(r0, s0) {
+    let mut derivative = |x: f64| {
+        let mut jac = [f64::NAN];
+        problem.jacobian(&[x], &mut jac);
+        jac[0]
+    };
+    let settled = |x: f64, r: f64, s: f64, jac: f64| {
+        within(r, s) && (r == 0.0 || step_ratio(&[x], &[r / jac]) <= 1.0)
+    };
+    if within(r0, s0) && settled(z0, r0, s0, derivative(z0)) {
         return Some((z0, 1));
     }
     let (mut lo, mut hi, mut evaluations) = bracket(problem, (z0, r0, s0))?;
@@ -176,12 +192,12 @@ pub fn bracketed(problem: &mut dyn Problem, z0: f64, settings: Settings) -> Opti
     let mut step_before = (hi.0 - lo.0).abs();
     let mut step = step_before;
     while evaluations < BRACKET_EVALUATIONS {
-        if within(rx, sx) {
-            return Some((x, evaluations));
-        }
         let mut jac = [f64::NAN];
         if rx.is_finite() {
             problem.jacobian(&[x], &mut jac);
+        }
+        if settled(x, rx, sx, jac[0]) {
+            return Some((x, evaluations));
         }
         let newton = x - rx / jac[0];
         let (a, b) = (lo.0.min(hi.0), lo.0.max(hi.0));
@@ -292,24 +308,40 @@ fn damped(problem: &mut dyn Problem, z: &mut [f64], settings: Settings) -> Resul
         }
     };
     problem.residual(z, &mut r, &mut s);
+    let mut floor = StepTest::default();
     for k in 0..=settings.max_iterations {
         if r.iter().chain(&s).any(|v| !v.is_finite()) {
             return Err(fail(FailureKind::NonFinite, k, &r));
         }
-        let converged = r.iter().zip(&s).all(|(r, s)| r.abs() <= settings.rtol * s);
-        if converged && (k > 0 || r.iter().all(|v| *v == 0.0)) {
+        let converged = within(&r, &s, settings.rtol);
+        if k == 0 && r.iter().all(|v| *v == 0.0) {
             return Ok(k);
         }
         if k == settings.max_iterations {
             break;
         }
         problem.jacobian(z, &mut jac);
-        if jac.iter().any(|v| !v.is_finite()) {
-            return Err(fail(FailureKind::NonFinite, k, &r));
-        }
         step.iter_mut().zip(&r).for_each(|(d, r)| *d = -r);
-        if !lu_solve(&mut jac, &mut step, n) {
-            return Err(fail(FailureKind::Singular, k, &r));
+        let solved = jac.iter().all(|v| v.is_finite()) && lu_solve(&mut jac, &mut step, n);
+        if !solved {
+            // A converged iterate where the step cannot be judged (a root where ∂r/∂z is singular) stays.
+            if converged && k > 0 {
+                return Ok(k);
+            }
+            let nonfinite = jac.iter().any(|v| !v.is_finite());
+            let kind = if nonfinite {
+                FailureKind::NonFinite
+            } else {
+                FailureKind::Singular
+            };
+            return Err(fail(kind, k, &r));
+        }
+        let ratio = converged.then(|| step_ratio(z, &step));
+        if let Some(ratio) = ratio
+            && k > 0
+            && floor.accepts(ratio)
+        {
+            return Ok(k);
         }
         let w: Vec<f64> = s.iter().map(|s| if *s > 0.0 { *s } else { 1.0 }).collect();
         let phi0 = merit(&r, &w);
@@ -321,19 +353,23 @@ fn damped(problem: &mut dyn Problem, z: &mut [f64], settings: Settings) -> Resul
             }
             problem.residual(&trial, &mut r_try, &mut s_try);
             let phi = merit(&r_try, &w);
-            if phi.is_finite() && phi <= (1.0 - 1e-4 * lambda) * phi0 {
+            // From an iterate that passed the residual test the full step is taken: the residual no longer
+            // measures the distance to the root there (it is at its rounding floor, or the loop is
+            // ill-conditioned), the Newton step does.
+            if phi.is_finite() && (converged || phi <= (1.0 - 1e-4 * lambda) * phi0) {
                 accepted = true;
                 break;
             }
             lambda /= 2.0;
         }
         if !accepted {
-            // At the rounding floor no step decreases the residual: a converged iterate stays as it is.
+            // No step from a converged iterate leads to finite residuals: it stays as it is.
             if converged {
                 return Ok(k);
             }
             return Err(fail(FailureKind::NoDescent, k, &r));
         }
+        floor.took(ratio, lambda == 1.0);
         z.copy_from_slice(&trial);
         std::mem::swap(&mut r, &mut r_try);
         std::mem::swap(&mut s, &mut s_try);
@@ -343,6 +379,63 @@ fn damped(problem: &mut dyn Problem, z: &mut [f64], settings: Settings) -> Resul
         settings.max_iterations,
         &r,
     ))
+}
+
+/// The residual test: `|r_i| ≤ rtol · s_i` for every `i`.
+pub(super) fn within(r: &[f64], s: &[f64], rtol: f64) -> bool {
+    r.iter().zip(s).all(|(r, s)| r.abs() <= rtol * s)
+}
+
+/// The Newton step's size in units of its tolerance, `max_i |Δ_i| / (STEP_RTOL · |z_i|)`: an iterate whose step
+/// is within it is accurate to about `STEP_RTOL` (Newton's method converges quadratically from there); `∞` for a
+/// step that is not finite or that moves a tear at zero. The tolerance has no absolute part: what rounding leaves
+/// of a tear at zero, `|(∂r/∂z)⁻¹| ε s`, is known only by how the steps stop contracting ([`StepTest`]).
+pub(super) fn step_ratio(z: &[f64], step: &[f64]) -> f64 {
+    z.iter().zip(step).fold(0.0, |m: f64, (z, d)| {
+        let q = if *d == 0.0 {
+            0.0
+        } else {
+            d.abs() / (STEP_RTOL * z.abs())
+        };
+        m.max(if q.is_nan() { f64::INFINITY } else { q })
+    })
+}
+
+/// The Newton step's tolerance relative to the tear ([`step_ratio`]).
+const STEP_RTOL: f64 = 1e-10;
+
+/// The step half of the convergence test, at iterates that passed the residual test: the Newton step is within
+/// the tolerance (`ratio ≤ 1`), or it is at least half the full step that led to the iterate from one that also
+/// passed. Newton's method at least halves its steps near a root at every precision the arithmetic resolves
+/// (quadratically where `∂r/∂z` is regular), so a step that does not is rounding noise, `|(∂r/∂z)⁻¹| ε s` in
+/// size: the iterate is as accurate as the residuals can be evaluated.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct StepTest {
+    /// The ratio of the last step if it was a full step from an iterate that passed the residual test.
+    previous: f64,
+}
+
+impl Default for StepTest {
+    fn default() -> Self {
+        StepTest {
+            previous: f64::INFINITY,
+        }
+    }
+}
+
+impl StepTest {
+    /// True when an iterate with this step ratio has converged.
+    pub(super) fn accepts(&self, ratio: f64) -> bool {
+        ratio <= 1.0 || ratio >= 0.5 * self.previous
+    }
+
+    /// Records the step taken: its ratio when the iterate passed the residual test, and whether it was full.
+    pub(super) fn took(&mut self, ratio: Option<f64>, full: bool) {
+        self.previous = match ratio {
+            Some(q) if full => q,
+            _ => f64::INFINITY,
+        };
+    }
 }
 
 /// Solves `a x = b` in place (`a` row-major `n × n`, overwritten; `b` becomes `x`). False when a pivot is zero or
@@ -555,5 +648,100 @@ mod tests {
         assert!((b[0] - 1.0).abs() < 1e-15 && (b[1] - 2.0).abs() < 1e-15);
         let mut singular = [1.0, 2.0, 2.0, 4.0];
         assert!(!lu_solve(&mut singular, &mut [1.0, 1.0], 2));
+    }
+
+    /// Two tears along a valley: with `w = z0 + z1` and `d = z0 − z1`,
+    /// `r0 = M d + μ w + w³ − c0` and `r1 = M d − μ w − w³ − c1`. The terms are of 10⁶ and cancel to leave the
+    /// weak direction `w` (`∂r/∂w` = 0.03 at the root): a residual within `10⁻¹² s` is no closer than 10⁻⁵ to the
+    /// root along it.
+    pub(crate) struct Valley {
+        pub c: [f64; 2],
+    }
+
+    pub(crate) const VALLEY_M: f64 = 1e6;
+    pub(crate) const VALLEY_MU: f64 = 1e-3;
+
+    impl Valley {
+        /// The root of the exact data: `2 M d = c0 + c1`, `μ w + w³ = (c0 − c1)/2` (a cubic with one real root,
+        /// by Newton's method on it, well-conditioned: `3w² + μ` ≥ 0.03 near it).
+        pub(crate) fn root(&self) -> [f64; 2] {
+            let k = (self.c[0] - self.c[1]) / 2.0;
+            let mut w = k.cbrt();
+            for _ in 0..50 {
+                w -= (VALLEY_MU * w + w.powi(3) - k) / (VALLEY_MU + 3.0 * w * w);
+            }
+            let d = (self.c[0] + self.c[1]) / (2.0 * VALLEY_M);
+            [(w + d) / 2.0, (w - d) / 2.0]
+        }
+
+        pub(crate) fn at(&self, z: &[f64]) -> ([f64; 2], [f64; 2], [f64; 4]) {
+            let (w, d) = (z[0] + z[1], z[0] - z[1]);
+            let weak = VALLEY_MU * w + w.powi(3);
+            let terms = (VALLEY_M * d).abs() + (VALLEY_MU * w).abs() + w.powi(3).abs();
+            let dw = VALLEY_MU + 3.0 * w * w;
+            (
+                [
+                    VALLEY_M * d + weak - self.c[0],
+                    VALLEY_M * d - weak - self.c[1],
+                ],
+                [terms + self.c[0].abs(), terms + self.c[1].abs()],
+                [VALLEY_M + dw, -VALLEY_M + dw, VALLEY_M - dw, -VALLEY_M - dw],
+            )
+        }
+    }
+
+    impl Problem for Valley {
+        fn size(&self) -> usize {
+            2
+        }
+        fn residual(&mut self, z: &[f64], r: &mut [f64], s: &mut [f64]) {
+            let (rr, ss, _) = self.at(z);
+            r.copy_from_slice(&rr);
+            s.copy_from_slice(&ss);
+        }
+        fn jacobian(&mut self, z: &[f64], j: &mut [f64]) {
+            j.copy_from_slice(&self.at(z).2);
+        }
+    }
+
+    /// The data of the valley: `c = 3·10⁶ ± (μ w + w³)` for `w` = 0.1, 0.3, 1 (so `d` = 3).
+    pub(crate) fn valleys() -> Vec<Valley> {
+        [0.1f64, 0.3, 1.0]
+            .iter()
+            .map(|w| {
+                let k = VALLEY_MU * w + w.powi(3);
+                Valley {
+                    c: [3e6 + k, 3e6 - k],
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn an_ill_conditioned_loop_is_solved_to_its_root_not_to_its_residual_tolerance() {
+        // Before the step test, damped Newton's method from zero stopped at w = 0.10004 (residuals within
+        // 10⁻¹² s), 4e-4 from the root along the valley; now the tears are as accurate as rounding allows:
+        // ε s / (∂r/∂w) ≈ 2e-16 · 10⁶ / 0.03 ≈ 7e-9 in w, 2e-9 relative to the tears.
+        for valley in valleys() {
+            let root = valley.root();
+            for start in [[0.0, 0.0], [1.0, -1.0], [2.0 * root[0], root[1]]] {
+                let mut problem = Valley { c: valley.c };
+                let mut z = start;
+                let k = solve(&mut problem, &mut z, Settings::default());
+                assert!(k.is_ok(), "{:?} from {start:?}: {k:?}", valley.c);
+                // The dogleg method on its own, as the fallback of a failed damped iteration.
+                let mut by_dogleg = start;
+                let k =
+                    super::super::dogleg::solve(&mut problem, &mut by_dogleg, Settings::default());
+                assert!(k.is_some(), "{:?} from {start:?}: dogleg failed", valley.c);
+                for (z, root) in z.iter().chain(&by_dogleg).zip(root.iter().cycle()) {
+                    assert!(
+                        (z - root).abs() <= 1e-8 * root.abs(),
+                        "{:?} from {start:?}: {z} against {root}",
+                        valley.c
+                    );
+                }
+            }
+        }
     }
 }

@@ -219,7 +219,14 @@ fn the_generated_solver_solves_a_block_where_damped_newton_creeps() {
     let printed = build_and_run(&dir, "two", &code, CUBIC_MAIN, LIBM_STD);
     let _ = std::fs::remove_dir_all(&dir);
     let lines: Vec<&str> = printed.lines().collect();
-    assert_eq!(lines.first(), Some(&"damped IterationLimit"), "{printed}");
+    // The damped method alone fails here (it ends where no damped step decreases the residual or contracts the
+    // Newton step; the compiler's, whose elimination refuses smaller pivots, at a Jacobian it takes for singular).
+    assert!(
+        lines
+            .first()
+            .is_some_and(|l| l.starts_with("damped ") && *l != "damped solved"),
+        "{printed}"
+    );
     let fields: Vec<&str> = lines.get(1).map_or(vec![], |l| l.split(' ').collect());
     let value = |k: usize| fields.get(k).and_then(|f| f.parse::<f64>().ok());
     assert!(

@@ -8,7 +8,7 @@
 //!   fixed-size values ([`NEWTON_FN`]), from `z = 0` (`solve_loops_from(p, t, x, u, guess)` starts from the
 //!   caller's guess, the last solution of a time-stepping caller, and retries from zero when that fails), with the analytic `∂r/∂z` (symbolic derivatives of the
 //!   residuals). It mirrors [`crate::equations::newton`]: the step solves `∂r/∂z Δ = −r`, the damping halves `λ`
-//!   until the Armijo test on `Σ (r_i/w_i)²` passes, and the block has converged when `|r_i| ≤ 10⁻¹² s_i` for every
+//!   until the Armijo test on `Σ (r_i/w_i)²` or the natural monotonicity test (`bgc_contracts`) passes, and the block has converged when `|r_i| ≤ 10⁻¹² s_i` for every
 //!   residual, `s_i` being the sum of the magnitudes of its terms ([`crate::equations::residual_scale`]), and the
 //!   Newton step from the iterate is within `10⁻¹⁰` of each tear or no longer contracts, after at least one step;
 //!   at most 100 iterations. A block of one tear whose Newton iteration fails is solved in a
@@ -337,6 +337,35 @@ fn bgc_step_ratio<const B: usize>(z: &Tears, first: usize, step: &SVector<f64, B
     ratio
 }
 
+/// Deuflhard's natural monotonicity test: the simplified Newton correction at the trial point
+/// (with the iterate's Jacobian `jz`) is at most `1 - lambda/4` of the step, in norms scaled by
+/// the tears' magnitudes. It does not change when the rows of the Jacobian are scaled, so it
+/// accepts the steps of an ill-conditioned block that the residual's decrease rejects.
+fn bgc_contracts<const B: usize>(
+    jz: &SMatrix<f64, B, B>,
+    r_trial: &SVector<f64, B>,
+    z: &Tears,
+    first: usize,
+    step: &SVector<f64, B>,
+    lambda: f64,
+) -> bool {
+    let mut minus_r = SVector::<f64, B>::zeros();
+    for i in 0..B {
+        minus_r[i] = -r_trial[i];
+    }
+    let correction = bgc_solve(*jz, minus_r);
+    let (mut correction_norm, mut step_norm) = (0.0, 0.0);
+    for i in 0..B {
+        let mut scale = libm::fabs(z[first + i]).max(libm::fabs(z[first + i] + step[i]));
+        if scale == 0.0 {
+            scale = 1.0;
+        }
+        correction_norm += (correction[i] / scale) * (correction[i] / scale);
+        step_norm += (step[i] / scale) * (step[i] / scale);
+    }
+    libm::sqrt(correction_norm) <= (1.0 - lambda / 4.0) * libm::sqrt(step_norm)
+}
+
 /// Damped Newton's method for the block, from the values in `z`.
 fn bgc_damped<const B: usize>(
     z: &mut Tears,
@@ -439,9 +468,9 @@ fn bgc_damped<const B: usize>(
             }
             // From a converged iterate the full step: the residual no longer measures the
             // distance to the root there, the Newton step does.
-            if merit_trial.is_finite()
-                && (converged || merit_trial <= (1.0 - 1e-4 * lambda) * merit)
-            {
+            let descends = merit_trial <= (1.0 - 1e-4 * lambda) * merit
+                || bgc_contracts(&jz, &at.0, z, first, &step, lambda);
+            if merit_trial.is_finite() && (converged || descends) {
                 accepted = Some(at);
                 break;
             }

@@ -8,7 +8,7 @@
 //! point is at most `1 − λ/4` of the step). The damping keeps a steep law (a diode's exponential) from throwing the
 //! iterate where it overflows; the second test, blind to how the rows of `∂r/∂z` are scaled, keeps an
 //! ill-conditioned loop from creeping (a loop of a random graph whose Jacobian has determinant 1 against products
-//! of 10⁸ needed hundreds of damped steps with the Armijo test alone).
+//! of 10⁸ ran out of 100 damped steps with the Armijo test alone).
 //!
 //! Convergence is tested on the residual and on the Newton step. The residual: `|r_i(z)| ≤ rtol · s_i(z)` for
 //! every `i`, where `s_i` is the scale of residual `i`, the sum of the magnitudes of its terms
@@ -300,6 +300,8 @@ fn damped(problem: &mut dyn Problem, z: &mut [f64], settings: Settings) -> Resul
     let (mut r, mut s) = (vec![0.0; n], vec![0.0; n]);
     let (mut r_try, mut s_try) = (vec![0.0; n], vec![0.0; n]);
     let mut jac = vec![0.0; n * n];
+    // The iterate's Jacobian, kept for the natural monotonicity test (`jac` is factored in place).
+    let mut jac0 = vec![0.0; n * n];
     let mut step = vec![0.0; n];
     let mut trial = vec![0.0; n];
     let fail = |kind, iterations, r: &[f64]| {
@@ -325,7 +327,7 @@ fn damped(problem: &mut dyn Problem, z: &mut [f64], settings: Settings) -> Resul
             break;
         }
         problem.jacobian(z, &mut jac);
-        let jac0 = jac.clone();
+        jac0.copy_from_slice(&jac);
         step.iter_mut().zip(&r).for_each(|(d, r)| *d = -r);
         let solved = jac.iter().all(|v| v.is_finite()) && lu_solve(&mut jac, &mut step, n);
         if !solved {

@@ -38,6 +38,7 @@ fn bench(c: &mut Criterion) {
         rtol: 1e-6,
         atol: 1e-9,
         max_steps: 100_000,
+        max_step: None,
     };
     let mut group = c.benchmark_group("simulate/benchmark_chain");
     group.sample_size(10);

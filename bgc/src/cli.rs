@@ -217,6 +217,11 @@ enum Command {
         /// Absolute tolerance (all states and the energy quadratures).
         #[arg(long, default_value_t = 1e-9, allow_hyphen_values = true)]
         atol: f64,
+        /// The longest step the solver may take, in seconds (none when absent). The error estimate sees the model
+        /// only where its steps evaluate it: a forcing that acts in short windows (a diode conducting near the
+        /// peaks of a sine) can fall between them; a bound below the window's length makes the solver see it.
+        #[arg(long, value_name = "H", allow_hyphen_values = true)]
+        max_step: Option<f64>,
         /// Replay the inputs of a record (a CSV file as for `bgc fit --data`: a `t` column and one column per
         /// input, values in the declared units or in the units of the header; columns of measured outputs are
         /// read and ignored). Inputs given with --input are not in the record.
@@ -405,6 +410,7 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
             solver,
             rtol,
             atol,
+            max_step,
             data,
             interp,
             verbose,
@@ -418,6 +424,7 @@ pub fn run(args: impl IntoIterator<Item = OsString>) -> ExitCode {
                 solver,
                 rtol,
                 atol,
+                max_step,
                 record: data.as_deref().map(|path| simulate::RecordArg {
                     path,
                     replay: match interp {

@@ -120,6 +120,7 @@ fn simulate(
         rtol: 1e-11,
         atol: 1e-13,
         max_steps: 10_000_000,
+        max_step: None,
     };
     run(&system, x0, &opts)
         .unwrap_or_else(|e| panic!("{e}"))

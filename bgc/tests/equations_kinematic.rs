@@ -157,6 +157,7 @@ fn cart_pole_as_mtfs_simulates_from_the_bottom() {
         rtol: 1e-10,
         atol: 1e-12,
         max_steps: 1_000_000,
+        max_step: None,
     };
     let traj = run(&system, &mtf_point(&eqs, 0.0, 0.0, 0.0, 0.0), &opts)
         .unwrap_or_else(|e| panic!("simulate from θ = 0: {e}"));

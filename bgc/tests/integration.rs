@@ -16,6 +16,7 @@ mod cli_examples;
 mod cli_fit;
 mod cli_hostile;
 mod cli_hostile_numbers;
+mod cli_max_step;
 mod cli_messages;
 mod cli_replay;
 mod cli_root_files;

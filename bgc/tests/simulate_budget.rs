@@ -23,6 +23,7 @@ fn an_implicit_run_too_slow_to_finish_stops_early() {
             rtol: 1e-6,
             atol: 1e-9,
             max_steps: 10_000,
+            max_step: None,
         };
         match run(&system, &[0.0, 0.0], &opts) {
             Err(err @ SimError::TooSlow { steps, .. }) => {

@@ -25,6 +25,8 @@ pub struct SimulateArgs<'a> {
     pub solver: Solver,
     pub rtol: f64,
     pub atol: f64,
+    /// `--max-step`.
+    pub max_step: Option<f64>,
     /// The record whose inputs are replayed (`--data`, `--interp`).
     pub record: Option<RecordArg<'a>>,
     /// Print the effective parameter values and initial state on standard error.
@@ -117,6 +119,7 @@ fn csv(
         rtol: args.rtol,
         atol: args.atol,
         max_steps: 10_000_000,
+        max_step: args.max_step,
     };
     // The options are checked before anything else is said about the run.
     opts.check().map_err(option_error)?;

@@ -59,6 +59,10 @@ pub struct RunOptions {
     pub atol: f64,
     /// Upper bound on internal steps per segment.
     pub max_steps: usize,
+    /// The longest step the solver may take, or none. The error estimate of a step sees the model only at the
+    /// points the step evaluates: a forcing whose effect lasts a short window (a diode conducting near each peak of
+    /// a sine) can fall between them, and then nothing makes the step shorter.
+    pub max_step: Option<f64>,
 }
 
 /// The smallest relative tolerance: 100 machine epsilons, as MATLAB's ODE solvers also raise `RelTol` to. Below
@@ -84,6 +88,23 @@ impl RunOptions {
                     name,
                     value,
                     reason: "it must be finite and positive",
+                });
+            }
+        }
+        if let Some(h) = self.max_step {
+            if !(h.is_finite() && h > 0.0) {
+                return Err(SimError::BadSetting {
+                    name: "max_step",
+                    value: h,
+                    reason: "it must be finite and positive",
+                });
+            }
+            if self.t_end / h > self.max_steps as f64 {
+                return Err(SimError::BadSetting {
+                    name: "max_step",
+                    value: h,
+                    reason: "the run would take more steps than its budget allows (t_end / max_step above \
+                             max_steps, 10,000,000 for the CLI)",
                 });
             }
         }
@@ -490,6 +511,7 @@ fn segment_once(
         to: b,
         wanted,
         max_steps: opts.max_steps,
+        max_step: opts.max_step,
         method: opts.method,
     };
     if let Some(full) = system.jacobian_pattern().filter(|_| dim >= SPARSE_FROM) {
@@ -598,6 +620,7 @@ struct Drive<'c> {
     to: f64,
     wanted: &'c Wanted,
     max_steps: usize,
+    max_step: Option<f64>,
     /// What a stall ([`Drive::stalled`]) does: BDF ends the drive with [`Outcome::Stalled`] and goes on with
     /// TR-BDF2; the explicit method, whose step a stiff mode or a fast forcing holds short for the rest of the run,
     /// ends it with [`SimError::TooSlow`]. An implicit one-step method's slow start may be a transient it leaves
@@ -631,6 +654,24 @@ impl Drive<'_> {
         let pace = (t_now - window_start) / window as f64;
         let left = self.max_steps.saturating_sub(steps) as f64;
         !(pace > 0.0 && (self.to - t_now) / pace <= left)
+    }
+
+    /// A `max_step` shorter than the solver resolves of time where the run is.
+    fn step_below_resolution(&self) -> SimError {
+        SimError::BadSetting {
+            name: "max_step",
+            value: self.max_step.unwrap_or(f64::NAN),
+            reason: "it is shorter than the solver resolves of time at this point of the run (about 1e-14 of the \
+                     time): give a longer one",
+        }
+    }
+
+    /// The time the solver may step to from `t`: the segment's end, or `t + max_step` when that comes first.
+    fn cap_after(&self, t: f64) -> f64 {
+        match self.max_step {
+            Some(h) if t + h < self.to => t + h,
+            _ => self.to,
+        }
     }
 
     fn too_slow(&self, time: f64, steps: usize, hint: &'static str) -> SimError {
@@ -677,8 +718,14 @@ impl Drive<'_> {
         Eqn: OdeEquations<T = f64> + 'a,
         S: OdeSolverMethod<'a, Eqn>,
     {
-        match solver.set_stop_time(self.to) {
+        let mut cap = self.cap_after(self.from);
+        match solver.set_stop_time(cap) {
             Ok(()) => {}
+            Err(DiffsolError::OdeSolverError(OdeSolverError::StopTimeAtCurrentTime))
+                if cap < self.to =>
+            {
+                return Err(self.step_below_resolution());
+            }
             // The segment is shorter than the solver's resolution of time at its start: two breakpoints that differ
             // by rounding (`step(0.3) + step(0.1 + 0.2)`) or a run of 1e-20 s. Integrating over it changes nothing
             // to rounding, so the state goes on unchanged (this failed the run before).
@@ -701,10 +748,24 @@ impl Drive<'_> {
         let long_window = (self.max_steps / ONE_STEP_STALL_SHARE).max(1);
         let one_step = matches!(self.method, Method::TrBdf2 | Method::Esdirk34);
         for step in 0..self.max_steps {
-            let reason = solver
+            let mut reason = solver
                 .step()
                 .map_err(|e| self.failure(solver.state().t, e))?;
             let t_now = solver.state().t;
+            if matches!(reason, OdeSolverStopReason::TstopReached) && cap < self.to {
+                // A cap of the step, not the segment's end: the next cap, or the end when it is within the
+                // solver's resolution of time from here.
+                cap = self.cap_after(t_now);
+                match solver.set_stop_time(cap) {
+                    Ok(()) => reason = OdeSolverStopReason::InternalTimestep,
+                    Err(DiffsolError::OdeSolverError(OdeSolverError::StopTimeAtCurrentTime))
+                        if cap >= self.to => {}
+                    Err(DiffsolError::OdeSolverError(OdeSolverError::StopTimeAtCurrentTime)) => {
+                        return Err(self.step_below_resolution());
+                    }
+                    Err(e) => return Err(self.failure(t_now, e)),
+                }
+            }
             let y = solver.state().y.clone_as_vec();
             if let Some(i) = y.iter().position(|v| !v.is_finite()) {
                 if let Some(loop_error) = self.loop_failure.borrow().clone() {
@@ -792,6 +853,7 @@ mod tests {
             rtol: 1e-6,
             atol: 1e-9,
             max_steps: 1000,
+            max_step: None,
         }
     }
 

@@ -467,10 +467,13 @@ fn bgc_damped<const B: usize>(
                 merit_trial += (at.0[i] / weights[i]) * (at.0[i] / weights[i]);
             }
             // From a converged iterate the full step: the residual no longer measures the
-            // distance to the root there, the Newton step does.
-            let descends = merit_trial <= (1.0 - 1e-4 * lambda) * merit
-                || bgc_contracts(&jz, &at.0, z, first, &step, lambda);
-            if merit_trial.is_finite() && (converged || descends) {
+            // distance to the root there, the Newton step does. The monotonicity test (an
+            // elimination) runs only when the others fail.
+            let accept = merit_trial.is_finite()
+                && (converged
+                    || merit_trial <= (1.0 - 1e-4 * lambda) * merit
+                    || bgc_contracts(&jz, &at.0, z, first, &step, lambda));
+            if accept {
                 accepted = Some(at);
                 break;
             }

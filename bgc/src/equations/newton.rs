@@ -362,10 +362,13 @@ fn damped(problem: &mut dyn Problem, z: &mut [f64], settings: Settings) -> Resul
             let phi = merit(&r_try, &w);
             // From an iterate that passed the residual test the full step is taken: the residual no longer
             // measures the distance to the root there (it is at its rounding floor, or the loop is
-            // ill-conditioned), the Newton step does.
-            let descends =
-                phi <= (1.0 - 1e-4 * lambda) * phi0 || contracts(&jac0, &r_try, z, &step, lambda);
-            if phi.is_finite() && (converged || descends) {
+            // ill-conditioned), the Newton step does. The monotonicity test (an elimination) runs only when
+            // the others fail.
+            let accept = phi.is_finite()
+                && (converged
+                    || phi <= (1.0 - 1e-4 * lambda) * phi0
+                    || contracts(&jac0, &r_try, z, &step, lambda));
+            if accept {
                 accepted = true;
                 break;
             }

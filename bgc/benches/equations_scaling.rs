@@ -9,6 +9,10 @@
 //! - the benchmark chain: `Se` drives mass 1; each 1-junction has `I` (m = 1) and `R` (b = 0.5); a `C` to the
 //!   wall at the first; a 0-junction and a `C` between neighbours; `2N` states.
 //!
+//! The `statespace/...` group times the state space of the ladder whose loops are one linear block (derivation,
+//! the block's solve and the implicit-function linearisation at the origin, what `bgc statespace` runs): each
+//! residual reads every tear, so its derivatives by them are taken in one reverse walk per residual.
+//!
 //! The `rust/...` groups time what `bgc rust` does after parsing (equations, Jacobians, code generation) on the
 //! benchmark chain, the output chain and the gear train: sparse Jacobians (a row that reads many states in one
 //! reverse walk) and shared subexpressions keep them linear in the model.
@@ -20,6 +24,7 @@
 mod families;
 
 use bgc::causality::analyse;
+use bgc::equations::StateSelection;
 use bgc::lower::{MemoryLoader, lower};
 use bgc::span::SourceMap;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
@@ -41,6 +46,47 @@ fn derive(text: &str) -> usize {
             bgc::equations::derive(m, &c).0.states.len()
         })
         .sum()
+}
+
+/// Derives and linearises at the origin (exact for a linear model whose loops are solved numerically); returns
+/// `A[0][0]` so that nothing is optimised away.
+fn state_space(text: &str) -> f64 {
+    let mut sources = SourceMap::new();
+    let root = sources.add("bench.bg".to_string(), text.to_string());
+    let (models, _) = lower(&mut sources, root, &mut MemoryLoader::new());
+    let Some(m) = models.first() else {
+        return f64::NAN;
+    };
+    let (c, _) = analyse(m);
+    let eqs = bgc::equations::derive(m, &c).0;
+    let p = eqs.default_params();
+    let (x0, u0) = (vec![0.0; eqs.states.len()], vec![0.0; eqs.inputs.len()]);
+    bgc::equations::linearise(&eqs, StateSelection::Energy, &p, &x0, &u0, 0.0).map_or(
+        f64::NAN,
+        |ss| {
+            ss.a.first()
+                .and_then(|row| row.first())
+                .copied()
+                .unwrap_or(f64::NAN)
+        },
+    )
+}
+
+fn state_space_family(
+    c: &mut Criterion,
+    name: &str,
+    sizes: &[usize],
+    generate: fn(usize) -> String,
+) {
+    let mut group = c.benchmark_group(format!("statespace/{name}"));
+    group.sample_size(10);
+    for &n in sizes {
+        let text = generate(n);
+        group.bench_with_input(BenchmarkId::from_parameter(n), &text, |b, t| {
+            b.iter(|| black_box(state_space(black_box(t))))
+        });
+    }
+    group.finish();
 }
 
 /// Compiles and generates the Rust module (without the runtime); returns its length.
@@ -91,6 +137,7 @@ fn bench(c: &mut Criterion) {
         &[6, 12, 24, 48, 96, 384],
         ladder_distinct,
     );
+    state_space_family(c, "ladder_distinct", &[96, 192, 384], ladder_distinct);
     family(c, "output_chain", &[6, 12, 24], output_chain);
     // The velocities behind the chain's moduli are found in one walk of the definitions, not one per inertia.
     family(c, "mtf_chain", &[25, 100, 1000], mtf_chain);

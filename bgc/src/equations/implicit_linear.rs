@@ -38,17 +38,25 @@ impl Point<'_> {
             direct: Vec::new(),
             tears: Vec::new(),
         };
-        for s in e.free_symbols().iter().filter_map(Sym::of) {
-            let slot = match s {
-                Sym::State(i) if i < self.n => (false, i),
-                Sym::Input(k) => (false, self.n + k),
-                Sym::Tear(_) => match self.tear_index.get(&s) {
-                    Some(&l) => (true, l),
-                    None => continue,
-                },
-                _ => continue,
-            };
-            let x = self.derivative(e, s, what)?;
+        let slots: Vec<(Sym, (bool, usize))> = e
+            .syms()
+            .into_iter()
+            .filter_map(|s| match s {
+                Sym::State(i) if i < self.n => Some((s, (false, i))),
+                Sym::Input(k) => Some((s, (false, self.n + k))),
+                Sym::Tear(_) => self.tear_index.get(&s).map(|&l| (s, (true, l))),
+                _ => None,
+            })
+            .collect();
+        let wrt: Vec<Sym> = slots.iter().map(|&(s, _)| s).collect();
+        let slopes = symbols::gradient(e, &wrt).map_err(|symbols::NotDifferentiable(func)| {
+            LinearError::NotDifferentiable {
+                what: what.to_string(),
+                func: func.name(),
+            }
+        })?;
+        for ((_, slot), d) in slots.into_iter().zip(slopes) {
+            let x = numeric::value_of(self.eqs, &d, &|| what.to_string(), self.value)?;
             match slot {
                 (false, c) => p.direct.push((c, x)),
                 (true, l) => p.tears.push((l, x)),
@@ -57,16 +65,6 @@ impl Point<'_> {
         p.direct.sort_by_key(|&(c, _)| c);
         p.tears.sort_by_key(|&(l, _)| l);
         Ok(p)
-    }
-
-    fn derivative(&self, e: &Expr, s: Sym, what: &str) -> Result<f64, LinearError> {
-        let d = symbols::diff(e, s).map_err(|symbols::NotDifferentiable(func)| {
-            LinearError::NotDifferentiable {
-                what: what.to_string(),
-                func: func.name(),
-            }
-        })?;
-        numeric::value_of(self.eqs, &d, &|| what.to_string(), self.value)
     }
 }
 

@@ -246,14 +246,16 @@ fn jacobian(
                     read.insert(j);
                 }
             });
+            let read: Vec<usize> = read.into_iter().collect();
+            let wrt: Vec<Sym> = read.iter().map(|&j| vars[j]).collect();
+            let slopes = symbols::gradient(r, &wrt).map_err(|symbols::NotDifferentiable(f)| {
+                LinearError::NotDifferentiable {
+                    what: what(i),
+                    func: f.name(),
+                }
+            })?;
             let mut row = vec![Expr::zero(); vars.len()];
-            for j in read {
-                let d = symbols::diff(r, vars[j]).map_err(|symbols::NotDifferentiable(f)| {
-                    LinearError::NotDifferentiable {
-                        what: what(i),
-                        func: f.name(),
-                    }
-                })?;
+            for (j, d) in read.into_iter().zip(slopes) {
                 row[j] = d;
             }
             Ok(row)

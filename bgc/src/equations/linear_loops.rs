@@ -62,9 +62,9 @@ fn linear_in_unknowns(e: &Expr) -> bool {
     {
         return false;
     }
-    let constant_slopes = read
-        .iter()
-        .all(|&s| symbols::diff(e, s).is_ok_and(|d| !d.any_sym(&unknown)));
+    let read: Vec<Sym> = read.into_iter().collect();
+    let constant_slopes =
+        symbols::gradient(e, &read).is_ok_and(|slopes| slopes.iter().all(|d| !d.any_sym(&unknown)));
     constant_slopes && symbols::subst(e, &mut |s| unknown(s).then(Expr::zero)).is_zero()
 }
 

@@ -322,10 +322,6 @@ impl<'a> Resolver<'a> {
         }) {
             return Err(ResolveError::HigherOrder(v));
         }
-        let d = |s: Sym| {
-            symbols::diff(e, s)
-                .map_err(|symbols::NotDifferentiable(f)| ResolveError::NotDifferentiable(v, f))
-        };
         // The symbols `e` reads, in one walk (not one walk per state of the model), in the order of the sum.
         let mut read = std::collections::BTreeSet::new();
         e.for_each_sym(&mut |s| {
@@ -336,15 +332,15 @@ impl<'a> Resolver<'a> {
                 read.insert(s);
             }
         });
-        let mut terms = Vec::new();
-        for s in read {
-            terms.push(match s {
-                Sym::State(i) => mul(vec![d(s)?, symbols::leaf(Sym::StateDot(i))]),
-                Sym::Input(j) => mul(vec![d(s)?, symbols::leaf(Sym::InputDot(j))]),
-                _ => d(s)?,
-            });
-        }
-        Ok(add(terms))
+        let read: Vec<Sym> = read.into_iter().collect();
+        let slopes = symbols::gradient(e, &read)
+            .map_err(|symbols::NotDifferentiable(f)| ResolveError::NotDifferentiable(v, f))?;
+        let terms = read.into_iter().zip(slopes).map(|(s, d)| match s {
+            Sym::State(i) => mul(vec![d, symbols::leaf(Sym::StateDot(i))]),
+            Sym::Input(j) => mul(vec![d, symbols::leaf(Sym::InputDot(j))]),
+            _ => d,
+        });
+        Ok(add(terms.collect()))
     }
 }
 

@@ -216,9 +216,10 @@ fn rate_derivatives(
         })
         .collect();
     read.sort_unstable();
+    let wrt: Vec<Sym> = read.iter().map(|&(_, j)| Sym::StateDot(j)).collect();
+    let slopes = symbols::gradient(f, &wrt).map_err(|_| SolveError::NotDifferentiable(i))?;
     let mut row = Vec::with_capacity(read.len());
-    for (c, j) in read {
-        let d = symbols::diff(f, Sym::StateDot(j)).map_err(|_| SolveError::NotDifferentiable(i))?;
+    for ((c, _), d) in read.into_iter().zip(slopes) {
         if d.any_sym(&|s| matches!(s, Sym::StateDot(_))) {
             return Err(SolveError::Nonlinear(i));
         }

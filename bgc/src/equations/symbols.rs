@@ -12,7 +12,7 @@
 //! an expression can grow with the model.
 
 use crate::ir::Func;
-use crate::symbolic::{Expr, ExprMap, ExprSet, Node, Symbol, SymbolKind};
+use crate::symbolic::{Expr, ExprMap, ExprSet, Node, Symbol, SymbolKind, WIDE_ROW};
 use std::cell::RefCell;
 
 /// A leaf of the stage's expressions. The variants are declared in the order of their [`SymbolKind`]s, so that
@@ -339,6 +339,24 @@ pub fn diff(e: &Expr, s: Sym) -> Result<Expr, NotDifferentiable> {
     Ok(e.diff(&x))
 }
 
+/// `∂e/∂s` for each `s` of `wrt`, which should be symbols that `e` reads (an unread one costs a walk and gives 0).
+/// More than [`WIDE_ROW`] of them are differentiated in one reverse-mode walk of `e` ([`Expr::gradient`]); fewer,
+/// symbol by symbol as [`diff`] does. Symbol by symbol, a row that reads many symbols is walked once per symbol:
+/// the square of its size, and the cube of a block of loops whose residuals each read every tear.
+/// Refused as [`diff`] refuses: a symbol of `wrt` read under `min` or `max`.
+pub fn gradient(e: &Expr, wrt: &[Sym]) -> Result<Vec<Expr>, NotDifferentiable> {
+    if wrt.len() <= WIDE_ROW {
+        return wrt.iter().map(|&s| diff(e, s)).collect();
+    }
+    let vars: Vec<Symbol> = wrt.iter().map(|s| s.symbol()).collect();
+    if let Some((f, under)) = e.symbols_under_calls(&[Func::Min, Func::Max])
+        && vars.iter().any(|v| under.contains(v))
+    {
+        return Err(NotDifferentiable(f));
+    }
+    Ok(e.gradient(&vars))
+}
+
 /// Why an expression could not be evaluated.
 #[derive(Clone, Debug, PartialEq)]
 pub enum EvalError {
@@ -584,6 +602,43 @@ mod tests {
             assert_eq!(s.expr().as_sym(), Some(s));
         }
         assert_ne!(Sym::Var(1).expr(), Sym::Tear(1).expr());
+    }
+
+    /// A row that reads more than `WIDE_ROW` symbols is differentiated in one reverse-mode walk: the same values as
+    /// symbol by symbol, and a switch over one of them is refused alike.
+    #[test]
+    fn the_gradient_of_a_wide_row_is_that_of_each_symbol() {
+        let n = WIDE_ROW + 36;
+        let v = |k: usize| Sym::Tear(k).expr();
+        // r = Σ_k (k + 1) z_k z_{k+1} + sin(z_0 z_{n−1}) / (1 + z_3²): products, a sum, a call and a quotient.
+        let mut terms: Vec<Expr> = (0..n - 1)
+            .map(|k| mul(vec![num((k + 1) as f64), v(k), v(k + 1)]))
+            .collect();
+        terms.push(div(
+            call(Func::Sin, vec![mul(vec![v(0), v(n - 1)])]),
+            add(vec![num(1.0), pow(v(3), num(2.0))]),
+        ));
+        let r = add(terms);
+        let wrt: Vec<Sym> = (0..n).map(Sym::Tear).collect();
+        let wide = gradient(&r, &wrt).unwrap_or_default();
+        assert_eq!(wide.len(), n);
+        let at = |s: Sym| match s {
+            Sym::Tear(k) => Some(0.3 + 0.01 * k as f64),
+            _ => None,
+        };
+        for (k, d) in wide.iter().enumerate() {
+            let one = diff(&r, Sym::Tear(k)).unwrap_or_else(|_| Expr::zero());
+            let (got, want) = match (eval(d, &at), eval(&one, &at)) {
+                (Ok(got), Ok(want)) => (got, want),
+                other => panic!("z_{k}: {other:?}"),
+            };
+            assert!(
+                (got - want).abs() <= 1e-14 * want.abs().max(1.0),
+                "z_{k}: {got} vs {want}"
+            );
+        }
+        let switch = add(vec![r, call(Func::Max, vec![v(5), num(0.0)])]);
+        assert_eq!(gradient(&switch, &wrt), Err(NotDifferentiable(Func::Max)));
     }
 
     #[test]

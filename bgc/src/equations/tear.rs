@@ -133,10 +133,25 @@ impl Problem for TreeBlock<'_> {
 
 /// `∂r_i/∂z_j` of a block, row-major; `None` when a residual uses a function without a derivative.
 pub(crate) fn block_jacobian(block: &TearBlock) -> Option<Vec<Expr>> {
-    let mut out = Vec::with_capacity(block.tears.len().pow(2));
-    for r in &block.residuals {
-        for &z in &block.tears {
-            out.push(symbols::diff(r, z).ok()?);
+    let m = block.tears.len();
+    let column: HashMap<Sym, usize> = block
+        .tears
+        .iter()
+        .enumerate()
+        .map(|(j, &z)| (z, j))
+        .collect();
+    let mut out = vec![Expr::zero(); m * m];
+    for (i, r) in block.residuals.iter().enumerate() {
+        // Only the tears the residual reads, all in one walk of it when they are many (a block of linear loops
+        // whose residuals each read every tear).
+        let read: Vec<(usize, Sym)> = r
+            .syms()
+            .into_iter()
+            .filter_map(|s| column.get(&s).map(|&j| (j, s)))
+            .collect();
+        let wrt: Vec<Sym> = read.iter().map(|&(_, s)| s).collect();
+        for ((j, _), d) in read.iter().zip(symbols::gradient(r, &wrt).ok()?) {
+            out[i * m + j] = d;
         }
     }
     Some(out)

@@ -17,8 +17,7 @@ use super::{MassPrograms, SimError};
 use crate::equations::MassBlock;
 use crate::equations::dense::{self, Mat};
 use crate::equations::symbols::{self, Sym, add, states_read};
-use crate::ir::Func;
-use crate::symbolic::{Expr, Node, Symbol, WIDE_ROW};
+use crate::symbolic::{Expr, Node};
 use std::collections::BTreeMap;
 
 /// Where an entry's value comes from.
@@ -148,8 +147,9 @@ impl BlockRows {
             .collect();
         let mut slopes_by_state = Vec::new();
         for (k, e) in rows.matrix.iter().flatten().enumerate() {
-            for c in states_read(e, n) {
-                let d = symbols::diff(e, Sym::State(c)).ok()?;
+            let read = states_read(e, n);
+            let wrt: Vec<Sym> = read.iter().map(|&c| Sym::State(c)).collect();
+            for (c, d) in read.into_iter().zip(symbols::gradient(e, &wrt).ok()?) {
                 if !d.is_zero() {
                     slopes_by_state.push((c, k / size, k % size, compile(&d, what).ok()?));
                 }
@@ -229,16 +229,11 @@ fn symbolic(
         };
         let mut parts: BTreeMap<usize, Vec<Expr>> = Default::default();
         for term in terms {
+            // Each term only by the states it reads, all in one walk of it when they are many (a long sum held
+            // whole).
             let read = states_read(term, n);
-            if read.len() > WIDE_ROW {
-                // A term that reads many states (a long sum held whole): its gradient in one walk.
-                for (c, d) in read.iter().zip(state_gradient(term, &read)?) {
-                    parts.entry(*c).or_default().push(d);
-                }
-                continue;
-            }
-            for c in read {
-                let d = symbols::diff(term, Sym::State(c)).ok()?;
+            let wrt: Vec<Sym> = read.iter().map(|&c| Sym::State(c)).collect();
+            for (c, d) in read.into_iter().zip(symbols::gradient(term, &wrt).ok()?) {
                 parts.entry(c).or_default().push(d);
             }
         }
@@ -250,16 +245,4 @@ fn symbolic(
         }
     }
     Some(entries)
-}
-
-/// `∂e/∂x_c` for each state `c` of `read` (those `e` reads), in one walk of `e`; `None` when `e` reads one of them
-/// under `min` or `max` (not differentiable), as [`symbols::diff`] refuses it.
-fn state_gradient(e: &Expr, read: &[usize]) -> Option<Vec<Expr>> {
-    let vars: Vec<Symbol> = read.iter().map(|&c| Sym::State(c).symbol()).collect();
-    if let Some((_, under)) = e.symbols_under_calls(&[Func::Min, Func::Max])
-        && vars.iter().any(|v| under.contains(v))
-    {
-        return None;
-    }
-    Some(e.gradient(&vars))
 }

@@ -323,6 +323,10 @@ fn empty_equations(model: &Model) -> Equations {
     }
 }
 
+/// An output converted to the stage's symbols with its explicit form (or why it has none), or why it could not be
+/// converted.
+type ResolvedOutput = Result<(Expr, Result<Expr, ResolveError>), String>;
+
 /// Derives the state equations of `model` with the causality `causality`.
 ///
 /// Returns the equations (as complete as possible) and the findings; an error diagnostic means some rate or output
@@ -447,7 +451,6 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
         .copied()
         .chain(kinematic_mass.iter().flat_map(|b| b.states.iter().copied()))
         .collect();
-    let needs_mass_rate = |e: &Expr| mass_states.iter().any(|&j| e.contains(Sym::StateDot(j)));
     if implicit
         .iter()
         .any(|e| field_states.iter().any(|&j| e.contains(Sym::StateDot(j))))
@@ -487,11 +490,37 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
         .collect();
     let all_rates_ok = rate_ok.iter().all(|&ok| ok);
 
-    // Outputs.
-    for (k, out) in model.outputs.iter().enumerate() {
-        let value = match ctx.convert_output(&out.value, k) {
-            Ok(v) => v,
-            Err(build::ConvertError::Unsupported(what)) => {
+    // Outputs: each resolved in turn, then what each reads found in one walk of them all (an output that holds
+    // the next one's value, as the efforts along a gear train do, would otherwise be walked once per check).
+    let resolved: Vec<ResolvedOutput> = model
+        .outputs
+        .iter()
+        .enumerate()
+        .map(|(k, out)| match ctx.convert_output(&out.value, k) {
+            Ok(v) => {
+                let explicit = resolver.expr(&v);
+                Ok((v, explicit))
+            }
+            Err(build::ConvertError::Unsupported(what)) => Err(what),
+        })
+        .collect();
+    let explicit_values: Vec<Expr> = resolved
+        .iter()
+        .map(|r| match r {
+            Ok((_, Ok(e))) => e.clone(),
+            _ => Expr::zero(),
+        })
+        .collect();
+    let mass_set: std::collections::HashSet<usize> = mass_states.iter().copied().collect();
+    let reads = |pred: &dyn Fn(Sym) -> bool| symbols::each_has_sym(&explicit_values, pred);
+    let reads_output = reads(&|s| matches!(s, Sym::Output(_)));
+    let reads_input_rate = reads(&|s| matches!(s, Sym::InputDot(_)));
+    let reads_rate = reads(&|s| matches!(s, Sym::StateDot(_)));
+    let reads_mass_rate = reads(&|s| matches!(s, Sym::StateDot(j) if mass_set.contains(&j)));
+    for (k, (out, r)) in model.outputs.iter().zip(resolved).enumerate() {
+        let (value, explicit) = match r {
+            Ok(x) => x,
+            Err(what) => {
                 let d = Diagnostic::error(
                     codes::UNSUPPORTED,
                     format!("cannot derive output `{}`: {what}", out.name),
@@ -506,12 +535,13 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
             }
         };
         let underived = |e: &Expr| {
-            e.any_sym(&|s| matches!(s, Sym::Output(j) if eqs.outputs.get(j).is_none_or(|o| o.explicit.is_none())))
+            reads_output[k]
+                && e.any_sym(&|s| matches!(s, Sym::Output(j) if eqs.outputs.get(j).is_none_or(|o| o.explicit.is_none())))
         };
-        let explicit = match resolver.expr(&value) {
+        let explicit = match explicit {
             // The output it is defined through has a diagnostic already.
             Ok(e) if underived(&e) => None,
-            Ok(e) if e.any_sym(&|s| matches!(s, Sym::InputDot(_))) => {
+            Ok(e) if reads_input_rate[k] => {
                 let names: Vec<String> = (0..model.inputs.len())
                     .filter(|&j| e.contains(Sym::InputDot(j)))
                     .map(|j| model.inputs[j].name.clone())
@@ -525,8 +555,8 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
                 diags.push(with_span(d, model.spans.outputs.get(k), "this output"));
                 None
             }
-            Ok(e) if e.any_sym(&|s| matches!(s, Sym::StateDot(_))) && !all_rates_ok => None,
-            Ok(e) if needs_mass_rate(&e) => {
+            Ok(_) if reads_rate[k] && !all_rates_ok => None,
+            Ok(_) if reads_mass_rate[k] => {
                 let d = Diagnostic::error(
                     codes::UNSUPPORTED,
                     format!("output `{}` needs the acceleration of an I-field's port, which the equations give only through its mass matrix", out.name),
@@ -535,7 +565,9 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
                 diags.push(with_span(d, model.spans.outputs.get(k), "this output"));
                 None
             }
-            Ok(e) => Some(rate_of(&e)),
+            // Only a rate is replaced: an output that reads none is its own explicit form, without a walk.
+            Ok(e) if reads_rate[k] => Some(rate_of(&e)),
+            Ok(e) => Some(e),
             Err(e) => {
                 diags.push(resolve_diag(
                     model,

@@ -2,6 +2,10 @@
 //! benchmark chain of `N` masses (`2N` states), `u = sin(3t)`, 0.01 s on BDF. From 200 states on the implicit
 //! methods factorise a sparse Jacobian, so the time grows with the number of non-zeros.
 //!
+//! `simulate/mtf_chain` derives, compiles and runs the chain of `N` modulated transformers (two states, one mass-matrix
+//! row whose inertia sums products of all the moduli): the compiled programs compute each shared node once, so
+//! their length and the time grow with `N`, not with the expressions as trees (`N²`).
+//!
 //! Run with `cargo bench -p bgc --bench simulate_scaling`.
 
 #[path = "support/families.rs"]
@@ -14,13 +18,18 @@ use bgc::simulate::input::Signal;
 use bgc::simulate::integrate::{Method, RunOptions, run};
 use bgc::span::SourceMap;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use families::benchmark_chain;
+use families::{benchmark_chain, mtf_chain};
 use std::hint::black_box;
 
 /// The compiled system of the chain of `n` masses, driven by `u = sin(3t)`.
 fn system(n: usize) -> Option<System> {
+    system_of(benchmark_chain(n))
+}
+
+/// The compiled system of a model with one input, driven by `sin(3t)`.
+fn system_of(text: String) -> Option<System> {
     let mut sources = SourceMap::new();
-    let root = sources.add("bench.bg".to_string(), benchmark_chain(n));
+    let root = sources.add("bench.bg".to_string(), text);
     let (models, _) = lower(&mut sources, root, &mut MemoryLoader::new());
     let model = models.first()?;
     let (causality, _) = analyse(model);
@@ -49,6 +58,20 @@ fn bench(c: &mut Criterion) {
         let x0 = vec![0.0; system.state_count()];
         group.bench_with_input(BenchmarkId::from_parameter(n), &system, |b, s| {
             b.iter(|| run(black_box(s), &x0, &opts).map(|t| t.times.len()))
+        });
+    }
+    group.finish();
+    let mut group = c.benchmark_group("simulate/mtf_chain");
+    group.sample_size(10);
+    for n in [250, 1000] {
+        let text = mtf_chain(n);
+        group.bench_with_input(BenchmarkId::from_parameter(n), &text, |b, t| {
+            b.iter(|| {
+                let s = system_of(black_box(t.clone()))?;
+                run(&s, &vec![0.0; s.state_count()], &opts)
+                    .ok()
+                    .map(|t| t.times.len())
+            })
         });
     }
     group.finish();

@@ -1,14 +1,17 @@
 //! Symbolic expressions compiled into flat stack programs for fast repeated evaluation.
 //!
-//! An [`Expr`] tree of the equations stage is walked once into a postfix list of `Op`s; evaluating it is then a
-//! loop over that list with a small value stack and no allocation per call (the stack is reused). Only the symbols
+//! An [`Expr`] of the equations stage is walked once into a postfix list of `Op`s; evaluating it is then a loop
+//! over that list with a small value stack and no allocation per call (the stack is reused). The expression is a
+//! DAG: a node that it holds more than once is computed once, kept in a slot at the bottom of the stack and read
+//! from there again, so a program is as long as the distinct nodes, not the tree (which can be the square of
+//! them, or exponential in them). The walk is on an explicit stack, however deep the expression. Only the symbols
 //! a simulation has values for are accepted: parameters, states, inputs and time. Every index is checked when the
 //! program is compiled, and evaluation uses checked access anyway, so a program never panics: a missing value reads
 //! as NaN, which the integrator reports as a non-finite derivative.
 
 use crate::equations::symbols::Sym;
 use crate::ir::Func;
-use crate::symbolic::{Expr, Node};
+use crate::symbolic::{Expr, ExprMap, Node};
 
 /// One instruction of a program.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -25,6 +28,10 @@ enum Op {
     Pow,
     /// Calls a function on the top `n` values.
     Call(Func, usize),
+    /// Copies the top value into slot `k` (it stays on top).
+    Store(usize),
+    /// Pushes the value of slot `k`.
+    Load(usize),
 }
 
 /// Why an expression cannot be compiled.
@@ -59,8 +66,10 @@ pub struct Values<'a> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Program {
     ops: Vec<Op>,
-    /// The deepest the value stack gets.
+    /// The deepest the value stack gets above the slots.
     depth: usize,
+    /// The slots of the shared nodes, at the bottom of the stack.
+    slots: usize,
 }
 
 impl Program {
@@ -70,19 +79,24 @@ impl Program {
         layout: Layout,
         name: &dyn Fn(Sym) -> String,
     ) -> Result<Program, CompileError> {
-        let mut ops = Vec::new();
-        let mut depth = 0;
-        let mut max_depth = 0;
-        emit(e, layout, name, &mut ops, &mut depth, &mut max_depth)?;
-        Ok(Program {
-            ops,
-            depth: max_depth,
-        })
+        Emitter {
+            layout,
+            name,
+            uses: uses(e),
+            slot_of: ExprMap::default(),
+            ops: Vec::new(),
+            depth: 0,
+            max_depth: 0,
+        }
+        .program(e)
     }
 
     /// Evaluates the program; `stack` is scratch space reused between calls.
     pub fn eval(&self, v: &Values<'_>, stack: &mut Vec<f64>) -> f64 {
         stack.clear();
+        if self.slots > 0 {
+            stack.resize(self.slots, f64::NAN);
+        }
         stack.reserve(self.depth);
         for op in &self.ops {
             match *op {
@@ -126,80 +140,147 @@ impl Program {
                         .unwrap_or(f64::NAN);
                     stack.push(value);
                 }
+                Op::Store(k) => {
+                    let top = stack.last().copied().unwrap_or(f64::NAN);
+                    if let Some(slot) = stack.get_mut(k) {
+                        *slot = top;
+                    }
+                }
+                Op::Load(k) => stack.push(stack.get(k).copied().unwrap_or(f64::NAN)),
             }
         }
         stack.pop().unwrap_or(f64::NAN)
     }
 }
 
-fn emit(
-    e: &Expr,
+/// For each distinct node of `e`, how many times the nodes above it hold it (the root once).
+fn uses(e: &Expr) -> ExprMap<usize> {
+    let mut uses: ExprMap<usize> = ExprMap::default();
+    let mut stack = vec![e];
+    while let Some(e) = stack.pop() {
+        if let Some(n) = uses.get_mut(e) {
+            *n += 1;
+            continue;
+        }
+        uses.insert(e.clone(), 1);
+        stack.extend((0..).map_while(|i| operand(e, i)));
+    }
+    uses
+}
+
+/// The compilation of one expression.
+struct Emitter<'a> {
     layout: Layout,
-    name: &dyn Fn(Sym) -> String,
-    ops: &mut Vec<Op>,
-    depth: &mut usize,
-    max_depth: &mut usize,
-) -> Result<(), CompileError> {
-    let push = |ops: &mut Vec<Op>, op: Op, depth: &mut usize, max_depth: &mut usize| {
-        ops.push(op);
-        *depth += 1;
-        *max_depth = (*max_depth).max(*depth);
-    };
-    match e.node() {
-        Node::Const(x) => push(ops, Op::Num(*x), depth, max_depth),
-        Node::Sym(symbol) => {
-            let Some(s) = Sym::of(symbol) else {
-                return Err(CompileError::Unsupported(symbol.to_string()));
-            };
-            let (op, ok) = match s {
-                Sym::Param(i) => (Op::Param(i), i < layout.params),
-                Sym::State(i) => (Op::State(i), i < layout.states),
-                Sym::Input(i) => (Op::Input(i), i < layout.inputs),
-                Sym::Time => (Op::Time, true),
-                other => return Err(CompileError::Unsupported(name(other))),
-            };
-            if !ok {
-                return Err(CompileError::OutOfRange(name(s)));
+    name: &'a dyn Fn(Sym) -> String,
+    uses: ExprMap<usize>,
+    /// The slot of each shared node already computed.
+    slot_of: ExprMap<usize>,
+    ops: Vec<Op>,
+    depth: usize,
+    max_depth: usize,
+}
+
+impl Emitter<'_> {
+    fn program(mut self, root: &Expr) -> Result<Program, CompileError> {
+        // Each frame: a node whose children are being emitted, and how many are done.
+        let mut frames: Vec<(&Expr, usize)> = Vec::new();
+        self.start(root, &mut frames)?;
+        while let Some((e, next)) = frames.last_mut() {
+            let e: &Expr = e;
+            if let Some(child) = operand(e, *next) {
+                *next += 1;
+                self.start(child, &mut frames)?;
+                continue;
             }
-            push(ops, op, depth, max_depth);
+            frames.pop();
+            self.finish(e);
         }
-        Node::Add(ts) | Node::Mul(ts) => {
-            for t in ts {
-                emit(t, layout, name, ops, depth, max_depth)?;
+        Ok(Program {
+            ops: self.ops,
+            depth: self.max_depth,
+            slots: self.slot_of.len(),
+        })
+    }
+
+    /// Emits a leaf or the read of a node computed before, or opens a frame for an operation.
+    fn start<'e>(
+        &mut self,
+        e: &'e Expr,
+        frames: &mut Vec<(&'e Expr, usize)>,
+    ) -> Result<(), CompileError> {
+        if let Some(&k) = self.slot_of.get(e) {
+            self.push(Op::Load(k), 1, 0);
+            return Ok(());
+        }
+        match e.node() {
+            Node::Const(x) => self.push(Op::Num(*x), 1, 0),
+            Node::Sym(symbol) => {
+                let op = self.leaf(symbol)?;
+                self.push(op, 1, 0);
             }
-            let n = ts.len();
-            ops.push(if matches!(e.node(), Node::Add(_)) {
-                Op::Add(n)
-            } else {
-                Op::Mul(n)
-            });
-            *depth = *depth + 1 - n.min(*depth + 1);
-            if n == 0 {
-                *max_depth = (*max_depth).max(*depth);
-            }
-        }
-        Node::Pow(b, x) => {
-            emit(b, layout, name, ops, depth, max_depth)?;
-            emit(x, layout, name, ops, depth, max_depth)?;
-            ops.push(Op::Pow);
-            *depth = depth.saturating_sub(1);
-        }
-        Node::Call(f, args) => {
-            if args.is_empty() || args.len() > 2 {
+            Node::Call(f, args) if args.is_empty() || args.len() > 2 => {
                 return Err(CompileError::Unsupported(format!(
                     "{} with {} arguments",
                     f.name(),
                     args.len()
                 )));
             }
-            for a in args {
-                emit(a, layout, name, ops, depth, max_depth)?;
-            }
-            ops.push(Op::Call(*f, args.len()));
-            *depth = *depth + 1 - args.len();
+            _ => frames.push((e, 0)),
+        }
+        Ok(())
+    }
+
+    /// Emits the operation of `e` on its operands' values, and keeps the value in a slot when `e` is shared.
+    fn finish(&mut self, e: &Expr) {
+        match e.node() {
+            Node::Add(ts) => self.push(Op::Add(ts.len()), 1, ts.len()),
+            Node::Mul(ts) => self.push(Op::Mul(ts.len()), 1, ts.len()),
+            Node::Pow(..) => self.push(Op::Pow, 1, 2),
+            Node::Call(f, args) => self.push(Op::Call(*f, args.len()), 1, args.len()),
+            Node::Const(_) | Node::Sym(_) => {}
+        }
+        if self.uses.get(e).is_some_and(|&n| n > 1) {
+            let k = self.slot_of.len();
+            self.slot_of.insert(e.clone(), k);
+            self.ops.push(Op::Store(k));
         }
     }
-    Ok(())
+
+    /// Appends `op`, which takes `popped` values and pushes `pushed`.
+    fn push(&mut self, op: Op, pushed: usize, popped: usize) {
+        self.ops.push(op);
+        self.depth = self.depth.saturating_sub(popped) + pushed;
+        self.max_depth = self.max_depth.max(self.depth).max(1);
+    }
+
+    fn leaf(&self, symbol: &crate::symbolic::Symbol) -> Result<Op, CompileError> {
+        let Some(s) = Sym::of(symbol) else {
+            return Err(CompileError::Unsupported(symbol.to_string()));
+        };
+        let layout = self.layout;
+        let (op, ok) = match s {
+            Sym::Param(i) => (Op::Param(i), i < layout.params),
+            Sym::State(i) => (Op::State(i), i < layout.states),
+            Sym::Input(i) => (Op::Input(i), i < layout.inputs),
+            Sym::Time => (Op::Time, true),
+            other => return Err(CompileError::Unsupported((self.name)(other))),
+        };
+        if ok {
+            Ok(op)
+        } else {
+            Err(CompileError::OutOfRange((self.name)(s)))
+        }
+    }
+}
+
+/// Operand `i` of a node, in evaluation order.
+fn operand(e: &Expr, i: usize) -> Option<&Expr> {
+    match (e.node(), i) {
+        (Node::Add(xs) | Node::Mul(xs) | Node::Call(_, xs), _) => xs.get(i),
+        (Node::Pow(b, _), 0) => Some(b),
+        (Node::Pow(_, x), 1) => Some(x),
+        _ => None,
+    }
 }
 
 #[cfg(test)]
@@ -258,6 +339,54 @@ mod tests {
         let mut stack = Vec::new();
         assert!((p.eval(&values, &mut stack) - expected).abs() < 1e-14);
         assert!((expected - hand).abs() < 1e-12);
+    }
+
+    /// A node held several times is computed once: `s_{k+1} = sin(s_k) s_k + s_k` holds `s_k` three times, so as
+    /// a tree 12 levels are 3^12 nodes, and as a program about a dozen per level.
+    #[test]
+    fn a_shared_node_is_computed_once() {
+        let x = symbols::leaf(Sym::State(0));
+        let mut e = x;
+        let mut want = 0.3f64;
+        for _ in 0..12 {
+            e = add(vec![
+                mul(vec![call(Func::Sin, vec![e.clone()]), e.clone()]),
+                e,
+            ]);
+            want = want.sin() * want + want;
+        }
+        let p = Program::compile(&e, LAYOUT, &name).unwrap();
+        assert!(p.ops.len() < 12 * 16, "{} ops", p.ops.len());
+        let (params, states, inputs) = ([0.0, 0.0], [0.3, 0.0], [0.0]);
+        let values = Values {
+            params: &params,
+            states: &states,
+            inputs: &inputs,
+            t: 0.0,
+        };
+        let got = p.eval(&values, &mut Vec::new());
+        assert!((got - want).abs() <= 1e-15 * want.abs(), "{got} vs {want}");
+    }
+
+    /// An expression as deep as a model is long (the efforts along a gear train each hold the next) is compiled
+    /// on an explicit stack: 50,000 nested calls on a test thread's stack.
+    #[test]
+    fn a_deep_expression_compiles_without_recursion() {
+        let mut e = symbols::leaf(Sym::State(1));
+        let mut want = 0.9f64;
+        for _ in 0..50_000 {
+            e = call(Func::Sin, vec![e]);
+            want = want.sin();
+        }
+        let p = Program::compile(&e, LAYOUT, &name).unwrap();
+        let (params, states, inputs) = ([0.0, 0.0], [0.0, 0.9], [0.0]);
+        let values = Values {
+            params: &params,
+            states: &states,
+            inputs: &inputs,
+            t: 0.0,
+        };
+        assert_eq!(p.eval(&values, &mut Vec::new()), want);
     }
 
     #[test]

@@ -6,6 +6,10 @@
 //! row whose inertia sums products of all the moduli): the compiled programs compute each shared node once, so
 //! their length and the time grow with `N`, not with the expressions as trees (`N²`).
 //!
+//! `simulate/gear_train` runs the gear train of `N` stages with an output at every stage for 101 rows: each
+//! output's effort holds the next one's, and all outputs are one program, so a row costs the train, not its
+//! square.
+//!
 //! Run with `cargo bench -p bgc --bench simulate_scaling`.
 
 #[path = "support/families.rs"]
@@ -18,7 +22,7 @@ use bgc::simulate::input::Signal;
 use bgc::simulate::integrate::{Method, RunOptions, run};
 use bgc::span::SourceMap;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use families::{benchmark_chain, mtf_chain};
+use families::{benchmark_chain, gear_train, mtf_chain};
 use std::hint::black_box;
 
 /// The compiled system of the chain of `n` masses, driven by `u = sin(3t)`.
@@ -72,6 +76,22 @@ fn bench(c: &mut Criterion) {
                     .ok()
                     .map(|t| t.times.len())
             })
+        });
+    }
+    group.finish();
+    let rows = RunOptions {
+        dt_out: 1e-4,
+        ..opts
+    };
+    let mut group = c.benchmark_group("simulate/gear_train");
+    group.sample_size(10);
+    for n in [1000, 4000] {
+        let Some(system) = system_of(gear_train(n)) else {
+            continue;
+        };
+        let x0 = vec![0.0; system.state_count()];
+        group.bench_with_input(BenchmarkId::from_parameter(n), &system, |b, s| {
+            b.iter(|| run(black_box(s), &x0, &rows).map(|t| t.times.len()))
         });
     }
     group.finish();

@@ -51,7 +51,7 @@ use crate::symbolic::Expr;
 use input::Signal;
 use jacobian::Jacobian;
 use newton::{BlockPrograms, Loops};
-use program::{CompileError, Layout, Program, Values};
+use program::{CompileError, Layout, Program, ProgramSeq, Values};
 
 /// Why a simulation could not be set up or run.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -146,7 +146,7 @@ pub struct System {
     /// The Jacobian of the rates (with the mass blocks' rows solved); `None` when a rate uses a function without
     /// a derivative or the model has algebraic loops (the Jacobian is then taken by finite differences).
     jacobian: Option<Jacobian>,
-    outputs_h: Vec<Program>,
+    outputs_h: ProgramSeq,
     stored: Program,
     /// The terms of `stored`, by element.
     stored_terms: Vec<(String, Program)>,
@@ -294,24 +294,29 @@ impl System {
                 element: b.element.clone(),
             });
         }
-        let mut outputs_h = Vec::with_capacity(eqs.outputs.len());
+        let mut output_exprs = Vec::with_capacity(eqs.outputs.len());
         for o in &eqs.outputs {
-            let what = format!("output `{}`", o.name);
-            let e = o
-                .explicit
-                .as_ref()
-                .ok_or_else(|| SimError::Incomplete { what: what.clone() })?;
+            let e = o.explicit.as_ref().ok_or_else(|| SimError::Incomplete {
+                what: format!("output `{}`", o.name),
+            })?;
             let e = symbols::subst(e, &mut |s| match s {
                 Sym::Output(j) => Some(symbols::leaf(Sym::Input(ext_len + j))),
                 _ => None,
             });
-            let program = Program::compile(&exogenous(&e, n_inputs, &tears), output_layout, &name)
-                .map_err(|reason| SimError::Compile {
-                    what: what.clone(),
-                    reason,
-                })?;
-            outputs_h.push(program);
+            output_exprs.push(exogenous(&e, n_inputs, &tears));
         }
+        // One program for all outputs: what they share (the efforts along a gear train hold one another) is
+        // computed once per row.
+        let outputs_h =
+            ProgramSeq::compile(&output_exprs, output_layout, &name).map_err(|(k, reason)| {
+                SimError::Compile {
+                    what: format!(
+                        "output `{}`",
+                        eqs.outputs.get(k).map_or("?", |o| o.name.as_str())
+                    ),
+                    reason,
+                }
+            })?;
         let system = System {
             states: (0..n).map(|i| eqs.sym_name(Sym::State(i))).collect(),
             outputs: eqs.outputs.iter().map(|o| o.name.clone()).collect(),
@@ -559,16 +564,15 @@ impl System {
         self.inputs_at(t, u);
         self.solve_loops(y, u, t, stack)?;
         let n = self.states.len();
-        let mut row = Vec::with_capacity(n + self.outputs_h.len() + 3);
+        let mut row = Vec::with_capacity(n + self.outputs.len() + 3);
         row.extend(y.iter().take(n));
         // Each output is written after the inputs before the next is evaluated (outputs defined through earlier
         // outputs read them there).
         u.truncate(self.ext_len);
-        for p in &self.outputs_h {
-            let value = p.eval(&self.values(y, u, t), stack);
-            u.push(value);
-            row.push(value);
-        }
+        // The programs read the inputs from `u` itself, where each output is appended.
+        self.outputs_h
+            .eval_appending(&self.values(y, &[], t), u, stack);
+        row.extend(u.iter().skip(self.ext_len));
         u.truncate(self.ext_len);
         let v = self.values(y, u, t);
         row.push(self.stored.eval(&v, stack));

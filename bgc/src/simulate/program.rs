@@ -32,6 +32,8 @@ enum Op {
     Store(usize),
     /// Pushes the value of slot `k`.
     Load(usize),
+    /// Pops a finished value and appends it to the inputs (a [`ProgramSeq`]'s next result).
+    Out,
 }
 
 /// Why an expression cannot be compiled.
@@ -79,20 +81,19 @@ impl Program {
         layout: Layout,
         name: &dyn Fn(Sym) -> String,
     ) -> Result<Program, CompileError> {
-        Emitter {
-            layout,
-            name,
-            uses: uses(e),
-            slot_of: ExprMap::default(),
-            ops: Vec::new(),
-            depth: 0,
-            max_depth: 0,
-        }
-        .program(e)
+        let mut emitter = Emitter::new(std::slice::from_ref(e), layout, name);
+        emitter.root(e)?;
+        Ok(emitter.program())
     }
 
     /// Evaluates the program; `stack` is scratch space reused between calls.
     pub fn eval(&self, v: &Values<'_>, stack: &mut Vec<f64>) -> f64 {
+        let mut inputs = v.inputs;
+        self.run(v, &mut inputs, stack)
+    }
+
+    /// The interpreter: reads the inputs from `inputs` (not `v.inputs`), where [`Op::Out`] appends.
+    fn run<I: Inputs + ?Sized>(&self, v: &Values<'_>, inputs: &mut I, stack: &mut Vec<f64>) -> f64 {
         stack.clear();
         if self.slots > 0 {
             stack.resize(self.slots, f64::NAN);
@@ -103,7 +104,7 @@ impl Program {
                 Op::Num(x) => stack.push(x),
                 Op::Param(i) => stack.push(v.params.get(i).copied().unwrap_or(f64::NAN)),
                 Op::State(i) => stack.push(v.states.get(i).copied().unwrap_or(f64::NAN)),
-                Op::Input(i) => stack.push(v.inputs.get(i).copied().unwrap_or(f64::NAN)),
+                Op::Input(i) => stack.push(inputs.input(i)),
                 Op::Time => stack.push(v.t),
                 Op::Add(n) => {
                     let start = stack.len().saturating_sub(n);
@@ -147,16 +148,70 @@ impl Program {
                     }
                 }
                 Op::Load(k) => stack.push(stack.get(k).copied().unwrap_or(f64::NAN)),
+                Op::Out => inputs.append(stack.pop().unwrap_or(f64::NAN)),
             }
         }
         stack.pop().unwrap_or(f64::NAN)
     }
 }
 
-/// For each distinct node of `e`, how many times the nodes above it hold it (the root once).
-fn uses(e: &Expr) -> ExprMap<usize> {
+/// Expressions compiled into one program, evaluated in order: a node that they hold more than once, in one of
+/// them or in several, is computed once. Each value is appended to the inputs, where the later expressions read
+/// it (outputs defined through earlier outputs), so outputs whose expressions hold one another (the efforts
+/// along a gear train) cost their distinct nodes together, not each its own tree.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProgramSeq(Program);
+
+impl ProgramSeq {
+    /// Compiles `es` in order; a failure gives the index of the expression that could not be compiled.
+    pub fn compile(
+        es: &[Expr],
+        layout: Layout,
+        name: &dyn Fn(Sym) -> String,
+    ) -> Result<ProgramSeq, (usize, CompileError)> {
+        let mut emitter = Emitter::new(es, layout, name);
+        for (i, e) in es.iter().enumerate() {
+            emitter.root(e).map_err(|err| (i, err))?;
+            emitter.push(Op::Out, 0, 1);
+        }
+        Ok(ProgramSeq(emitter.program()))
+    }
+
+    /// Evaluates the expressions in order at `v` (whose `inputs` are not read), appending each value to `inputs`.
+    pub fn eval_appending(&self, v: &Values<'_>, inputs: &mut Vec<f64>, stack: &mut Vec<f64>) {
+        self.0.run(v, inputs, stack);
+    }
+}
+
+/// Where a program reads its inputs, and where [`Op::Out`] puts its results.
+trait Inputs {
+    fn input(&self, k: usize) -> f64;
+    fn append(&mut self, value: f64);
+}
+
+impl Inputs for &[f64] {
+    fn input(&self, k: usize) -> f64 {
+        self.get(k).copied().unwrap_or(f64::NAN)
+    }
+
+    /// A single expression has no results to append.
+    fn append(&mut self, _: f64) {}
+}
+
+impl Inputs for Vec<f64> {
+    fn input(&self, k: usize) -> f64 {
+        self.get(k).copied().unwrap_or(f64::NAN)
+    }
+
+    fn append(&mut self, value: f64) {
+        self.push(value);
+    }
+}
+
+/// For each distinct node of `roots`, how many times the nodes above it hold it (each root once more).
+fn uses(roots: &[Expr]) -> ExprMap<usize> {
     let mut uses: ExprMap<usize> = ExprMap::default();
-    let mut stack = vec![e];
+    let mut stack: Vec<&Expr> = roots.iter().collect();
     while let Some(e) = stack.pop() {
         if let Some(n) = uses.get_mut(e) {
             *n += 1;
@@ -180,8 +235,21 @@ struct Emitter<'a> {
     max_depth: usize,
 }
 
-impl Emitter<'_> {
-    fn program(mut self, root: &Expr) -> Result<Program, CompileError> {
+impl<'a> Emitter<'a> {
+    fn new(roots: &[Expr], layout: Layout, name: &'a dyn Fn(Sym) -> String) -> Emitter<'a> {
+        Emitter {
+            layout,
+            name,
+            uses: uses(roots),
+            slot_of: ExprMap::default(),
+            ops: Vec::new(),
+            depth: 0,
+            max_depth: 0,
+        }
+    }
+
+    /// Emits the ops that leave the value of `root` on top of the stack.
+    fn root(&mut self, root: &Expr) -> Result<(), CompileError> {
         // Each frame: a node whose children are being emitted, and how many are done.
         let mut frames: Vec<(&Expr, usize)> = Vec::new();
         self.start(root, &mut frames)?;
@@ -195,11 +263,15 @@ impl Emitter<'_> {
             frames.pop();
             self.finish(e);
         }
-        Ok(Program {
+        Ok(())
+    }
+
+    fn program(self) -> Program {
+        Program {
             ops: self.ops,
             depth: self.max_depth,
             slots: self.slot_of.len(),
-        })
+        }
     }
 
     /// Emits a leaf or the read of a node computed before, or opens a frame for an operation.
@@ -366,6 +438,58 @@ mod tests {
         };
         let got = p.eval(&values, &mut Vec::new());
         assert!((got - want).abs() <= 1e-15 * want.abs(), "{got} vs {want}");
+    }
+
+    /// Expressions compiled together share their nodes: `S`, held by both, is computed once, and the second reads
+    /// the first's value where it was appended to the inputs.
+    #[test]
+    fn a_sequence_computes_what_its_expressions_share_once() {
+        let x = symbols::leaf(Sym::State(0));
+        let mut shared = x;
+        for _ in 0..10 {
+            shared = add(vec![
+                mul(vec![call(Func::Sin, vec![shared.clone()]), shared.clone()]),
+                shared,
+            ]);
+        }
+        let layout = Layout {
+            params: 0,
+            states: 2,
+            inputs: 3,
+        };
+        let first = mul(vec![shared.clone(), symbols::leaf(Sym::State(1))]);
+        let second = add(vec![shared, symbols::leaf(Sym::Input(1))]);
+        let seq = ProgramSeq::compile(&[first.clone(), second.clone()], layout, &name).unwrap();
+        let (p1, p2) = (
+            Program::compile(&first, layout, &name).unwrap(),
+            Program::compile(&second, layout, &name).unwrap(),
+        );
+        let states = [0.3, -1.7];
+        let at = |inputs: &[f64]| {
+            let v = Values {
+                params: &[],
+                states: &states,
+                inputs,
+                t: 0.0,
+            };
+            (p1.eval(&v, &mut Vec::new()), p2.eval(&v, &mut Vec::new()))
+        };
+        let y1 = at(&[0.5]).0;
+        let y2 = at(&[0.5, y1]).1;
+        let mut inputs = vec![0.5];
+        let v = Values {
+            params: &[],
+            states: &states,
+            inputs: &[],
+            t: 0.0,
+        };
+        seq.eval_appending(&v, &mut inputs, &mut Vec::new());
+        assert_eq!(inputs, vec![0.5, y1, y2]);
+        let (together, apart) = (seq.0.ops.len(), p1.ops.len() + p2.ops.len());
+        assert!(
+            together + 80 < apart,
+            "{together} ops together, {apart} apart"
+        );
     }
 
     /// An expression as deep as a model is long (the efforts along a gear train each hold the next) is compiled

@@ -223,7 +223,7 @@ fn uses(roots: &[Expr]) -> ExprMap<usize> {
     uses
 }
 
-/// The compilation of one expression.
+/// The compilation of one expression, or of several into one program.
 struct Emitter<'a> {
     layout: Layout,
     name: &'a dyn Fn(Sym) -> String,

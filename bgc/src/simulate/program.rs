@@ -93,7 +93,7 @@ impl Program {
     }
 
     /// The interpreter: reads the inputs from `inputs` (not `v.inputs`), where [`Op::Out`] appends.
-    fn run<I: Inputs + ?Sized>(&self, v: &Values<'_>, inputs: &mut I, stack: &mut Vec<f64>) -> f64 {
+    fn run<I: Inputs>(&self, v: &Values<'_>, inputs: &mut I, stack: &mut Vec<f64>) -> f64 {
         stack.clear();
         if self.slots > 0 {
             stack.resize(self.slots, f64::NAN);
@@ -413,30 +413,38 @@ mod tests {
         assert!((expected - hand).abs() < 1e-12);
     }
 
-    /// A node held several times is computed once: `s_{k+1} = sin(s_k) s_k + s_k` holds `s_k` three times, so as
-    /// a tree 12 levels are 3^12 nodes, and as a program about a dozen per level.
-    #[test]
-    fn a_shared_node_is_computed_once() {
-        let x = symbols::leaf(Sym::State(0));
-        let mut e = x;
-        let mut want = 0.3f64;
-        for _ in 0..12 {
+    /// `s_{k+1} = sin(s_k) s_k + s_k` from `s_0 = x_0`, `levels` times: each level holds the one below three
+    /// times. With its value at `x_0`, by `f64` arithmetic.
+    fn shared_chain(levels: usize, x0: f64) -> (Expr, f64) {
+        let (mut e, mut value) = (symbols::leaf(Sym::State(0)), x0);
+        for _ in 0..levels {
             e = add(vec![
                 mul(vec![call(Func::Sin, vec![e.clone()]), e.clone()]),
                 e,
             ]);
-            want = want.sin() * want + want;
+            value = value.sin() * value + value;
         }
+        (e, value)
+    }
+
+    /// The values of a program that reads only states and inputs.
+    fn at<'a>(states: &'a [f64], inputs: &'a [f64]) -> Values<'a> {
+        Values {
+            params: &[],
+            states,
+            inputs,
+            t: 0.0,
+        }
+    }
+
+    /// A node held several times is computed once: in [`shared_chain`] 12 levels are 3^12 nodes as a tree, and as
+    /// a program about a dozen per level.
+    #[test]
+    fn a_shared_node_is_computed_once() {
+        let (e, want) = shared_chain(12, 0.3);
         let p = Program::compile(&e, LAYOUT, &name).unwrap();
         assert!(p.ops.len() < 12 * 16, "{} ops", p.ops.len());
-        let (params, states, inputs) = ([0.0, 0.0], [0.3, 0.0], [0.0]);
-        let values = Values {
-            params: &params,
-            states: &states,
-            inputs: &inputs,
-            t: 0.0,
-        };
-        let got = p.eval(&values, &mut Vec::new());
+        let got = p.eval(&at(&[0.3, 0.0], &[0.0]), &mut Vec::new());
         assert!((got - want).abs() <= 1e-15 * want.abs(), "{got} vs {want}");
     }
 
@@ -444,14 +452,7 @@ mod tests {
     /// the first's value where it was appended to the inputs.
     #[test]
     fn a_sequence_computes_what_its_expressions_share_once() {
-        let x = symbols::leaf(Sym::State(0));
-        let mut shared = x;
-        for _ in 0..10 {
-            shared = add(vec![
-                mul(vec![call(Func::Sin, vec![shared.clone()]), shared.clone()]),
-                shared,
-            ]);
-        }
+        let (shared, _) = shared_chain(10, 0.0);
         let layout = Layout {
             params: 0,
             states: 2,
@@ -465,25 +466,10 @@ mod tests {
             Program::compile(&second, layout, &name).unwrap(),
         );
         let states = [0.3, -1.7];
-        let at = |inputs: &[f64]| {
-            let v = Values {
-                params: &[],
-                states: &states,
-                inputs,
-                t: 0.0,
-            };
-            (p1.eval(&v, &mut Vec::new()), p2.eval(&v, &mut Vec::new()))
-        };
-        let y1 = at(&[0.5]).0;
-        let y2 = at(&[0.5, y1]).1;
+        let y1 = p1.eval(&at(&states, &[0.5]), &mut Vec::new());
+        let y2 = p2.eval(&at(&states, &[0.5, y1]), &mut Vec::new());
         let mut inputs = vec![0.5];
-        let v = Values {
-            params: &[],
-            states: &states,
-            inputs: &[],
-            t: 0.0,
-        };
-        seq.eval_appending(&v, &mut inputs, &mut Vec::new());
+        seq.eval_appending(&at(&states, &[]), &mut inputs, &mut Vec::new());
         assert_eq!(inputs, vec![0.5, y1, y2]);
         let (together, apart) = (seq.0.ops.len(), p1.ops.len() + p2.ops.len());
         assert!(
@@ -503,14 +489,7 @@ mod tests {
             want = want.sin();
         }
         let p = Program::compile(&e, LAYOUT, &name).unwrap();
-        let (params, states, inputs) = ([0.0, 0.0], [0.0, 0.9], [0.0]);
-        let values = Values {
-            params: &params,
-            states: &states,
-            inputs: &inputs,
-            t: 0.0,
-        };
-        assert_eq!(p.eval(&values, &mut Vec::new()), want);
+        assert_eq!(p.eval(&at(&[0.0, 0.9], &[0.0]), &mut Vec::new()), want);
     }
 
     #[test]

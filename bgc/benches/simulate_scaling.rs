@@ -10,6 +10,10 @@
 //! output's effort holds the next one's, and all outputs are one program, so a row costs the train, not its
 //! square.
 //!
+//! `simulate/loops_in_series` runs `N` separate diode loops of ten capacitors each (`10N` states, a nonlinear
+//! algebraic loop per diode): the Jacobian takes each loop's implicit derivatives, so it stays block-diagonal and
+//! the sparse LU's cost grows with `N` (with finite differences and a dense LU it grew as `N³`).
+//!
 //! Run with `cargo bench -p bgc --bench simulate_scaling`.
 
 #[path = "support/families.rs"]
@@ -22,7 +26,7 @@ use bgc::simulate::input::Signal;
 use bgc::simulate::integrate::{Method, RunOptions, run};
 use bgc::span::SourceMap;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use families::{benchmark_chain, gear_train, mtf_chain};
+use families::{benchmark_chain, gear_train, loops_in_series, mtf_chain};
 use std::hint::black_box;
 
 /// The compiled system of the chain of `n` masses, driven by `u = sin(3t)`.
@@ -76,6 +80,18 @@ fn bench(c: &mut Criterion) {
                     .ok()
                     .map(|t| t.times.len())
             })
+        });
+    }
+    group.finish();
+    let mut group = c.benchmark_group("simulate/loops_in_series");
+    group.sample_size(10);
+    for n in [50, 200] {
+        let Some(system) = system_of(loops_in_series(n, 10)) else {
+            continue;
+        };
+        let x0 = vec![0.0; system.state_count()];
+        group.bench_with_input(BenchmarkId::from_parameter(n), &system, |b, s| {
+            b.iter(|| run(black_box(s), &x0, &opts).map(|t| t.times.len()))
         });
     }
     group.finish();

@@ -67,5 +67,6 @@ mod lsp_session;
 mod lsp_stdio;
 mod pipeline_props;
 mod simulate_budget;
+mod simulate_loop_jacobian;
 mod syntax_fixtures;
 mod syntax_fuzz;

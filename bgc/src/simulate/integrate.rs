@@ -7,8 +7,8 @@
 //! method's order). At a breakpoint the states are continuous but a jump of an input may change the stored energy
 //! (a flow source imposing an inertia's velocity): that jump, [`System::stored_jump`], is added to the `supplied`
 //! quadrature there, so `energy + dissipated − supplied` stays constant across steps. The Jacobian handed to the
-//! implicit methods is the symbolic one of the equations, or finite differences when a rate uses a function
-//! without a derivative.
+//! implicit methods is the symbolic one of the equations (through nonlinear algebraic loops, from the sparse path
+//! on), or finite differences when a rate uses a function without a derivative.
 //!
 //! BDF's orders 3 to 5 are not A-stable: a lightly damped fast mode that the tolerances resolve holds its steps at a
 //! fraction of that mode's period. When BDF advances so slowly that the rest of a segment would exceed the step

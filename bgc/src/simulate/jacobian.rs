@@ -12,6 +12,7 @@
 //! separate mechanisms keeps a sparse Jacobian (before, such models took finite differences of the whole rhs, one
 //! column at a time, and a dense factorisation).
 
+use super::loop_jacobian::{LoopCorrection, Tears};
 use super::program::{Program, Values};
 use super::{MassPrograms, SimError};
 use crate::equations::MassBlock;
@@ -30,6 +31,12 @@ enum Source {
         block: usize,
         row: usize,
         column: usize,
+    },
+    /// A rate that reads tears: its derivative holding them fixed (if any) plus `Σ ∂f/∂z_k ∂z_k/∂x`, over
+    /// `(the rate's k-th tear derivative, the column's position among tear k's columns)`.
+    Loop {
+        direct: Option<Program>,
+        via: Vec<(usize, usize)>,
     },
 }
 
@@ -50,20 +57,50 @@ pub(super) struct Jacobian {
     /// `(row, column, source)`, row by row.
     entries: Vec<(usize, usize, Source)>,
     blocks: Vec<BlockRows>,
+    /// The nonlinear algebraic loops' derivatives, when the model has loops.
+    loops: Option<LoopCorrection>,
+    /// Per rate: `(global tear k, ∂f/∂z_k)`.
+    through: Vec<Vec<(usize, Program)>>,
 }
 
 impl Jacobian {
-    /// The Jacobian of `rates` over the `n` model states, with the rows of `mass` solved; `None` when a rate or
-    /// a mass entry uses a function without a derivative (the caller then takes finite differences).
+    /// The Jacobian of `rates` over the `n` model states, with the rows of `mass` solved and the tears of the
+    /// loops moving with the states ([`super::loop_jacobian`]); `None` when a rate or a mass entry uses a function
+    /// without a derivative, the model has both loops and mass blocks, or the loops make more than
+    /// `max_loop_entries` entries (the caller then takes finite differences).
     pub(super) fn new(
         rates: &[(Expr, String)],
         n: usize,
         mass: &[MassBlock],
+        loops: Option<(Tears, LoopCorrection)>,
+        max_loop_entries: usize,
         compile: &dyn Fn(&Expr, &str) -> Result<Program, SimError>,
     ) -> Option<Jacobian> {
+        let (tears, correction) = match loops {
+            Some((tears, correction)) if mass.is_empty() => (tears, Some(correction)),
+            Some(_) => return None,
+            None => (Tears::new(&[]), None),
+        };
         let mut direct: Vec<Vec<(usize, Program)>> = vec![Vec::new(); rates.len()];
-        for (r, c, p) in symbolic(rates, n, compile)? {
+        let mut through: Vec<Vec<(usize, Program)>> = vec![Vec::new(); rates.len()];
+        for (r, c, p) in symbolic(rates, n, &tears, &mut through, compile)? {
             direct[r].push((c, p));
+        }
+        if let Some(correction) = &correction {
+            // At least the widest tear's columns in every row that reads tears: refuse a dense Jacobian before
+            // building it.
+            let least: usize = through
+                .iter()
+                .map(|row| {
+                    row.iter()
+                        .map(|(k, _)| correction.columns_of(*k).len())
+                        .max()
+                        .unwrap_or(0)
+                })
+                .sum();
+            if least > max_loop_entries {
+                return None;
+            }
         }
         let mut block_of: BTreeMap<usize, (usize, usize)> = BTreeMap::new();
         let mut blocks = Vec::with_capacity(mass.len());
@@ -88,10 +125,23 @@ impl Jacobian {
                         (r, c, source)
                     }));
                 }
-                None => entries.extend(row.into_iter().map(|(c, p)| (r, c, Source::Direct(p)))),
+                None => match (&correction, through.get(r).filter(|t| !t.is_empty())) {
+                    (Some(correction), Some(tears_read)) => {
+                        entries.extend(loop_row(r, row, tears_read, correction));
+                        if entries.len() > max_loop_entries {
+                            return None;
+                        }
+                    }
+                    _ => entries.extend(row.into_iter().map(|(c, p)| (r, c, Source::Direct(p)))),
+                },
             }
         }
-        Some(Jacobian { entries, blocks })
+        Some(Jacobian {
+            entries,
+            blocks,
+            loops: correction,
+            through,
+        })
     }
 
     /// The positions `(row, column)` of the entries, row by row.
@@ -99,9 +149,14 @@ impl Jacobian {
         self.entries.iter().map(|(r, c, _)| (*r, *c)).collect()
     }
 
+    /// Whether the entries take the loops' derivatives, so that the loops must be solved at the point first.
+    pub(super) fn through_loops(&self) -> bool {
+        self.loops.is_some()
+    }
+
     /// Calls `each(row, column, value)` for every entry at the point (all NaN in the rows of a block whose `M`
     /// is singular there); `rates` evaluates the generalised forces of the block rows, `mass` the blocks (those
-    /// [`Jacobian::new`] was given, compiled, in the same order).
+    /// [`Jacobian::new`] was given, compiled, in the same order). `values` holds the loops' solution at the point.
     pub(super) fn for_each(
         &self,
         values: &Values<'_>,
@@ -115,6 +170,10 @@ impl Jacobian {
             .zip(mass)
             .map(|(b, block)| b.solve(block, values, rates, stack))
             .collect();
+        let slopes = self.loops.as_ref().map(|l| l.slopes(values, stack));
+        // The current loop row's `∂f/∂z`, evaluated once per row.
+        let mut row_at = usize::MAX;
+        let mut by_tear: Vec<f64> = Vec::new();
         for (r, c, source) in &self.entries {
             let v = match source {
                 Source::Direct(p) => p.eval(values, stack),
@@ -124,6 +183,23 @@ impl Jacobian {
                     .and_then(|row| row.get(*column))
                     .copied()
                     .unwrap_or(f64::NAN),
+                Source::Loop { direct, via } => {
+                    let tears = self.through.get(*r).map_or(&[][..], Vec::as_slice);
+                    if row_at != *r {
+                        row_at = *r;
+                        by_tear.clear();
+                        by_tear.extend(tears.iter().map(|(_, p)| p.eval(values, stack)));
+                    }
+                    let mut v = direct.as_ref().map_or(0.0, |p| p.eval(values, stack));
+                    if let (Some(loops), Some(slopes)) = (&self.loops, &slopes) {
+                        for &(slot, at) in via {
+                            let k = tears.get(slot).map_or(usize::MAX, |(k, _)| *k);
+                            v += by_tear.get(slot).copied().unwrap_or(f64::NAN)
+                                * slopes.get(loops, k, at);
+                        }
+                    }
+                    v
+                }
             };
             each(*r, *c, v);
         }
@@ -216,9 +292,12 @@ impl BlockRows {
 ///
 /// A sum is differentiated term by term, each term only by the states it reads: the dissipated power sums a term
 /// per resistor, and differentiating the whole sum by every state it reads would be quadratic in the model.
+/// The derivatives by the tears of `tears` go into `through`, a row per rate.
 fn symbolic(
     rates: &[(Expr, String)],
     n: usize,
+    tears: &Tears,
+    through: &mut [Vec<(usize, Program)>],
     compile: &dyn Fn(&Expr, &str) -> Result<Program, SimError>,
 ) -> Option<Vec<(usize, usize, Program)>> {
     let mut entries = Vec::new();
@@ -228,13 +307,23 @@ fn symbolic(
             _ => std::slice::from_ref(e),
         };
         let mut parts: BTreeMap<usize, Vec<Expr>> = Default::default();
+        let mut tear_parts: BTreeMap<usize, Vec<Expr>> = Default::default();
         for term in terms {
-            // Each term only by the states it reads, all in one walk of it when they are many (a long sum held
-            // whole).
-            let read = states_read(term, n);
-            let wrt: Vec<Sym> = read.iter().map(|&c| Sym::State(c)).collect();
-            for (c, d) in read.into_iter().zip(symbols::gradient(term, &wrt).ok()?) {
-                parts.entry(c).or_default().push(d);
+            // Each term only by the states (and tears) it reads, all in one walk of it when they are many (a long
+            // sum held whole).
+            let (read, tears_read) = tears.partition(term, n);
+            let wrt: Vec<Sym> = read
+                .iter()
+                .map(|&c| Sym::State(c))
+                .chain(tears_read.iter().filter_map(|&k| tears.sym(k)))
+                .collect();
+            let grads = symbols::gradient(term, &wrt).ok()?;
+            let (by_state, by_tear) = grads.split_at(read.len());
+            for (&c, d) in read.iter().zip(by_state) {
+                parts.entry(c).or_default().push(d.clone());
+            }
+            for (&k, d) in tears_read.iter().zip(by_tear) {
+                tear_parts.entry(k).or_default().push(d.clone());
             }
         }
         for (c, part) in parts {
@@ -243,6 +332,37 @@ fn symbolic(
                 entries.push((r, c, compile(&d, what).ok()?));
             }
         }
+        for (k, part) in tear_parts {
+            let d = add(part);
+            if !d.is_zero() {
+                through.get_mut(r)?.push((k, compile(&d, what).ok()?));
+            }
+        }
     }
     Some(entries)
+}
+
+/// The entries of rate `r`, which reads the tears `tears_read`: over its direct columns and those its tears
+/// depend on, increasing.
+fn loop_row(
+    r: usize,
+    direct: Vec<(usize, Program)>,
+    tears_read: &[(usize, Program)],
+    loops: &LoopCorrection,
+) -> Vec<(usize, usize, Source)> {
+    // Per column: the derivative holding the tears fixed, and the `(tear slot, column position)` pairs.
+    type Column = (Option<Program>, Vec<(usize, usize)>);
+    let mut columns: BTreeMap<usize, Column> = BTreeMap::new();
+    for (c, p) in direct {
+        columns.entry(c).or_default().0 = Some(p);
+    }
+    for (slot, (k, _)) in tears_read.iter().enumerate() {
+        for (at, &c) in loops.columns_of(*k).iter().enumerate() {
+            columns.entry(c).or_default().1.push((slot, at));
+        }
+    }
+    columns
+        .into_iter()
+        .map(|(c, (direct, via))| (r, c, Source::Loop { direct, via }))
+        .collect()
 }

@@ -28,8 +28,9 @@
 //! outputs and energy terms: the programs read them after the inputs (`[u, u̇, z]`), and every evaluation first
 //! solves the loops at the current state and time by Newton's method, warm-started from the previous solution
 //! ([`newton`]). When that fails the run stops with [`SimError::AlgebraicLoop`], which names the tear variables,
-//! the time and the residual. The rates' Jacobian is then taken by finite differences (the rates depend on the
-//! states also through the loops' solution).
+//! the time and the residual. The rates depend on the states also through the loops' solution: the symbolic
+//! Jacobian adds that dependence (module `loop_jacobian`) where it stays sparse, else the Jacobian is taken by finite
+//! differences.
 //!
 //! Energy terms the equations stage could not express (a stored energy of a non-polynomial law) are left out of
 //! their sums; [`System::new`] returns a warning that names each one.
@@ -39,6 +40,7 @@ pub mod input_rate;
 #[cfg(feature = "cli")]
 pub mod integrate;
 mod jacobian;
+mod loop_jacobian;
 pub mod newton;
 pub mod program;
 pub mod samples;
@@ -50,6 +52,11 @@ use crate::equations::{EnergyKind, Equations, block_jacobian, residual_scale};
 use crate::symbolic::Expr;
 use input::Signal;
 use jacobian::Jacobian;
+use std::collections::HashMap;
+
+/// A Jacobian through algebraic loops is kept when it has at most `n² / DENSE_LOOP_JACOBIAN` entries (or 16 a row,
+/// for a small model): denser, the sparse factorisation costs more than finite differences and a dense one.
+const DENSE_LOOP_JACOBIAN: usize = 10;
 use newton::{BlockPrograms, Loops};
 use program::{CompileError, Layout, Program, ProgramSeq, Values};
 
@@ -143,8 +150,9 @@ pub struct System {
     input_rates: Vec<Signal>,
     /// `f_i` for the model states, then the dissipated and the supplied power.
     rates: Vec<Program>,
-    /// The Jacobian of the rates (with the mass blocks' rows solved); `None` when a rate uses a function without
-    /// a derivative or the model has algebraic loops (the Jacobian is then taken by finite differences).
+    /// The Jacobian of the rates (with the mass blocks' rows solved, and through the algebraic loops); `None` when
+    /// a rate uses a function without a derivative or the loops make it dense (the Jacobian is then taken by
+    /// finite differences).
     jacobian: Option<Jacobian>,
     outputs_h: ProgramSeq,
     stored: Program,
@@ -271,11 +279,27 @@ impl System {
             .map(|(e, what)| compile(e, what))
             .collect::<Result<Vec<_>, _>>()?;
         let loops = compile_loops(eqs, 2 * n_inputs, &compile)?;
-        // The symbolic Jacobian does not see the loops' unknowns move: leave loops to finite differences.
-        let jacobian = if loops.is_empty() {
-            Jacobian::new(&rate_exprs, n, &eqs.mass, &compile)
-        } else {
-            None
+        // With loops, the Jacobian takes their tears' derivatives; kept only where it stays sparse (a loop that
+        // reads many states makes every rate that reads its tear a dense row), else finite differences.
+        let compile_seq = |es: &[Expr], what: &str| {
+            let es = exogenous_all(es, n_inputs, &tears);
+            ProgramSeq::compile(&es, layout, &name).map_err(|(_, reason)| SimError::Compile {
+                what: what.to_string(),
+                reason,
+            })
+        };
+        let through_loops = match eqs.tear_blocks.is_empty() {
+            true => None,
+            false => {
+                let all = loop_jacobian::Tears::new(&eqs.tear_blocks);
+                loop_jacobian::LoopCorrection::new(&eqs.tear_blocks, n, &all, &compile_seq)
+                    .map(|correction| (all, correction))
+            }
+        };
+        let loop_entries = (n.saturating_mul(n) / DENSE_LOOP_JACOBIAN).max(n.saturating_mul(16));
+        let jacobian = match (eqs.tear_blocks.is_empty(), through_loops) {
+            (false, None) => None,
+            (_, loops) => Jacobian::new(&rate_exprs, n, &eqs.mass, loops, loop_entries, &compile),
         };
         let mut mass = Vec::with_capacity(eqs.mass.len());
         for b in &eqs.mass {
@@ -497,7 +521,8 @@ impl System {
     }
 
     /// `J v` for the Jacobian `J = ∂rhs/∂y`; `None` when it has no symbolic form (a rate uses a function without a
-    /// derivative, or the model has algebraic loops).
+    /// derivative) or takes the loops' derivatives: the dense path asks for one product per column, and each would
+    /// solve every loop's derivatives again, where finite differences cost two evaluations of the rates.
     pub fn jacobian_times(
         &self,
         y: &[f64],
@@ -507,7 +532,7 @@ impl System {
         jv: &mut [f64],
         stack: &mut Vec<f64>,
     ) -> Option<()> {
-        let jacobian = self.jacobian.as_ref()?;
+        let jacobian = self.jacobian.as_ref().filter(|j| !j.through_loops())?;
         jv.iter_mut().for_each(|x| *x = 0.0);
         jacobian.for_each(
             &self.values(y, u, t),
@@ -540,6 +565,18 @@ impl System {
     ) -> Option<()> {
         let jacobian = self.jacobian.as_ref()?;
         let mut slots = out.iter_mut();
+        // The loops solved at the point, in a copy of the inputs' vector (its tear slots start the iteration).
+        let mut solved;
+        let u = if jacobian.through_loops() {
+            solved = u.to_vec();
+            if self.solve_loops(y, &mut solved, t, stack).is_err() {
+                out.iter_mut().for_each(|v| *v = f64::NAN);
+                return Some(());
+            }
+            &solved[..]
+        } else {
+            u
+        };
         jacobian.for_each(
             &self.values(y, u, t),
             (&self.rates, &self.mass),
@@ -633,6 +670,19 @@ fn exogenous(e: &Expr, n_inputs: usize, tears: &[Sym]) -> Expr {
         Sym::Tear(_) => tears
             .iter()
             .position(|&z| z == s)
+            .map(|k| symbols::leaf(Sym::Input(2 * n_inputs + k))),
+        _ => None,
+    })
+}
+
+/// [`exogenous`] of several expressions in one walk of their distinct nodes: a loop's derivatives share its
+/// residual's nodes.
+fn exogenous_all(es: &[Expr], n_inputs: usize, tears: &[Sym]) -> Vec<Expr> {
+    let slot: HashMap<Sym, usize> = tears.iter().enumerate().map(|(k, &z)| (z, k)).collect();
+    symbols::subst_all(es, &mut |s| match s {
+        Sym::InputDot(j) => Some(symbols::leaf(Sym::Input(n_inputs + j))),
+        Sym::Tear(_) => slot
+            .get(&s)
             .map(|k| symbols::leaf(Sym::Input(2 * n_inputs + k))),
         _ => None,
     })

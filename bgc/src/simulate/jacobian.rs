@@ -312,18 +312,12 @@ fn symbolic(
             // Each term only by the states (and tears) it reads, all in one walk of it when they are many (a long
             // sum held whole).
             let (read, tears_read) = tears.partition(term, n);
-            let wrt: Vec<Sym> = read
-                .iter()
-                .map(|&c| Sym::State(c))
-                .chain(tears_read.iter().filter_map(|&k| tears.sym(k)))
-                .collect();
-            let grads = symbols::gradient(term, &wrt).ok()?;
-            let (by_state, by_tear) = grads.split_at(read.len());
-            for (&c, d) in read.iter().zip(by_state) {
-                parts.entry(c).or_default().push(d.clone());
+            let (by_state, by_tear) = tears.derivatives(term, (&read, &tears_read))?;
+            for (c, d) in by_state {
+                parts.entry(c).or_default().push(d);
             }
-            for (&k, d) in tears_read.iter().zip(by_tear) {
-                tear_parts.entry(k).or_default().push(d.clone());
+            for (k, d) in by_tear {
+                tear_parts.entry(k).or_default().push(d);
             }
         }
         for (c, part) in parts {

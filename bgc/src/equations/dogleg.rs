@@ -42,7 +42,7 @@ pub(super) fn solve(problem: &mut dyn Problem, z: &mut [f64], settings: Settings
         let mut ratio = None;
         if moved && within(&r, &s, settings.rtol) {
             let mut newton: Vec<f64> = r.iter().map(|v| -v).collect();
-            if !lu_solve(&mut jac.clone(), &mut newton, n) {
+            if !lu_solve(&jac, &mut newton, n) {
                 // A root where ∂r/∂z is singular: the step cannot be judged.
                 z[..n].copy_from_slice(&x);
                 return Some(k);
@@ -115,8 +115,7 @@ fn linear_merit(j: &[f64], r: &[f64], p: &[f64], n: usize) -> f64 {
 fn dogleg_step(j: &[f64], r: &[f64], n: usize, radius: f64) -> Option<(Vec<f64>, bool)> {
     let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
     let mut newton: Vec<f64> = r.iter().map(|v| -v).collect();
-    let mut a = j.to_vec();
-    let has_newton = lu_solve(&mut a, &mut newton, n);
+    let has_newton = lu_solve(j, &mut newton, n);
     if has_newton && norm(&newton) <= radius {
         return Some((newton, true));
     }

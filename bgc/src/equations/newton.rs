@@ -300,8 +300,6 @@ fn damped(problem: &mut dyn Problem, z: &mut [f64], settings: Settings) -> Resul
     let (mut r, mut s) = (vec![0.0; n], vec![0.0; n]);
     let (mut r_try, mut s_try) = (vec![0.0; n], vec![0.0; n]);
     let mut jac = vec![0.0; n * n];
-    // The iterate's Jacobian, kept for the natural monotonicity test (`jac` is factored in place).
-    let mut jac0 = vec![0.0; n * n];
     let mut step = vec![0.0; n];
     let mut trial = vec![0.0; n];
     let fail = |kind, iterations, r: &[f64]| {
@@ -327,9 +325,8 @@ fn damped(problem: &mut dyn Problem, z: &mut [f64], settings: Settings) -> Resul
             break;
         }
         problem.jacobian(z, &mut jac);
-        jac0.copy_from_slice(&jac);
         step.iter_mut().zip(&r).for_each(|(d, r)| *d = -r);
-        let solved = jac.iter().all(|v| v.is_finite()) && lu_solve(&mut jac, &mut step, n);
+        let solved = jac.iter().all(|v| v.is_finite()) && lu_solve(&jac, &mut step, n);
         if !solved {
             // A converged iterate where the step cannot be judged (a root where ∂r/∂z is singular) stays.
             if converged && k > 0 {
@@ -367,7 +364,7 @@ fn damped(problem: &mut dyn Problem, z: &mut [f64], settings: Settings) -> Resul
             let accept = phi.is_finite()
                 && (converged
                     || phi <= (1.0 - 1e-4 * lambda) * phi0
-                    || contracts(&jac0, &r_try, z, &step, lambda));
+                    || contracts(&jac, &r_try, z, &step, lambda));
             if accept {
                 accepted = true;
                 break;
@@ -401,8 +398,7 @@ fn damped(problem: &mut dyn Problem, z: &mut [f64], settings: Settings) -> Resul
 fn contracts(jac: &[f64], r_trial: &[f64], z: &[f64], step: &[f64], lambda: f64) -> bool {
     let n = step.len();
     let mut bar: Vec<f64> = r_trial.iter().map(|v| -v).collect();
-    let mut a = jac.to_vec();
-    if !lu_solve(&mut a, &mut bar, n) {
+    if !lu_solve(jac, &mut bar, n) {
         return false;
     }
     let norm = |v: &[f64]| {
@@ -472,49 +468,133 @@ impl StepTest {
     }
 }
 
-/// Solves `a x = b` in place (`a` row-major `n × n`, overwritten; `b` becomes `x`). False when a pivot is zero or
-/// below `1e-14` times the largest entry of its column before elimination.
-pub(super) fn lu_solve(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
-    if a.len() < n * n || b.len() < n {
-        return false;
+/// Solves `a x = b` in place (`a` row-major `n × n`; `b` becomes `x`). False when a pivot is zero or below `1e-14`
+/// times the largest entry of its column before elimination.
+pub(super) fn lu_solve(a: &[f64], b: &mut [f64], n: usize) -> bool {
+    Lu::factor(a.to_vec(), n).is_some_and(|lu| lu.solve(b))
+}
+
+/// A square matrix factored by Gaussian elimination with partial pivoting, `P a = L U`, to solve with many
+/// right-hand sides: an algebraic loop that is linear with a Jacobian of parameters only is factored once per
+/// simulation, not at every solve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lu {
+    /// `U` on and above the diagonal, `L`'s multipliers below it (row-major).
+    factors: Vec<f64>,
+    /// The row swapped with row `k` at step `k`.
+    pivots: Vec<usize>,
+    n: usize,
+}
+
+impl Lu {
+    /// Factors `a` (row-major `n × n`); `None` when a pivot is zero or below `1e-14` times the largest entry of
+    /// its column before elimination.
+    pub fn factor(mut a: Vec<f64>, n: usize) -> Option<Lu> {
+        if a.len() != n * n {
+            return None;
+        }
+        let mut pivots = Vec::with_capacity(n);
+        for col in 0..n {
+            let column_scale = (0..n).fold(0.0f64, |m, i| m.max(a[i * n + col].abs()));
+            let pivot =
+                (col..n).max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs()))?;
+            let p = a[pivot * n + col];
+            if p == 0.0 || p.abs() <= 1e-14 * column_scale {
+                return None;
+            }
+            if pivot != col {
+                for j in 0..n {
+                    a.swap(pivot * n + j, col * n + j);
+                }
+            }
+            pivots.push(pivot);
+            for i in col + 1..n {
+                let factor = a[i * n + col] / p;
+                a[i * n + col] = factor;
+                if factor == 0.0 {
+                    continue;
+                }
+                for j in col + 1..n {
+                    a[i * n + j] -= factor * a[col * n + j];
+                }
+            }
+        }
+        Some(Lu {
+            factors: a,
+            pivots,
+            n,
+        })
     }
-    for col in 0..n {
-        let column_scale = (0..n).fold(0.0f64, |m, i| m.max(a[i * n + col].abs()));
-        let Some(pivot) =
-            (col..n).max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs()))
-        else {
-            return false;
-        };
-        let p = a[pivot * n + col];
-        if p == 0.0 || p.abs() <= 1e-14 * column_scale {
+
+    /// Solves `a x = b` in place; false when `b` has another length or `x` is not finite.
+    pub fn solve(&self, b: &mut [f64]) -> bool {
+        let (a, n) = (&self.factors, self.n);
+        if b.len() != n {
             return false;
         }
-        if pivot != col {
-            for j in 0..n {
-                a.swap(pivot * n + j, col * n + j);
-            }
+        // The rows were swapped whole, multipliers included: all the swaps first, then `L`.
+        for (col, &pivot) in self.pivots.iter().enumerate() {
             b.swap(pivot, col);
         }
-        for i in col + 1..n {
-            let factor = a[i * n + col] / p;
-            if factor == 0.0 {
-                continue;
+        for col in 0..n {
+            for i in col + 1..n {
+                let factor = a[i * n + col];
+                if factor != 0.0 {
+                    b[i] -= factor * b[col];
+                }
             }
-            for j in col..n {
-                a[i * n + j] -= factor * a[col * n + j];
+        }
+        for i in (0..n).rev() {
+            let mut acc = b[i];
+            for j in i + 1..n {
+                acc -= a[i * n + j] * b[j];
             }
-            b[i] -= factor * b[col];
+            b[i] = acc / a[i * n + i];
         }
+        b.iter().all(|v| v.is_finite())
     }
-    for i in (0..n).rev() {
-        let mut acc = b[i];
-        for j in i + 1..n {
-            acc -= a[i * n + j] * b[j];
-        }
-        b[i] = acc / a[i * n + i];
-    }
-    b.iter().all(|v| v.is_finite())
 }
+
+/// Solves a problem whose residual is affine in `z` with the constant Jacobian factored in `lu`: Newton steps
+/// with that factorisation, accepted by the tests of [`solve`] (residuals within the tolerance, then a step within
+/// its tolerance or no longer contracting). False when they do not pass within a few steps (rounding that
+/// refinement does not remove, or a residual that is not affine after all): the caller then runs [`solve`].
+pub fn solve_affine(problem: &mut dyn Problem, lu: &Lu, z: &mut [f64], settings: Settings) -> bool {
+    let n = problem.size();
+    if z.len() != n || lu.n != n {
+        return false;
+    }
+    let (mut r, mut s, mut step) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut floor = StepTest::default();
+    for k in 0..AFFINE_STEPS {
+        problem.residual(z, &mut r, &mut s);
+        if r.iter().chain(&s).any(|v| !v.is_finite()) {
+            return false;
+        }
+        if k == 0 && r.iter().all(|v| *v == 0.0) {
+            return true;
+        }
+        let converged = within(&r, &s, settings.rtol);
+        step.iter_mut().zip(&r).for_each(|(d, r)| *d = -r);
+        if !lu.solve(&mut step) {
+            return false;
+        }
+        let ratio = converged.then(|| step_ratio(z, &step));
+        if let Some(ratio) = ratio
+            && k > 0
+            && floor.accepts(ratio)
+        {
+            return true;
+        }
+        floor.took(ratio, true);
+        z.iter_mut().zip(&step).for_each(|(z, d)| *z += d);
+    }
+    false
+}
+
+/// The most steps [`solve_affine`] takes: one lands on the solution, the next confirms it, and a third or fourth
+/// refines what rounding left.
+const AFFINE_STEPS: usize = 4;
 
 #[cfg(test)]
 mod tests {
@@ -676,12 +756,74 @@ mod tests {
     #[test]
     fn solves_small_linear_systems() {
         // [[0, 2], [3, 1]] x = [4, 5]: x = (1, 2), with a pivot swap.
-        let mut a = [0.0, 2.0, 3.0, 1.0];
+        let a = [0.0, 2.0, 3.0, 1.0];
         let mut b = [4.0, 5.0];
-        assert!(lu_solve(&mut a, &mut b, 2));
+        assert!(lu_solve(&a, &mut b, 2));
         assert!((b[0] - 1.0).abs() < 1e-15 && (b[1] - 2.0).abs() < 1e-15);
-        let mut singular = [1.0, 2.0, 2.0, 4.0];
-        assert!(!lu_solve(&mut singular, &mut [1.0, 1.0], 2));
+        let singular = [1.0, 2.0, 2.0, 4.0];
+        assert!(!lu_solve(&singular, &mut [1.0, 1.0], 2));
+    }
+
+    /// A 3 × 3 system whose elimination swaps rows after the first column's multipliers are stored, solved for two
+    /// right-hand sides with one factorisation: `x = (1, 1, 1)` and `x = (1, −2, 1)` (by hand: `A x = b`).
+    #[test]
+    fn a_factorisation_solves_several_right_hand_sides() {
+        let a = vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 10.0];
+        let lu = Lu::factor(a, 3).expect("regular");
+        for (mut b, x) in [
+            ([6.0, 15.0, 25.0], [1.0, 1.0, 1.0]),
+            ([0.0, 0.0, 1.0], [1.0, -2.0, 1.0]),
+        ] {
+            assert!(lu.solve(&mut b));
+            for (got, want) in b.iter().zip(x) {
+                assert!((got - want).abs() < 1e-13, "{b:?} vs {x:?}");
+            }
+        }
+        assert!(
+            Lu::factor(vec![1.0, 2.0, 2.0, 4.0], 2).is_none(),
+            "singular"
+        );
+    }
+
+    /// `r(z) = A z − b` with the scales the magnitudes of its terms.
+    struct Affine {
+        a: [[f64; 2]; 2],
+        b: [f64; 2],
+    }
+
+    impl Problem for Affine {
+        fn size(&self) -> usize {
+            2
+        }
+        fn residual(&mut self, z: &[f64], r: &mut [f64], s: &mut [f64]) {
+            for i in 0..2 {
+                r[i] = self.a[i][0] * z[0] + self.a[i][1] * z[1] - self.b[i];
+                s[i] = (self.a[i][0] * z[0]).abs() + (self.a[i][1] * z[1]).abs() + self.b[i].abs();
+            }
+        }
+        fn jacobian(&mut self, _: &[f64], jac: &mut [f64]) {
+            jac.copy_from_slice(&[self.a[0][0], self.a[0][1], self.a[1][0], self.a[1][1]]);
+        }
+    }
+
+    #[test]
+    fn an_affine_problem_is_solved_with_its_factorisation_and_a_wrong_one_is_refused() {
+        let mut p = Affine {
+            a: [[2.0, 1.0], [1.0, 3.0]],
+            b: [3.0, 5.0],
+        };
+        let lu = Lu::factor(vec![2.0, 1.0, 1.0, 3.0], 2).expect("regular");
+        let mut z = [10.0, -7.0];
+        assert!(solve_affine(&mut p, &lu, &mut z, Settings::default()));
+        // x = (4/5, 7/5).
+        assert!(
+            (z[0] - 0.8).abs() < 1e-14 && (z[1] - 1.4).abs() < 1e-14,
+            "{z:?}"
+        );
+        // A factorisation of another matrix does not converge in its few steps: the caller runs Newton's method.
+        let wrong = Lu::factor(vec![1.0, 0.0, 0.0, 1.0], 2).expect("regular");
+        let mut z = [10.0, -7.0];
+        assert!(!solve_affine(&mut p, &wrong, &mut z, Settings::default()));
     }
 
     /// Two tears along a valley: with `w = z0 + z1` and `d = z0 − z1`, `r0 = M d + β w² + μ w + w³ − c0` and

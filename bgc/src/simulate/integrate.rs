@@ -30,9 +30,7 @@ use super::{SimError, System};
 type M = NalgebraMat<f64>;
 type Ls = NalgebraLU<f64>;
 
-/// From this many states on, a model with a symbolic Jacobian is solved with a sparse Jacobian and LU
-/// (`simulate/sparse_ode.rs`). Below it the dense LU is cheap.
-pub const SPARSE_FROM: usize = 200;
+pub use super::SPARSE_FROM;
 
 /// The integration method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

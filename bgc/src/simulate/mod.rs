@@ -54,9 +54,14 @@ use input::Signal;
 use jacobian::Jacobian;
 use std::collections::HashMap;
 
+/// From this many states on (with the two energy quadratures), a model with a symbolic Jacobian is solved with a
+/// sparse Jacobian and LU (`simulate/sparse_ode.rs`). Below it the dense LU is cheap.
+pub const SPARSE_FROM: usize = 200;
+
 /// A Jacobian through algebraic loops is kept when it has at most `n² / DENSE_LOOP_JACOBIAN` entries (or 16 a row,
 /// for a small model): denser, the sparse factorisation costs more than finite differences and a dense one.
 const DENSE_LOOP_JACOBIAN: usize = 10;
+use crate::equations::newton::Lu;
 use newton::{BlockPrograms, Loops};
 use program::{CompileError, Layout, Program, ProgramSeq, Values};
 
@@ -278,7 +283,7 @@ impl System {
             .iter()
             .map(|(e, what)| compile(e, what))
             .collect::<Result<Vec<_>, _>>()?;
-        let loops = compile_loops(eqs, 2 * n_inputs, &compile)?;
+        let loops = compile_loops(eqs, (2 * n_inputs, &params), &compile)?;
         // With loops, the Jacobian takes their tears' derivatives; kept only where it stays sparse (a loop that
         // reads many states makes every rate that reads its tear a dense row), else finite differences.
         let compile_seq = |es: &[Expr], what: &str| {
@@ -288,7 +293,9 @@ impl System {
                 reason,
             })
         };
-        let through_loops = match eqs.tear_blocks.is_empty() {
+        // Only the sparse path uses the Jacobian through loops (the dense one takes finite differences): below it,
+        // the loops' derivatives are not built (a block of 400 linear loops has 160,000).
+        let through_loops = match eqs.tear_blocks.is_empty() || n + 2 < SPARSE_FROM {
             true => None,
             false => {
                 let all = loop_jacobian::Tears::new(&eqs.tear_blocks);
@@ -675,6 +682,27 @@ fn exogenous(e: &Expr, n_inputs: usize, tears: &[Sym]) -> Expr {
     })
 }
 
+/// `∂r/∂z` factored at the parameter values `params`, when every entry reads parameters only; `None` otherwise or
+/// when it is singular there (Newton's method then reports the loop).
+fn constant_jacobian(entries: &[Expr], programs: &[Program], params: &[f64]) -> Option<Lu> {
+    let constant = entries
+        .iter()
+        .all(|e| e.syms().iter().all(|s| matches!(s, Sym::Param(_))));
+    if !constant {
+        return None;
+    }
+    let at = Values {
+        params,
+        states: &[],
+        inputs: &[],
+        t: 0.0,
+    };
+    let mut stack = Vec::new();
+    let values: Vec<f64> = programs.iter().map(|p| p.eval(&at, &mut stack)).collect();
+    let n = values.len().isqrt();
+    Lu::factor(values, n)
+}
+
 /// [`exogenous`] of several expressions in one walk of their distinct nodes: a loop's derivatives share its
 /// residual's nodes.
 fn exogenous_all(es: &[Expr], n_inputs: usize, tears: &[Sym]) -> Vec<Expr> {
@@ -688,10 +716,11 @@ fn exogenous_all(es: &[Expr], n_inputs: usize, tears: &[Sym]) -> Vec<Expr> {
     })
 }
 
-/// The programs of the tear blocks: residuals, their scales and `∂r/∂z`, with the tears at `offset + k`.
+/// The programs of the tear blocks: residuals, their scales and `∂r/∂z`, with the tears at `offset + k`; `∂r/∂z`
+/// factored at `params` where it is constant.
 fn compile_loops(
     eqs: &Equations,
-    offset: usize,
+    (offset, params): (usize, &[f64]),
     compile: &dyn Fn(&Expr, &str) -> Result<Program, SimError>,
 ) -> Result<Loops, SimError> {
     let mut loops = Loops::default();
@@ -715,12 +744,15 @@ fn compile_loops(
             .zip(&block.tears)
             .map(|(r, &z)| residual_scale(r, z))
             .collect();
+        let programs = all(&jacobian)?;
+        let constant = constant_jacobian(&jacobian, &programs, params);
         loops.push(BlockPrograms {
             slots: (k..k + block.tears.len()).collect(),
             names: block.names.clone(),
             residuals: all(&block.residuals)?,
             scales: all(&scales)?,
-            jacobian: all(&jacobian)?,
+            jacobian: programs,
+            constant,
         });
         k += block.tears.len();
     }

@@ -10,7 +10,7 @@
 
 use super::program::{Program, Values};
 use crate::equations::LoopFailure;
-use crate::equations::newton::{self, Problem, Settings};
+use crate::equations::newton::{self, Lu, Problem, Settings};
 
 /// The compiled blocks of a model, in solving order.
 #[derive(Clone, Debug, Default)]
@@ -28,6 +28,9 @@ pub struct BlockPrograms {
     pub scales: Vec<Program>,
     /// Row-major `∂r_i/∂z_j`.
     pub jacobian: Vec<Program>,
+    /// `∂r/∂z` factored, when it reads parameters only (a linear loop): the block is then solved by steps with
+    /// this factorisation, not by evaluating and factoring its Jacobian at every solve.
+    pub constant: Option<Lu>,
 }
 
 impl Loops {
@@ -62,6 +65,21 @@ impl Loops {
                 ext: &mut *ext,
                 stack: &mut *stack,
             };
+            // A linear loop: from the last solution, else from zero (where a loop whose terms have all but vanished
+            // lands exactly: rounding keeps the residual from ever being small against terms of that size).
+            if let Some(lu) = &block.constant {
+                let start = z.clone();
+                let zero = vec![0.0; z.len()];
+                let solved = [start.clone(), zero].into_iter().find_map(|mut from| {
+                    newton::solve_affine(&mut problem, lu, &mut from, Settings::default())
+                        .then_some(from)
+                });
+                if let Some(solved) = solved {
+                    problem.place(&solved);
+                    continue;
+                }
+                z = start;
+            }
             let mut result = newton::solve(&mut problem, &mut z, Settings::default());
             if result.is_err() && warm {
                 z.iter_mut().for_each(|v| *v = 0.0);

@@ -14,6 +14,9 @@
 //! algebraic loop per diode): the Jacobian takes each loop's implicit derivatives, so it stays block-diagonal and
 //! the sparse LU's cost grows with `N` (with finite differences and a dense LU it grew as `N³`).
 //!
+//! `simulate/ladder` runs the resistor ladder of `N` rungs (one state, one block of linear loops of about `N`
+//! tears): its `∂r/∂z` reads parameters only and is factored once per run, so a solve costs the block's residuals.
+//!
 //! Run with `cargo bench -p bgc --bench simulate_scaling`.
 
 #[path = "support/families.rs"]
@@ -26,7 +29,7 @@ use bgc::simulate::input::Signal;
 use bgc::simulate::integrate::{Method, RunOptions, run};
 use bgc::span::SourceMap;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use families::{benchmark_chain, gear_train, loops_in_series, mtf_chain};
+use families::{benchmark_chain, gear_train, ladder, loops_in_series, mtf_chain};
 use std::hint::black_box;
 
 /// The compiled system of the chain of `n` masses, driven by `u = sin(3t)`.
@@ -87,6 +90,18 @@ fn bench(c: &mut Criterion) {
     group.sample_size(10);
     for n in [50, 200] {
         let Some(system) = system_of(loops_in_series(n, 10)) else {
+            continue;
+        };
+        let x0 = vec![0.0; system.state_count()];
+        group.bench_with_input(BenchmarkId::from_parameter(n), &system, |b, s| {
+            b.iter(|| run(black_box(s), &x0, &opts).map(|t| t.times.len()))
+        });
+    }
+    group.finish();
+    let mut group = c.benchmark_group("simulate/ladder");
+    group.sample_size(10);
+    for n in [100] {
+        let Some(system) = system_of(ladder(n)) else {
             continue;
         };
         let x0 = vec![0.0; system.state_count()];

@@ -32,11 +32,6 @@ use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use families::{benchmark_chain, gear_train, ladder, loops_in_series, mtf_chain};
 use std::hint::black_box;
 
-/// The compiled system of the chain of `n` masses, driven by `u = sin(3t)`.
-fn system(n: usize) -> Option<System> {
-    system_of(benchmark_chain(n))
-}
-
 /// The compiled system of a model with one input, driven by `sin(3t)`.
 fn system_of(text: String) -> Option<System> {
     let mut sources = SourceMap::new();
@@ -50,6 +45,28 @@ fn system_of(text: String) -> Option<System> {
     Some(system)
 }
 
+/// Benchmarks the run of `model(n)` for each size `n`, compiled once outside the timing.
+fn run_group(
+    c: &mut Criterion,
+    name: &str,
+    sizes: &[usize],
+    model: fn(usize) -> String,
+    opts: &RunOptions,
+) {
+    let mut group = c.benchmark_group(name);
+    group.sample_size(10);
+    for &n in sizes {
+        let Some(system) = system_of(model(n)) else {
+            continue;
+        };
+        let x0 = vec![0.0; system.state_count()];
+        group.bench_with_input(BenchmarkId::from_parameter(n), &system, |b, s| {
+            b.iter(|| run(black_box(s), &x0, opts).map(|t| t.times.len()))
+        });
+    }
+    group.finish();
+}
+
 fn bench(c: &mut Criterion) {
     let opts = RunOptions {
         t_end: 0.01,
@@ -60,18 +77,13 @@ fn bench(c: &mut Criterion) {
         max_steps: 100_000,
         max_step: None,
     };
-    let mut group = c.benchmark_group("simulate/benchmark_chain");
-    group.sample_size(10);
-    for n in [100, 1000, 10_000] {
-        let Some(system) = system(n) else {
-            continue;
-        };
-        let x0 = vec![0.0; system.state_count()];
-        group.bench_with_input(BenchmarkId::from_parameter(n), &system, |b, s| {
-            b.iter(|| run(black_box(s), &x0, &opts).map(|t| t.times.len()))
-        });
-    }
-    group.finish();
+    run_group(
+        c,
+        "simulate/benchmark_chain",
+        &[100, 1000, 10_000],
+        benchmark_chain,
+        &opts,
+    );
     let mut group = c.benchmark_group("simulate/mtf_chain");
     group.sample_size(10);
     for n in [250, 1000] {
@@ -86,46 +98,14 @@ fn bench(c: &mut Criterion) {
         });
     }
     group.finish();
-    let mut group = c.benchmark_group("simulate/loops_in_series");
-    group.sample_size(10);
-    for n in [50, 200] {
-        let Some(system) = system_of(loops_in_series(n, 10)) else {
-            continue;
-        };
-        let x0 = vec![0.0; system.state_count()];
-        group.bench_with_input(BenchmarkId::from_parameter(n), &system, |b, s| {
-            b.iter(|| run(black_box(s), &x0, &opts).map(|t| t.times.len()))
-        });
-    }
-    group.finish();
-    let mut group = c.benchmark_group("simulate/ladder");
-    group.sample_size(10);
-    for n in [100] {
-        let Some(system) = system_of(ladder(n)) else {
-            continue;
-        };
-        let x0 = vec![0.0; system.state_count()];
-        group.bench_with_input(BenchmarkId::from_parameter(n), &system, |b, s| {
-            b.iter(|| run(black_box(s), &x0, &opts).map(|t| t.times.len()))
-        });
-    }
-    group.finish();
+    let ten_caps = |n| loops_in_series(n, 10);
+    run_group(c, "simulate/loops_in_series", &[50, 200], ten_caps, &opts);
+    run_group(c, "simulate/ladder", &[100], ladder, &opts);
     let rows = RunOptions {
         dt_out: 1e-4,
         ..opts
     };
-    let mut group = c.benchmark_group("simulate/gear_train");
-    group.sample_size(10);
-    for n in [1000, 4000] {
-        let Some(system) = system_of(gear_train(n)) else {
-            continue;
-        };
-        let x0 = vec![0.0; system.state_count()];
-        group.bench_with_input(BenchmarkId::from_parameter(n), &system, |b, s| {
-            b.iter(|| run(black_box(s), &x0, &rows).map(|t| t.times.len()))
-        });
-    }
-    group.finish();
+    run_group(c, "simulate/gear_train", &[1000, 4000], gear_train, &rows);
 }
 
 criterion_group!(benches, bench);

@@ -204,7 +204,7 @@ impl Tears {
     }
 
     /// The symbol of global tear `k`.
-    pub(super) fn sym(&self, k: usize) -> Option<Sym> {
+    fn sym(&self, k: usize) -> Option<Sym> {
         self.syms.get(k).copied()
     }
 

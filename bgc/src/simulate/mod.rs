@@ -47,11 +47,14 @@ pub mod samples;
 #[cfg(feature = "cli")]
 mod sparse_ode;
 
+use crate::equations::newton::Lu;
 use crate::equations::symbols::{self, Sym, SymExt, add};
 use crate::equations::{EnergyKind, Equations, block_jacobian, residual_scale};
 use crate::symbolic::Expr;
 use input::Signal;
 use jacobian::Jacobian;
+use newton::{BlockPrograms, Loops};
+use program::{CompileError, Layout, Program, ProgramSeq, Values};
 use std::collections::HashMap;
 
 /// From this many states on (with the two energy quadratures), a model with a symbolic Jacobian is solved with a
@@ -61,9 +64,6 @@ pub const SPARSE_FROM: usize = 200;
 /// A Jacobian through algebraic loops is kept when it has at most `n² / DENSE_LOOP_JACOBIAN` entries (or 16 a row,
 /// for a small model): denser, the sparse factorisation costs more than finite differences and a dense one.
 const DENSE_LOOP_JACOBIAN: usize = 10;
-use crate::equations::newton::Lu;
-use newton::{BlockPrograms, Loops};
-use program::{CompileError, Layout, Program, ProgramSeq, Values};
 
 /// Why a simulation could not be set up or run.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -214,6 +214,7 @@ impl System {
             .flat_map(|b| b.tears.iter().copied())
             .collect();
         let ext_len = 2 * n_inputs + tears.len();
+        let exogenous = Exogenous::new(n_inputs, &tears);
         let layout = Layout {
             params: params.len(),
             states: n,
@@ -232,11 +233,9 @@ impl System {
             other => eqs.sym_name(other),
         };
         let compile = |e: &Expr, what: &str| {
-            Program::compile(&exogenous(e, n_inputs, &tears), layout, &name).map_err(|reason| {
-                SimError::Compile {
-                    what: what.to_string(),
-                    reason,
-                }
+            Program::compile(&exogenous.one(e), layout, &name).map_err(|reason| SimError::Compile {
+                what: what.to_string(),
+                reason,
             })
         };
         let mut rate_exprs = Vec::with_capacity(n + 2);
@@ -287,7 +286,7 @@ impl System {
         // With loops, the Jacobian takes their tears' derivatives; kept only where it stays sparse (a loop that
         // reads many states makes every rate that reads its tear a dense row), else finite differences.
         let compile_seq = |es: &[Expr], what: &str| {
-            let es = exogenous_all(es, n_inputs, &tears);
+            let es = exogenous.all(es);
             ProgramSeq::compile(&es, layout, &name).map_err(|(_, reason)| SimError::Compile {
                 what: what.to_string(),
                 reason,
@@ -334,7 +333,7 @@ impl System {
                 Sym::Output(j) => Some(symbols::leaf(Sym::Input(ext_len + j))),
                 _ => None,
             });
-            output_exprs.push(exogenous(&e, n_inputs, &tears));
+            output_exprs.push(exogenous.one(&e));
         }
         // One program for all outputs: what they share (the efforts along a gear train hold one another) is
         // computed once per row.
@@ -666,20 +665,42 @@ fn check_len(what: &'static str, expected: usize, got: usize) -> Result<(), SimE
     }
 }
 
-/// `e` with each [`Sym::InputDot`]`(j)` renamed to the input `n_inputs + j` and each tear `tears[k]` to the input
-/// `2 n_inputs + k` (the programs' `[u, u̇, z]` layout).
-fn exogenous(e: &Expr, n_inputs: usize, tears: &[Sym]) -> Expr {
-    if !e.any_sym(&|s| matches!(s, Sym::InputDot(_) | Sym::Tear(_))) {
-        return e.clone();
+/// The renaming into the programs' `[u, u̇, z]` layout: each [`Sym::InputDot`]`(j)` to the input `n_inputs + j`
+/// and each tear `tears[k]` to the input `2 n_inputs + k`.
+struct Exogenous {
+    n_inputs: usize,
+    slot: HashMap<Sym, usize>,
+}
+
+impl Exogenous {
+    fn new(n_inputs: usize, tears: &[Sym]) -> Exogenous {
+        let slot = tears.iter().enumerate().map(|(k, &z)| (z, k)).collect();
+        Exogenous { n_inputs, slot }
     }
-    symbols::subst(e, &mut |s| match s {
-        Sym::InputDot(j) => Some(symbols::leaf(Sym::Input(n_inputs + j))),
-        Sym::Tear(_) => tears
-            .iter()
-            .position(|&z| z == s)
-            .map(|k| symbols::leaf(Sym::Input(2 * n_inputs + k))),
-        _ => None,
-    })
+
+    fn rename(&self, s: Sym) -> Option<Expr> {
+        match s {
+            Sym::InputDot(j) => Some(symbols::leaf(Sym::Input(self.n_inputs + j))),
+            Sym::Tear(_) => self
+                .slot
+                .get(&s)
+                .map(|k| symbols::leaf(Sym::Input(2 * self.n_inputs + k))),
+            _ => None,
+        }
+    }
+
+    /// `e` renamed.
+    fn one(&self, e: &Expr) -> Expr {
+        if !e.any_sym(&|s| matches!(s, Sym::InputDot(_) | Sym::Tear(_))) {
+            return e.clone();
+        }
+        symbols::subst(e, &mut |s| self.rename(s))
+    }
+
+    /// `es` renamed in one walk of their distinct nodes: a loop's derivatives share its residual's nodes.
+    fn all(&self, es: &[Expr]) -> Vec<Expr> {
+        symbols::subst_all(es, &mut |s| self.rename(s))
+    }
 }
 
 /// `∂r/∂z` factored at the parameter values `params`, when every entry reads parameters only; `None` otherwise or
@@ -701,19 +722,6 @@ fn constant_jacobian(entries: &[Expr], programs: &[Program], params: &[f64]) -> 
     let values: Vec<f64> = programs.iter().map(|p| p.eval(&at, &mut stack)).collect();
     let n = values.len().isqrt();
     Lu::factor(values, n)
-}
-
-/// [`exogenous`] of several expressions in one walk of their distinct nodes: a loop's derivatives share its
-/// residual's nodes.
-fn exogenous_all(es: &[Expr], n_inputs: usize, tears: &[Sym]) -> Vec<Expr> {
-    let slot: HashMap<Sym, usize> = tears.iter().enumerate().map(|(k, &z)| (z, k)).collect();
-    symbols::subst_all(es, &mut |s| match s {
-        Sym::InputDot(j) => Some(symbols::leaf(Sym::Input(n_inputs + j))),
-        Sym::Tear(_) => slot
-            .get(&s)
-            .map(|k| symbols::leaf(Sym::Input(2 * n_inputs + k))),
-        _ => None,
-    })
 }
 
 /// The programs of the tear blocks: residuals, their scales and `∂r/∂z`, with the tears at `offset + k`; `∂r/∂z`

@@ -68,17 +68,16 @@ impl Loops {
             // A linear loop: from the last solution, else from zero (where a loop whose terms have all but vanished
             // lands exactly: rounding keeps the residual from ever being small against terms of that size).
             if let Some(lu) = &block.constant {
-                let start = z.clone();
-                let zero = vec![0.0; z.len()];
-                let solved = [start.clone(), zero].into_iter().find_map(|mut from| {
-                    newton::solve_affine(&mut problem, lu, &mut from, Settings::default())
-                        .then_some(from)
-                });
+                let solved = [z.clone(), vec![0.0; z.len()]]
+                    .into_iter()
+                    .find_map(|mut from| {
+                        newton::solve_affine(&mut problem, lu, &mut from, Settings::default())
+                            .then_some(from)
+                    });
                 if let Some(solved) = solved {
                     problem.place(&solved);
                     continue;
                 }
-                z = start;
             }
             let mut result = newton::solve(&mut problem, &mut z, Settings::default());
             if result.is_err() && warm {

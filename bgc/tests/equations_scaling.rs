@@ -371,6 +371,41 @@ fn chain_of_modulated_transformers_follows_lagrange() {
     }
 }
 
+/// Everything the equations of a model store: rates, mass matrices and energy terms, as distinct nodes.
+fn stored_equations(eqs: &Equations) -> usize {
+    let mut all: Vec<Expr> = eqs.rates.clone();
+    all.extend(
+        eqs.mass
+            .iter()
+            .flat_map(|m| m.matrix.iter().flatten().cloned()),
+    );
+    all.extend(eqs.energy.iter().filter_map(|t| t.value.clone()));
+    Expr::distinct_nodes(&all)
+}
+
+/// Along a chain of modulated transformers each flow is the next one times `1 + 0.1 cos θ`. Kept as products the
+/// flows share their levels and the equations are stored in a size linear in the chain; multiplied out into
+/// polynomials of degree `k` in `cos θ` they shared nothing: 60 and 120 links took 4,172 and 6,921 nodes (850 and
+/// 1,684 as products), and `bgc rust` of 200 links wrote 63 MB of code.
+#[test]
+fn the_flows_along_a_chain_of_modulated_transformers_stay_products() {
+    let (n, m) = (60, 120);
+    let (small, large) = (
+        stored_equations(&equations(&mtf_chain(n))),
+        stored_equations(&equations(&mtf_chain(m))),
+    );
+    assert!(
+        large <= 20 * m && large <= 2 * small + 200,
+        "{n} links: {small} nodes; {m} links: {large} nodes"
+    );
+    let text = bgc::equations::to_text(&equations(&mtf_chain(3)));
+    let stored_i0 = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("stored i0 = "))
+        .unwrap_or_default();
+    assert!(stored_i0.contains("cos(theta) + 1)^4"), "{stored_i0}");
+}
+
 /// `n` voltage sources in series on one 1-junction with a load resistor: the junction's flow `(u0 + ... )/r`
 /// is in the power of every source.
 fn many_sources(n: usize) -> String {

@@ -371,17 +371,21 @@ fn has_rates(e: &Expr) -> bool {
     e.any_sym(&|s| matches!(s, Sym::StateDot(_) | Sym::InputDot(_)))
 }
 
-/// `e` multiplied out when that makes it no larger. A value is copied into every variable that uses it: in a chain
-/// of algebraic loops each rung's solution `b / (1 − a)` holds the previous ones as nested products of sums, which
+/// `e` multiplied out when that makes it no larger as a tree and smaller as stored (a tie keeps `e`, whose levels
+/// are shared with the values it holds). A value is copied into every variable that uses it: in a chain of algebraic
+/// loops each rung's solution `b / (1 − a)` holds the previous ones as nested products of sums, which
 /// grow geometrically; multiplied out, the like terms collect and the size stays that of the model's symbols.
 fn compact(expander: &mut Expander, e: Expr) -> Expr {
     let expanded = expander.expand(&e);
     if expanded == e {
         return e;
     }
-    if expanded.node_count() <= e.node_count() {
-        expanded
-    } else {
-        e
-    }
+    // Sizes are compared as trees (cheap, kept in the nodes) and as stored: a product of `k` factors
+    // `1 + c·cos θ` (a chain of modulated transformers) is as small a tree as the polynomial of degree `k` it
+    // multiplies out to, but it shares its levels with the values before it and the polynomial shares nothing,
+    // so keeping the polynomials made every later stage quadratic in the chain.
+    let smaller = expanded.node_count() <= e.node_count()
+        && Expr::distinct_nodes(std::slice::from_ref(&expanded))
+            < Expr::distinct_nodes(std::slice::from_ref(&e));
+    if smaller { expanded } else { e }
 }

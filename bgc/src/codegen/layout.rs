@@ -14,6 +14,7 @@
 //! expression on one line. Only a single name or literal wider than a line can make a line longer than
 //! [`MAX_WIDTH`].
 
+use super::layout_widths::{text_width, text_within, widest_call_args};
 use super::names::Namer;
 use crate::symbolic::RustCode;
 
@@ -27,23 +28,6 @@ const TEMP_NAME_WIDTH: usize = 8;
 /// The width of `s` in columns (its characters: generated code has no wide characters).
 pub(super) fn width(s: &str) -> usize {
     s.chars().count()
-}
-
-/// The widest argument list of any call in `code`.
-fn widest_call_args(code: &RustCode) -> usize {
-    match code {
-        RustCode::Atom(_) => 0,
-        RustCode::Neg(inner) | RustCode::Paren(inner) => widest_call_args(inner),
-        RustCode::Chain(first, rest) => rest
-            .iter()
-            .map(|(_, o)| widest_call_args(o))
-            .fold(widest_call_args(first), usize::max),
-        RustCode::Call(_, args) => {
-            let own = args.iter().map(|a| width(&a.to_string())).sum::<usize>()
-                + 2 * args.len().saturating_sub(1);
-            args.iter().map(widest_call_args).fold(own, usize::max)
-        }
-    }
 }
 
 /// The lines of a function body: statements with the `let`s they need before them, and lines given as they are.
@@ -146,8 +130,9 @@ impl<'n> Body<'n> {
     /// The text of `code` in at most `budget` columns, with every call's arguments within [`CALL_ARGS_WIDTH`],
     /// binding parts to temporaries as needed.
     fn fit(&mut self, code: &RustCode, budget: usize) -> String {
-        let flat = code.to_string();
-        if width(&flat) <= budget && widest_call_args(code) <= CALL_ARGS_WIDTH {
+        if let Some(flat) = text_within(code, budget)
+            && widest_call_args(code) <= CALL_ARGS_WIDTH
+        {
             return flat;
         }
         match code {
@@ -161,22 +146,42 @@ impl<'n> Body<'n> {
 
     fn fit_call(&mut self, callee: &str, args: &[RustCode], budget: usize) -> String {
         let room = CALL_ARGS_WIDTH.min(budget.saturating_sub(width(callee) + 2));
-        let mut texts: Vec<String> = args.iter().map(|a| a.to_string()).collect();
+        let mut texts: Vec<Option<String>> = args.iter().map(|a| text_within(a, room)).collect();
+        // The widths decide which argument is bound first. One too wide for the room alone is bound in any case;
+        // its exact width (a walk of it) is needed only to order it among others like it.
+        let too_wide = (0..args.len())
+            .filter(|&i| texts[i].is_none() && !args[i].is_atom())
+            .count();
+        let mut columns: Vec<usize> = args
+            .iter()
+            .zip(&texts)
+            .map(|(a, t)| match t {
+                Some(t) => width(t),
+                None if too_wide > 1 || a.is_atom() => text_width(a),
+                None => room + 1,
+            })
+            .collect();
         let mut bound = vec![false; args.len()];
         loop {
-            let used =
-                texts.iter().map(|t| width(t)).sum::<usize>() + 2 * texts.len().saturating_sub(1);
+            let used = columns.iter().sum::<usize>() + 2 * columns.len().saturating_sub(1);
             if used <= room {
                 break;
             }
             // The widest argument not bound yet that is more than a name.
             let widest = (0..args.len())
                 .filter(|&i| !bound[i] && !args[i].is_atom())
-                .max_by_key(|&i| (width(&texts[i]), std::cmp::Reverse(i)));
+                .max_by_key(|&i| (columns[i], std::cmp::Reverse(i)));
             let Some(i) = widest else { break };
-            texts[i] = self.hoist(&args[i]);
+            let name = self.hoist(&args[i]);
+            columns[i] = width(&name);
+            texts[i] = Some(name);
             bound[i] = true;
         }
+        let texts: Vec<String> = args
+            .iter()
+            .zip(texts)
+            .map(|(a, t)| t.unwrap_or_else(|| a.to_string()))
+            .collect();
         format!("{callee}({})", texts.join(", "))
     }
 
@@ -191,17 +196,17 @@ impl<'n> Body<'n> {
             std::iter::once((None, first)).chain(rest.iter().map(|(op, o)| (Some(*op), o)));
         let mut line = String::new();
         for (op, operand) in operands {
-            let flat = operand.to_string();
-            let text = if !operand.is_atom()
-                && (2 * width(&flat) > limit || widest_call_args(operand) > CALL_ARGS_WIDTH)
-            {
-                match operand {
-                    // `-x` keeps its minus here; `x` gets the line.
-                    RustCode::Neg(inner) => format!("-{}", self.hoist(inner)),
-                    _ => self.hoist(operand),
-                }
-            } else {
-                flat
+            // An operand wider than half a line, or with a call too wide, gets a line of its own.
+            let flat = match operand {
+                RustCode::Atom(s) => Some(s.clone()),
+                _ => text_within(operand, limit / 2)
+                    .filter(|_| widest_call_args(operand) <= CALL_ARGS_WIDTH),
+            };
+            let text = match (flat, operand) {
+                (Some(flat), _) => flat,
+                // `-x` keeps its minus here; `x` gets the line.
+                (None, RustCode::Neg(inner)) => format!("-{}", self.hoist(inner)),
+                (None, _) => self.hoist(operand),
             };
             line = match op {
                 None => text,

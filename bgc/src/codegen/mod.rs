@@ -22,6 +22,7 @@ mod adapter;
 pub(crate) mod emit;
 mod format;
 mod layout;
+mod layout_widths;
 mod loops;
 mod loops_dogleg;
 pub(crate) mod mass;

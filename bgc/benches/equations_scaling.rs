@@ -150,6 +150,8 @@ fn bench(c: &mut Criterion) {
     rust_family(c, "benchmark_chain", &[100, 1000, 10000], benchmark_chain);
     // The rate of the input mass reads every state: its Jacobian row is differentiated in one reverse walk.
     rust_family(c, "gear_train", &[1000, 10_000], gear_train);
+    // Nested code (the mass matrix's Horner chain) is laid out with each part printed only as far as a line holds.
+    rust_family(c, "mtf_chain", &[50, 100, 200], mtf_chain);
 }
 
 criterion_group!(benches, bench);

@@ -29,6 +29,7 @@ mod codegen_build;
 mod codegen_generate;
 mod codegen_hostile_names;
 mod codegen_large;
+mod codegen_mass_jacobian;
 mod codegen_no_std;
 mod codegen_param_terms;
 mod codegen_rustfmt;

@@ -153,7 +153,7 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
         .collect();
     let chain = ParamChain::new(eqs, &free, &[]).map_err(|e| e.to_string())?;
     let chain = named_chain(eqs, chain).map_err(|e| e.to_string())?;
-    let mass = super::mass::plan(eqs, &states, &chain)?;
+    let mut mass = super::mass::plan(eqs, &states, &chain)?;
     let loops = super::loops::plan(eqs, &f, &h, (&states, &inputs), &chain)?;
     if let Some(l) = &loops {
         let in_mass = mass
@@ -172,7 +172,7 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
             let (selection, linear_ss) = linear_state_space(eqs);
             (selection, linear_ss, ParamJacobians::new(&chain, &f, &h))
         },
-        || PointPlan::new(eqs, (&f, &h), (&states, &inputs)),
+        || PointPlan::new(eqs, (&f, &h), (&states, &inputs), &mut mass),
     );
     p.shared.insert("jac_p_into", params.dfdp_shared);
     p.shared.insert("output_jac_p_into", params.dhdp_shared);
@@ -265,10 +265,12 @@ struct PointPlan {
 }
 
 impl PointPlan {
+    /// The plan at a point; the mass blocks' `∂M/∂x`, which `jac_x_into` prints beside `∂f/∂x`, share its names.
     fn new(
         eqs: &Equations,
         (f, h): (&[Expr], &[Expr]),
         (states, inputs): (&[Symbol], &[Symbol]),
+        mass: &mut [super::mass::MassPlan],
     ) -> PointPlan {
         let rhs = block(eqs, &eqs.rates, f);
         let readable_outputs: Vec<Expr> = eqs.outputs.iter().map(|o| o.value.clone()).collect();
@@ -286,7 +288,12 @@ impl PointPlan {
         let mut shared = BTreeMap::from([
             (
                 "jac_x_into",
-                share("dfdx_", sparse_entries(&mut dfdx).into_iter()),
+                share(
+                    "dfdx_",
+                    sparse_entries(&mut dfdx)
+                        .into_iter()
+                        .chain(mass_slopes(mass)),
+                ),
             ),
             (
                 "jac_u_into",
@@ -379,6 +386,14 @@ fn state_space(
         d: m(d, inputs)?,
         states,
     })
+}
+
+/// The entries of the mass blocks' `∂M/∂x`, to rewrite in place. Along a chain of modulated transformers they are
+/// nested sums whose levels share the powers of the moduli: printed as trees they took 363,772 nodes at 200 links.
+fn mass_slopes(mass: &mut [super::mass::MassPlan]) -> impl Iterator<Item = &mut Expr> {
+    mass.iter_mut()
+        .flat_map(|b| b.derivatives.iter_mut())
+        .flat_map(|(_, d)| d.iter_mut().flatten())
 }
 
 /// The entries of a sparse matrix, to rewrite in place.

@@ -174,7 +174,10 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
         },
         || PointPlan::new(eqs, (&f, &h), (&states, &inputs), &mut mass),
     );
-    p.shared.insert("jac_p_into", params.dfdp_shared);
+    // The mass blocks' `dM/dp` (printed in `jac_p_into` beside `∂F/∂p`) under names of their own.
+    let mut dfdp_shared = params.dfdp_shared;
+    dfdp_shared.extend(share("dmdp_", mass_param_slopes(&mut mass)));
+    p.shared.insert("jac_p_into", dfdp_shared);
     p.shared.insert("output_jac_p_into", params.dhdp_shared);
     // Entries of `A, B, C, D` that would print as huge trees (nested loops solved in closed form) are written over
     // `let`s of their shared subexpressions too.
@@ -393,6 +396,13 @@ fn state_space(
 fn mass_slopes(mass: &mut [super::mass::MassPlan]) -> impl Iterator<Item = &mut Expr> {
     mass.iter_mut()
         .flat_map(|b| b.derivatives.iter_mut())
+        .flat_map(|(_, d)| d.iter_mut().flatten())
+}
+
+/// The entries of the mass blocks' `dM/dp`, to rewrite in place.
+fn mass_param_slopes(mass: &mut [super::mass::MassPlan]) -> impl Iterator<Item = &mut Expr> {
+    mass.iter_mut()
+        .flat_map(|b| b.param_derivatives.iter_mut())
         .flat_map(|(_, d)| d.iter_mut().flatten())
 }
 

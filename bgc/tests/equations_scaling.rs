@@ -371,6 +371,63 @@ fn chain_of_modulated_transformers_follows_lagrange() {
     }
 }
 
+/// The chain of [`mtf_chain`] with a phase per link: modulus `k` is `1 + 0.1 cos(θ + k/100)`.
+fn mtf_chain_with_phases(n_mtf: usize) -> String {
+    let mut text = mtf_chain(n_mtf);
+    for k in (1..=n_mtf).rev() {
+        let from = format!("MTF g{k} = 1 + 0.1*cos(theta);");
+        let to = format!("MTF g{k} = 1 + 0.1*cos(theta + {k}*0.01);");
+        text = text.replace(&from, &to);
+    }
+    text
+}
+
+/// With distinct moduli `n_k(θ)` junction `k` turns at `ω/(n_1⋯n_k)`, so by Lagrange `m = J Σ_k Π_{j≤k} n_j^(−2)`
+/// and `m ω̇ + ½ m' ω² = τ − b ω`; the state is the far end's flow `ω/(n_1⋯n_N)`, whose rate is
+/// `ω̇/Π − ω Π'/Π²` with `Π'/Π = Σ_j n_j'/n_j · ω`. The rates the equations derive are these, for 3 and 12 links.
+#[test]
+fn chain_of_modulated_transformers_with_distinct_moduli_follows_lagrange() {
+    let (j, b) = (1.0, 0.1);
+    for n_mtf in [3, 12] {
+        let eqs = equations(&mtf_chain_with_phases(n_mtf));
+        let p = eqs.default_params();
+        let (iw, it) = (state(&eqs, &format!("f_j{n_mtf}")), state(&eqs, "theta"));
+        for &(theta, w0, tau) in &[(0.3, 0.5, 1.0), (2.0, -1.2, 0.0), (-1.0, 0.1, -2.0)] {
+            let n: Vec<f64> = (1..=n_mtf)
+                .map(|k| 1.0 + 0.1 * (theta + k as f64 * 0.01).cos())
+                .collect();
+            let dn: Vec<f64> = (1..=n_mtf)
+                .map(|k| -0.1 * (theta + k as f64 * 0.01).sin())
+                .collect();
+            // Π_k = n_1⋯n_k and its θ-derivative Π_k Σ_{j≤k} n_j'/n_j.
+            let (mut m, mut dm, mut prod, mut log_slope) = (j, 0.0, 1.0, 0.0);
+            for k in 0..n_mtf {
+                prod *= n[k];
+                log_slope += dn[k] / n[k];
+                m += j / (prod * prod);
+                dm += -2.0 * j * log_slope / (prod * prod);
+            }
+            let dw0 = (tau - b * w0 - 0.5 * dm * w0 * w0) / m;
+            let want = dw0 / prod - w0 / prod * log_slope * w0;
+            let mut x = vec![0.0; eqs.states.len()];
+            x[it] = theta;
+            x[iw] = w0 / prod;
+            let rates = eqs
+                .rates_at(&p, &x, &[tau], 0.0)
+                .unwrap_or_else(|e| panic!("{e}"));
+            assert!(
+                (rates[it] - w0).abs() < 1e-12 * (1.0 + w0.abs()),
+                "θ̇ {rates:?}"
+            );
+            assert!(
+                (rates[iw] - want).abs() < 1e-10 * (1.0 + want.abs()),
+                "N = {n_mtf}, θ = {theta}: {} vs {want}",
+                rates[iw]
+            );
+        }
+    }
+}
+
 /// Everything the equations of a model store: rates, mass matrices and energy terms, as distinct nodes.
 fn stored_equations(eqs: &Equations) -> usize {
     let mut all: Vec<Expr> = eqs.rates.clone();

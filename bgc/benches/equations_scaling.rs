@@ -29,8 +29,8 @@ use bgc::lower::{MemoryLoader, lower};
 use bgc::span::SourceMap;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use families::{
-    benchmark_chain, gear_train, gyrator_chain, ladder, ladder_distinct, mtf_chain, output_chain,
-    parallel_pairs,
+    benchmark_chain, gear_train, gyrator_chain, ladder, ladder_distinct, mtf_chain,
+    mtf_chain_with_phases, output_chain, parallel_pairs,
 };
 use std::hint::black_box;
 
@@ -141,6 +141,14 @@ fn bench(c: &mut Criterion) {
     family(c, "output_chain", &[6, 12, 24], output_chain);
     // The velocities behind the chain's moduli are found in one walk of the definitions, not one per inertia.
     family(c, "mtf_chain", &[25, 100, 1000], mtf_chain);
+    // Distinct moduli: the flows are flat products of distinct factors (the engine keeps products flat), and the
+    // derivative-causality rates grow with the cube of the chain.
+    family(
+        c,
+        "mtf_chain_with_phases",
+        &[10, 20, 40],
+        mtf_chain_with_phases,
+    );
     family(c, "gear_train", &[1000, 10_000], gear_train);
     // Every compliance in derivative causality: the rates are solved by a sparse elimination of the coupled block.
     family(c, "gyrator_chain", &[1000, 10_000], gyrator_chain);

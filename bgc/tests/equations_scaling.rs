@@ -18,7 +18,7 @@ use bgc::symbolic::Expr;
 
 use crate::equations_support::families::{
     gear_train, gyrator_chain, ladder, ladder_distinct, ladder_distinct_resistances, mtf_chain,
-    output_chain, parallel_pairs,
+    mtf_chain_with_phases, output_chain, parallel_pairs,
 };
 
 /// Lowers, analyses and derives one model from source text; any error fails the test.
@@ -369,17 +369,6 @@ fn chain_of_modulated_transformers_follows_lagrange() {
             );
         }
     }
-}
-
-/// The chain of [`mtf_chain`] with a phase per link: modulus `k` is `1 + 0.1 cos(θ + k/100)`.
-fn mtf_chain_with_phases(n_mtf: usize) -> String {
-    let mut text = mtf_chain(n_mtf);
-    for k in (1..=n_mtf).rev() {
-        let from = format!("MTF g{k} = 1 + 0.1*cos(theta);");
-        let to = format!("MTF g{k} = 1 + 0.1*cos(theta + {k}*0.01);");
-        text = text.replace(&from, &to);
-    }
-    text
 }
 
 /// With distinct moduli `n_k(θ)` junction `k` turns at `ω/(n_1⋯n_k)`, so by Lagrange `m = J Σ_k Π_{j≤k} n_j^(−2)`

@@ -103,6 +103,18 @@ pub fn mtf_chain(n: usize) -> String {
     s + "}\n"
 }
 
+/// [`mtf_chain`] with a phase per link: modulus `k` is `1 + 0.1 cos(theta + k/100)`, so the flows are products of
+/// distinct factors rather than powers of one.
+pub fn mtf_chain_with_phases(n: usize) -> String {
+    let mut text = mtf_chain(n);
+    for k in (1..=n).rev() {
+        let from = format!("MTF g{k} = 1 + 0.1*cos(theta);");
+        let to = format!("MTF g{k} = 1 + 0.1*cos(theta + {k}*0.01);");
+        text = text.replace(&from, &to);
+    }
+    text
+}
+
 /// `Se tau -> 1 j0 {I J, R b} -> GY g1 -> 0 z1 {C 1/k} -> 1 j1 {I J, R b} -> GY g2 -> … -> 1 jN`: each gyrator
 /// turns the inertia's flow before it into the effort of the compliance after it, so every compliance is in
 /// derivative causality, coupled to its neighbours through the rates.

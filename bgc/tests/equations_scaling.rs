@@ -323,97 +323,64 @@ fn outputs_through_earlier_outputs_are_shared_not_copied() {
     }
 }
 
-/// `(ω, ω̇)` of the MTF chain by Lagrange: with `n = 1 + 0.1 cos θ` and `ω = θ̇ = f(j0)`, junction `k` turns at
-/// `ω/nᵏ` (a transformer's output flow is its input flow over its modulus), so `T = ½ m(θ) ω²` with
-/// `m = J Σ_{k=0..N} n^(−2k)`, and `m ω̇ + ½ m'(θ) ω² = τ − b ω`.
-fn mtf_chain_lagrange(n_mtf: usize, theta: f64, w: f64, tau: f64) -> f64 {
+/// Checks the rates derived for an MTF chain of `n_mtf` links (`text`) whose modulus `k` and its `θ`-derivative
+/// are `modulus(k, θ)`, at three points, against Lagrange. With `ω = θ̇ = f(j0)`, junction `k` turns at
+/// `ω/(n_1⋯n_k)` (a transformer's output flow is its input flow over its modulus), so `T = ½ m(θ) ω²` with
+/// `m = J Σ_{k=0..N} Π_{j≤k} n_j^(−2)`, and `m ω̇ + ½ m'(θ) ω² = τ − b ω`. The velocity state is the far end's flow
+/// `ω/Π` (`Π = n_1⋯n_N`), whose rate is `ω̇/Π − (ω/Π) (Π'/Π) θ̇` with `Π'/Π = Σ_j n_j'/n_j`.
+fn assert_follows_lagrange(text: &str, n_mtf: usize, modulus: impl Fn(usize, f64) -> (f64, f64)) {
     let (j, b) = (1.0, 0.1);
-    let n = 1.0 + 0.1 * theta.cos();
-    let dn = -0.1 * theta.sin();
-    let m: f64 = (0..=n_mtf).map(|k| j * n.powi(-2 * k as i32)).sum();
-    let dm: f64 = (0..=n_mtf)
-        .map(|k| j * (-2.0 * k as f64) * n.powi(-2 * k as i32 - 1) * dn)
-        .sum();
-    (tau - b * w - 0.5 * dm * w * w) / m
-}
-
-#[test]
-fn chain_of_modulated_transformers_follows_lagrange() {
-    for n_mtf in [3, 50] {
-        let eqs = equations(&mtf_chain(n_mtf));
-        let p = eqs.default_params();
-        // The velocity state is that of the chain's far end, whose flow the others follow as products.
-        let far = format!("f_j{n_mtf}");
-        let (iw, it) = (state(&eqs, &far), state(&eqs, "theta"));
-        for &(theta, w0, tau) in &[(0.3, 0.5, 1.0), (2.0, -1.2, 0.0), (-1.0, 0.1, -2.0)] {
-            let n = 1.0 + 0.1 * f64::cos(theta);
-            let dn = -0.1 * f64::sin(theta);
-            let mut x = vec![0.0; eqs.states.len()];
-            x[it] = theta;
-            x[iw] = w0 / n.powi(n_mtf as i32);
-            let rates = eqs
-                .rates_at(&p, &x, &[tau], 0.0)
-                .unwrap_or_else(|e| panic!("{e}"));
-            assert!(
-                (rates[it] - w0).abs() < 1e-12 * (1.0 + w0.abs()),
-                "θ̇ {rates:?}"
-            );
-            let dw0 = mtf_chain_lagrange(n_mtf, theta, w0, tau);
-            // f_jN = ω n^(−N): its rate is ω̇ n^(−N) − N ω n^(−N−1) n' θ̇.
-            let k = n_mtf as i32;
-            let want = dw0 * n.powi(-k) - f64::from(k) * w0 * n.powi(-k - 1) * dn * w0;
-            assert!(
-                (rates[iw] - want).abs() < 1e-10 * (1.0 + want.abs()),
-                "N = {n_mtf}, θ = {theta}: {} vs {want}",
-                rates[iw]
-            );
+    let eqs = equations(text);
+    let p = eqs.default_params();
+    let (iw, it) = (state(&eqs, &format!("f_j{n_mtf}")), state(&eqs, "theta"));
+    for &(theta, w0, tau) in &[(0.3, 0.5, 1.0), (2.0, -1.2, 0.0), (-1.0, 0.1, -2.0)] {
+        // Π_k = n_1⋯n_k and Π_k'/Π_k = Σ_{j≤k} n_j'/n_j, accumulated link by link.
+        let (mut m, mut dm, mut prod, mut log_slope) = (j, 0.0, 1.0, 0.0);
+        for k in 1..=n_mtf {
+            let (n, dn) = modulus(k, theta);
+            prod *= n;
+            log_slope += dn / n;
+            m += j / (prod * prod);
+            dm += -2.0 * j * log_slope / (prod * prod);
         }
+        let dw0 = (tau - b * w0 - 0.5 * dm * w0 * w0) / m;
+        let want = dw0 / prod - w0 / prod * log_slope * w0;
+        let mut x = vec![0.0; eqs.states.len()];
+        x[it] = theta;
+        x[iw] = w0 / prod;
+        let rates = eqs
+            .rates_at(&p, &x, &[tau], 0.0)
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            (rates[it] - w0).abs() < 1e-12 * (1.0 + w0.abs()),
+            "θ̇ {rates:?}"
+        );
+        assert!(
+            (rates[iw] - want).abs() < 1e-10 * (1.0 + want.abs()),
+            "N = {n_mtf}, θ = {theta}: {} vs {want}",
+            rates[iw]
+        );
     }
 }
 
-/// With distinct moduli `n_k(θ)` junction `k` turns at `ω/(n_1⋯n_k)`, so by Lagrange `m = J Σ_k Π_{j≤k} n_j^(−2)`
-/// and `m ω̇ + ½ m' ω² = τ − b ω`; the state is the far end's flow `ω/(n_1⋯n_N)`, whose rate is
-/// `ω̇/Π − ω Π'/Π²` with `Π'/Π = Σ_j n_j'/n_j · ω`. The rates the equations derive are these, for 3 and 12 links.
+/// Every modulus `1 + 0.1 cos θ` (whose powers the engine collects), for 3 and 50 links.
+#[test]
+fn chain_of_modulated_transformers_follows_lagrange() {
+    for n_mtf in [3, 50] {
+        let modulus = |_: usize, theta: f64| (1.0 + 0.1 * theta.cos(), -0.1 * theta.sin());
+        assert_follows_lagrange(&mtf_chain(n_mtf), n_mtf, modulus);
+    }
+}
+
+/// Modulus `k` is `1 + 0.1 cos(θ + k/100)`: the flows are products of distinct factors. 3 and 12 links.
 #[test]
 fn chain_of_modulated_transformers_with_distinct_moduli_follows_lagrange() {
-    let (j, b) = (1.0, 0.1);
     for n_mtf in [3, 12] {
-        let eqs = equations(&mtf_chain_with_phases(n_mtf));
-        let p = eqs.default_params();
-        let (iw, it) = (state(&eqs, &format!("f_j{n_mtf}")), state(&eqs, "theta"));
-        for &(theta, w0, tau) in &[(0.3, 0.5, 1.0), (2.0, -1.2, 0.0), (-1.0, 0.1, -2.0)] {
-            let n: Vec<f64> = (1..=n_mtf)
-                .map(|k| 1.0 + 0.1 * (theta + k as f64 * 0.01).cos())
-                .collect();
-            let dn: Vec<f64> = (1..=n_mtf)
-                .map(|k| -0.1 * (theta + k as f64 * 0.01).sin())
-                .collect();
-            // Π_k = n_1⋯n_k and its θ-derivative Π_k Σ_{j≤k} n_j'/n_j.
-            let (mut m, mut dm, mut prod, mut log_slope) = (j, 0.0, 1.0, 0.0);
-            for k in 0..n_mtf {
-                prod *= n[k];
-                log_slope += dn[k] / n[k];
-                m += j / (prod * prod);
-                dm += -2.0 * j * log_slope / (prod * prod);
-            }
-            let dw0 = (tau - b * w0 - 0.5 * dm * w0 * w0) / m;
-            let want = dw0 / prod - w0 / prod * log_slope * w0;
-            let mut x = vec![0.0; eqs.states.len()];
-            x[it] = theta;
-            x[iw] = w0 / prod;
-            let rates = eqs
-                .rates_at(&p, &x, &[tau], 0.0)
-                .unwrap_or_else(|e| panic!("{e}"));
-            assert!(
-                (rates[it] - w0).abs() < 1e-12 * (1.0 + w0.abs()),
-                "θ̇ {rates:?}"
-            );
-            assert!(
-                (rates[iw] - want).abs() < 1e-10 * (1.0 + want.abs()),
-                "N = {n_mtf}, θ = {theta}: {} vs {want}",
-                rates[iw]
-            );
-        }
+        let modulus = |k: usize, theta: f64| {
+            let phase = theta + k as f64 * 0.01;
+            (1.0 + 0.1 * phase.cos(), -0.1 * phase.sin())
+        };
+        assert_follows_lagrange(&mtf_chain_with_phases(n_mtf), n_mtf, modulus);
     }
 }
 

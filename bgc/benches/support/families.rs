@@ -91,28 +91,28 @@ pub fn output_chain_with(levels: usize, q0: f64) -> String {
 /// `Se tau -> 1 j0 {I J, R b} -> MTF g1 -> 1 j1 {I J} -> … -> MTF gN -> 1 jN {I J}`, every modulus
 /// `1 + 0.1 cos(theta)` with `theta = ∫ f(j0)`.
 pub fn mtf_chain(n: usize) -> String {
-    let mut s = String::from(
-        "model mtfchain {\n    domain rotational;\n    param J = 1 [kg m^2];\n    param b = 0.1 [N m s/rad];\n    input tau [N m];\n    var theta [rad] = int(f(j0));\n    Se drive = tau;\n    1 j0;\n    I i0 = J;\n    R r0 = b;\n    bond drive -> j0;\n    bond j0 -> i0;\n    bond j0 -> r0;\n",
-    );
-    for k in 1..=n {
-        let p = k - 1;
-        s += &format!(
-            "    1 j{k};\n    I i{k} = J;\n    MTF g{k} = 1 + 0.1*cos(theta);\n    bond j{p} -> g{k} -> j{k};\n    bond j{k} -> i{k};\n"
-        );
-    }
-    s + "}\n"
+    mtf_chain_of(n, |_| "1 + 0.1*cos(theta)".to_string())
 }
 
 /// [`mtf_chain`] with a phase per link: modulus `k` is `1 + 0.1 cos(theta + k/100)`, so the flows are products of
 /// distinct factors rather than powers of one.
 pub fn mtf_chain_with_phases(n: usize) -> String {
-    let mut text = mtf_chain(n);
-    for k in (1..=n).rev() {
-        let from = format!("MTF g{k} = 1 + 0.1*cos(theta);");
-        let to = format!("MTF g{k} = 1 + 0.1*cos(theta + {k}*0.01);");
-        text = text.replace(&from, &to);
+    mtf_chain_of(n, |k| format!("1 + 0.1*cos(theta + {k}*0.01)"))
+}
+
+/// The chain of [`mtf_chain`] with modulus `k` (from 1) written as `modulus(k)`.
+fn mtf_chain_of(n: usize, modulus: impl Fn(usize) -> String) -> String {
+    let mut s = String::from(
+        "model mtfchain {\n    domain rotational;\n    param J = 1 [kg m^2];\n    param b = 0.1 [N m s/rad];\n    input tau [N m];\n    var theta [rad] = int(f(j0));\n    Se drive = tau;\n    1 j0;\n    I i0 = J;\n    R r0 = b;\n    bond drive -> j0;\n    bond j0 -> i0;\n    bond j0 -> r0;\n",
+    );
+    for k in 1..=n {
+        let p = k - 1;
+        let g = modulus(k);
+        s += &format!(
+            "    1 j{k};\n    I i{k} = J;\n    MTF g{k} = {g};\n    bond j{p} -> g{k} -> j{k};\n    bond j{k} -> i{k};\n"
+        );
     }
-    text
+    s + "}\n"
 }
 
 /// `Se tau -> 1 j0 {I J, R b} -> GY g1 -> 0 z1 {C 1/k} -> 1 j1 {I J, R b} -> GY g2 -> … -> 1 jN`: each gyrator

@@ -176,7 +176,10 @@ pub(crate) fn plan(eqs: &Equations) -> Result<Plan, String> {
     );
     // The mass blocks' `dM/dp` (printed in `jac_p_into` beside `∂F/∂p`) under names of their own.
     let mut dfdp_shared = params.dfdp_shared;
-    dfdp_shared.extend(share("dmdp_", mass_param_slopes(&mut mass)));
+    dfdp_shared.extend(share(
+        "dmdp_",
+        mass_slopes(&mut mass, |b| &mut b.param_derivatives),
+    ));
     p.shared.insert("jac_p_into", dfdp_shared);
     p.shared.insert("output_jac_p_into", params.dhdp_shared);
     // Entries of `A, B, C, D` that would print as huge trees (nested loops solved in closed form) are written over
@@ -295,7 +298,7 @@ impl PointPlan {
                     "dfdx_",
                     sparse_entries(&mut dfdx)
                         .into_iter()
-                        .chain(mass_slopes(mass)),
+                        .chain(mass_slopes(mass, |b| &mut b.derivatives)),
                 ),
             ),
             (
@@ -391,18 +394,15 @@ fn state_space(
     })
 }
 
-/// The entries of the mass blocks' `∂M/∂x`, to rewrite in place. Along a chain of modulated transformers they are
-/// nested sums whose levels share the powers of the moduli: printed as trees they took 363,772 nodes at 200 links.
-fn mass_slopes(mass: &mut [super::mass::MassPlan]) -> impl Iterator<Item = &mut Expr> {
+/// The entries of the mass blocks' derivatives that `of` picks (`∂M/∂x` or `dM/dp`), to rewrite in place. Along a
+/// chain of modulated transformers they are nested sums whose levels share the powers of the moduli: printed as
+/// trees, `∂M/∂θ` took 363,772 nodes at 200 links.
+fn mass_slopes(
+    mass: &mut [super::mass::MassPlan],
+    of: fn(&mut super::mass::MassPlan) -> &mut super::mass::Derivatives,
+) -> impl Iterator<Item = &mut Expr> {
     mass.iter_mut()
-        .flat_map(|b| b.derivatives.iter_mut())
-        .flat_map(|(_, d)| d.iter_mut().flatten())
-}
-
-/// The entries of the mass blocks' `dM/dp`, to rewrite in place.
-fn mass_param_slopes(mass: &mut [super::mass::MassPlan]) -> impl Iterator<Item = &mut Expr> {
-    mass.iter_mut()
-        .flat_map(|b| b.param_derivatives.iter_mut())
+        .flat_map(move |b| of(b).iter_mut())
         .flat_map(|(_, d)| d.iter_mut().flatten())
 }
 

@@ -153,7 +153,7 @@ fn bgc_solve<const N: usize, const C: usize>(
 ";
 
 /// `(column, ∂M/∂v_column)` for the columns `M` depends on.
-type Derivatives = [(usize, Vec<Vec<Expr>>)];
+pub(crate) type Derivatives = [(usize, Vec<Vec<Expr>>)];
 
 /// The columns of a Jacobian whose mass-matrix rows are solved.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

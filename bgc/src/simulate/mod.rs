@@ -294,13 +294,12 @@ impl System {
         };
         // Only the sparse path uses the Jacobian through loops (the dense one takes finite differences): below it,
         // the loops' derivatives are not built (a block of 400 linear loops has 160,000).
-        let through_loops = match eqs.tear_blocks.is_empty() || n + 2 < SPARSE_FROM {
-            true => None,
-            false => {
-                let all = loop_jacobian::Tears::new(&eqs.tear_blocks);
-                loop_jacobian::LoopCorrection::new(&eqs.tear_blocks, n, &all, &compile_seq)
-                    .map(|correction| (all, correction))
-            }
+        let through_loops = if eqs.tear_blocks.is_empty() || n + 2 < SPARSE_FROM {
+            None
+        } else {
+            let all = loop_jacobian::Tears::new(&eqs.tear_blocks);
+            loop_jacobian::LoopCorrection::new(&eqs.tear_blocks, n, &all, &compile_seq)
+                .map(|correction| (all, correction))
         };
         let loop_entries = (n.saturating_mul(n) / DENSE_LOOP_JACOBIAN).max(n.saturating_mul(16));
         let jacobian = match (eqs.tear_blocks.is_empty(), through_loops) {

@@ -544,3 +544,43 @@ fn the_parameter_jacobian_has_a_column_per_free_parameter_through_the_derived_on
     assert!(bare.contains(&body));
     assert!(!bare.contains("ParamJacobians"));
 }
+
+/// `rust::write_with` streams the text of `rust::generate_with` byte for byte (a file with one model, with two, and
+/// a chain long enough that the text is held in several pieces), and a failed write comes back as the writer's
+/// error.
+#[test]
+fn the_streamed_module_is_the_generated_text_and_a_failed_write_is_an_error() {
+    let one = TWO_MODELS.split("model second").next().unwrap_or_default();
+    let long = codegen_support::chain(400);
+    for (name, text) in [("one", one), ("two", TWO_MODELS), ("chain", long.as_str())] {
+        let mut sources = SourceMap::new();
+        let root = sources.add("test.bg", text);
+        let file = codegen::compile(&mut sources, root, &mut MemoryLoader::new())
+            .unwrap_or_else(|d| panic!("{name}: {d:?}"));
+        for options in [Options::default(), Options { runtime: false }] {
+            let whole = rust::generate_with(&file, "test.bg", options);
+            let mut streamed = Vec::new();
+            let written = rust::write_with(&file, "test.bg", options, &mut streamed);
+            assert!(written.is_ok(), "{name}: {written:?}");
+            assert!(streamed == whole.as_bytes(), "{name}: the texts differ");
+            if name == "chain" {
+                assert!(whole.len() > 1 << 20, "{name}: {} bytes", whole.len());
+            }
+        }
+        struct Full;
+        impl std::io::Write for Full {
+            fn write(&mut self, _: &[u8]) -> std::io::Result<usize> {
+                Err(std::io::Error::other("disk full"))
+            }
+            fn flush(&mut self) -> std::io::Result<()> {
+                Ok(())
+            }
+        }
+        let err = rust::write_with(&file, "test.bg", Options::default(), &mut Full);
+        assert_eq!(
+            err.map_err(|e| e.to_string()),
+            Err("disk full".to_string()),
+            "{name}"
+        );
+    }
+}

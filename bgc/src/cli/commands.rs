@@ -1,8 +1,8 @@
 //! The subcommands. Each returns the process status; all printing happens here.
 
 use super::io::{
-    Root, is_stdin, keep_until_exit, read_root, read_source, stderr, stderrln, stdin_once, stdout,
-    stdoutln,
+    Root, is_stdin, keep_until_exit, output_failed, read_root, read_source, stderr, stderrln,
+    stdin_once, stdout, stdoutln,
 };
 use super::{DiagFormat, DrawFormat, ReportFormat, Status};
 use bgc::diagnostic::unprintable::shown;
@@ -386,8 +386,14 @@ pub fn rust(path: &Path, runtime: bool, color: bool) -> Status {
                 false => bgc::build::header_name(path, cwd.as_deref()),
             };
             let options = bgc::codegen::rust::Options { runtime };
-            let code = bgc::codegen::rust::generate_with(&compiled, &name, options);
-            stdout(&code);
+            // Streamed: a large model's module (250 MB for 200,000 states) is not held a second time.
+            let mut out = std::io::BufWriter::with_capacity(1 << 16, std::io::stdout().lock());
+            let written = bgc::codegen::rust::write_with(&compiled, &name, options, &mut out)
+                .and_then(|()| std::io::Write::flush(&mut out));
+            drop(out);
+            if let Err(e) = written {
+                output_failed(&e);
+            }
             keep_until_exit(compiled);
             Status::Ok
         }

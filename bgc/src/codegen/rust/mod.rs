@@ -60,6 +60,7 @@
 //! rounded `π`, `e`, ...: the number is what the model file says. A comment at the top of the file says so.
 
 mod calls;
+mod chunks;
 mod functions;
 mod model;
 pub(in crate::codegen) use functions::state_space_through_loops;
@@ -81,6 +82,7 @@ use super::{CompiledFile, CompiledModel};
 use crate::symbolic::{
     Expr, ExprMap, RUST_HELPER_FNS, RustCode, Symbol, rust_helpers_used, to_rust_code,
 };
+use chunks::{AllowDeadCode, Chunks};
 use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 use std::fmt::Write;
@@ -117,10 +119,37 @@ pub fn generate(file: &CompiledFile, source_name: &str) -> String {
 
 /// The Rust module of a compiled file; `source_name` names the file in the header.
 pub fn generate_with(file: &CompiledFile, source_name: &str, options: Options) -> String {
-    // The header first, then each model's code appended: a large model's text (250 MB for 200,000 states) is
-    // not copied again.
-    let mut out = header(source_name, file.hash);
-    out.push_str(
+    let mut out = String::new();
+    generate_into(file, source_name, options, &mut |text| out.push_str(text));
+    out
+}
+
+/// Writes the Rust module of a compiled file (the text of [`generate_with`], byte for byte) to `out` as it is
+/// produced, without holding the whole module in memory a second time.
+pub fn write_with(
+    file: &CompiledFile,
+    source_name: &str,
+    options: Options,
+    out: &mut dyn std::io::Write,
+) -> std::io::Result<()> {
+    let mut result = Ok(());
+    generate_into(file, source_name, options, &mut |text| {
+        if result.is_ok() {
+            result = out.write_all(text.as_bytes());
+        }
+    });
+    result
+}
+
+/// The text of the module, handed to `out` piece by piece in order.
+fn generate_into(
+    file: &CompiledFile,
+    source_name: &str,
+    options: Options,
+    out: &mut dyn FnMut(&str),
+) {
+    let mut head = header(source_name, file.hash);
+    head.push_str(
         "\n// Do not edit: this file is regenerated from the .bg source when it changes.\n",
     );
     for line in format::comment(
@@ -133,52 +162,68 @@ pub fn generate_with(file: &CompiledFile, source_name: &str, options: Options) -
         Wrap::Prose,
         MAX_WIDTH,
     ) {
-        out.push_str(&line);
-        out.push('\n');
+        head.push_str(&line);
+        head.push('\n');
     }
+    out(&head);
     match file.models.as_slice() {
         [single] => {
-            out.push('\n');
-            model_code_into(&mut out, single, options, 0);
+            out("\n");
+            // The lines joined by `\n`, and one after the last when the code ends with it.
+            let mut first = true;
+            let ends_with_newline = model_code_into(single, options, 0, &mut |line| {
+                if !std::mem::take(&mut first) {
+                    out("\n");
+                }
+                out(line);
+            });
+            if ends_with_newline {
+                out("\n");
+            }
         }
         many => {
             let mut namer = Namer::with_reserved();
             for m in many {
                 let name = namer.ident(&m.model.name);
-                let _ = writeln!(
-                    out,
-                    "\n/// The generated code of model `{}`.",
+                let mut open = format!(
+                    "\n/// The generated code of model `{}`.\n",
                     comment(&m.model.name)
                 );
                 if !format::is_snake_case(&name) {
-                    out.push_str("#[allow(non_snake_case)]\n");
+                    open.push_str("#[allow(non_snake_case)]\n");
                 }
-                let _ = writeln!(out, "pub mod {name} {{");
-                let mut code = String::new();
-                model_code_into(&mut code, m, options, 4);
-                for line in code.lines() {
-                    if line.is_empty() {
-                        out.push('\n');
-                    } else {
-                        let _ = writeln!(out, "    {line}");
+                let _ = writeln!(open, "pub mod {name} {{");
+                out(&open);
+                let mut indented = String::new();
+                model_code_into(m, options, 4, &mut |line| {
+                    indented.clear();
+                    if !line.is_empty() {
+                        indented.push_str("    ");
+                        indented.push_str(line);
                     }
-                }
-                out.push_str("}\n");
+                    indented.push('\n');
+                    out(&indented);
+                });
+                out("}\n");
             }
         }
     }
-    out
 }
 
-/// Appends the code of one model (items at the top level), for lines of `MAX_WIDTH - base_indent` columns, to
-/// `out`.
-fn model_code_into(out: &mut String, m: &CompiledModel, options: Options, base_indent: usize) {
+/// Hands the lines of the code of one model (items at the top level), for lines of `MAX_WIDTH - base_indent`
+/// columns, to `line`; returns whether the code ends with a line break.
+fn model_code_into(
+    m: &CompiledModel,
+    options: Options,
+    base_indent: usize,
+    line: &mut dyn FnMut(&str),
+) -> bool {
     let width = MAX_WIDTH - base_indent;
-    Writer::new(m, &m.plan, options, width).write_into(out);
+    Writer::new(m, &m.plan, options, width).write_into(line)
 }
 
 /// The item keywords that start a line of a model's code at the top level.
-const ITEM_STARTS: &[&str] = &[
+pub(in crate::codegen) const ITEM_STARTS: &[&str] = &[
     "pub const ",
     "pub static ",
     "pub type ",
@@ -194,42 +239,6 @@ const ITEM_STARTS: &[&str] = &[
     "impl ",
     "impl<",
 ];
-
-/// Appends the lines of `code` (a model's items at the top level) to `out`, with `dead_code` allowed on each item,
-/// right above its keyword line (below its documentation and other attributes; joined to an `#[allow(...)]` line
-/// already there), so that a crate that uses some of them builds without warnings. The lines are joined by `\n`,
-/// and a `\n` ends the last one when `ends_with_newline`.
-fn allow_dead_code_into<'a>(
-    out: &mut String,
-    code: impl Iterator<Item = &'a str>,
-    ends_with_newline: bool,
-) {
-    // Where the last line written starts.
-    let mut last = out.len();
-    let mut first = true;
-    let mut push_line = |out: &mut String, last: &mut usize, line: &str| {
-        if !std::mem::take(&mut first) {
-            out.push('\n');
-        }
-        *last = out.len();
-        out.push_str(line);
-    };
-    for line in code {
-        if ITEM_STARTS.iter().any(|k| line.starts_with(k)) {
-            let prev = out.get(last..).unwrap_or("");
-            if prev.starts_with("#[allow(") && prev.ends_with(")]") {
-                out.truncate(out.len() - 2);
-                out.push_str(", dead_code)]");
-            } else {
-                push_line(out, &mut last, "#[allow(dead_code)]");
-            }
-        }
-        push_line(out, &mut last, line);
-    }
-    if ends_with_newline {
-        out.push('\n');
-    }
-}
 
 fn rust_f64(v: f64) -> String {
     if v.is_nan() {
@@ -319,7 +328,7 @@ pub(in crate::codegen) struct Writer<'a> {
     terms_enabled: bool,
     /// Printed forms of expressions met before: a large model's Jacobians repeat a few entries thousands of times.
     printed: RefCell<Printed>,
-    pub(in crate::codegen) out: String,
+    pub(in crate::codegen) out: Chunks,
 }
 
 /// The largest expression, in nodes written out as a tree (shared parts counted each time), that a comment in
@@ -428,7 +437,7 @@ impl<'a> Writer<'a> {
             with_terms: Vec::new(),
             terms_enabled: false,
             printed: RefCell::default(),
-            out: String::new(),
+            out: Chunks::default(),
         }
     }
 
@@ -562,7 +571,9 @@ impl<'a> Writer<'a> {
 
     /// Appends the model's code to `out`: the helpers it calls, then its items, each allowed `dead_code`. The items
     /// are written once and copied once (a large model's text is hundreds of megabytes).
-    fn write_into(mut self, out: &mut String) {
+    /// Writes the model's items and hands their lines to `out`, the prelude (imports and helper functions) first;
+    /// returns whether the text ends with a line break.
+    fn write_into(mut self, out: &mut dyn FnMut(&str)) -> bool {
         self.sizes();
         self.params();
         self.functions();
@@ -586,7 +597,7 @@ impl<'a> Writer<'a> {
         // their versions (a second nalgebra makes every signature "a different `Matrix`").
         let mut prelude = String::new();
         if self.options.runtime {
-            if calls_libm(&solvers) || calls_libm(&self.out) {
+            if calls_libm(solvers.lines()) || calls_libm(self.out.lines()) {
                 prelude.push_str("use bgc_runtime::libm;\n");
             }
             prelude.push_str("use bgc_runtime::nalgebra::{SMatrix, SVector};\n");
@@ -596,12 +607,16 @@ impl<'a> Writer<'a> {
         prelude.push_str(&solvers);
         // Every piece of the prelude ends its last line, so its lines and the items' lines are those of the two
         // texts joined.
-        out.reserve(prelude.len() + self.out.len() + self.out.len() / 8);
-        allow_dead_code_into(
-            out,
-            prelude.lines().chain(self.out.lines()),
-            self.out.ends_with('\n') || (self.out.is_empty() && prelude.ends_with('\n')),
-        );
+        let ends_with_newline =
+            self.out.ends_with('\n') || (self.out.is_empty() && prelude.ends_with('\n'));
+        let items = std::mem::take(&mut self.out);
+        // The writer's tables go before the items are handed on: only the text is still needed.
+        drop(self);
+        let mut lines = AllowDeadCode::new(out);
+        prelude.lines().for_each(|l| lines.line(l));
+        items.into_lines(&mut |l| lines.line(l));
+        lines.finish();
+        ends_with_newline
     }
 
     /// The lines of code (not comments or documentation, which quote the model's text) that may call a helper.
@@ -622,8 +637,7 @@ fn output_names(eqs: &crate::equations::Equations) -> Vec<String> {
     eqs.outputs.iter().map(|o| o.name.clone()).collect()
 }
 
-/// Whether a line of code (not a comment, which may quote anything) in `text` calls `libm`.
-fn calls_libm(text: &str) -> bool {
-    text.lines()
-        .any(|l| l.contains("libm::") && !l.trim_start().starts_with("//"))
+/// Whether a line of code (not a comment, which may quote anything) of `lines` calls `libm`.
+fn calls_libm<'a>(mut lines: impl Iterator<Item = &'a str>) -> bool {
+    lines.any(|l| l.contains("libm::") && !l.trim_start().starts_with("//"))
 }

@@ -78,7 +78,7 @@ mod tests;
 
 pub use compiled::Compiled;
 pub use cse::{cse, to_rust_cse, to_text_cse};
-pub use diff::WIDE_ROW;
+pub use diff::{ProductTails, WIDE_ROW};
 pub use error::SymbolicError;
 pub use eval::{max, min, sign};
 pub use expr::{Expr, ExprMap, ExprSet, Node, Symbol, SymbolKind};

@@ -16,7 +16,7 @@
 use super::build::{Built, Def};
 use super::symbols::{self, Expander, Sym, SymExt, add, div, mul};
 use crate::ir::Func;
-use crate::symbolic::Expr;
+use crate::symbolic::{Expr, ProductTails};
 
 /// Why a variable could not be resolved.
 #[derive(Clone, Debug, PartialEq)]
@@ -61,6 +61,9 @@ pub(crate) struct Resolver<'a> {
     implicit: Vec<(usize, Expr)>,
     /// Multiplies out the values; it remembers the expansions of earlier values, which later values hold.
     expander: Expander,
+    /// The derivatives of long products' tails, shared by the time derivatives of all storages in derivative
+    /// causality (the flows along a chain of modulated transformers are products with common tails).
+    tails: ProductTails,
 }
 
 impl<'a> Resolver<'a> {
@@ -78,6 +81,7 @@ impl<'a> Resolver<'a> {
             opened_at: vec![0; n],
             implicit: Vec::new(),
             expander: Expander::default(),
+            tails: ProductTails::default(),
         }
     }
 
@@ -313,7 +317,7 @@ impl<'a> Resolver<'a> {
     }
 
     /// `d/dt e` for `e` in states, inputs, parameters and time.
-    fn time_derivative(&self, e: &Expr, v: usize) -> Result<Expr, ResolveError> {
+    fn time_derivative(&mut self, e: &Expr, v: usize) -> Result<Expr, ResolveError> {
         if e.any_sym(&|s| {
             matches!(
                 s,
@@ -333,7 +337,7 @@ impl<'a> Resolver<'a> {
             }
         });
         let read: Vec<Sym> = read.into_iter().collect();
-        let slopes = symbols::gradient(e, &read)
+        let slopes = symbols::gradient_sharing(e, &read, &mut self.tails)
             .map_err(|symbols::NotDifferentiable(f)| ResolveError::NotDifferentiable(v, f))?;
         let terms = read.into_iter().zip(slopes).map(|(s, d)| match s {
             Sym::State(i) => mul(vec![d, symbols::leaf(Sym::StateDot(i))]),

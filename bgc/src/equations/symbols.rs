@@ -12,7 +12,7 @@
 //! an expression can grow with the model.
 
 use crate::ir::Func;
-use crate::symbolic::{Expr, ExprMap, ExprSet, Node, Symbol, SymbolKind, WIDE_ROW};
+use crate::symbolic::{Expr, ExprMap, ExprSet, Node, ProductTails, Symbol, SymbolKind, WIDE_ROW};
 use std::cell::RefCell;
 
 /// A leaf of the stage's expressions. The variants are declared in the order of their [`SymbolKind`]s, so that
@@ -327,6 +327,11 @@ pub struct NotDifferentiable(pub Func);
 /// `∂e/∂s`. `min` and `max` of an argument holding `s` are refused: the equations stage does not differentiate
 /// through a switch (a law in derivative causality must be smooth).
 pub fn diff(e: &Expr, s: Sym) -> Result<Expr, NotDifferentiable> {
+    diff_sharing(e, s, &mut ProductTails::default())
+}
+
+/// [`diff`], with the derivatives of long products' tails kept in `tails` between calls.
+fn diff_sharing(e: &Expr, s: Sym, tails: &mut ProductTails) -> Result<Expr, NotDifferentiable> {
     let x = s.symbol();
     if !e.depends_on(&x) {
         return Ok(Expr::zero());
@@ -336,7 +341,7 @@ pub fn diff(e: &Expr, s: Sym) -> Result<Expr, NotDifferentiable> {
     {
         return Err(NotDifferentiable(f));
     }
-    Ok(e.diff(&x))
+    Ok(e.diff_sharing(&x, tails))
 }
 
 /// `∂e/∂s` for each `s` of `wrt`, which should be symbols that `e` reads (an unread one costs a walk and gives 0).
@@ -345,8 +350,18 @@ pub fn diff(e: &Expr, s: Sym) -> Result<Expr, NotDifferentiable> {
 /// the square of its size, and the cube of a block of loops whose residuals each read every tear.
 /// Refused as [`diff`] refuses: a symbol of `wrt` read under `min` or `max`.
 pub fn gradient(e: &Expr, wrt: &[Sym]) -> Result<Vec<Expr>, NotDifferentiable> {
+    gradient_sharing(e, wrt, &mut ProductTails::default())
+}
+
+/// [`gradient`], with the derivatives of long products' tails kept in `tails` between calls
+/// ([`Expr::diff_sharing`]).
+pub fn gradient_sharing(
+    e: &Expr,
+    wrt: &[Sym],
+    tails: &mut ProductTails,
+) -> Result<Vec<Expr>, NotDifferentiable> {
     if wrt.len() <= WIDE_ROW {
-        return wrt.iter().map(|&s| diff(e, s)).collect();
+        return wrt.iter().map(|&s| diff_sharing(e, s, tails)).collect();
     }
     let vars: Vec<Symbol> = wrt.iter().map(|s| s.symbol()).collect();
     if let Some((f, under)) = e.symbols_under_calls(&[Func::Min, Func::Max])

@@ -1,7 +1,8 @@
 //! Symbolic differentiation.
 //!
 //! Rules, with `u' = du/dx`:
-//! - sums term by term; products by the product rule `Σᵢ fᵢ' Πⱼ≠ᵢ fⱼ`;
+//! - sums term by term; products by the product rule `Σᵢ fᵢ' Πⱼ≠ᵢ fⱼ`, or, with four or more factors that depend on
+//!   `x`, one factor at a time over tails that products share (`product_derivative`);
 //! - `(b^e)' = e b^(e-1) b'` when `e` does not depend on `x`, else `b^e (e' ln b + e b'/b)`;
 //! - `sin' = cos`, `cos' = -sin`, `tan' = 1/cos²`, `asin' = 1/sqrt(1-u²)`, `acos' = -1/sqrt(1-u²)`,
 //!   `atan' = 1/(1+u²)`, `atan2(y, x)' = (x y' - y x')/(x² + y²)`, `exp' = exp`, `ln' = 1/u`,
@@ -12,7 +13,7 @@
 //!   `s = sign(a - b)`: the derivative of the active argument, and the mean of both where `a = b`.
 
 use super::dag::{Dag, Memo};
-use super::expr::{Expr, Node, Symbol};
+use super::expr::{Expr, ExprMap, Node, Symbol};
 use crate::ir::Func;
 use std::collections::{BTreeMap, BTreeSet};
 use std::f64::consts::LN_10;
@@ -20,7 +21,15 @@ use std::f64::consts::LN_10;
 impl Expr {
     /// `d self / d x`, simplified. Each distinct node is differentiated once.
     pub fn diff(&self, x: &Symbol) -> Expr {
-        diff_all(std::slice::from_ref(self), x)
+        self.diff_sharing(x, &mut ProductTails::default())
+    }
+
+    /// `d self / d x` as [`Expr::diff`], with the derivatives of long products' tails kept in `tails` for later
+    /// calls: a caller that differentiates many expressions one at a time (the time derivative of each storage in
+    /// derivative causality) shares them as one call over all would.
+    pub fn diff_sharing(&self, x: &Symbol, tails: &mut ProductTails) -> Expr {
+        let tails = tails.0.entry(x.clone()).or_default();
+        diff_all(std::slice::from_ref(self), x, tails)
             .pop()
             .unwrap_or_else(Expr::zero)
     }
@@ -69,7 +78,10 @@ impl Expr {
         }
         for ((j, v), rows) in vars.iter().enumerate().zip(&rows_of) {
             let picked: Vec<Expr> = rows.iter().filter_map(|&i| exprs.get(i).cloned()).collect();
-            for (&i, d) in rows.iter().zip(diff_all(&picked, v)) {
+            for (&i, d) in rows
+                .iter()
+                .zip(diff_all(&picked, v, &mut ExprMap::default()))
+            {
                 if !d.is_zero() {
                     out.push((i, j, d));
                 }
@@ -162,7 +174,7 @@ fn partial(n: &Expr, c: &Expr) -> Expr {
 
 /// `d e / d x` for each `e` of `exprs`, over one walk of their nodes: first which nodes depend on `x`, then the
 /// derivative of each of those from its children's.
-fn diff_all(exprs: &[Expr], x: &Symbol) -> Vec<Expr> {
+fn diff_all(exprs: &[Expr], x: &Symbol, tails: &mut ExprMap<Expr>) -> Vec<Expr> {
     let dag = Dag::new(exprs);
     let depends = dag.reading(|s| s == x);
     let mut memo: Memo<Expr> = Memo::new(&dag);
@@ -177,13 +189,71 @@ fn diff_all(exprs: &[Expr], x: &Symbol) -> Vec<Expr> {
                 .unwrap_or(false)
         };
         let d = |u: &Expr| memo.get(u).cloned().unwrap_or_else(Expr::zero);
-        let derivative = diff_node(e, x, &dep, &d);
+        let derivative = match e.node() {
+            Node::Mul(factors) if factors.iter().filter(|f| dep(f)).count() >= PEEL_FACTORS => {
+                product_derivative(factors, &dep, &d, tails)
+            }
+            _ => diff_node(e, x, &dep, &d),
+        };
         memo.set(i, derivative);
     }
     exprs
         .iter()
         .map(|e| memo.get(e).cloned().unwrap_or_else(Expr::zero))
         .collect()
+}
+
+/// The derivatives of the tails of long products by each variable, kept between calls of [`Expr::diff_sharing`]: a
+/// product of four or more factors `gᵢ` that vary with the variable is differentiated one factor at a time,
+/// `d(gᵢ Tᵢ₊₁) = dgᵢ · Tᵢ₊₁ + gᵢ · dTᵢ₊₁`, and products with a common tail `Tᵢ₊₁` share its derivative.
+#[derive(Default)]
+pub struct ProductTails(BTreeMap<Symbol, ExprMap<Expr>>);
+
+/// Products with at least this many factors that depend on the variable are differentiated one factor at a time
+/// ([`product_derivative`]). Shorter products keep the flat rule, whose sum of products reads as a textbook writes
+/// it; the nested form pays only where products are long (no model of the repository has one of four varying
+/// factors in its printed equations or its generated code).
+const PEEL_FACTORS: usize = 4;
+
+/// `d(c · g₁ g₂ ⋯ gₘ)` for the factors `gᵢ` that depend on the variable (in canonical order) and the others `c`:
+/// `c · dT₁` with the tails `Tᵢ = gᵢ Tᵢ₊₁`, `dTᵢ = dgᵢ · Tᵢ₊₁ + gᵢ · dTᵢ₊₁`. The flat rule `Σᵢ dgᵢ Πⱼ≠ᵢ gⱼ` writes
+/// `m` products of `m` factors for each product and shares nothing; the tails are nodes of their own, and their
+/// derivatives are kept in `tails`, so products with a common tail (the flows along a chain of modulated
+/// transformers, `v_k = n_{k+1} v_{k+1}`, whose moduli all vary with one angle) share its derivative. The tails
+/// are looked up from the longest: a product whose first tail is known costs one tail, not all of them.
+fn product_derivative(
+    factors: &[Expr],
+    depends: &dyn Fn(&Expr) -> bool,
+    d: &dyn Fn(&Expr) -> Expr,
+    tails: &mut ExprMap<Expr>,
+) -> Expr {
+    let (varying, constant): (Vec<&Expr>, Vec<&Expr>) = factors.iter().partition(|f| depends(f));
+    let tail = |i: usize| Expr::product(varying.iter().skip(i).map(|g| (*g).clone()));
+    // Down the tails to the first whose derivative is known (or the last factor alone), then back up.
+    let mut opened = Vec::new();
+    let mut i = 0;
+    let mut t = tail(0);
+    let mut dt = loop {
+        if let Some(known) = tails.get(&t) {
+            break known.clone();
+        }
+        match varying.get(i) {
+            Some(g) if i + 1 == varying.len() => break d(g),
+            Some(_) => {
+                let next = tail(i + 1);
+                opened.push((i, std::mem::replace(&mut t, next)));
+                i += 1;
+            }
+            None => break Expr::zero(),
+        }
+    };
+    while let Some((k, whole)) = opened.pop() {
+        let Some(g) = varying.get(k) else { break };
+        dt = d(g) * &t + *g * &dt;
+        tails.insert(whole.clone(), dt.clone());
+        t = whole;
+    }
+    Expr::product(constant.into_iter().cloned().chain(std::iter::once(dt)))
 }
 
 /// The derivative of the node `e`, given which children depend on `x` and their derivatives.

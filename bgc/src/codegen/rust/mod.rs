@@ -125,7 +125,8 @@ pub fn generate_with(file: &CompiledFile, source_name: &str, options: Options) -
 }
 
 /// Writes the Rust module of a compiled file (the text of [`generate_with`], byte for byte) to `out` as it is
-/// produced, without holding the whole module in memory a second time.
+/// produced, without holding the whole module in memory a second time. A failed write is returned (the first
+/// one; nothing is written after it, though the module is still generated to its end).
 pub fn write_with(
     file: &CompiledFile,
     source_name: &str,

@@ -94,15 +94,18 @@ pub(super) fn with_bound_calls(code: RustCode, calls: &BTreeMap<String, String>)
 }
 
 /// A local name for the value of `call`: the function's name and the names and literals of its arguments
-/// (`cos_theta`, `sqrt_k`, `cos_q_1_q_2_q_3` for `libm::cos(q_1 - q_2 + q_3)`).
+/// (`cos_theta`, `sqrt_k`, `cos_q_1_q_2_q_3` for `libm::cos(q_1 - q_2 + q_3)`). A literal is named by its first
+/// four significant digits (`cos_6_283_t` for `libm::cos(6.283185307179586 * t)`): its full digits made names of
+/// 30 characters, and past [`MAX_NAME`] a later word was dropped, so that `cos(theta + 0.35000000000000003)` was
+/// bound as `cos_theta`.
 pub(super) fn call_name(call: &RustCode) -> String {
     fn words(code: &RustCode, out: &mut Vec<String>) {
         match code {
-            RustCode::Atom(s) => out.push(
+            RustCode::Atom(s) => out.push(short_number(s).unwrap_or_else(|| {
                 s.trim_start_matches("p.")
                     .trim_start_matches("c.")
-                    .to_string(),
-            ),
+                    .to_string()
+            })),
             RustCode::Neg(inner) | RustCode::Paren(inner) => words(inner, out),
             RustCode::Chain(first, rest) => {
                 words(first, out);
@@ -132,3 +135,72 @@ pub(super) fn call_name(call: &RustCode) -> String {
 
 /// The longest name [`call_name`] builds from several words.
 const MAX_NAME: usize = 24;
+
+/// A numeric literal written with at most four significant digits, positionally from 0.001 to 99,999 (`6.283`,
+/// `0.35`, `1`) and in exponent form beyond (`1e-12`); `None` for anything else.
+fn short_number(text: &str) -> Option<String> {
+    let value: f64 = text.parse().ok().filter(|v: &f64| v.is_finite())?;
+    let scientific = format!("{value:.3e}");
+    let (mantissa, exponent) = scientific.split_once('e')?;
+    let exponent: i32 = exponent.parse().ok()?;
+    if (-3..=4).contains(&exponent) {
+        let rounded: f64 = scientific.parse().ok()?;
+        Some(format!("{rounded}"))
+    } else {
+        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+        Some(format!("{mantissa}e{exponent}"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn call(callee: &str, args: Vec<RustCode>) -> RustCode {
+        RustCode::Call(callee.to_string(), args)
+    }
+
+    fn atom(s: &str) -> RustCode {
+        RustCode::Atom(s.to_string())
+    }
+
+    #[test]
+    fn literals_are_named_by_four_significant_digits() {
+        let cases = [
+            ("6.283185307179586", "6.283"),
+            ("12.566370614359172", "12.57"),
+            ("0.35000000000000003", "0.35"),
+            ("1.0", "1"),
+            ("1234.5678", "1235"),
+            ("0.001", "0.001"),
+            ("1e-12", "1e-12"),
+            ("-2.5e7", "-2.5e7"),
+        ];
+        for (text, short) in cases {
+            assert_eq!(short_number(text).as_deref(), Some(short), "{text}");
+        }
+        assert_eq!(short_number("theta"), None);
+        assert_eq!(short_number("inf"), None);
+    }
+
+    #[test]
+    fn a_call_with_a_long_literal_keeps_every_word_of_its_name() {
+        let plus = |a: RustCode, b: RustCode| {
+            RustCode::Chain(Box::new(a), vec![(crate::symbolic::RustOp::Add, b)])
+        };
+        let shifted = call(
+            "libm::cos",
+            vec![plus(atom("theta"), atom("0.35000000000000003"))],
+        );
+        assert_eq!(call_name(&shifted), "cos_theta_0.35");
+        let scaled = call(
+            "libm::sin",
+            vec![RustCode::Chain(
+                Box::new(atom("6.283185307179586")),
+                vec![(crate::symbolic::RustOp::Mul, atom("t"))],
+            )],
+        );
+        assert_eq!(call_name(&scaled), "sin_6.283_t");
+        assert_eq!(call_name(&call("libm::sqrt", vec![atom("p.k")])), "sqrt_k");
+    }
+}

@@ -65,7 +65,7 @@ pub(super) fn text_width(code: &RustCode) -> usize {
     total
 }
 
-/// The widest argument list of any call in `code`. It prints the arguments: for code that fits on a line.
+/// The widest argument list of any call in `code`. It recurses: for code that fits on a line.
 pub(super) fn widest_call_args(code: &RustCode) -> usize {
     match code {
         RustCode::Atom(_) => 0,
@@ -75,8 +75,7 @@ pub(super) fn widest_call_args(code: &RustCode) -> usize {
             .map(|(_, o)| widest_call_args(o))
             .fold(widest_call_args(first), usize::max),
         RustCode::Call(_, args) => {
-            let own = args.iter().map(|a| width(&a.to_string())).sum::<usize>()
-                + 2 * args.len().saturating_sub(1);
+            let own = args.iter().map(text_width).sum::<usize>() + 2 * args.len().saturating_sub(1);
             args.iter().map(widest_call_args).fold(own, usize::max)
         }
     }

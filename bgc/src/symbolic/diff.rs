@@ -21,17 +21,29 @@ use std::f64::consts::LN_10;
 impl Expr {
     /// `d self / d x`, simplified. Each distinct node is differentiated once.
     pub fn diff(&self, x: &Symbol) -> Expr {
-        self.diff_sharing(x, &mut ProductTails::default())
+        diff_all(std::slice::from_ref(self), x, &mut ExprMap::default())
+            .pop()
+            .unwrap_or_else(Expr::zero)
     }
 
     /// `d self / d x` as [`Expr::diff`], with the derivatives of long products' tails kept in `tails` for later
     /// calls: a caller that differentiates many expressions one at a time (the time derivative of each storage in
     /// derivative causality) shares them as one call over all would.
     pub fn diff_sharing(&self, x: &Symbol, tails: &mut ProductTails) -> Expr {
-        let tails = tails.0.entry(x.clone()).or_default();
-        diff_all(std::slice::from_ref(self), x, tails)
+        let one = std::slice::from_ref(self);
+        if let Some(kept) = tails.0.get_mut(x) {
+            return diff_all(one, x, kept).pop().unwrap_or_else(Expr::zero);
+        }
+        // A variable's map is kept once it holds a tail: most expressions have no long product, and a caller that
+        // differentiates them one by one (a Jacobian row by row) then allocates nothing for it.
+        let mut fresh = ExprMap::default();
+        let d = diff_all(one, x, &mut fresh)
             .pop()
-            .unwrap_or_else(Expr::zero)
+            .unwrap_or_else(Expr::zero);
+        if !fresh.is_empty() {
+            tails.0.insert(x.clone(), fresh);
+        }
+        d
     }
 
     /// The Jacobian `∂ exprsᵢ / ∂ varsⱼ`, row by row: the entries of [`Expr::sparse_jacobian`] with zeros

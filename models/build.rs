@@ -30,7 +30,7 @@ const CORPUS: &[&str] = &[
 ];
 
 /// Test models of this crate (`tests/models`), generated with the corpus.
-const TEST_MODELS: &[&str] = &["ladder_closed", "ladder_loops"];
+const TEST_MODELS: &[&str] = &["chained_loops", "ladder_closed", "ladder_loops"];
 
 fn main() -> Result<(), bgc::build::Error> {
     bgc::build::compile(MODELS)?;

@@ -382,6 +382,20 @@ fn generated_loops_are_bounded_and_a_linear_block_has_its_state_space() {
         assert!(errors[0].contains(part), "{part}: {}", errors[0]);
     }
     assert!(!errors[0].contains("  "), "{}", errors[0]);
+    // The bound is a block's: 200 separate loops of one tear each are generated, each block solved and correcting
+    // the Jacobians with matrices of its own tear (1 × 1), none of all 200 tears.
+    let separate =
+        compile("star.bg", &families::loops_in_series(200, 1)).unwrap_or_else(|d| panic!("{d:?}"));
+    assert!(warnings_of(&separate, "BG0703").is_empty());
+    let module = bgc::codegen::rust::generate(&separate, "star.bg");
+    assert!(module.contains("pub const N_TEARS: usize = 200;"));
+    for shape in [
+        "    rz_199 = SMatrix::<f64, 1, 1>::zeros();",
+        "    dz_199 = bgc_solve(rz_199, rv_199);",
+    ] {
+        assert!(module.contains(shape), "no `{}`", shape.trim());
+    }
+    assert!(!module.contains("SMatrix::<f64, N_TEARS, N_TEARS>"));
     // Below the bound the loops are generated; the model is linear but has no symbolic state space, so its
     // `state_space` evaluates its Jacobians at the origin (models/tests/loops.rs checks the numbers).
     let small = crate::equations_support::families::ladder_distinct(40);
@@ -410,18 +424,28 @@ fn generated_loops_are_bounded_and_a_linear_block_has_its_state_space() {
         "a state_space of 183 states"
     );
     // The loops' correction of `∂f/∂x` is taken where it can be, at the capacitor the ladder drives: its
-    // matrices are tears by that one state, not by all 183 (`rows × cols × N_TEARS` multiplications per call).
-    for shape in [
-        "    const LOOP_ROWS: [usize; 1] = [0];\n",
-        "    let mut rv = SMatrix::<f64, N_TEARS, 1>::zeros();\n",
-        "    let mut gz = SMatrix::<f64, 1, N_TEARS>::zeros();\n",
-    ] {
-        assert!(module.contains(shape), "no `{}`", shape.trim());
-    }
+    // matrices are the block's tears by that one state, not by all 183 (`rows × cols × tears` multiplications
+    // per call).
+    let tears = module
+        .lines()
+        .find_map(|l| l.strip_prefix("pub const N_TEARS: usize = "))
+        .and_then(|n| n.trim_end_matches(';').parse::<usize>().ok());
+    let Some(tears) = tears else {
+        panic!("no N_TEARS")
+    };
     assert!(
-        !module.contains("N_TEARS, N_STATES>"),
-        "tears by all states"
+        tears > 30,
+        "{tears} tears: the ladder's rungs are one block"
     );
+    for shape in [
+        "    const LOOP_ROWS_0: [usize; 1] = [0];\n".to_string(),
+        "    const LOOP_COLS_0: [usize; 1] = [0];\n".to_string(),
+        format!("    let mut rv_0 = SMatrix::<f64, {tears}, 1>::zeros();\n"),
+        format!("    let mut gz_0 = SMatrix::<f64, 1, {tears}>::zeros();\n"),
+    ] {
+        assert!(module.contains(&shape), "no `{}`", shape.trim());
+    }
+    assert!(!module.contains(", 183>"), "tears by all states");
     // A ladder of four rungs keeps its loops in closed form and has its state space.
     let closed = crate::equations_support::families::ladder_distinct(4);
     let compiled = compile("closed.bg", &closed).unwrap_or_else(|d| panic!("{d:?}"));
@@ -438,24 +462,26 @@ fn generated_loops_are_bounded_and_a_linear_block_has_its_state_space() {
     assert!(lines < 3_500, "{lines} lines");
 }
 
-/// Loops whose tears reach many states: the generated Jacobians keep `rv`, `gz` and `dz` of tears by those states on
-/// the stack, and above 256 KiB a warning says so and what to do (30 tears by 1,110 states: 260 KiB); 30 tears by
-/// 1,080 states (253 KiB) compile without it.
+/// A block of loops whose tears reach many states: the generated Jacobians keep its `rv`, `gz` and `dz`, tears by
+/// those states, on the stack, and above 256 KiB a warning says so and what to do (one block of 30 tears by 1,110
+/// states: 260 KiB); 30 tears by 1,080 states (253 KiB) compile without it, and so do 30 separate loops of one
+/// tear each by 37 states, whose matrices are per block.
 #[test]
 fn jacobian_matrices_above_256_kib_on_the_stack_are_a_warning() {
     let warnings = |text: &str| {
         let compiled = compile("loops.bg", text).unwrap_or_else(|d| panic!("{d:?}"));
         warnings_of(&compiled, "BG0703")
     };
-    let large = warnings(&families::loops_in_series(30, 37));
+    let large = warnings(&families::loops_sharing_a_resistor(30, 37));
     assert_eq!(large.len(), 1, "{large:?}");
     for part in [
-        "the generated Jacobian functions of `star` keep a matrix of the algebraic loops' tear variables",
+        "the generated Jacobian functions of `hub` keep a matrix of the algebraic loops' tear variables",
         "(260 KiB) on the stack",
         "std::thread::Builder::stack_size",
         "`bgc fmu` refuses",
     ] {
         assert!(large[0].contains(part), "{part}: {}", large[0]);
     }
-    assert!(warnings(&families::loops_in_series(30, 36)).is_empty());
+    assert!(warnings(&families::loops_sharing_a_resistor(30, 36)).is_empty());
+    assert!(warnings(&families::loops_in_series(30, 37)).is_empty());
 }

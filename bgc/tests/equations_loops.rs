@@ -213,7 +213,7 @@ fn code_generation_solves_the_tear_block_in_the_generated_module() {
         "fn bgc_newton<const B: usize>(",
         "    let z = loop_values(p, t, x, u);",
         // The Jacobians go through the loop: dz/dx = −(∂r/∂z)⁻¹ ∂r/∂x.
-        "    let dz = bgc_solve(rz, rv);",
+        "    let dz_0 = bgc_solve(rz_0, rv_0);",
     ] {
         assert!(code.contains(item), "missing `{item}`");
     }

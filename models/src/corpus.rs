@@ -26,6 +26,7 @@ corpus!(
     series_rlc,
     two_tank,
     // This crate's test models (`tests/models`).
+    chained_loops,
     ladder_closed,
     ladder_loops,
 );

@@ -54,6 +54,19 @@ fn diode_rc() {
     );
 }
 
+/// Loops solved block after block, a block reading an earlier one's tear: the generated Jacobians' correction through
+/// the loops, block by block, against finite differences of the generated rates and outputs. Charges within ±1 mC, as
+/// for `diode_rc`.
+#[test]
+fn chained_loops() {
+    use corpus::chained_loops as m;
+    check_agreement_in::<m::Model, { m::N_STATES }, { m::N_INPUTS }, { m::N_OUTPUTS }>(
+        "models/tests/models/chained_loops.bg",
+        m::Model::default(),
+        1e-3,
+    );
+}
+
 macro_rules! state_space {
     ($($test:ident: $module:path => $file:expr),* $(,)?) => {
         $(

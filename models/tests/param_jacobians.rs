@@ -172,6 +172,18 @@ fn diode_rc_parameter_jacobians_agree() {
     );
 }
 
+/// Loops solved block after block, a block reading an earlier one's tear: `∂z/∂p` block by block, through
+/// `r_m` of the second loops' sources and `I_s`, `V_t` of every diode (charges of ±1 mC).
+#[test]
+fn chained_loops_parameter_jacobians_agree() {
+    use corpus::chained_loops as m;
+    check::<m::Model, { m::N_STATES }, { m::N_INPUTS }, { m::N_OUTPUTS }>(
+        "models/tests/models/chained_loops.bg",
+        m::Model::default(),
+        1e-3,
+    );
+}
+
 /// The oscillator of corpus/oscillator.bg: ṗ = F − d p/m − k q, q̇ = p/m, so ∂ṗ/∂m = d p/m², ∂ṗ/∂k = −q,
 /// ∂ṗ/∂d = −p/m, ∂q̇/∂m = −p/m², and nothing else.
 #[test]

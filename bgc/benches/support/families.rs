@@ -179,3 +179,23 @@ pub fn loops_in_series(loops: usize, caps: usize) -> String {
     }
     s + "}\n"
 }
+
+/// `loops` diode branches (a diode and a resistor each, with `caps` capacitors in series) fed from one source through
+/// one shared resistor: every branch current changes the shared resistor's drop, which every diode sees, so the
+/// branches are one algebraic loop of `loops` tear variables that reads all `loops × caps` charges.
+pub fn loops_sharing_a_resistor(loops: usize, caps: usize) -> String {
+    let mut s = String::from(
+        "model hub {\n    domain electrical;\n    input u [V];\n    param I_s = 1e-6 [A];\n    param V_t = 0.05 [V];\n    \
+         Se src = u;\n    1 feed;\n    R r0 = 10;\n    0 hub;\n    bond src -> feed -> r0;\n    bond feed -> hub;\n",
+    );
+    for k in 1..=loops {
+        s += &format!(
+            "    1 l{k};\n    R d{k} {{ f = I_s * (exp(e / V_t) - 1); }}\n    R r{k} = 100;\n    \
+             bond hub -> l{k} -> d{k}, r{k};\n"
+        );
+        for c in 1..=caps {
+            s += &format!("    C c{k}_{c} = 1e-3;\n    bond l{k} -> c{k}_{c};\n");
+        }
+    }
+    s + "}\n"
+}

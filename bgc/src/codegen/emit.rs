@@ -82,28 +82,36 @@ pub(crate) struct Plan {
 impl Plan {
     /// The bytes (and what its rows are) of the largest matrix that the generated Jacobian functions of the states
     /// and inputs keep on the stack besides the one they fill, when it exceeds the generated code's bound for dense
-    /// matrices ([`super::rust::MAX_CONSTANT_JACOBIAN_BYTES`]): the loops' `∂r/∂z`, and `∂r/∂v` and `∂g/∂z` at
-    /// the columns and rows where the loops' correction can be ([`super::loops::correction_support`]), and each
+    /// matrices ([`super::rust::MAX_CONSTANT_JACOBIAN_BYTES`]): each loop block's `∂r/∂z`, and its `∂r/∂v` and
+    /// `∂g/∂z` at the columns and rows where its correction can be ([`super::loops::block_supports`]), and each
     /// mass block's rows by the states ([`super::mass`]). Warned about by `compile` (BG0703) and refused by an FMU,
     /// whose solver keeps `JacX` itself off the stack.
     pub(crate) fn oversized_stack_matrix(&self) -> Option<(usize, &'static str)> {
         let f64s = std::mem::size_of::<f64>();
         let block = self.mass.iter().map(|b| b.rows.len()).max().unwrap_or(0) * self.states.len();
         let loops = self.loops.as_ref().map_or(0, |l| {
-            let tears = l.tears.len();
             let pairs = [
                 (&l.dfdz, &l.drdx),
                 (&l.dfdz, &l.drdu),
                 (&l.dhdz, &l.drdx),
                 (&l.dhdz, &l.drdu),
             ];
+            let square = l
+                .blocks
+                .iter()
+                .map(|b| b.residuals.len().pow(2))
+                .max()
+                .unwrap_or(0);
             pairs
                 .iter()
-                .map(|(g_z, r_v)| {
-                    let (rows, cols) = super::loops::correction_support(g_z, r_v);
-                    tears * rows.len().max(cols.len())
+                .flat_map(|(g_z, r_v)| {
+                    let supports = super::loops::block_supports(l, g_z, r_v);
+                    l.blocks
+                        .iter()
+                        .zip(supports)
+                        .map(|(b, s)| b.residuals.len() * s.rows.len().max(s.cols.len()))
                 })
-                .fold(tears * tears, usize::max)
+                .fold(square, usize::max)
         });
         let (bytes, rows) = if loops >= block {
             (loops * f64s, "the algebraic loops' tear variables")

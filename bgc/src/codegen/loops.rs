@@ -20,7 +20,9 @@
 //!
 //! The Jacobians follow from the implicit function theorem: with `r(z(x, u), x, u) = 0`,
 //! `dz/dx = −(∂r/∂z)⁻¹ ∂r/∂x` and `dz/du = −(∂r/∂z)⁻¹ ∂r/∂u`, so `∂f/∂x` gets `∂f/∂z dz/dx` added (the same for
-//! `u` and for the outputs). `∂r/∂z` of all blocks together is block-triangular and is solved by `bgc_solve`.
+//! `u` and for the outputs). `∂r/∂z` of all blocks together is block-triangular, so `dz` is formed block by block
+//! (`dz_k = −(∂r_k/∂z_k)⁻¹ (∂r_k/∂v + Σ_c ∂r_k/∂z_c dz_c)`, each by `bgc_solve`) with matrices of one block's tears
+//! only ([`block_supports`]).
 
 use super::adapter::to_symbolic;
 use super::rust::{Draft, MAX_CONSTANT_JACOBIAN_BYTES, Writer};
@@ -28,8 +30,8 @@ use crate::equations::{Equations, ParamChain, residual_scale};
 use crate::symbolic::{Expr, Symbol};
 use std::fmt::Write;
 
-/// The most tear variables generated code takes: `∂r/∂z` of all loops is an `N_TEARS × N_TEARS` matrix on the
-/// stack, held to the bound of a dense `JacX` ([`MAX_CONSTANT_JACOBIAN_BYTES`], 181 tears).
+/// The most tear variables of one block that generated code takes: its `∂r/∂z` is a square matrix on the stack,
+/// held to the bound of a dense `JacX` ([`MAX_CONSTANT_JACOBIAN_BYTES`], 181 tears).
 const MAX_TEARS: usize = (MAX_CONSTANT_JACOBIAN_BYTES / 8).isqrt();
 
 /// One block of the loops for the generator.
@@ -70,14 +72,21 @@ pub(crate) fn plan(
     if eqs.tear_blocks.is_empty() {
         return Ok(None);
     }
-    let count: usize = eqs.tear_blocks.iter().map(|b| b.tears.len()).sum();
+    // Each block is solved, and corrects the Jacobians, with matrices of its own tears: the largest one bounds them.
+    let count = eqs
+        .tear_blocks
+        .iter()
+        .map(|b| b.tears.len())
+        .max()
+        .unwrap_or(0);
     if count > MAX_TEARS {
         let (kib, bound) = (count * count * 8 / 1024, MAX_CONSTANT_JACOBIAN_BYTES / 1024);
         return Err(format!(
-            "its algebraic loops have {count} tear variables: the generated Newton iteration and Jacobians keep \
-             {count} × {count} matrices ({kib} KiB each) on the stack, more than the {bound} KiB generated code \
-             allows (at most {MAX_TEARS} tears); a storage element on a loop (a parasitic compliance or \
-             inertia) removes its tear, and `bgc simulate` runs the model as it is"
+            "one of its algebraic loops has {count} tear variables that must be solved together: the generated \
+             Newton iteration and Jacobians keep {count} × {count} matrices ({kib} KiB each) on the stack, more \
+             than the {bound} KiB generated code allows (at most {MAX_TEARS} tears a loop); a storage element on \
+             the loop (a parasitic compliance or inertia) removes its tear, and `bgc simulate` runs the model as \
+             it is"
         ));
     }
     let convert = |e: &Expr| to_symbolic(eqs, e).map_err(|e| e.to_string());
@@ -753,29 +762,43 @@ fn loop_values(p: &Params, t: f64, x: &State, u: &Inputs) -> Tears {
         self.tear_lets(d, exprs);
     }
 
-    /// The expressions the loop correction of a Jacobian needs: `∂g/∂z` and `∂r/∂v` (`v` = x or u), with `∂r/∂z`.
+    /// The expressions the loop correction of a Jacobian needs ([`Self::loop_correction`]): of each block whose
+    /// `dz` is formed, its `∂r/∂z` (its own tears and the formed earlier blocks' it reads), its `∂r/∂v` at its
+    /// columns and `∂g/∂z` at its rows.
     pub(super) fn loop_correction_exprs(&self, g_z: &[Vec<Expr>], r_v: &[Vec<Expr>]) -> Vec<Expr> {
         let Some(lp) = &self.plan.loops else {
             return Vec::new();
         };
-        let (rows, cols) = correction_support(g_z, r_v);
-        if rows.is_empty() || cols.is_empty() {
+        let (read_rows, read_cols) = correction_support(g_z, r_v);
+        if read_rows.is_empty() || read_cols.is_empty() {
             return Vec::new();
         }
-        lp.drdz
-            .iter()
-            .chain(r_v)
-            .chain(g_z)
-            .flatten()
-            .filter(|e| !e.is_zero())
-            .cloned()
-            .collect()
+        let (supports, formed) = formed_blocks(lp, g_z, r_v);
+        let mut out = Vec::new();
+        for (k, b) in lp.blocks.iter().enumerate().filter(|&(k, _)| formed[k]) {
+            let own = b.first..b.first + b.residuals.len();
+            for i in own.clone() {
+                out.extend(own.clone().map(|j| &lp.drdz[i][j]));
+                out.extend(supports[k].cols.iter().map(|&c| &r_v[i][c]));
+                for (c, earlier) in lp.blocks.iter().enumerate().take(k) {
+                    if formed[c] {
+                        let theirs = earlier.first..earlier.first + earlier.residuals.len();
+                        out.extend(theirs.map(|m| &lp.drdz[i][m]));
+                    }
+                }
+            }
+            for &row in &supports[k].rows {
+                out.extend(own.clone().map(|m| &g_z[row][m]));
+            }
+        }
+        out.into_iter().filter(|e| !e.is_zero()).cloned().collect()
     }
 
-    /// The lines that add `∂g/∂z dz/dv` to `jac`, `dz/dv = −(∂r/∂z)⁻¹ ∂r/∂v`, over the rows of
-    /// `∂g/∂z` and the columns of `∂r/∂v` that are not identically zero only ([`correction_support`]): the
-    /// matrices on the stack are `N_TEARS` by those, and the product costs their count times `N_TEARS`, not
-    /// `rows × cols × N_TEARS`.
+    /// The lines that add `∂g/∂z dz/dv` to `jac`, `dz/dv = −(∂r/∂z)⁻¹ ∂r/∂v`, block by block
+    /// ([`block_supports`]): block `k` solves `∂r_k/∂z_k dz_k = −(∂r_k/∂v + Σ_c ∂r_k/∂z_c dz_c)` over the earlier
+    /// blocks `c` it reads, at the columns it reaches only, and adds `∂g/∂z_k dz_k` at the rows that read its tears.
+    /// The matrices on the stack are a block's tears by those rows and columns, so independent loops keep small
+    /// ones however many there are, and the products cost their counts, not `rows × cols × N_TEARS`.
     pub(super) fn loop_correction(&self, d: &mut Draft, g_z: &[Vec<Expr>], r_v: &[Vec<Expr>]) {
         let Some(lp) = &self.plan.loops else {
             return;
@@ -785,59 +808,200 @@ fn loop_values(p: &Params, t: f64, x: &State, u: &Inputs) -> Tears {
             return;
         }
         d.lines.extend(self.comment_lines(
-            "Through the algebraic loops (implicit function theorem): dz = −(∂r/∂z)⁻¹ ∂r, jac += (∂/∂z) dz, \
-             only at the rows that read a tear (`LOOP_ROWS`) and the columns that a residual reads (`LOOP_COLS`).",
+            "Through the algebraic loops (implicit function theorem), block by block: dz_k = −(∂r_k/∂z_k)⁻¹ (∂r_k/∂v \
+             + Σ ∂r_k/∂z_c dz_c), jac += (∂/∂z_k) dz_k, only at the rows that read a tear of the block \
+             (`LOOP_ROWS_k`) and the columns that its residuals reach (`LOOP_COLS_k`).",
         ));
-        let (n_rows, n_cols) = (read_rows.len(), read_cols.len());
-        for (name, list) in [("LOOP_ROWS", &read_rows), ("LOOP_COLS", &read_cols)] {
+        let (supports, formed) = formed_blocks(lp, g_z, r_v);
+        for (k, b) in lp.blocks.iter().enumerate() {
+            if formed[k] {
+                self.block_correction(d, lp, (k, b), (&supports, &formed), (g_z, r_v));
+            }
+        }
+    }
+
+    /// The lines of block `k`'s part of [`Self::loop_correction`].
+    fn block_correction(
+        &self,
+        d: &mut Draft,
+        lp: &LoopPlan,
+        (k, b): (usize, &LoopBlockPlan),
+        (supports, formed): (&[BlockSupport], &[bool]),
+        (g_z, r_v): (&[Vec<Expr>], &[Vec<Expr>]),
+    ) {
+        let support = &supports[k];
+        let (n, first) = (b.residuals.len(), b.first);
+        let (n_rows, n_cols) = (support.rows.len(), support.cols.len());
+        let index_list = |name: String, list: &[usize], d: &mut Draft| {
             let items: Vec<String> = list.iter().map(usize::to_string).collect();
             let head = format!("    const {name}: [usize; {}] = ", items.len());
             d.lines.push(crate::codegen::format::array(
                 &head, &items, ";", 4, self.width,
             ));
+        };
+        index_list(format!("LOOP_COLS_{k}"), &support.cols, d);
+        d.lines.push(format!(
+            "    let mut rz_{k} = SMatrix::<f64, {n}, {n}>::zeros();"
+        ));
+        d.lines.push(format!(
+            "    let mut rv_{k} = SMatrix::<f64, {n}, {n_cols}>::zeros();"
+        ));
+        for i in 0..n {
+            for j in 0..n {
+                self.cell(
+                    d,
+                    &format!("rz_{k}"),
+                    (i, j),
+                    &lp.drdz[first + i][first + j],
+                    false,
+                );
+            }
+            for (j, &col) in support.cols.iter().enumerate() {
+                self.cell(d, &format!("rv_{k}"), (i, j), &r_v[first + i][col], true);
+            }
+        }
+        for (c, earlier) in lp.blocks.iter().enumerate().take(k) {
+            if !formed[c] || !reads_block(lp, k, c) {
+                continue;
+            }
+            let width = earlier.residuals.len();
+            let to = format!("rc_{k}_{c}");
+            d.lines.push(format!(
+                "    let mut {to} = SMatrix::<f64, {n}, {width}>::zeros();"
+            ));
+            for i in 0..n {
+                for m in 0..width {
+                    self.cell(
+                        d,
+                        &to,
+                        (i, m),
+                        &lp.drdz[first + i][earlier.first + m],
+                        false,
+                    );
+                }
+            }
+            // Where each of block c's columns is among block k's (a superset, by construction).
+            let at: Vec<usize> = supports[c]
+                .cols
+                .iter()
+                .filter_map(|col| support.cols.iter().position(|x| x == col))
+                .collect();
+            index_list(format!("LOOP_AT_{k}_{c}"), &at, d);
+            d.lines.push(format!(
+                "    for (j, &to) in LOOP_AT_{k}_{c}.iter().enumerate() {{\n        for i in 0..{n} {{\n            \
+                 for m in 0..{width} {{\n                rv_{k}[(i, to)] -= {to}[(i, m)] * dz_{c}[(m, j)];\n            \
+                 }}\n        }}\n    }}"
+            ));
         }
         d.lines
-            .push("    let mut rz = SMatrix::<f64, N_TEARS, N_TEARS>::zeros();".into());
+            .push(format!("    let dz_{k} = bgc_solve(rz_{k}, rv_{k});"));
+        if n_rows == 0 {
+            return;
+        }
+        index_list(format!("LOOP_ROWS_{k}"), &support.rows, d);
         d.lines.push(format!(
-            "    let mut rv = SMatrix::<f64, N_TEARS, {n_cols}>::zeros();"
+            "    let mut gz_{k} = SMatrix::<f64, {n_rows}, {n}>::zeros();"
         ));
+        for (i, &row) in support.rows.iter().enumerate() {
+            for m in 0..n {
+                self.cell(d, &format!("gz_{k}"), (i, m), &g_z[row][first + m], false);
+            }
+        }
         d.lines.push(format!(
-            "    let mut gz = SMatrix::<f64, {n_rows}, N_TEARS>::zeros();"
+            "    for (i, &row) in LOOP_ROWS_{k}.iter().enumerate() {{\n        for (j, &col) in \
+             LOOP_COLS_{k}.iter().enumerate() {{\n            for m in 0..{n} {{\n                \
+             jac[(row, col)] += gz_{k}[(i, m)] * dz_{k}[(m, j)];\n            }}\n        }}\n    }}"
         ));
-        let mut cell = |var: &str, i: usize, j: usize, e: &Expr, sign: bool| {
-            if e.is_zero() {
-                return;
-            }
-            let value = if sign { -e } else { e.clone() };
-            self.statement(
-                d,
-                &format!("{var}[{i}, {j}] = "),
-                &value,
-                &format!("{var}[({i}, {j})] = "),
-                ";",
-            );
-        };
-        for (i, row) in lp.drdz.iter().enumerate() {
-            for (j, e) in row.iter().enumerate() {
-                cell("rz", i, j, e, false);
-            }
+    }
+
+    /// `var[(i, j)] = e;` (`-e` with `negate`) under its equation, unless `e` is zero.
+    fn cell(&self, d: &mut Draft, var: &str, (i, j): (usize, usize), e: &Expr, negate: bool) {
+        if e.is_zero() {
+            return;
         }
-        for (k, row) in r_v.iter().enumerate() {
-            for (j, &col) in read_cols.iter().enumerate() {
-                cell("rv", k, j, &row[col], true);
-            }
-        }
-        for (i, &row) in read_rows.iter().enumerate() {
-            for (k, e) in g_z[row].iter().enumerate() {
-                cell("gz", i, k, e, false);
-            }
-        }
-        d.lines.push("    let dz = bgc_solve(rz, rv);".into());
-        d.lines.push(
-            "    for (i, &row) in LOOP_ROWS.iter().enumerate() {\n        for (j, &col) in LOOP_COLS.iter().enumerate() {\n            for k in 0..N_TEARS {\n                jac[(row, col)] += gz[(i, k)] * dz[(k, j)];\n            }\n        }\n    }"
-                .into(),
+        let value = if negate { -e } else { e.clone() };
+        self.statement(
+            d,
+            &format!("{var}[{i}, {j}] = "),
+            &value,
+            &format!("{var}[({i}, {j})] = "),
+            ";",
         );
     }
+}
+
+/// Where block `k`'s part of a Jacobian's loop correction is: the rows of `∂g/∂z` that read its tears, and the
+/// columns of `v` its residuals read directly or through the earlier blocks' tears they read (ascending).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct BlockSupport {
+    pub rows: Vec<usize>,
+    pub cols: Vec<usize>,
+}
+
+/// The [`BlockSupport`] of each block, and whether its `dz` is formed: where it reaches a column and is used, by
+/// rows that read its tears or by a later block, formed, that reads them.
+fn formed_blocks(
+    lp: &LoopPlan,
+    g_z: &[Vec<Expr>],
+    r_v: &[Vec<Expr>],
+) -> (Vec<BlockSupport>, Vec<bool>) {
+    let supports = block_supports(lp, g_z, r_v);
+    let mut formed = vec![false; lp.blocks.len()];
+    for k in (0..lp.blocks.len()).rev() {
+        let used = !supports[k].rows.is_empty()
+            || (k + 1..lp.blocks.len()).any(|j| formed[j] && reads_block(lp, j, k));
+        formed[k] = used && !supports[k].cols.is_empty();
+    }
+    (supports, formed)
+}
+
+/// Whether the residuals of block `k` read a tear of block `c`.
+fn reads_block(lp: &LoopPlan, k: usize, c: usize) -> bool {
+    let (Some(b), Some(earlier)) = (lp.blocks.get(k), lp.blocks.get(c)) else {
+        return false;
+    };
+    let theirs = earlier.first..earlier.first + earlier.residuals.len();
+    (b.first..b.first + b.residuals.len()).any(|i| {
+        theirs.clone().any(|m| {
+            lp.drdz
+                .get(i)
+                .and_then(|row| row.get(m))
+                .is_some_and(|e| !e.is_zero())
+        })
+    })
+}
+
+/// The [`BlockSupport`] of each block of `lp` for the correction of `g` by `v` (`∂g/∂z`, `∂r/∂v`).
+pub(crate) fn block_supports(
+    lp: &LoopPlan,
+    g_z: &[Vec<Expr>],
+    r_v: &[Vec<Expr>],
+) -> Vec<BlockSupport> {
+    let mut supports: Vec<BlockSupport> = Vec::with_capacity(lp.blocks.len());
+    for b in &lp.blocks {
+        let own = b.first..b.first + b.residuals.len();
+        let mut cols = std::collections::BTreeSet::new();
+        for i in own.clone() {
+            let row = r_v.get(i).map_or(&[][..], Vec::as_slice);
+            cols.extend((0..row.len()).filter(|&j| !row[j].is_zero()));
+        }
+        for (c, earlier) in supports.iter().enumerate() {
+            if reads_block(lp, supports.len(), c) {
+                cols.extend(earlier.cols.iter().copied());
+            }
+        }
+        let rows = (0..g_z.len())
+            .filter(|&r| {
+                own.clone()
+                    .any(|m| g_z[r].get(m).is_some_and(|e| !e.is_zero()))
+            })
+            .collect();
+        supports.push(BlockSupport {
+            rows,
+            cols: cols.into_iter().collect(),
+        });
+    }
+    supports
 }
 
 /// The rows of `∂g/∂z` and the columns of `∂r/∂v` that are not identically zero: where the loops' correction of

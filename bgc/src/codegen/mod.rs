@@ -16,7 +16,7 @@
 //! | BG0700 | the file declares no `model` (components alone generate nothing) |
 //! | BG0701 | equations that cannot be generated (incomplete, or an expression with no value in code) |
 //! | BG0702 | warning: a linear model whose loops are solved numerically and which has more than 181 states gets no `state_space` |
-//! | BG0703 | warning: the generated Jacobians keep a matrix of more than 256 KiB on the stack (loops' tears or a mass block's rows by the states they reach) |
+//! | BG0703 | warning: the generated Jacobians keep a matrix of more than 256 KiB on the stack (a loop block's tears or a mass block's rows by the states they reach) |
 
 mod adapter;
 pub(crate) mod emit;

@@ -152,6 +152,33 @@ fn bgc_solve<const N: usize, const C: usize>(
 }
 ";
 
+/// The mass blocks' solve in the dense Jacobians: each block's rows are solved in a frame of their own, so that the
+/// Jacobian of many blocks holds one block's rows on the stack at a time (150 pairs of coupled coils held all
+/// their rows at once and overflowed a 2 MiB thread). Emitted after [`SOLVE_FN`] when the model has mass blocks.
+pub(crate) const SOLVE_ROWS_FN: &str = "
+/// Solves `m z = b` for the rows `rows` of `jac` (`b` is those rows, and `z` is written back
+/// into them) in a frame of its own, so that one block's rows are on the stack at a time.
+#[inline(never)]
+fn bgc_solve_rows<const R: usize, const C: usize, const N: usize>(
+    jac: &mut SMatrix<f64, R, C>,
+    rows: [usize; N],
+    m: SMatrix<f64, N, N>,
+) {
+    let mut b = SMatrix::<f64, N, C>::zeros();
+    for (k, &r) in rows.iter().enumerate() {
+        for c in 0..C {
+            b[(k, c)] = jac[(r, c)];
+        }
+    }
+    let solved = bgc_solve(m, b);
+    for (k, &r) in rows.iter().enumerate() {
+        for c in 0..C {
+            jac[(r, c)] = solved[(k, c)];
+        }
+    }
+}
+";
+
 /// `(column, ∂M/∂v_column)` for the columns `M` depends on.
 pub(crate) type Derivatives = [(usize, Vec<Vec<Expr>>)];
 
@@ -161,17 +188,6 @@ pub(super) enum MassColumns {
     States,
     Inputs,
     Params,
-}
-
-impl MassColumns {
-    /// The number of columns, as the generated code names it.
-    fn size(self) -> &'static str {
-        match self {
-            MassColumns::States => "N_STATES",
-            MassColumns::Inputs => "N_INPUTS",
-            MassColumns::Params => "N_PARAMS",
-        }
-    }
 }
 
 impl Writer<'_> {
@@ -238,13 +254,31 @@ impl Writer<'_> {
     /// turn the rows of `∂F` in `jac` into those of the rates: `M ∂ḟ = ∂F − (∂M/∂v) ḟ` (`M` does not depend on the
     /// inputs).
     pub(super) fn mass_solve_in_jacobian(&self, d: &mut Draft, columns: MassColumns) {
-        let cols = columns.size();
+        fn slopes(b: &MassPlan, columns: MassColumns) -> &Derivatives {
+            match columns {
+                MassColumns::States => &b.derivatives,
+                MassColumns::Inputs => &[],
+                MassColumns::Params => &b.param_derivatives,
+            }
+        }
+        // The rates `ḟ` that the slope corrections read, once for all blocks.
+        if self
+            .plan
+            .mass
+            .iter()
+            .any(|b| !slopes(b, columns).is_empty())
+        {
+            d.lines.push("    let mut dx = State::zeros();".into());
+            d.lines.push("    rhs_into(p, t, x, u, &mut dx);".into());
+            d.uses.t = true;
+            d.uses.u = true;
+        }
         for b in &self.plan.mass {
-            let n = b.rows.len();
-            let (derivatives, v): (&Derivatives, &str) = match columns {
-                MassColumns::States => (&b.derivatives, "x_k"),
-                MassColumns::Inputs => (&[], ""),
-                MassColumns::Params => (&b.param_derivatives, "p_k"),
+            let derivatives = slopes(b, columns);
+            let v = match columns {
+                MassColumns::States => "x_k",
+                MassColumns::Inputs => "",
+                MassColumns::Params => "p_k",
             };
             let correction = if v.is_empty() {
                 String::new()
@@ -255,55 +289,40 @@ impl Writer<'_> {
                 "The rows of d/dt [{}]: M (∂ḟ) = ∂F{correction}, solved with M.",
                 self.state_list(&b.rows),
             )));
-            d.lines.push(format!(
-                "    let mut rows = SMatrix::<f64, {n}, {cols}>::zeros();"
-            ));
-            for (k, r) in b.rows.iter().enumerate() {
-                d.lines.push(format!(
-                    "    for c in 0..{cols} {{\n        rows[({k}, c)] = jac[({r}, c)];\n    }}"
-                ));
+            for (k, dm) in derivatives {
+                let by = self.column_name(columns, *k);
+                let cell = |i: usize| {
+                    format!("jac[({}, {k})]", b.rows.get(i).copied().unwrap_or_default())
+                };
+                self.slope_correction(d, (&b.rows, &cell), dm, &by);
             }
-            if !derivatives.is_empty() {
-                d.lines.push("    let mut dx = State::zeros();".into());
-                d.lines.push("    rhs_into(p, t, x, u, &mut dx);".into());
-                d.uses.t = true;
-                d.uses.u = true;
-                for (k, dm) in derivatives {
-                    let by = self.column_name(columns, *k);
-                    self.slope_correction(d, &b.rows, dm, &by, *k);
-                }
-            }
+            let rows: Vec<String> = b.rows.iter().map(usize::to_string).collect();
             d.lines.push(format!(
-                "    let solved = bgc_solve(mass_{}(p, x), rows);",
+                "    bgc_solve_rows(jac, [{}], mass_{}(p, x));",
+                rows.join(", "),
                 b.ident
             ));
-            for (k, r) in b.rows.iter().enumerate() {
-                d.lines.push(format!(
-                    "    for c in 0..{cols} {{\n        jac[({r}, c)] = solved[({k}, c)];\n    }}"
-                ));
-            }
             d.uses.p = true;
             d.uses.x = true;
         }
     }
 
-    /// The lines `rows[(i, column)] -= ∂M[i, j]/∂by · dx[j-th row]` of the correction of a block with the rows
-    /// `rows`, for the derivative `dm` of its `M` by the variable `by` of column `column`.
+    /// The lines `{cell(i)} -= ∂M[i, j]/∂by · dx[j-th row]` of the correction of a block with the rows `rows`, for
+    /// the derivative `dm` of its `M` by the variable `by`; `cell(i)` is where row `i` of the block holds the column
+    /// of `by`.
     pub(super) fn slope_correction(
         &self,
         d: &mut Draft,
-        rows: &[usize],
+        (rows, cell): (&[usize], &dyn Fn(usize) -> String),
         dm: &[Vec<Expr>],
         by: &str,
-        column: usize,
     ) {
         for (i, row) in dm.iter().enumerate() {
             for (j, e) in row.iter().enumerate().filter(|(_, e)| !e.is_zero()) {
                 let label = format!("∂M[{}, {}]/∂{by} = ", i + 1, j + 1);
                 self.statement(d, &label, e, "let dm = ", ";");
                 let rate = rows.get(j).copied().unwrap_or_default();
-                d.lines
-                    .push(format!("    rows[({i}, {column})] -= dm * dx[{rate}];"));
+                d.lines.push(format!("    {} -= dm * dx[{rate}];", cell(i)));
             }
         }
     }

@@ -590,6 +590,9 @@ impl<'a> Writer<'a> {
         if !self.plan.mass.is_empty() || self.plan.loops.is_some() {
             solvers.push_str(super::mass::SOLVE_FN);
         }
+        if !self.plan.mass.is_empty() {
+            solvers.push_str(super::mass::SOLVE_ROWS_FN);
+        }
         if self.plan.loops.is_some() {
             solvers.push_str(super::loops::NEWTON_FN);
             solvers.push_str(super::loops_dogleg::DOGLEG_FN);

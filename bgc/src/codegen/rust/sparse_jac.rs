@@ -200,7 +200,8 @@ impl Writer<'_> {
             for (c, dm) in &block.derivatives {
                 let k = b.columns.binary_search(c).unwrap_or_default();
                 let by = self.plan.states.get(*c).map_or("", |s| s.name());
-                self.slope_correction(&mut d, &block.rows, dm, by, k);
+                let cell = |i: usize| format!("rows[({i}, {k})]");
+                self.slope_correction(&mut d, (&block.rows, &cell), dm, by);
             }
             d.lines.push(format!(
                 "    let solved = bgc_solve(mass_{}(p, x), rows);",

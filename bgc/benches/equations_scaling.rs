@@ -14,7 +14,7 @@
 //! residual reads every tear, so its derivatives by them are taken in one reverse walk per residual.
 //!
 //! The `rust/...` groups time what `bgc rust` does after parsing (equations, Jacobians, code generation) on the
-//! benchmark chain, the output chain and the gear train: sparse Jacobians (a row that reads many states in one
+//! benchmark chain, the output chain, the gear train and separate algebraic loops: sparse Jacobians (a row that reads many states in one
 //! reverse walk) and shared subexpressions keep them linear in the model.
 //!
 //! Run with `cargo bench -p bgc --bench equations_scaling`. The same generators, at small sizes, are checked against
@@ -29,8 +29,8 @@ use bgc::lower::{MemoryLoader, lower};
 use bgc::span::SourceMap;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use families::{
-    benchmark_chain, gear_train, gyrator_chain, ladder, ladder_distinct, mtf_chain,
-    mtf_chain_with_phases, output_chain, parallel_pairs,
+    benchmark_chain, gear_train, gyrator_chain, ladder, ladder_distinct, loops_in_series,
+    mtf_chain, mtf_chain_with_phases, output_chain, parallel_pairs,
 };
 use std::hint::black_box;
 
@@ -167,6 +167,14 @@ fn bench(c: &mut Criterion) {
         &[20, 40, 80],
         mtf_chain_with_phases,
     );
+    // Separate diode loops, one block of one tear each: every block corrects the Jacobians with its own matrices,
+    // and which tears a function reads is found from the symbols of all its expressions at once.
+    rust_family(c, "separate_loops", &[250, 500, 1000], separate_loops);
+}
+
+/// `loops` separate diode loops of one capacitor each.
+fn separate_loops(loops: usize) -> String {
+    loops_in_series(loops, 1)
 }
 
 criterion_group!(benches, bench);

@@ -731,8 +731,11 @@ fn loop_values(p: &Params, t: f64, x: &State, u: &Inputs) -> Tears {
         let Some(lp) = &self.plan.loops else {
             return;
         };
+        // The symbols of all of `exprs` once: a test per tear and expression costs their product (a second per
+        // Jacobian function at 1,000 separate loops).
+        let used = symbols_of(exprs);
         for (i, s) in lp.tears.iter().enumerate() {
-            if exprs.iter().any(|e| e.free_symbols().contains(s)) {
+            if used.contains(s) {
                 let name = self.name(s);
                 d.lines.push(format!("    let {name} = z[{i}];"));
                 d.push_local(name);
@@ -743,9 +746,8 @@ fn loop_values(p: &Params, t: f64, x: &State, u: &Inputs) -> Tears {
     /// True when any of `exprs` holds a tear.
     pub(super) fn uses_tears(&self, exprs: &[&Expr]) -> bool {
         self.plan.loops.as_ref().is_some_and(|lp| {
-            exprs
-                .iter()
-                .any(|e| e.free_symbols().iter().any(|s| lp.tears.contains(s)))
+            let used = symbols_of(exprs);
+            lp.tears.iter().any(|s| used.contains(s))
         })
     }
 
@@ -953,6 +955,15 @@ fn formed_blocks(
         formed[k] = used && !supports[k].cols.is_empty();
     }
     (supports, formed)
+}
+
+/// The free symbols of all of `exprs`.
+fn symbols_of(exprs: &[&Expr]) -> std::collections::BTreeSet<Symbol> {
+    let mut used = std::collections::BTreeSet::new();
+    for e in exprs {
+        used.extend(e.free_symbols());
+    }
+    used
 }
 
 /// Whether the residuals of block `k` read a tear of block `c`.

@@ -37,7 +37,9 @@ fn main() {{
     )
 }
 
-const STATE_COLUMNS: &str = r#"
+/// `jac_x_into` at `x, u` into `jac`, and `worst` updated with its worst relative difference from central
+/// differences of `rhs`.
+const CENTRAL_DIFFERENCES: &str = r#"
     let mut jac = model::JacX::zeros();
     model::jac_x_into(&p, 0.0, &x, &u, &mut jac);
     for c in 0..model::N_STATES {
@@ -50,8 +52,12 @@ const STATE_COLUMNS: &str = r#"
             worst = worst.max((jac[(r, c)] - want).abs() / (1.0 + want.abs()));
         }
     }
-    println!("{:e} {:e}", jac[(0, 1)], worst);
 "#;
+
+/// [`CENTRAL_DIFFERENCES`] at the program's point, then `∂f_0/∂x_1` and the worst difference printed.
+fn state_columns() -> String {
+    format!("{CENTRAL_DIFFERENCES}    println!(\"{{:e}} {{:e}}\", jac[(0, 1)], worst);\n")
+}
 
 const PARAMETER_A: &str = r#"
     let mut jac = model::JacP::zeros();
@@ -75,16 +81,22 @@ fn check(name: &str, text: &str, (label, prefix, bytes): (&str, &str, usize), bo
     let head = correction.lines().next().unwrap_or_default();
     assert!(head.contains(prefix) && !head.contains("cos("), "{head}");
     assert!(code.len() < bytes, "{} bytes", code.len());
+    let (entry, worst) = run(name, &code, body);
+    assert!(entry.abs() > 1e-3, "{entry:e}");
+    assert!(worst < 1e-6, "{worst:e}");
+}
+
+/// Builds and runs [`program`] with `body` on the module `code` (named `name`): the two numbers it prints.
+fn run(name: &str, code: &str, body: &str) -> (f64, f64) {
     let dir = scratch(&format!("{name}-jacobian"));
-    let printed = build_and_run(&dir, name, &code, &program(name, body), LIBM_STD);
+    let printed = build_and_run(&dir, name, code, &program(name, body), LIBM_STD);
     let _ = std::fs::remove_dir_all(&dir);
     let fields: Vec<f64> = printed
         .split_whitespace()
         .map(|v| v.parse().unwrap_or(f64::NAN))
         .collect();
     assert_eq!(fields.len(), 2, "{printed}");
-    assert!(fields[0].abs() > 1e-3, "{printed}");
-    assert!(fields[1] < 1e-6, "{printed}");
+    (fields[0], fields[1])
 }
 
 /// 40 links: `jac_x` equals central differences of `rhs` to 1e-6, its `θ` column (which holds the `∂M/∂θ`
@@ -92,7 +104,7 @@ fn check(name: &str, text: &str, (label, prefix, bytes): (&str, &str, usize), bo
 #[test]
 fn the_jacobian_of_a_chain_of_modulated_transformers_is_written_over_shared_names() {
     let correction = ("∂M[1, 1]/∂theta = ", "*dfdx_", 200_000);
-    check("mtf", &mtf_chain(40), correction, STATE_COLUMNS);
+    check("mtf", &mtf_chain(40), correction, &state_columns());
 }
 
 /// The chain of 40 links with the modulus `1 + a cos θ`: the column of `a` in `jac_p` equals central differences
@@ -117,62 +129,29 @@ fn the_parameter_jacobian_of_a_chain_of_modulated_transformers_is_written_over_s
 /// rates, which solve the loop and `M` at each point, to 1e-6 (1.2e-9 when this was written).
 #[test]
 fn a_mass_matrix_behind_a_loop_has_the_jacobian_of_its_rates() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/fixtures/fields/cart_pole_field.bg"
-    );
-    let Ok(fixture) = std::fs::read_to_string(path) else {
-        panic!("{path}")
-    };
-    let text = fixture.replace(
-        "    output angle",
-        "    param b = 0.5 [N s/m];\n    param v0 = 1 [m/s];\n    \
-         1 s1; R rs1 = b; 0 n1; R rp1 { e = b*f + b*v0*tanh(f/v0); }\n    \
-         1 s2; R rs2 = b; 0 n2; R rp2 = 2*b;\n    \
-         bond cart -> s1; bond s1 -> rs1; bond s1 -> n1; bond n1 -> rp1;\n    \
-         bond n1 -> s2; bond s2 -> rs2; bond s2 -> n2; bond n2 -> rp2;\n    output angle",
-    );
+    let text = crate::equations_loops::cart_pole_behind_a_loop_text();
     let code = generate_text("cart_loop.bg", &text, Options { runtime: false });
     for item in ["pub const N_TEARS: usize = 1;", "    bgc_solve_rows(jac, ["] {
         assert!(code.contains(item), "no `{}`", item.trim());
     }
-    let body = r#"
-    let mut largest = 0.0f64;
-    for k in 0..20 {
+    let point = r#"
         for i in 0..model::N_STATES {
             x[i] = 0.3 * (((i + k) % 5) as f64 - 2.0) + 0.01 * k as f64;
         }
         u[0] = 0.4 - 0.05 * k as f64;
-        let mut jac = model::JacX::zeros();
-        model::jac_x_into(&p, 0.0, &x, &u, &mut jac);
-        for c in 0..model::N_STATES {
-            let (mut up, mut down) = (x, x);
-            up[c] += h;
-            down[c] -= h;
-            let (fu, fd) = (model::rhs(&p, 0.0, &up, &u), model::rhs(&p, 0.0, &down, &u));
-            for r in 0..model::N_STATES {
-                let want = (fu[r] - fd[r]) / (2.0 * h);
+"#;
+    let largest = r#"
+        for r in 0..model::N_STATES {
+            for c in 0..model::N_STATES {
                 largest = largest.max(jac[(r, c)].abs());
-                worst = worst.max((jac[(r, c)] - want).abs() / (1.0 + want.abs()));
             }
         }
-    }
-    println!("{:e} {:e}", largest, worst);
 "#;
-    let dir = scratch("cart-loop-jacobian");
-    let printed = build_and_run(
-        &dir,
-        "cart_loop",
-        &code,
-        &program("cart_loop", body),
-        LIBM_STD,
+    let body = format!(
+        "    let mut largest = 0.0f64;\n    for k in 0..20 {{{point}{CENTRAL_DIFFERENCES}{largest}    }}\n    \
+         println!(\"{{:e}} {{:e}}\", largest, worst);\n"
     );
-    let _ = std::fs::remove_dir_all(&dir);
-    let fields: Vec<f64> = printed
-        .split_whitespace()
-        .map(|v| v.parse().unwrap_or(f64::NAN))
-        .collect();
-    assert_eq!(fields.len(), 2, "{printed}");
-    assert!(fields[0] > 1.0, "{printed}");
-    assert!(fields[1] < 1e-6, "{printed}");
+    let (largest, worst) = run("cart_loop", &code, &body);
+    assert!(largest > 1.0, "{largest:e}");
+    assert!(worst < 1e-6, "{worst:e}");
 }

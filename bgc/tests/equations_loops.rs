@@ -223,19 +223,23 @@ fn code_generation_solves_the_tear_block_in_the_generated_module() {
 /// nonlinear algebraic loop: a damper `b` in series with a nonlinear damper `rp1` (`e = b f + b v0 tanh(f/v0)`)
 /// that is in parallel with two dampers `b` and `2 b` in series.
 fn cart_pole_behind_a_loop() -> Equations {
+    derived("cart_pole_loop.bg", cart_pole_behind_a_loop_text())
+}
+
+/// The text of [`cart_pole_behind_a_loop`].
+pub(crate) fn cart_pole_behind_a_loop_text() -> String {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/tests/fixtures/fields/cart_pole_field.bg"
     );
-    let text = std::fs::read_to_string(path).expect("fixture").replace(
+    std::fs::read_to_string(path).expect("fixture").replace(
         "    output angle",
         "    param b = 0.5 [N s/m];\n    param v0 = 1 [m/s];\n    \
          1 s1; R rs1 = b; 0 n1; R rp1 { e = b*f + b*v0*tanh(f/v0); }\n    \
          1 s2; R rs2 = b; 0 n2; R rp2 = 2*b;\n    \
          bond cart -> s1; bond s1 -> rs1; bond s1 -> n1; bond n1 -> rp1;\n    \
          bond n1 -> s2; bond s2 -> rs2; bond s2 -> n2; bond n2 -> rp2;\n    output angle",
-    );
-    derived("cart_pole_loop.bg", text)
+    )
 }
 
 /// The rates of the cart-pole behind the loop, by hand: the network's force on the cart is `b v + e`, where the

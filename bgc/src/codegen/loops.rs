@@ -764,36 +764,12 @@ fn loop_values(p: &Params, t: f64, x: &State, u: &Inputs) -> Tears {
         self.tear_lets(d, exprs);
     }
 
-    /// The expressions the loop correction of a Jacobian needs ([`Self::loop_correction`]): of each block whose
-    /// `dz` is formed, its `∂r/∂z` (its own tears and the formed earlier blocks' it reads), its `∂r/∂v` at its
-    /// columns and `∂g/∂z` at its rows.
+    /// The expressions the loop correction of a Jacobian needs ([`Self::loop_correction`]): the cells it writes,
+    /// listed by the same walk.
     pub(super) fn loop_correction_exprs(&self, g_z: &[Vec<Expr>], r_v: &[Vec<Expr>]) -> Vec<Expr> {
-        let Some(lp) = &self.plan.loops else {
-            return Vec::new();
-        };
-        let (read_rows, read_cols) = correction_support(g_z, r_v);
-        if read_rows.is_empty() || read_cols.is_empty() {
-            return Vec::new();
-        }
-        let (supports, formed) = formed_blocks(lp, g_z, r_v);
-        let mut out = Vec::new();
-        for (k, b) in lp.blocks.iter().enumerate().filter(|&(k, _)| formed[k]) {
-            let own = b.first..b.first + b.residuals.len();
-            for i in own.clone() {
-                out.extend(own.clone().map(|j| &lp.drdz[i][j]));
-                out.extend(supports[k].cols.iter().map(|&c| &r_v[i][c]));
-                for (c, earlier) in lp.blocks.iter().enumerate().take(k) {
-                    if formed[c] {
-                        let theirs = earlier.first..earlier.first + earlier.residuals.len();
-                        out.extend(theirs.map(|m| &lp.drdz[i][m]));
-                    }
-                }
-            }
-            for &row in &supports[k].rows {
-                out.extend(own.clone().map(|m| &g_z[row][m]));
-            }
-        }
-        out.into_iter().filter(|e| !e.is_zero()).cloned().collect()
+        let mut listed = Vec::new();
+        self.correction_into(&mut Sink::Listed(&mut listed), g_z, r_v);
+        listed
     }
 
     /// The lines that add `∂g/∂z dz/dv` to `jac`, `dz/dv = −(∂r/∂z)⁻¹ ∂r/∂v`, block by block
@@ -802,30 +778,39 @@ fn loop_values(p: &Params, t: f64, x: &State, u: &Inputs) -> Tears {
     /// The matrices on the stack are a block's tears by those rows and columns, so independent loops keep small
     /// ones however many there are, and the products cost their counts, not `rows × cols × N_TEARS`.
     pub(super) fn loop_correction(&self, d: &mut Draft, g_z: &[Vec<Expr>], r_v: &[Vec<Expr>]) {
+        self.correction_into(&mut Sink::Body(d), g_z, r_v);
+    }
+
+    /// The loop correction of `g` by `v` into `sink`: nothing when no row of `∂g/∂z` reads a tear or no residual
+    /// reads `v`.
+    fn correction_into(&self, sink: &mut Sink<'_>, g_z: &[Vec<Expr>], r_v: &[Vec<Expr>]) {
         let Some(lp) = &self.plan.loops else {
             return;
         };
-        let (read_rows, read_cols) = correction_support(g_z, r_v);
-        if read_rows.is_empty() || read_cols.is_empty() {
+        let (supports, formed) = formed_blocks(lp, g_z, r_v);
+        let reads_tears = supports.iter().any(|s| !s.rows.is_empty());
+        let reads_v = supports.iter().any(|s| !s.cols.is_empty());
+        if !(reads_tears && reads_v) {
             return;
         }
-        d.lines.extend(self.comment_lines(
-            "Through the algebraic loops (implicit function theorem), block by block: dz_k = −(∂r_k/∂z_k)⁻¹ (∂r_k/∂v \
-             + Σ ∂r_k/∂z_c dz_c), jac += (∂/∂z_k) dz_k, only at the rows that read a tear of the block \
-             (`LOOP_ROWS_k`) and the columns that its residuals reach (`LOOP_COLS_k`).",
-        ));
-        let (supports, formed) = formed_blocks(lp, g_z, r_v);
+        if let Sink::Body(d) = sink {
+            d.lines.extend(self.comment_lines(
+                "Through the algebraic loops (implicit function theorem), block by block: dz_k = −(∂r_k/∂z_k)⁻¹ \
+                 (∂r_k/∂v + Σ ∂r_k/∂z_c dz_c), jac += (∂/∂z_k) dz_k, only at the rows that read a tear of the block \
+                 (`LOOP_ROWS_k`) and the columns that its residuals reach (`LOOP_COLS_k`).",
+            ));
+        }
         for (k, b) in lp.blocks.iter().enumerate() {
             if formed[k] {
-                self.block_correction(d, lp, (k, b), (&supports, &formed), (g_z, r_v));
+                self.block_correction(sink, lp, (k, b), (&supports, &formed), (g_z, r_v));
             }
         }
     }
 
-    /// The lines of block `k`'s part of [`Self::loop_correction`].
+    /// Block `k`'s part of [`Self::loop_correction`].
     fn block_correction(
         &self,
-        d: &mut Draft,
+        sink: &mut Sink<'_>,
         lp: &LoopPlan,
         (k, b): (usize, &LoopBlockPlan),
         (supports, formed): (&[BlockSupport], &[bool]),
@@ -834,24 +819,18 @@ fn loop_values(p: &Params, t: f64, x: &State, u: &Inputs) -> Tears {
         let support = &supports[k];
         let (n, first) = (b.residuals.len(), b.first);
         let (n_rows, n_cols) = (support.rows.len(), support.cols.len());
-        let index_list = |name: String, list: &[usize], d: &mut Draft| {
+        let index_list = |name: String, list: &[usize]| {
             let items: Vec<String> = list.iter().map(usize::to_string).collect();
             let head = format!("    const {name}: [usize; {}] = ", items.len());
-            d.lines.push(crate::codegen::format::array(
-                &head, &items, ";", 4, self.width,
-            ));
+            crate::codegen::format::array(&head, &items, ";", 4, self.width)
         };
-        index_list(format!("LOOP_COLS_{k}"), &support.cols, d);
-        d.lines.push(format!(
-            "    let mut rz_{k} = SMatrix::<f64, {n}, {n}>::zeros();"
-        ));
-        d.lines.push(format!(
-            "    let mut rv_{k} = SMatrix::<f64, {n}, {n_cols}>::zeros();"
-        ));
+        sink.line(|| index_list(format!("LOOP_COLS_{k}"), &support.cols));
+        sink.line(|| format!("    let mut rz_{k} = SMatrix::<f64, {n}, {n}>::zeros();"));
+        sink.line(|| format!("    let mut rv_{k} = SMatrix::<f64, {n}, {n_cols}>::zeros();"));
         for i in 0..n {
             for j in 0..n {
                 self.cell(
-                    d,
+                    sink,
                     &format!("rz_{k}"),
                     (i, j),
                     &lp.drdz[first + i][first + j],
@@ -859,7 +838,7 @@ fn loop_values(p: &Params, t: f64, x: &State, u: &Inputs) -> Tears {
                 );
             }
             for (j, &col) in support.cols.iter().enumerate() {
-                self.cell(d, &format!("rv_{k}"), (i, j), &r_v[first + i][col], true);
+                self.cell(sink, &format!("rv_{k}"), (i, j), &r_v[first + i][col], true);
             }
         }
         for (c, earlier) in lp.blocks.iter().enumerate().take(k) {
@@ -868,18 +847,11 @@ fn loop_values(p: &Params, t: f64, x: &State, u: &Inputs) -> Tears {
             }
             let width = earlier.residuals.len();
             let to = format!("rc_{k}_{c}");
-            d.lines.push(format!(
-                "    let mut {to} = SMatrix::<f64, {n}, {width}>::zeros();"
-            ));
+            sink.line(|| format!("    let mut {to} = SMatrix::<f64, {n}, {width}>::zeros();"));
             for i in 0..n {
                 for m in 0..width {
-                    self.cell(
-                        d,
-                        &to,
-                        (i, m),
-                        &lp.drdz[first + i][earlier.first + m],
-                        false,
-                    );
+                    let e = &lp.drdz[first + i][earlier.first + m];
+                    self.cell(sink, &to, (i, m), e, false);
                 }
             }
             // Where each of block c's columns is among block k's (a superset, by construction).
@@ -888,47 +860,75 @@ fn loop_values(p: &Params, t: f64, x: &State, u: &Inputs) -> Tears {
                 .iter()
                 .filter_map(|col| support.cols.iter().position(|x| x == col))
                 .collect();
-            index_list(format!("LOOP_AT_{k}_{c}"), &at, d);
-            d.lines.push(format!(
-                "    for (j, &to) in LOOP_AT_{k}_{c}.iter().enumerate() {{\n        for i in 0..{n} {{\n            \
-                 for m in 0..{width} {{\n                rv_{k}[(i, to)] -= {to}[(i, m)] * dz_{c}[(m, j)];\n            \
-                 }}\n        }}\n    }}"
-            ));
+            sink.line(|| index_list(format!("LOOP_AT_{k}_{c}"), &at));
+            sink.line(|| {
+                format!(
+                    "    for (j, &to) in LOOP_AT_{k}_{c}.iter().enumerate() {{\n        for i in 0..{n} {{\n            \
+                     for m in 0..{width} {{\n                rv_{k}[(i, to)] -= {to}[(i, m)] * dz_{c}[(m, j)];\n            \
+                     }}\n        }}\n    }}"
+                )
+            });
         }
-        d.lines
-            .push(format!("    let dz_{k} = bgc_solve(rz_{k}, rv_{k});"));
+        sink.line(|| format!("    let dz_{k} = bgc_solve(rz_{k}, rv_{k});"));
         if n_rows == 0 {
             return;
         }
-        index_list(format!("LOOP_ROWS_{k}"), &support.rows, d);
-        d.lines.push(format!(
-            "    let mut gz_{k} = SMatrix::<f64, {n_rows}, {n}>::zeros();"
-        ));
+        sink.line(|| index_list(format!("LOOP_ROWS_{k}"), &support.rows));
+        sink.line(|| format!("    let mut gz_{k} = SMatrix::<f64, {n_rows}, {n}>::zeros();"));
         for (i, &row) in support.rows.iter().enumerate() {
             for m in 0..n {
-                self.cell(d, &format!("gz_{k}"), (i, m), &g_z[row][first + m], false);
+                self.cell(
+                    sink,
+                    &format!("gz_{k}"),
+                    (i, m),
+                    &g_z[row][first + m],
+                    false,
+                );
             }
         }
-        d.lines.push(format!(
-            "    for (i, &row) in LOOP_ROWS_{k}.iter().enumerate() {{\n        for (j, &col) in \
-             LOOP_COLS_{k}.iter().enumerate() {{\n            for m in 0..{n} {{\n                \
-             jac[(row, col)] += gz_{k}[(i, m)] * dz_{k}[(m, j)];\n            }}\n        }}\n    }}"
-        ));
+        sink.line(|| {
+            format!(
+                "    for (i, &row) in LOOP_ROWS_{k}.iter().enumerate() {{\n        for (j, &col) in \
+                 LOOP_COLS_{k}.iter().enumerate() {{\n            for m in 0..{n} {{\n                \
+                 jac[(row, col)] += gz_{k}[(i, m)] * dz_{k}[(m, j)];\n            }}\n        }}\n    }}"
+            )
+        });
     }
 
-    /// `var[(i, j)] = e;` (`-e` with `negate`) under its equation, unless `e` is zero.
-    fn cell(&self, d: &mut Draft, var: &str, (i, j): (usize, usize), e: &Expr, negate: bool) {
+    /// `var[(i, j)] = e;` (`-e` with `negate`) under its equation, unless `e` is zero; listed, `e` itself.
+    fn cell(&self, sink: &mut Sink<'_>, var: &str, (i, j): (usize, usize), e: &Expr, negate: bool) {
         if e.is_zero() {
             return;
         }
-        let value = if negate { -e } else { e.clone() };
-        self.statement(
-            d,
-            &format!("{var}[{i}, {j}] = "),
-            &value,
-            &format!("{var}[({i}, {j})] = "),
-            ";",
-        );
+        match sink {
+            Sink::Listed(listed) => listed.push(e.clone()),
+            Sink::Body(d) => {
+                let value = if negate { -e } else { e.clone() };
+                self.statement(
+                    d,
+                    &format!("{var}[{i}, {j}] = "),
+                    &value,
+                    &format!("{var}[({i}, {j})] = "),
+                    ";",
+                );
+            }
+        }
+    }
+}
+
+/// Where the loop correction goes: written into a function body, or its cells' expressions only listed (for the
+/// body's bindings, before it is written).
+enum Sink<'s> {
+    Body(&'s mut Draft),
+    Listed(&'s mut Vec<Expr>),
+}
+
+impl Sink<'_> {
+    /// Appends the line `make` builds to a body.
+    fn line(&mut self, make: impl FnOnce() -> String) {
+        if let Sink::Body(d) = self {
+            d.lines.push(make());
+        }
     }
 }
 
@@ -1013,17 +1013,4 @@ pub(crate) fn block_supports(
         });
     }
     supports
-}
-
-/// The rows of `∂g/∂z` and the columns of `∂r/∂v` that are not identically zero: where the loops' correction of
-/// a Jacobian can be (it is zero when either list is empty).
-pub(crate) fn correction_support(g_z: &[Vec<Expr>], r_v: &[Vec<Expr>]) -> (Vec<usize>, Vec<usize>) {
-    let rows = (0..g_z.len())
-        .filter(|&i| g_z[i].iter().any(|e| !e.is_zero()))
-        .collect();
-    let width = r_v.first().map_or(0, Vec::len);
-    let cols = (0..width)
-        .filter(|&j| r_v.iter().any(|r| r.get(j).is_some_and(|e| !e.is_zero())))
-        .collect();
-    (rows, cols)
 }

@@ -190,6 +190,26 @@ pub(super) enum MassColumns {
     Params,
 }
 
+impl MassColumns {
+    /// A block's `(column, ∂M/∂v_column)` by these columns (`M` does not depend on the inputs).
+    fn slopes(self, b: &MassPlan) -> &Derivatives {
+        match self {
+            MassColumns::States => &b.derivatives,
+            MassColumns::Inputs => &[],
+            MassColumns::Params => &b.param_derivatives,
+        }
+    }
+
+    /// The term of `M`'s slope in the rows' equation, as the comments write it.
+    fn slope_term(self) -> &'static str {
+        match self {
+            MassColumns::States => " − (∂M/∂x_k) ḟ",
+            MassColumns::Inputs => "",
+            MassColumns::Params => " − (∂M/∂p_k) ḟ",
+        }
+    }
+}
+
 impl Writer<'_> {
     /// `pub fn mass_<field>(p, x) -> SMatrix`: the inertia matrix of each I-field.
     pub(super) fn mass_fns(&mut self) {
@@ -254,40 +274,19 @@ impl Writer<'_> {
     /// turn the rows of `∂F` in `jac` into those of the rates: `M ∂ḟ = ∂F − (∂M/∂v) ḟ` (`M` does not depend on the
     /// inputs).
     pub(super) fn mass_solve_in_jacobian(&self, d: &mut Draft, columns: MassColumns) {
-        fn slopes(b: &MassPlan, columns: MassColumns) -> &Derivatives {
-            match columns {
-                MassColumns::States => &b.derivatives,
-                MassColumns::Inputs => &[],
-                MassColumns::Params => &b.param_derivatives,
-            }
-        }
         // The rates `ḟ` that the slope corrections read, once for all blocks.
-        if self
-            .plan
-            .mass
-            .iter()
-            .any(|b| !slopes(b, columns).is_empty())
-        {
+        if self.plan.mass.iter().any(|b| !columns.slopes(b).is_empty()) {
             d.lines.push("    let mut dx = State::zeros();".into());
             d.lines.push("    rhs_into(p, t, x, u, &mut dx);".into());
             d.uses.t = true;
             d.uses.u = true;
         }
         for b in &self.plan.mass {
-            let derivatives = slopes(b, columns);
-            let v = match columns {
-                MassColumns::States => "x_k",
-                MassColumns::Inputs => "",
-                MassColumns::Params => "p_k",
-            };
-            let correction = if v.is_empty() {
-                String::new()
-            } else {
-                format!(" − (∂M/∂{v}) ḟ")
-            };
+            let derivatives = columns.slopes(b);
             d.lines.extend(self.comment_lines(&format!(
-                "The rows of d/dt [{}]: M (∂ḟ) = ∂F{correction}, solved with M.",
+                "The rows of d/dt [{}]: M (∂ḟ) = ∂F{}, solved with M.",
                 self.state_list(&b.rows),
+                columns.slope_term(),
             )));
             for (k, dm) in derivatives {
                 let by = self.column_name(columns, *k);

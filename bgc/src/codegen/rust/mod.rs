@@ -570,10 +570,8 @@ impl<'a> Writer<'a> {
         }
     }
 
-    /// Appends the model's code to `out`: the helpers it calls, then its items, each allowed `dead_code`. The items
-    /// are written once and copied once (a large model's text is hundreds of megabytes).
-    /// Writes the model's items and hands their lines to `out`, the prelude (imports and helper functions) first;
-    /// returns whether the text ends with a line break.
+    /// Writes the model's items and hands their lines to `out`, each item allowed `dead_code`, the prelude (imports
+    /// and the helper functions it calls) first; returns whether the text ends with a line break.
     fn write_into(mut self, out: &mut dyn FnMut(&str)) -> bool {
         self.sizes();
         self.params();

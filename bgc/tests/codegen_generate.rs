@@ -182,9 +182,39 @@ fn elementary_functions_are_libm_calls_bound_once() {
 fn each_distinct_elementary_call_is_computed_once_per_body() {
     // The walking leg's gravity and ground terms take cos and sin of angle differences in several equations
     // (`cos(q_leg_1 - q_leg_2 + q_leg_3)` in three of the rhs): each distinct call is bound once per body.
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../models/walking_leg.bg");
-    let text = std::fs::read_to_string(path).unwrap();
-    let code = generate(&text);
+    let code = generate_file("../models/walking_leg.bg");
+    assert!(calls_per_body(&code) >= 3, "bodies with libm calls");
+    assert!(
+        code.contains("libm::cos(q_leg_1 - q_leg_2 + q_leg_3)"),
+        "{code}"
+    );
+}
+
+#[test]
+fn a_call_on_a_tear_is_computed_once_per_body() {
+    // The diode's current `I_s*(exp((u - q/C - R_s*i)/V_t) - 1)` in a loop torn at `i`: its residual, scale and
+    // slope, and every entry of the Jacobians through the loop, read the same exponential of the tear.
+    for (file, tear) in [
+        ("tests/corpus/diode_rc.bg", "loop_f_diode"),
+        ("../models/tests/models/chained_loops.bg", "loop_"),
+    ] {
+        let code = generate_file(file);
+        assert!(calls_per_body(&code) >= 5, "{file}: bodies with libm calls");
+        let bound = code
+            .lines()
+            .any(|l| l.trim_start().starts_with("let exp_") && l.contains(tear));
+        assert!(bound, "{file}: no call on a tear bound once in\n{code}");
+    }
+}
+
+fn generate_file(relative: &str) -> String {
+    let path = format!("{}/{relative}", env!("CARGO_MANIFEST_DIR"));
+    generate(&std::fs::read_to_string(path).unwrap())
+}
+
+/// The number of public functions of `code` that call `libm`, after checking that none calls a function twice on
+/// the same argument text.
+fn calls_per_body(code: &str) -> usize {
     let mut bodies = 0;
     for body in code.split("\npub fn ").skip(1) {
         let body = &body[..body.find("\n}\n").unwrap_or(body.len())];
@@ -211,11 +241,7 @@ fn each_distinct_elementary_call_is_computed_once_per_body() {
         assert!(repeated.is_empty(), "{repeated:?} in\n{body}");
         bodies += usize::from(!seen.is_empty());
     }
-    assert!(bodies >= 3, "{bodies} bodies with libm calls");
-    assert!(
-        code.contains("libm::cos(q_leg_1 - q_leg_2 + q_leg_3)"),
-        "{code}"
-    );
+    bodies
 }
 
 #[test]

@@ -25,9 +25,10 @@
 //! only ([`block_supports`]).
 
 use super::adapter::to_symbolic;
-use super::rust::{Draft, MAX_CONSTANT_JACOBIAN_BYTES, Writer};
+use super::rust::{Draft, MAX_CONSTANT_JACOBIAN_BYTES, TearValues, Writer};
 use crate::equations::{Equations, ParamChain, residual_scale};
 use crate::symbolic::{Expr, Symbol};
+use std::collections::BTreeSet;
 use std::fmt::Write;
 
 /// The most tear variables of one block that generated code takes: its `∂r/∂z` is a square matrix on the stack,
@@ -588,8 +589,7 @@ impl Writer<'_> {
             let n = b.residuals.len();
             let mut all: Vec<&Expr> = b.residuals.iter().chain(&b.scales).collect();
             all.extend(b.jacobian.iter().flatten().filter(|e| !e.is_zero()));
-            let mut d = self.draft(&all);
-            self.tear_lets(&mut d, &all);
+            let mut d = self.draft_through_loops(&all, false, TearValues::Given);
             d.lines
                 .push(format!("    let mut r = SVector::<f64, {n}>::zeros();"));
             d.lines
@@ -726,42 +726,38 @@ fn loop_values(p: &Params, t: f64, x: &State, u: &Inputs) -> Tears {
         );
     }
 
-    /// `let loop_v = z[i];` for the tears `exprs` use.
-    fn tear_lets(&self, d: &mut Draft, exprs: &[&Expr]) {
+    /// Binds the tears of `used` in `d`: from `tears`, `let loop_v = z[i];` each, after
+    /// `let z = loop_values(p, t, x, u);` when the body solves the loops. The names bound, none when `used` holds
+    /// no tear.
+    pub(super) fn bind_tears(
+        &self,
+        d: &mut Draft,
+        used: &BTreeSet<Symbol>,
+        tears: TearValues,
+    ) -> Vec<String> {
         let Some(lp) = &self.plan.loops else {
-            return;
+            return Vec::new();
         };
-        // The symbols of all of `exprs` once: a test per tear and expression costs their product (a second per
-        // Jacobian function at 1,000 separate loops).
-        let used = symbols_of(exprs);
+        if tears == TearValues::None || !lp.tears.iter().any(|s| used.contains(s)) {
+            return Vec::new();
+        }
+        if tears == TearValues::Solved {
+            d.lines.push("    let z = loop_values(p, t, x, u);".into());
+            d.uses.p = true;
+            d.uses.t = true;
+            d.uses.x = true;
+            d.uses.u = true;
+        }
+        let mut bound = Vec::new();
         for (i, s) in lp.tears.iter().enumerate() {
             if used.contains(s) {
                 let name = self.name(s);
                 d.lines.push(format!("    let {name} = z[{i}];"));
-                d.push_local(name);
+                d.push_local(name.clone());
+                bound.push(name);
             }
         }
-    }
-
-    /// True when any of `exprs` holds a tear.
-    pub(super) fn uses_tears(&self, exprs: &[&Expr]) -> bool {
-        self.plan.loops.as_ref().is_some_and(|lp| {
-            let used = symbols_of(exprs);
-            lp.tears.iter().any(|s| used.contains(s))
-        })
-    }
-
-    /// When `exprs` hold tears: `let z = loop_values(p, t, x, u);` and the tears' `let`s.
-    pub(super) fn solve_tears(&self, d: &mut Draft, exprs: &[&Expr]) {
-        if !self.uses_tears(exprs) {
-            return;
-        }
-        d.lines.push("    let z = loop_values(p, t, x, u);".into());
-        d.uses.p = true;
-        d.uses.t = true;
-        d.uses.x = true;
-        d.uses.u = true;
-        self.tear_lets(d, exprs);
+        bound
     }
 
     /// The expressions the loop correction of a Jacobian needs ([`Self::loop_correction`]): the cells it writes,
@@ -955,15 +951,6 @@ fn formed_blocks(
         formed[k] = used && !supports[k].cols.is_empty();
     }
     (supports, formed)
-}
-
-/// The free symbols of all of `exprs`.
-fn symbols_of(exprs: &[&Expr]) -> std::collections::BTreeSet<Symbol> {
-    let mut used = std::collections::BTreeSet::new();
-    for e in exprs {
-        used.extend(e.free_symbols());
-    }
-    used
 }
 
 /// Whether the residuals of block `k` read a tear of block `c`.

@@ -1,5 +1,6 @@
 //! Calls of elementary functions bound once at the top of a body: a `libm` call whose arguments are computed
-//! from states, inputs, parameters, time and literals alone (`libm::cos(theta)`, `libm::cos(q_1 - q_2)`) is
+//! from states, inputs, parameters, time, the loops' tears and literals alone (`libm::cos(theta)`,
+//! `libm::cos(q_1 - q_2)`, `libm::exp((u - r*loop_f_d)/v_t)` in a loop's residual and slope) is
 //! computed once (`let cos_theta = ...;`, calls nested in its arguments first) and its name replaces it in the
 //! statements. The same call on the same values gives the same bits, so nothing changes
 //! but the number of calls and the length of the lines.

@@ -38,15 +38,38 @@ impl Draft {
     }
 }
 
+/// Where a body finds the values of the algebraic loops' tears that its expressions read.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(in crate::codegen) enum TearValues {
+    /// The body reads no tear.
+    None,
+    /// The body solves the loops: `let z = loop_values(p, t, x, u);`.
+    Solved,
+    /// The tears are the body's argument `z`.
+    Given,
+}
+
 impl<'a> Writer<'a> {
     /// A body that binds the states and inputs `exprs` use, and what it uses.
     pub(in crate::codegen) fn draft(&self, exprs: &[&Expr]) -> Draft {
-        self.draft_with(exprs, false)
+        self.draft_with(exprs, false, TearValues::None)
     }
 
     /// A body as [`Self::draft`] whose statements read parameter-only subexpressions from `c: &ParamTerms`.
     pub(super) fn draft_cached(&self, exprs: &[&Expr]) -> Draft {
-        self.draft_with(exprs, self.terms_enabled)
+        self.draft_with(exprs, self.terms_enabled, TearValues::None)
+    }
+
+    /// A body as [`Self::draft`] (with the parameter terms when `cache`) that also binds the tears `exprs` read,
+    /// from `tears`, before the calls that are computed once: a call on a tear (`exp((u - R*loop_i)/V_t)` in a
+    /// residual, its slope and its parameter derivatives) is then computed once too.
+    pub(in crate::codegen) fn draft_through_loops(
+        &self,
+        exprs: &[&Expr],
+        cache: bool,
+        tears: TearValues,
+    ) -> Draft {
+        self.draft_with(exprs, cache && self.terms_enabled, tears)
     }
 
     /// `e` as the body of `d` computes it: with its parameter terms when `d` reads them from `c`.
@@ -58,7 +81,7 @@ impl<'a> Writer<'a> {
         }
     }
 
-    fn draft_with(&self, exprs: &[&Expr], cache: bool) -> Draft {
+    fn draft_with(&self, exprs: &[&Expr], cache: bool, tears: TearValues) -> Draft {
         let rewritten: Vec<Expr> = if cache {
             let mut terms = self.terms.borrow_mut();
             exprs.iter().map(|e| terms.rewrite(e)).collect()
@@ -105,13 +128,14 @@ impl<'a> Writer<'a> {
             d.lines.push(format!("    let {name} = {vector}[{i}];"));
             d.locals.push(name);
         }
-        // The names available from the start: states and inputs bound above, parameters, time (not the
-        // intermediates and earlier outputs, computed in the body).
-        let early: BTreeSet<String> = used
+        // The names available from the start: states and inputs bound above, parameters, time, the tears bound
+        // next (not the intermediates and earlier outputs, computed in the body).
+        let mut early: BTreeSet<String> = used
             .iter()
             .filter(|s| !matches!(s.kind(), SymbolKind::Intermediate | SymbolKind::Output))
             .map(|s| self.name(s))
             .collect();
+        early.extend(self.bind_tears(&mut d, &used, tears));
         let mut calls = BTreeMap::new();
         for e in &exprs {
             early_calls(&self.code(e), &early, &mut calls);
@@ -222,8 +246,7 @@ impl<'a> Writer<'a> {
         }
         let mut all: Vec<&Expr> = b.lets.iter().map(|l| &l.1).collect();
         all.extend(b.results.iter());
-        let mut d = self.draft_cached(&all);
-        self.solve_tears(&mut d, &all);
+        let mut d = self.draft_through_loops(&all, true, TearValues::Solved);
         for (s, v) in &b.lets {
             let local = self.name(s);
             self.statement(
@@ -445,8 +468,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             self.jacobian_parts(name, ty, &statements, self.terms_enabled)
         } else {
             nonzero.extend(shared.iter().map(|(_, v)| v));
-            let mut d = self.draft_cached(&nonzero);
-            self.solve_tears(&mut d, &nonzero);
+            let mut d = self.draft_through_loops(&nonzero, true, TearValues::Solved);
             self.shared_statements(&mut d, shared);
             self.matrix_entries(&mut d, m.iter(), (rows, cols, row_prefix));
             self.loop_correction(&mut d, g_z, r_v);
@@ -871,8 +893,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             }
             let mut exprs: Vec<&Expr> = terms.iter().map(|t| &t.1).collect();
             exprs.extend(shared.iter().map(|(_, v)| v));
-            let mut d = self.draft(&exprs);
-            self.solve_tears(&mut d, &exprs);
+            let mut d = self.draft_through_loops(&exprs, false, TearValues::Solved);
             self.shared_statements(&mut d, shared);
             match terms.as_slice() {
                 [] => d.lines.push("    0.0".into()),

@@ -72,7 +72,7 @@ mod scopes;
 mod sparse_jac;
 mod terms;
 
-pub(super) use functions::Draft;
+pub(super) use functions::{Draft, TearValues};
 
 use super::emit::Plan;
 use super::format::{self, Wrap};

@@ -9,7 +9,7 @@
 
 use super::super::format;
 use super::super::mass::MassColumns;
-use super::{Arg, Writer, output_names};
+use super::{Arg, TearValues, Writer, output_names};
 use crate::symbolic::Expr;
 
 /// A matrix of expressions, row by row.
@@ -94,8 +94,7 @@ pub type OutJacP = SMatrix<f64, N_OUTPUTS, N_PARAMS>;
             return;
         }
         needed.extend(shared.iter().map(|(_, v)| v));
-        let mut d = self.draft(&needed);
-        self.solve_tears(&mut d, &needed);
+        let mut d = self.draft_through_loops(&needed, false, TearValues::Solved);
         self.shared_statements(&mut d, shared);
         self.matrix_entries(&mut d, entries, (rows, cols, row_prefix));
         self.loop_correction(&mut d, g_z, r_p);

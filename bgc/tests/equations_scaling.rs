@@ -17,8 +17,8 @@ use bgc::span::SourceMap;
 use bgc::symbolic::{Expr, Node};
 
 use crate::equations_support::families::{
-    gear_train, gyrator_chain, ladder, ladder_distinct, ladder_distinct_resistances, mtf_chain,
-    mtf_chain_with_phases, output_chain, parallel_pairs,
+    gear_train, gyrator_chain, ladder, ladder_distinct, ladder_distinct_resistances,
+    loops_sharing_a_resistor, mtf_chain, mtf_chain_with_phases, output_chain, parallel_pairs,
 };
 
 /// Lowers, analyses and derives one model from source text; any error fails the test.
@@ -218,6 +218,49 @@ fn ladder_with_a_resistance_per_resistor_keeps_its_loops_linear_and_small() {
             );
         }
     }
+}
+
+/// The currents along a ladder with a resistance per resistor each hold every rung beyond them. Multiplied out in
+/// the loop's unknowns, the residual of one rung read all rungs beyond it, and the equations grew with the square
+/// of the ladder (14 MB of text at 1,000 rungs). A sum of more than 16 unknowns is an unknown of its own, so each
+/// residual reads a bounded number of them and the text grows with the ladder. Many diode branches that share a
+/// resistor are the same case across: each branch reads its own current and the shared one.
+#[test]
+fn each_residual_of_a_loop_reads_a_bounded_number_of_its_unknowns() {
+    // Per residual of every block: the unknowns it reads.
+    let read = |eqs: &Equations| -> Vec<usize> {
+        eqs.tear_blocks
+            .iter()
+            .flat_map(|b| b.residuals.iter())
+            .map(|r| {
+                r.syms()
+                    .into_iter()
+                    .filter(|s| matches!(s, Sym::Tear(_)))
+                    .count()
+            })
+            .collect()
+    };
+    let size = |eqs: &Equations| to_text(eqs).len();
+    let (medium, long) = (
+        equations(&ladder_distinct(100)),
+        equations(&ladder_distinct(200)),
+    );
+    for (rungs, eqs) in [(100, &medium), (200, &long)] {
+        let most = read(eqs).into_iter().max().unwrap_or(0);
+        assert!(
+            most <= 20,
+            "{rungs} rungs: a residual reads {most} unknowns"
+        );
+    }
+    let (a, b) = (size(&medium), size(&long));
+    assert!(b < 2 * a + a / 4, "{a} bytes at 100 rungs, {b} at 200");
+    let hub = equations(&loops_sharing_a_resistor(30, 1));
+    let mut counts = read(&hub);
+    counts.sort_unstable();
+    // The shared current sums the 30 branches; each branch reads its own current and the shared one.
+    assert_eq!(counts.len(), 31, "{counts:?}");
+    assert_eq!(counts.last(), Some(&31), "{counts:?}");
+    assert!(counts[..30].iter().all(|&n| n <= 2), "{counts:?}");
 }
 
 /// A signal of time on loops kept as a linear block is refused by name, as it is in a rate: the state space has no

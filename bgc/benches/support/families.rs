@@ -182,7 +182,8 @@ pub fn loops_in_series(loops: usize, caps: usize) -> String {
 
 /// `loops` diode branches (a diode and a resistor each, with `caps` capacitors in series) fed from one source through
 /// one shared resistor: every branch current changes the shared resistor's drop, which every diode sees, so the
-/// branches are one algebraic loop of `loops` tear variables that reads all `loops × caps` charges.
+/// branches are one algebraic loop that reads all `loops × caps` charges: `loops` tear variables, and one more for
+/// the shared current when it sums more than 16 branches.
 pub fn loops_sharing_a_resistor(loops: usize, caps: usize) -> String {
     let mut s = String::from(
         "model hub {\n    domain electrical;\n    input u [V];\n    param I_s = 1e-6 [A];\n    param V_t = 0.05 [V];\n    \

@@ -16,7 +16,7 @@
 use super::build::{Built, Def};
 use super::symbols::{self, Expander, Sym, SymExt, add, div, mul};
 use crate::ir::Func;
-use crate::symbolic::{Expr, ProductTails};
+use crate::symbolic::{Expr, Node, ProductTails};
 
 /// Why a variable could not be resolved.
 #[derive(Clone, Debug, PartialEq)]
@@ -149,7 +149,8 @@ impl<'a> Resolver<'a> {
                     } else {
                         value
                     }
-                });
+                })
+                .map(|value| self.kept_local(w, value));
             match value {
                 Ok(value) => {
                     self.cache[w] = Some(value);
@@ -242,6 +243,26 @@ impl<'a> Resolver<'a> {
         }
         self.implicit.iter_mut().for_each(|(_, r)| replace(r));
         Ok(solved)
+    }
+
+    /// `value` of `w`, or `w`'s tear when `value` sums more than [`LOCAL_TERMS`] terms in the tears of an algebraic
+    /// loop: `w` is then one more unknown of the loop's block, with the residual `value − Tear(w)`. A value inside a
+    /// loop is multiplied out, so a sum that holds the next one (the currents along a ladder of resistors, each
+    /// the sum of all rungs beyond it) would otherwise hold every term beyond it, and the residuals would grow
+    /// with the square of the ladder.
+    fn kept_local(&mut self, w: usize, value: Expr) -> Expr {
+        let many_terms = matches!(value.node(), Node::Add(terms) if terms.len() > LOCAL_TERMS);
+        if !many_terms
+            || self.torn[w]
+            || has_rates(&value)
+            || !value.any_sym(&|s| matches!(s, Sym::Tear(_)))
+        {
+            return value;
+        }
+        let tear = Sym::Tear(w);
+        self.implicit
+            .push((w, symbols::sub(value, symbols::leaf(tear))));
+        symbols::leaf(tear)
     }
 
     /// Whether closing the loop of `tear` in closed form costs at most [`REWRITE_BUDGET`], as trees: the values
@@ -358,6 +379,11 @@ fn vars_read(e: &Expr) -> Vec<usize> {
         })
         .collect()
 }
+
+/// The most terms a sum in the tears of an algebraic loop holds before it is made an unknown of the loop's block
+/// ([`Resolver::kept_local`]): a residual then holds at most about this many terms, however long the chain of sums
+/// that feed each other.
+const LOCAL_TERMS: usize = 16;
 
 /// Values outside algebraic loops up to this size as a tree are multiplied out too: a small model's values keep one
 /// form however they are reached, and multiplying out a value this size costs at most this much, so a chain of

@@ -224,7 +224,8 @@ fn ladder_with_a_resistance_per_resistor_keeps_its_loops_linear_and_small() {
 /// the loop's unknowns, the residual of one rung read all rungs beyond it, and the equations grew with the square
 /// of the ladder (14 MB of text at 1,000 rungs). A sum of more than 16 unknowns is an unknown of its own, so each
 /// residual reads a bounded number of them and the text grows with the ladder. Many diode branches that share a
-/// resistor are the same case across: each branch reads its own current and the shared one.
+/// resistor are the same case across: each branch reads its own current and the shared one. Loops solved in closed
+/// form nest at most four deep.
 #[test]
 fn each_residual_of_a_loop_reads_a_bounded_number_of_its_unknowns() {
     // Per residual of every block: the unknowns it reads.
@@ -254,6 +255,12 @@ fn each_residual_of_a_loop_reads_a_bounded_number_of_its_unknowns() {
     }
     let (a, b) = (size(&medium), size(&long));
     assert!(b < 2 * a + a / 4, "{a} bytes at 100 rungs, {b} at 200");
+    // Short residuals leave the closed-form budget room for many rungs, and each rung's closed form holds the
+    // previous one several times (its parameter derivatives in generated code grew to 13 MB at 100 rungs with
+    // eight nested): four nest at most, as on a short ladder.
+    for (rungs, eqs) in [(12, &equations(&ladder_distinct(12))), (100, &medium)] {
+        assert_eq!(eqs.loops.len(), 4, "{rungs} rungs: {:?}", eqs.loops);
+    }
     let hub = equations(&loops_sharing_a_resistor(30, 1));
     let mut counts = read(&hub);
     counts.sort_unstable();

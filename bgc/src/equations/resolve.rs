@@ -57,6 +57,8 @@ pub(crate) struct Resolver<'a> {
     /// The variables whose value holds a tear, an algebraic loop's solution or the rate of a storage in derivative
     /// causality, directly or through others: the values that are multiplied out.
     looped: Vec<bool>,
+    /// Per variable: how many loops solved in closed form its value holds one inside the other.
+    nesting: Vec<usize>,
     /// The torn variables kept implicit, with their residuals `E(Tear(v)) − Tear(v)`, in the order they closed.
     implicit: Vec<(usize, Expr)>,
     /// Multiplies out the values; it remembers the expansions of earlier values, which later values hold.
@@ -77,6 +79,7 @@ impl<'a> Resolver<'a> {
             mark: vec![Mark::New; n],
             torn: vec![false; n],
             looped: vec![false; n],
+            nesting: vec![0; n],
             completed: Vec::new(),
             opened_at: vec![0; n],
             implicit: Vec::new(),
@@ -140,6 +143,7 @@ impl<'a> Resolver<'a> {
             self.looped[w] =
                 rate || self.torn[w] || deps.iter().any(|&d| self.torn[d] || self.looped[d]);
             let looped = self.looped[w];
+            self.nesting[w] = deps.iter().map(|&d| self.nesting[d]).max().unwrap_or(0);
             let value = self
                 .compute(w)
                 .and_then(|value| self.close_loop(w, value))
@@ -219,7 +223,9 @@ impl<'a> Resolver<'a> {
         // there. The tear exists only while `v` is being computed, so only the values completed since `v` was opened
         // can hold it (looking through every value at each loop cost the number of loops times the model).
         let since = self.opened_at.get(v).copied().unwrap_or(0);
-        if !has_rates(&value) && !self.closed_form_affordable(since, tear, &solved) {
+        let nesting = self.nesting.get(v).map_or(1, |n| n + 1);
+        let too_deep = nesting > MAX_NESTED_CLOSED_FORMS;
+        if !has_rates(&value) && (too_deep || !self.closed_form_affordable(since, tear, &solved)) {
             // Nested loops whose closed forms feed each other (a ladder of resistors with parameters of their own)
             // grow geometrically when solved one inside the other: the loop stays a linear block, solved
             // numerically like a nonlinear one (Newton's method takes one exact step on it).
@@ -229,19 +235,29 @@ impl<'a> Resolver<'a> {
         }
         let expander = &mut self.expander;
         let mut replace = |e: &mut Expr| {
-            if e.contains(tear) {
+            let holds = e.contains(tear);
+            if holds {
                 *e = compact(
                     expander,
                     symbols::subst(e, &mut |s| (s == tear).then(|| solved.clone())),
                 );
             }
+            holds
         };
         for &w in self.completed.get(since..).unwrap_or_default() {
-            if let Some(Some(e)) = self.cache.get_mut(w) {
-                replace(e);
+            if let Some(Some(e)) = self.cache.get_mut(w)
+                && replace(e)
+                && let Some(n) = self.nesting.get_mut(w)
+            {
+                *n = (*n).max(nesting);
             }
         }
-        self.implicit.iter_mut().for_each(|(_, r)| replace(r));
+        if let Some(n) = self.nesting.get_mut(v) {
+            *n = nesting;
+        }
+        self.implicit.iter_mut().for_each(|(_, r)| {
+            replace(r);
+        });
         Ok(solved)
     }
 
@@ -395,6 +411,11 @@ const COMPACT_TREE: usize = 1024;
 /// a resistance per resistor doubles per rung); with this bound a four-rung one keeps its closed form, a longer one
 /// has its outer rungs' loops in one linear block, and the cost stays polynomial.
 const REWRITE_BUDGET: usize = 100_000;
+
+/// The most loops solved in closed form one inside the other: each level's closed form holds the previous one
+/// several times (a ladder with a resistance per resistor: 29, 58, 104, 199 nodes as a tree for four rungs), and so
+/// do its derivatives, which generated code prints per entry. A loop nested deeper is kept as a linear block.
+const MAX_NESTED_CLOSED_FORMS: usize = 4;
 
 /// Whether `e` holds the rate of a state or of an input (a storage in derivative causality on a loop).
 fn has_rates(e: &Expr) -> bool {

@@ -178,7 +178,7 @@ fn a_loop_without_a_solution_at_the_operating_point_is_an_error() {
     let err = linearise(&eqs, StateSelection::Energy, &p, &[0.0], &[-10.0], 0.0)
         .expect_err("no solution");
     assert!(
-        matches!(&err, LinearError::LoopNotSolved { tears, .. } if tears == "loop_f_valve"),
+        matches!(&err, LinearError::LoopNotSolved { tears, .. } if tears == "`loop_f_valve`"),
         "{err:?}"
     );
     // The smallest |r| over real i is 100 - 19^2/4 = 9.75, where the damped iteration stops.

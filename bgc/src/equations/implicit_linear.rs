@@ -80,7 +80,7 @@ fn tear_slopes(
     residuals: &[Expr],
     names: &str,
 ) -> Result<TearSlopes, LinearError> {
-    let what = format!("the algebraic loop for `{names}`");
+    let what = format!("the algebraic loop for {names}");
     let m = point.tear_index.len();
     let partials: Vec<Partials> = residuals
         .iter()
@@ -183,11 +183,12 @@ pub(super) fn linearise_sparse(
             .map(|(l, (z, _))| (*z, l))
             .collect(),
     };
-    let names = tears
-        .iter()
-        .map(|&(z, _)| eqs.sym_name(z))
-        .collect::<Vec<_>>()
-        .join("`, `");
+    let names = super::tear::tear_names(
+        &tears
+            .iter()
+            .map(|&(z, _)| eqs.sym_name(z))
+            .collect::<Vec<_>>(),
+    );
     let residuals: Vec<Expr> = eqs
         .tear_blocks
         .iter()

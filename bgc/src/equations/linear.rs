@@ -61,11 +61,14 @@ pub enum LinearError {
         got: usize,
     },
     #[error(
-        "the model has an algebraic loop solved numerically (for `{tears}`): its Jacobians have no closed form; linearise it at an operating point instead"
+        "the model has an algebraic loop solved numerically (for {tears}): its Jacobians have no closed form; linearise it at an operating point instead"
     )]
-    ImplicitLoop { tears: String },
+    ImplicitLoop {
+        /// The tear variables, as messages list them ([`super::tear::tear_names`]), here and below.
+        tears: String,
+    },
     #[error(
-        "the algebraic loop for `{tears}` could not be solved at the operating point: {reason} (largest residual {residual:e})"
+        "the algebraic loop for {tears} could not be solved at the operating point: {reason} (largest residual {residual:e})"
     )]
     LoopNotSolved {
         tears: String,
@@ -73,7 +76,7 @@ pub enum LinearError {
         residual: f64,
     },
     #[error(
-        "the algebraic loop for `{tears}` is singular at the operating point: its solution does not depend smoothly on the states and inputs"
+        "the algebraic loop for {tears} is singular at the operating point: its solution does not depend smoothly on the states and inputs"
     )]
     SingularLoop { tears: String },
 }
@@ -140,11 +143,12 @@ pub(super) fn implicit_in(
         found
     };
     let names = || {
-        eqs.tear_blocks
+        let all: Vec<String> = eqs
+            .tear_blocks
             .iter()
             .flat_map(|b| b.names.iter().cloned())
-            .collect::<Vec<_>>()
-            .join("`, `")
+            .collect();
+        super::tear::tear_names(&all)
     };
     for (i, e) in f.iter().enumerate() {
         if let Some(z) = tear(e) {

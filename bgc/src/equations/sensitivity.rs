@@ -442,13 +442,13 @@ impl Sensitivity<'_> {
         rows: Rows,
     ) -> Result<Mat, LinearError> {
         let eqs = self.eqs;
-        let names = l
-            .tears
-            .iter()
-            .map(|z| eqs.symbol_name(z))
-            .collect::<Vec<_>>()
-            .join("`, `");
-        let what = |_: usize, _: usize| format!("the algebraic loop for `{names}`");
+        let names = super::tear::tear_names(
+            &l.tears
+                .iter()
+                .map(|z| eqs.symbol_name(z))
+                .collect::<Vec<_>>(),
+        );
+        let what = |_: usize, _: usize| format!("the algebraic loop for {names}");
         let rz = at.matrix(&l.rz, &what)?;
         let mut rv = at.matrix(&l.rv, &what)?;
         rv.iter_mut().flatten().for_each(|v| *v = -*v);

@@ -168,9 +168,32 @@ pub struct LoopFailure {
 }
 
 impl LoopFailure {
-    /// `loop_a, loop_b`.
+    /// Its tears for a message ([`tear_names`]).
     pub fn tear_list(&self) -> String {
-        self.tears.join("`, `")
+        tear_names(&self.tears)
+    }
+}
+
+/// The most tear names a message lists; a longer list gives the first few, the last and the count.
+const LISTED_TEARS: usize = 8;
+
+/// The tear variables `names` of a loop for a message, each in backticks: `` `loop_a`, `loop_b` ``, or for a block
+/// of more than eight the first four, the last and how many there are (a ladder's block of a thousand tears would
+/// otherwise make a message of twenty thousand characters).
+pub fn tear_names(names: &[String]) -> String {
+    let quoted = |ns: &[String]| {
+        ns.iter()
+            .map(|n| format!("`{n}`"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    match names {
+        [first @ .., last] if names.len() > LISTED_TEARS => format!(
+            "{}, …, `{last}` ({} tear variables)",
+            quoted(first.get(..LISTED_TEARS / 2).unwrap_or(first)),
+            names.len()
+        ),
+        _ => quoted(names),
     }
 }
 
@@ -293,5 +316,19 @@ mod tests {
             _ => None,
         });
         assert_eq!(v, Ok(12.0));
+    }
+
+    #[test]
+    fn a_message_lists_a_long_block_by_its_ends_and_count() {
+        let names = |n: usize| (1..=n).map(|k| format!("loop_e_n{k}")).collect::<Vec<_>>();
+        assert_eq!(tear_names(&names(1)), "`loop_e_n1`");
+        assert_eq!(
+            tear_names(&names(8)),
+            "`loop_e_n1`, `loop_e_n2`, `loop_e_n3`, `loop_e_n4`, `loop_e_n5`, `loop_e_n6`, `loop_e_n7`, `loop_e_n8`"
+        );
+        assert_eq!(
+            tear_names(&names(1000)),
+            "`loop_e_n1`, `loop_e_n2`, `loop_e_n3`, `loop_e_n4`, …, `loop_e_n1000` (1000 tear variables)"
+        );
     }
 }

@@ -103,9 +103,10 @@ pub enum SimError {
     #[error("`{state}` became non-finite at t = {time:?}")]
     NonFiniteState { time: f64, state: String },
     #[error(
-        "the algebraic loop for `{tears}` could not be solved at t = {time:?}: after {iterations} Newton iterations {reason}; the residual of `{worst}` is {residual:.3e}"
+        "the algebraic loop for {tears} could not be solved at t = {time:?}: after {iterations} Newton iterations {reason}; the residual of `{worst}` is {residual:.3e}"
     )]
     AlgebraicLoop {
+        /// The tear variables, as messages list them ([`crate::equations::tear::tear_names`]).
         tears: String,
         time: f64,
         reason: &'static str,
@@ -113,7 +114,7 @@ pub enum SimError {
         worst: String,
         residual: f64,
     },
-    #[error("the algebraic loop for `{tears}` cannot be solved: {reason}")]
+    #[error("the algebraic loop for {tears} cannot be solved: {reason}")]
     LoopSetup { tears: String, reason: String },
     #[error("the solver failed at t = {time:?}: {message}")]
     Solver { time: f64, message: String },
@@ -424,7 +425,7 @@ impl System {
         self.loops
             .solve(&values, u, stack)
             .map_err(|e| SimError::AlgebraicLoop {
-                tears: e.tears.join("`, `"),
+                tears: e.tear_list(),
                 time: t,
                 reason: e.failure.kind.describe(),
                 iterations: e.failure.iterations,
@@ -733,8 +734,8 @@ fn compile_loops(
     let mut loops = Loops::default();
     let mut k = offset;
     for block in &eqs.tear_blocks {
-        let tears = block.names.join("`, `");
-        let what = format!("the algebraic loop for `{tears}`");
+        let tears = crate::equations::tear::tear_names(&block.names);
+        let what = format!("the algebraic loop for {tears}");
         let jacobian = block_jacobian(block).ok_or_else(|| SimError::LoopSetup {
             tears: tears.clone(),
             reason: "its residuals use a function without a derivative (min or max), which Newton's method needs"

@@ -14,8 +14,8 @@
 //! residual reads every tear, so its derivatives by them are taken in one reverse walk per residual.
 //!
 //! The `rust/...` groups time what `bgc rust` does after parsing (equations, Jacobians, code generation) on the
-//! benchmark chain, the output chain, the gear train and separate algebraic loops: sparse Jacobians (a row that reads many states in one
-//! reverse walk) and shared subexpressions keep them linear in the model.
+//! benchmark chain, the output chain, the gear train and separate algebraic loops: sparse Jacobians (a row that
+//! reads many states in one reverse walk) and shared subexpressions keep them linear in the model.
 //!
 //! Run with `cargo bench -p bgc --bench equations_scaling`. The same generators, at small sizes, are checked against
 //! hand-derived values in `tests/equations_scaling.rs`.

@@ -77,10 +77,7 @@ pub fn time_in_loops(eqs: &Equations) -> Option<LinearError> {
         .iter()
         .find(|b| b.residuals.iter().any(|r| r.contains(Sym::Time)))?;
     Some(LinearError::TimeDependent {
-        what: format!(
-            "the algebraic loop for {}",
-            super::tear::tear_names(&block.names)
-        ),
+        what: super::tear::loop_named(&block.names),
         elements: time_elements_text(eqs),
     })
 }

@@ -210,9 +210,7 @@ impl<'a> Resolver<'a> {
             if has_rates(&value) {
                 return Err(ResolveError::NonlinearLoop(v));
             }
-            let residual = symbols::sub(value, symbols::leaf(tear));
-            self.implicit.push((v, residual));
-            return Ok(symbols::leaf(tear));
+            return Ok(self.kept_implicit(v, value));
         };
         let gain = symbols::sub(Expr::one(), a);
         if gain.is_zero() {
@@ -229,9 +227,7 @@ impl<'a> Resolver<'a> {
             // Nested loops whose closed forms feed each other (a ladder of resistors with parameters of their own)
             // grow geometrically when solved one inside the other: the loop stays a linear block, solved
             // numerically like a nonlinear one (Newton's method takes one exact step on it).
-            let residual = symbols::sub(value, symbols::leaf(tear));
-            self.implicit.push((v, residual));
-            return Ok(symbols::leaf(tear));
+            return Ok(self.kept_implicit(v, value));
         }
         let expander = &mut self.expander;
         let mut replace = |e: &mut Expr| {
@@ -255,9 +251,9 @@ impl<'a> Resolver<'a> {
         if let Some(n) = self.nesting.get_mut(v) {
             *n = nesting;
         }
-        self.implicit.iter_mut().for_each(|(_, r)| {
+        for (_, r) in &mut self.implicit {
             replace(r);
-        });
+        }
         Ok(solved)
     }
 
@@ -275,10 +271,14 @@ impl<'a> Resolver<'a> {
         {
             return value;
         }
-        let tear = Sym::Tear(w);
-        self.implicit
-            .push((w, symbols::sub(value, symbols::leaf(tear))));
-        symbols::leaf(tear)
+        self.kept_implicit(w, value)
+    }
+
+    /// `v`'s tear, with `v` an unknown of its loop's block defined by the residual `value − Tear(v)`.
+    fn kept_implicit(&mut self, v: usize, value: Expr) -> Expr {
+        let tear = symbols::leaf(Sym::Tear(v));
+        self.implicit.push((v, symbols::sub(value, tear.clone())));
+        tear
     }
 
     /// Whether closing the loop of `tear` in closed form costs at most [`REWRITE_BUDGET`], as trees: the values

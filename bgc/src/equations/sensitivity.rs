@@ -442,18 +442,17 @@ impl Sensitivity<'_> {
         rows: Rows,
     ) -> Result<Mat, LinearError> {
         let eqs = self.eqs;
-        let names = super::tear::tear_names(
-            &l.tears
-                .iter()
-                .map(|z| eqs.symbol_name(z))
-                .collect::<Vec<_>>(),
+        let names: Vec<String> = l.tears.iter().map(|z| eqs.symbol_name(z)).collect();
+        let (label, tears) = (
+            super::tear::loop_named(&names),
+            super::tear::tear_names(&names),
         );
-        let what = |_: usize, _: usize| format!("the algebraic loop for {names}");
+        let what = |_: usize, _: usize| label.clone();
         let rz = at.matrix(&l.rz, &what)?;
         let mut rv = at.matrix(&l.rv, &what)?;
         rv.iter_mut().flatten().for_each(|v| *v = -*v);
         // dz/dv = −(∂r/∂z)⁻¹ ∂r/∂v
-        let dz = dense::solve(&rz, &rv).ok_or(LinearError::SingularLoop { tears: names })?;
+        let dz = dense::solve(&rz, &rv).ok_or(LinearError::SingularLoop { tears })?;
         if rows.rates() {
             let rate =
                 |i: usize, _: usize| format!("∂(the rate of `{}`)/∂z", eqs.sym_name(Sym::State(i)));

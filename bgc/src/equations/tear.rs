@@ -179,7 +179,7 @@ const LISTED_TEARS: usize = 8;
 
 /// The tear variables `names` of a loop for a message, each in backticks: `` `loop_a`, `loop_b` ``, or for a block
 /// of more than eight the first four, the last and how many there are (a ladder's block of a thousand tears would
-/// otherwise make a message of twenty thousand characters).
+/// otherwise make a message of sixteen thousand characters).
 pub fn tear_names(names: &[String]) -> String {
     let quoted = |ns: &[String]| {
         ns.iter()
@@ -195,6 +195,11 @@ pub fn tear_names(names: &[String]) -> String {
         ),
         _ => quoted(names),
     }
+}
+
+/// `the algebraic loop for` its tears `names` ([`tear_names`]), as the loop errors name a block.
+pub fn loop_named(names: &[String]) -> String {
+    format!("the algebraic loop for {}", tear_names(names))
 }
 
 /// Solves every block at the values `value` of the other symbols (parameters, states, inputs, `t`), from `z = 0`.

@@ -32,6 +32,29 @@ pub(crate) fn join<A: Send, B>(
     })
 }
 
+/// `(background(), foreground())` as [`join`], for a background computation that owns what it works on (a copy of
+/// a writer with its own caches) instead of sharing it with the calling thread.
+pub(crate) fn join_owned<A: Send, B>(
+    background: impl FnOnce() -> A + Send,
+    foreground: impl FnOnce() -> B,
+) -> (A, B) {
+    // Behind a lock, so that the closure can be handed to `join`, which may run it on either thread (it is only
+    // taken under the lock, and run after).
+    let slot = std::sync::Mutex::new(Some(background));
+    let run = || {
+        let f = slot
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .take();
+        f.map(|f| f())
+    };
+    match join(run, foreground) {
+        (Some(a), b) => (a, b),
+        // `join` runs `run` exactly once, and `run` finds the closure in its slot.
+        (None, _) => unreachable!("the background computation did not run"),
+    }
+}
+
 /// Below this many items, [`map_halves`] maps on the calling thread: starting a thread costs more than the work.
 const PARALLEL_ITEMS: usize = 4096;
 

@@ -88,8 +88,8 @@ pub use print::latex::{
     latex_subscript, latex_symbol, latex_symbol_parts, to_latex, to_latex_with,
 };
 pub use print::rust::{
-    RUST_HELPER_FNS, RUST_HELPERS, RUST_MAX_FN, RUST_MIN_FN, RUST_POWI_FN, RUST_SIGN_FN, RustCode,
-    RustOp, rust_helpers_used, to_rust, to_rust_code,
+    RUST_HELPER_FNS, RUST_HELPER_PREFIX, RUST_HELPERS, RUST_MAX_FN, RUST_MIN_FN, RUST_POWI_FN,
+    RUST_SIGN_FN, RustCode, RustOp, rust_helpers_used, to_rust, to_rust_code,
 };
 pub use print::text::{to_text, to_text_with};
 pub use solve::{LinearSolution, MAX_SOLVE_SIZE, solve_linear};

@@ -210,6 +210,77 @@ fn validate_checks_each_distinct_value_once_and_names_its_first_element() {
     );
 }
 
+/// A chain of `n` masses whose last quarter has parameters of its own (`m2`, `b2`).
+fn chain_in_two_halves(n: usize) -> String {
+    let mut s = String::from(
+        "model chain {\n    domain translational;\n    param m = 1 [kg];\n    param b = 0.5 [N s/m];\n    \
+         param m2 = 2 [kg];\n    param b2 = 0.25 [N s/m];\n    param k = 1 [N/m];\n    input u [N];\n    \
+         Se drive = u;\n    C wall = 1/k;\n    bond drive -> v1;\n    bond v1 -> wall;\n",
+    );
+    for i in 1..=n {
+        let (m, b) = if 4 * i <= 3 * n {
+            ("m", "b")
+        } else {
+            ("m2", "b2")
+        };
+        s += &format!(
+            "    1 v{i};\n    I mass{i} = {m};\n    R damp{i} = {b};\n    bond v{i} -> mass{i};\n    bond v{i} -> damp{i};\n"
+        );
+        if i < n {
+            let j = i + 1;
+            s += &format!(
+                "    0 x{i};\n    C spring{i} = 1/k;\n    bond v{i} -> x{i};\n    bond x{i} -> v{j};\n    bond x{i} -> spring{i};\n"
+            );
+        }
+    }
+    s + "}\n"
+}
+
+#[test]
+fn parts_drafted_on_two_threads_read_the_parameter_terms_the_module_declares_in_order() {
+    // 1,800 rates: eight parts of `rhs`, the later four drafted on a second thread; the terms of `m2` and `b2` are
+    // first met in the sixth.
+    let code = generate_text(
+        "chain.bg",
+        &chain_in_two_halves(900),
+        Options { runtime: false },
+    );
+    assert!(
+        code.contains("fn rhs_part_8("),
+        "rhs is not split into eight parts"
+    );
+    let start = code.find("pub struct ParamTerms {").unwrap_or_default();
+    let end = code[start..].find("\n}\n").map_or(start, |e| start + e);
+    let declared: Vec<&str> = code[start..end]
+        .lines()
+        .filter_map(|l| l.trim().trim_start_matches("pub ").strip_suffix(": f64,"))
+        .collect();
+    // Each field read is declared, and read in some part.
+    let mut read: Vec<&str> = code
+        .match_indices("c.")
+        .filter(|(at, _)| !code[..*at].ends_with(|c: char| c.is_alphanumeric() || c == '_'))
+        .map(|(at, _)| {
+            let rest = &code[at + 2..];
+            let len = rest
+                .find(|c: char| !(c.is_alphanumeric() || c == '_'))
+                .unwrap_or(rest.len());
+            &rest[..len]
+        })
+        .collect();
+    read.sort_unstable();
+    read.dedup();
+    let mut sorted = declared.clone();
+    sorted.sort_unstable();
+    assert_eq!(read, sorted, "read vs declared {declared:?}");
+    // In the order the statements meet them: the first half's terms before the second half's.
+    let half = |f: &&str| f.contains("m2") || f.contains("b2");
+    let first_later = declared.iter().position(half).unwrap_or(declared.len());
+    assert!(
+        first_later > 0 && declared[first_later..].iter().all(half),
+        "{declared:?}"
+    );
+}
+
 /// The function of `code` with the most lines, and that number.
 fn longest_function(code: &str) -> (String, usize) {
     let mut longest = (String::new(), 0);

@@ -80,12 +80,14 @@ use super::layout::MAX_WIDTH;
 use super::names::{Namer, comment, string_literal};
 use super::{CompiledFile, CompiledModel};
 use crate::symbolic::{
-    Expr, ExprMap, RUST_HELPER_FNS, RustCode, Symbol, rust_helpers_used, to_rust_code,
+    Expr, ExprMap, RUST_HELPER_FNS, RUST_HELPER_PREFIX, RustCode, Symbol, rust_helpers_used,
+    to_rust_code,
 };
 use chunks::{AllowDeadCode, Chunks};
 use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 use std::fmt::Write;
+use std::sync::Arc;
 
 /// The version written into the header of generated files.
 pub const BGC_VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -302,10 +304,10 @@ pub(in crate::codegen) struct Writer<'a> {
     m: &'a CompiledModel,
     pub(in crate::codegen) plan: &'a Plan,
     options: Options,
-    /// Rust text of each symbol inside a model function (`p.J_m`, `p_rotor`, `t`).
-    names: HashMap<Symbol, String>,
+    /// Rust text of each symbol inside a model function (`p.J_m`, `p_rotor`, `t`); shared with [`Writer::fork`]s.
+    names: Arc<HashMap<Symbol, String>>,
     /// Where each state and input is read from: `(0, i)` for `x[i]`, `(1, i)` for `u[i]`.
-    positions: HashMap<Symbol, (u8, usize)>,
+    positions: Arc<HashMap<Symbol, (u8, usize)>>,
     /// Every local name of the model functions taken (states, inputs, intermediates); cloned for each function.
     namer: Namer,
     /// Field names of the free parameters, in parameter order (the fields of `Params`).
@@ -410,7 +412,7 @@ impl<'a> Writer<'a> {
         }
         names.insert(Symbol::time(), "t".into());
         let namer = namer.frozen();
-        let positions = (plan
+        let positions: HashMap<Symbol, (u8, usize)> = (plan
             .states
             .iter()
             .enumerate()
@@ -423,11 +425,11 @@ impl<'a> Writer<'a> {
         )
         .collect();
         Writer {
-            positions,
+            positions: Arc::new(positions),
             m,
             plan,
             options,
-            names,
+            names: Arc::new(names),
             namer,
             fields,
             free,
@@ -437,6 +439,29 @@ impl<'a> Writer<'a> {
             terms: RefCell::new(terms::ParamTerms::new(derived_symbols)),
             with_terms: Vec::new(),
             terms_enabled: false,
+            printed: RefCell::default(),
+            out: Chunks::default(),
+        }
+    }
+
+    /// A writer of the same model with its own text, caches and records, for drafting bodies on another thread:
+    /// it reads parameter terms from `terms` (which must rewrite every expression it drafts to what `self` would).
+    fn fork(&self, terms: terms::ParamTerms) -> Writer<'a> {
+        Writer {
+            m: self.m,
+            plan: self.plan,
+            options: self.options,
+            names: Arc::clone(&self.names),
+            positions: Arc::clone(&self.positions),
+            namer: self.namer.clone(),
+            fields: self.fields.clone(),
+            free: self.free.clone(),
+            all_fields: self.all_fields.clone(),
+            width: self.width,
+            constant_jacobians: Vec::new(),
+            terms: RefCell::new(terms),
+            with_terms: Vec::new(),
+            terms_enabled: self.terms_enabled,
             printed: RefCell::default(),
             out: Chunks::default(),
         }
@@ -625,7 +650,9 @@ impl<'a> Writer<'a> {
     fn helper_calls(&self) -> String {
         let mut code = String::new();
         for line in self.out.lines().filter(|l| {
-            RUST_HELPER_FNS.iter().any(|h| l.contains(h)) && !l.trim_start().starts_with("//")
+            l.contains(RUST_HELPER_PREFIX)
+                && RUST_HELPER_FNS.iter().any(|h| l.contains(h))
+                && !l.trim_start().starts_with("//")
         }) {
             code.push_str(line);
             code.push('\n');

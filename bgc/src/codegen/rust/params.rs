@@ -5,7 +5,7 @@ use super::super::layout::Body;
 use super::super::names::{Namer, comment, sanitize, string_literal};
 use super::{Writer, output_names, rust_f64};
 use crate::ir;
-use crate::symbolic::{Expr, Symbol, from_ir, to_rust_code, to_text};
+use crate::symbolic::{Expr, ExprMap, Symbol, from_ir, to_rust_code, to_text};
 use crate::syntax::ast::ElementKind;
 use std::collections::HashMap;
 use std::fmt::Write;
@@ -451,6 +451,7 @@ impl Writer<'_> {
         let model = &self.m.model;
         let mut checks: Vec<ElementCheck> = Vec::new();
         let mut index: HashMap<(String, &'static str), usize> = HashMap::new();
+        let mut printed: ExprMap<Option<CheckCode>> = ExprMap::default();
         for node in model.graph.node_weights() {
             let (expr, rule) = match (&node.kind, &node.relation) {
                 (ElementKind::I, ir::Relation::Linear(e)) => (e, Rule::Positive("inertia")),
@@ -469,19 +470,20 @@ impl Writer<'_> {
             let Ok(value) = from_ir(expr, &leaf) else {
                 continue;
             };
-            let Some(first) = value.free_symbols().into_iter().next() else {
+            // Elements of one value share its node: its code and key are made once (a chain of 100,000 masses
+            // has one inertia `m`).
+            let made = match printed.get(&value) {
+                Some(made) => made.clone(),
+                None => {
+                    let made = check_code(&value, field_of);
+                    printed.insert(value.clone(), made.clone());
+                    made
+                }
+            };
+            let Some((first, first_field, code, code_key)) = made else {
                 continue;
             };
-            let Some(first_field) = field_of.get(first.name()) else {
-                continue;
-            };
-            let code = to_rust_code(&value, &|s| {
-                field_of
-                    .get(s.name())
-                    .cloned()
-                    .unwrap_or_else(|| "f64::NAN".into())
-            });
-            let key = (format!("{code:?}"), rule.key());
+            let key = (code_key, rule.key());
             if let Some(&k) = index.get(&key) {
                 if let Some(check) = checks.get_mut(k) {
                     check.others += 1;
@@ -495,8 +497,8 @@ impl Writer<'_> {
                 text: to_text(&value),
                 code,
                 rule,
-                param: first.name().to_string(),
-                field: first_field.clone(),
+                param: first,
+                field: first_field,
             });
         }
         checks
@@ -525,6 +527,23 @@ impl Writer<'_> {
             })
             .collect()
     }
+}
+
+/// A checked value's first parameter, that parameter's field, the value's code and the text that identifies it.
+type CheckCode = (String, String, crate::symbolic::RustCode, String);
+
+/// The [`CheckCode`] of `value`, read through `field_of`; `None` for a value without a parameter.
+fn check_code(value: &Expr, field_of: &HashMap<String, String>) -> Option<CheckCode> {
+    let first = value.free_symbols().into_iter().next()?;
+    let first_field = field_of.get(first.name())?.clone();
+    let code = to_rust_code(value, &|s| {
+        field_of
+            .get(s.name())
+            .cloned()
+            .unwrap_or_else(|| "f64::NAN".into())
+    });
+    let key = format!("{code:?}");
+    Some((first.name().to_string(), first_field, code, key))
 }
 
 /// One check of `validate`: the value of `element` (and of `others` more elements with the same value and rule)

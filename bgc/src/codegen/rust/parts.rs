@@ -6,6 +6,11 @@
 //! states, inputs and elementary functions their own statements read; the function calls them in order. The
 //! statements and their order are those of the single body, so the results are the same bits.
 //!
+//! A function of many parts has the later half of them drafted on a second thread (a large model's writer
+//! spends most of its time drafting statements), by a copy of the writer with its own caches. The parameter
+//! terms are found first, on the calling thread and in statement order, so that the terms and their names are
+//! those of drafting the parts in turn; the parts are then written in order.
+//!
 //! Only bodies of independent statements are split: entries of a matrix, rates and outputs without `let`s (a
 //! large model's are explicit, see `emit::MAX_LETS`), terms of a sum. A model with nonlinear algebraic loops keeps
 //! single bodies (each solves its loops first).
@@ -16,6 +21,10 @@ use crate::symbolic::Expr;
 
 /// The most statements one part computes (each under its comment, with the `let`s its layout needs).
 pub(in crate::codegen) const MAX_PART_STATEMENTS: usize = 256;
+
+/// The fewest parts of one function that are drafted on two threads: below, a second thread costs more than it
+/// saves.
+const PARALLEL_PARTS: usize = 8;
 
 /// One statement of a body: `{head}{expr}{tail}` under the comment `{label}{expr}`.
 pub(super) struct Statement<'e> {
@@ -50,19 +59,8 @@ impl Writer<'_> {
         cached: bool,
         prologue: Vec<String>,
     ) -> Draft {
-        let mut drafts = Vec::new();
-        for chunk in statements.chunks(MAX_PART_STATEMENTS) {
-            let exprs: Vec<&Expr> = chunk.iter().map(|s| s.expr).collect();
-            let mut d = if cached {
-                self.draft_cached(&exprs)
-            } else {
-                self.draft(&exprs)
-            };
-            for s in chunk {
-                self.statement(&mut d, &s.label, s.expr, &s.head, &s.tail);
-            }
-            drafts.push(d);
-        }
+        let chunks: Vec<&[Statement]> = statements.chunks(MAX_PART_STATEMENTS).collect();
+        let drafts = self.part_drafts(&chunks, cached);
         // Every part takes the arguments some part reads, so that the calls pass the same ones.
         let mut all = Uses::default();
         let mut terms = false;
@@ -102,6 +100,51 @@ impl Writer<'_> {
             self.private_part(doc, name, args, d);
         }
         main
+    }
+
+    /// The body of each part: those of the later half drafted on a second thread when there are many, by a
+    /// [`Writer::fork`] whose parameter terms were found first, in statement order, so that the terms and their
+    /// names are those of drafting the parts one after the other.
+    fn part_drafts<'e>(&self, chunks: &[&[Statement<'e>]], cached: bool) -> Vec<Draft> {
+        if chunks.len() < PARALLEL_PARTS {
+            return chunks.iter().map(|c| self.part_draft(c, cached)).collect();
+        }
+        let (first, second) = chunks.split_at(chunks.len() / 2);
+        let roots = |half: &[&[Statement<'e>]]| -> Vec<&'e Expr> {
+            half.iter().flat_map(|c| c.iter().map(|s| s.expr)).collect()
+        };
+        let fork_terms = {
+            let mut terms = self.terms.borrow_mut();
+            if cached && self.terms_enabled {
+                roots(first).into_iter().for_each(|e| {
+                    terms.rewrite(e);
+                });
+                terms.rewriting_only(&roots(second))
+            } else {
+                terms.rewriting_only(&[])
+            }
+        };
+        let fork = self.fork(fork_terms);
+        let (later, mut drafts) = crate::concurrent::join_owned(
+            move || -> Vec<Draft> { second.iter().map(|c| fork.part_draft(c, cached)).collect() },
+            || -> Vec<Draft> { first.iter().map(|c| self.part_draft(c, cached)).collect() },
+        );
+        drafts.extend(later);
+        drafts
+    }
+
+    /// The body of one part: its statements, with the parameter terms when `cached`.
+    fn part_draft(&self, chunk: &[Statement], cached: bool) -> Draft {
+        let exprs: Vec<&Expr> = chunk.iter().map(|s| s.expr).collect();
+        let mut d = if cached {
+            self.draft_cached(&exprs)
+        } else {
+            self.draft(&exprs)
+        };
+        for s in chunk {
+            self.statement(&mut d, &s.label, s.expr, &s.head, &s.tail);
+        }
+        d
     }
 
     /// Writes the draft `d` as a private `#[inline(never)]` function `name(args)` without a result.

@@ -66,6 +66,11 @@ impl ParamTerms {
         self.terms.is_empty()
     }
 
+    /// Forgets every term and rewriting found.
+    fn clear(&mut self) {
+        *self = ParamTerms::new(std::mem::take(&mut self.derived));
+    }
+
     pub(in crate::codegen) fn len(&self) -> usize {
         self.terms.len()
     }
@@ -91,6 +96,24 @@ impl ParamTerms {
         };
         self.memo.insert(e.clone(), out.clone());
         out
+    }
+
+    /// Rewrites `roots` in order (finding their terms as [`Self::rewrite`] does), and returns terms that rewrite
+    /// each of them the same way, by lookup, without the memo of every other expression met so far: for drafting
+    /// bodies of those roots on another thread.
+    pub(in crate::codegen) fn rewriting_only(&mut self, roots: &[&Expr]) -> ParamTerms {
+        let memo: ExprMap<Expr> = roots
+            .iter()
+            .map(|&e| (e.clone(), self.rewrite(e)))
+            .collect();
+        ParamTerms {
+            terms: self.terms.clone(),
+            by_expr: self.by_expr.clone(),
+            fields: self.fields.clone(),
+            derived: self.derived.clone(),
+            pure: ExprMap::default(),
+            memo,
+        }
     }
 
     /// The operands of a sum or product rewritten, the parameter-only ones combined into one term.
@@ -180,6 +203,14 @@ fn field_name(e: &Expr) -> String {
     name
 }
 
+/// The Jacobian functions whose entries [`Writer::param_terms_fit`] rewrites, in the order they are written.
+const JACOBIANS: [&str; 4] = [
+    "jac_x_into",
+    "jac_u_into",
+    "output_jac_x_into",
+    "output_jac_u_into",
+];
+
 /// The longest field name [`field_name`] builds from several parameter names.
 const MAX_FIELD: usize = 24;
 
@@ -188,8 +219,25 @@ impl Writer<'_> {
     /// binds each to a `let`, and rustc's stack overflows on a few thousand `let`s in one function (a chain of a
     /// thousand masses has a term `1/m` for each). Larger models read their parameters at each call.
     pub(super) fn param_terms_fit(&self) -> bool {
-        let mut terms = self.terms.borrow().clone();
         let plan = self.plan;
+        // The bodies meet these expressions in this order when nothing is written before `rhs` (the loops' and mass
+        // blocks' functions) and no Jacobian has shared subexpressions (rewritten after its entries). Then the
+        // terms are found here as the bodies would find them, and the bodies find them again by lookup (a large
+        // model's rewriting takes seconds); otherwise they are counted on a copy.
+        let in_place = plan.loops.is_none()
+            && plan.mass.is_empty()
+            && JACOBIANS
+                .iter()
+                .all(|name| self.shared_lets(name).is_empty());
+        let mut copy;
+        let mut own;
+        let terms: &mut ParamTerms = if in_place {
+            own = self.terms.borrow_mut();
+            &mut own
+        } else {
+            copy = self.terms.borrow().clone();
+            &mut copy
+        };
         let blocks = [&plan.rhs, &plan.outputs];
         let exprs = blocks
             .iter()
@@ -202,6 +250,7 @@ impl Writer<'_> {
         for e in exprs {
             terms.rewrite(e);
             if terms.len() > MAX_LETS {
+                terms.clear();
                 return false;
             }
         }

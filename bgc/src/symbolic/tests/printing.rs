@@ -1,8 +1,9 @@
 //! Printer snapshots for text, LaTeX and Rust, and the exact forms the code generators rely on.
 
 use super::super::{
-    Expr, RUST_HELPERS, RustCode, RustOp, Symbol, SymbolKind, latex_subscript, latex_symbol,
-    latex_symbol_parts, rust_helpers_used, to_latex, to_rust, to_rust_code, to_text,
+    Expr, RUST_HELPER_FNS, RUST_HELPER_PREFIX, RUST_HELPERS, RustCode, RustOp, Symbol, SymbolKind,
+    latex_subscript, latex_symbol, latex_symbol_parts, rust_helpers_used, to_latex, to_rust,
+    to_rust_code, to_text,
 };
 use super::{c, p, s};
 
@@ -166,6 +167,10 @@ fn only_the_helpers_a_piece_of_code_calls_are_picked() {
     // All four, in file order, give the file back.
     let all = rust_helpers_used("bgc_sign( bgc_min( bgc_max( bgc_powi(");
     assert_eq!(all.trim_end(), RUST_HELPERS.trim_end());
+    // The generator looks for the common start of their names first.
+    for name in RUST_HELPER_FNS {
+        assert!(name.starts_with(RUST_HELPER_PREFIX), "{name}");
+    }
 }
 
 #[test]

@@ -75,7 +75,7 @@ pub(crate) fn map_halves<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sy
 
 #[cfg(test)]
 mod tests {
-    use super::{PARALLEL_ITEMS, join, map_halves};
+    use super::{PARALLEL_ITEMS, join, join_owned, map_halves};
 
     #[test]
     fn halves_are_mapped_in_order_on_both_sides_of_the_threshold() {
@@ -88,6 +88,20 @@ mod tests {
                 "{n} items"
             );
         }
+    }
+
+    #[test]
+    fn an_owned_background_computation_gives_back_what_it_built() {
+        let mut owned = vec![1u64, 2, 3];
+        let mut shared = vec![10u64];
+        let (built, ()) = join_owned(
+            move || {
+                owned.push(4);
+                owned
+            },
+            || shared.push(20),
+        );
+        assert_eq!((built, shared), (vec![1, 2, 3, 4], vec![10, 20]));
     }
 
     #[test]

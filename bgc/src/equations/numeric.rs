@@ -253,18 +253,12 @@ impl Equations {
         for block in &self.mass {
             roots.extend(block.matrix.iter().flatten().cloned());
         }
-        let mut found: Vec<usize> = symbols::post_order(&roots)
-            .iter()
-            .filter_map(|e| match e.node() {
-                Node::Pow(base, exponent) if exponent.as_const().is_some_and(|x| x < 0.0) => {
-                    match base.as_sym() {
-                        Some(Sym::Param(i)) => Some(i),
-                        _ => None,
-                    }
-                }
-                _ => None,
-            })
-            .collect();
+        // The two halves of the roots walked at once: a node both reach is looked at twice, and the union is
+        // the same.
+        let (first, second) = roots.split_at(roots.len() / 2);
+        let (mut found, more) =
+            crate::concurrent::join(|| divisors_under(first), || divisors_under(second));
+        found.extend(more);
         found.sort_unstable();
         found.dedup();
         found
@@ -465,4 +459,20 @@ pub(crate) fn correct_mass_rows(
         }
     }
     Ok(())
+}
+
+/// The parameters raised to a negative power somewhere in `roots` (repeated, unordered).
+fn divisors_under(roots: &[Expr]) -> Vec<usize> {
+    symbols::post_order(roots)
+        .iter()
+        .filter_map(|e| match e.node() {
+            Node::Pow(base, exponent) if exponent.as_const().is_some_and(|x| x < 0.0) => {
+                match base.as_sym() {
+                    Some(Sym::Param(i)) => Some(i),
+                    _ => None,
+                }
+            }
+            _ => None,
+        })
+        .collect()
 }

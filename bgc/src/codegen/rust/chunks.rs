@@ -37,6 +37,13 @@ impl Chunks {
         }
     }
 
+    /// Appends the text of `other`.
+    pub(in crate::codegen) fn append(&mut self, other: Chunks) {
+        for piece in other.pieces {
+            self.push_str(&piece);
+        }
+    }
+
     pub(in crate::codegen) fn is_empty(&self) -> bool {
         self.pieces.iter().all(String::is_empty)
     }

@@ -9,7 +9,8 @@
 //! A function of many parts has the later half of them drafted on a second thread (a large model's writer
 //! spends most of its time drafting statements), by a copy of the writer with its own caches. The parameter
 //! terms are found first, on the calling thread and in statement order, so that the terms and their names are
-//! those of drafting the parts in turn; the parts are then written in order.
+//! those of drafting the parts in turn. The later half is written on the second thread too, into text of its
+//! own that then follows the first half's.
 //!
 //! Only bodies of independent statements are split: entries of a matrix, rates and outputs without `let`s (a
 //! large model's are explicit, see `emit::MAX_LETS`), terms of a sum. A model with nonlinear algebraic loops keeps
@@ -76,6 +77,7 @@ impl Writer<'_> {
         main.reads_terms = terms;
         main.lines = prologue;
         let count = drafts.len();
+        let mut written = Vec::with_capacity(count);
         for (k, d) in drafts.into_iter().enumerate() {
             let name = format!("{stem}_part_{}", k + 1);
             let mut args = Vec::new();
@@ -97,9 +99,37 @@ impl Writer<'_> {
             main.lines
                 .push(format!("    {name}({});", passed.join(", ")));
             let doc = format!("Part {} of {count} of the statements of `{stem}`.", k + 1);
-            self.private_part(doc, name, args, d);
+            written.push((doc, name, args, d));
         }
+        self.write_parts(written);
         main
+    }
+
+    /// Writes the parts in order: the later half of many into a [`Writer::fork`]'s text on a second thread, which
+    /// then follows this writer's.
+    fn write_parts(&mut self, mut parts: Vec<(String, String, Vec<Arg>, Draft)>) {
+        if parts.len() < PARALLEL_PARTS {
+            for (doc, name, args, d) in parts {
+                self.private_part(doc, name, args, d);
+            }
+            return;
+        }
+        let later = parts.split_off(parts.len() / 2);
+        let mut fork = self.fork(self.terms.borrow_mut().rewriting_only(&[]));
+        let (fork_text, ()) = crate::concurrent::join_owned(
+            move || {
+                for (doc, name, args, d) in later {
+                    fork.private_part(doc, name, args, d);
+                }
+                fork.out
+            },
+            || {
+                for (doc, name, args, d) in parts {
+                    self.private_part(doc, name, args, d);
+                }
+            },
+        );
+        self.out.append(fork_text);
     }
 
     /// The body of each part: those of the later half drafted on a second thread when there are many, by a

@@ -11,35 +11,14 @@ use std::thread;
 const STACK_BYTES: usize = 8 << 20;
 
 /// `(background(), foreground())`, the first on a helper thread while the calling thread computes the second (or
-/// after it, when no thread can be started). A panic in either is propagated, as if they had run in turn.
+/// after it, when no thread can be started). A panic in either is propagated, as if they had run in turn. The
+/// background computation may own what it works on (a copy of a writer with its own caches).
 pub(crate) fn join<A: Send, B>(
-    background: impl Fn() -> A + Sync,
-    foreground: impl FnOnce() -> B,
-) -> (A, B) {
-    thread::scope(|scope| {
-        let helper = thread::Builder::new()
-            .name("bgc-worker".into())
-            .stack_size(STACK_BYTES)
-            .spawn_scoped(scope, &background);
-        let b = foreground();
-        let a = match helper {
-            Ok(handle) => handle
-                .join()
-                .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
-            Err(_) => background(),
-        };
-        (a, b)
-    })
-}
-
-/// `(background(), foreground())` as [`join`], for a background computation that owns what it works on (a copy of
-/// a writer with its own caches) instead of sharing it with the calling thread.
-pub(crate) fn join_owned<A: Send, B>(
     background: impl FnOnce() -> A + Send,
     foreground: impl FnOnce() -> B,
 ) -> (A, B) {
-    // Behind a lock, so that the closure can be handed to `join`, which may run it on either thread (it is only
-    // taken under the lock, and run after).
+    // Behind a lock, so that the calling thread can still run it when no thread can be started: `run` holds only
+    // a reference, so the thread takes a copy of it and the calling thread keeps one.
     let slot = std::sync::Mutex::new(Some(background));
     let run = || {
         let f = slot
@@ -48,10 +27,24 @@ pub(crate) fn join_owned<A: Send, B>(
             .take();
         f.map(|f| f())
     };
-    match join(run, foreground) {
-        (Some(a), b) => (a, b),
-        // `join` runs `run` exactly once, and `run` finds the closure in its slot.
-        (None, _) => unreachable!("the background computation did not run"),
+    let (a, b) = thread::scope(|scope| {
+        let helper = thread::Builder::new()
+            .name("bgc-worker".into())
+            .stack_size(STACK_BYTES)
+            .spawn_scoped(scope, run);
+        let b = foreground();
+        let a = match helper {
+            Ok(handle) => handle
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+            Err(_) => run(),
+        };
+        (a, b)
+    });
+    match a {
+        Some(a) => (a, b),
+        // The closure is taken out of its slot once, by the thread or after it could not start.
+        None => unreachable!("the background computation did not run"),
     }
 }
 
@@ -75,7 +68,7 @@ pub(crate) fn map_halves<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sy
 
 #[cfg(test)]
 mod tests {
-    use super::{PARALLEL_ITEMS, join, join_owned, map_halves};
+    use super::{PARALLEL_ITEMS, join, map_halves};
 
     #[test]
     fn halves_are_mapped_in_order_on_both_sides_of_the_threshold() {
@@ -94,7 +87,7 @@ mod tests {
     fn an_owned_background_computation_gives_back_what_it_built() {
         let mut owned = vec![1u64, 2, 3];
         let mut shared = vec![10u64];
-        let (built, ()) = join_owned(
+        let (built, ()) = join(
             move || {
                 owned.push(4);
                 owned

@@ -80,7 +80,7 @@ fn tear_slopes(
     residuals: &[Expr],
     names: &str,
 ) -> Result<TearSlopes, LinearError> {
-    let what = format!("the algebraic loop for {names}");
+    let what = super::tear::loop_for(names);
     let m = point.tear_index.len();
     let partials: Vec<Partials> = residuals
         .iter()
@@ -226,7 +226,7 @@ fn refuse_unselected_states(eqs: &Equations, n: usize) -> Result<(), LinearError
             for j in n..eqs.states.len() {
                 if r.contains(Sym::State(j)) {
                     return Err(LinearError::NeedsIntegratedState {
-                        what: format!("the algebraic loop for `{name}`"),
+                        what: super::tear::loop_named(std::slice::from_ref(name)),
                         state: eqs.sym_name(Sym::State(j)),
                     });
                 }

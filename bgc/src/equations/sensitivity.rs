@@ -272,7 +272,8 @@ impl Equations {
         for b in &self.tear_blocks {
             tears.extend(b.tears.iter().map(|&z| z.symbol()));
             for (r, name) in b.residuals.iter().zip(&b.names) {
-                residuals.push(self.convert(r, || format!("the algebraic loop for `{name}`"))?);
+                residuals
+                    .push(self.convert(r, || super::tear::loop_named(std::slice::from_ref(name)))?);
             }
         }
         Ok(Some(Loops {
@@ -443,10 +444,8 @@ impl Sensitivity<'_> {
     ) -> Result<Mat, LinearError> {
         let eqs = self.eqs;
         let names: Vec<String> = l.tears.iter().map(|z| eqs.symbol_name(z)).collect();
-        let (label, tears) = (
-            super::tear::loop_named(&names),
-            super::tear::tear_names(&names),
-        );
+        let tears = super::tear::tear_names(&names);
+        let label = super::tear::loop_for(&tears);
         let what = |_: usize, _: usize| label.clone();
         let rz = at.matrix(&l.rz, &what)?;
         let mut rv = at.matrix(&l.rv, &what)?;

@@ -199,7 +199,12 @@ pub fn tear_names(names: &[String]) -> String {
 
 /// `the algebraic loop for` its tears `names` ([`tear_names`]), as the loop errors name a block.
 pub fn loop_named(names: &[String]) -> String {
-    format!("the algebraic loop for {}", tear_names(names))
+    loop_for(&tear_names(names))
+}
+
+/// `the algebraic loop for` the tears `tears`, already listed for a message ([`tear_names`]).
+pub fn loop_for(tears: &str) -> String {
+    format!("the algebraic loop for {tears}")
 }
 
 /// Solves every block at the values `value` of the other symbols (parameters, states, inputs, `t`), from `z = 0`.

@@ -735,7 +735,7 @@ fn compile_loops(
     let mut k = offset;
     for block in &eqs.tear_blocks {
         let tears = crate::equations::tear::tear_names(&block.names);
-        let what = crate::equations::tear::loop_named(&block.names);
+        let what = crate::equations::tear::loop_for(&tears);
         let jacobian = block_jacobian(block).ok_or_else(|| SimError::LoopSetup {
             tears: tears.clone(),
             reason: "its residuals use a function without a derivative (min or max), which Newton's method needs"

@@ -115,8 +115,8 @@ impl Writer<'_> {
             return;
         }
         let later = parts.split_off(parts.len() / 2);
-        let mut fork = self.fork(self.terms.borrow_mut().rewriting_only(&[]));
-        let (fork_text, ()) = crate::concurrent::join_owned(
+        let mut fork = self.fork(self.terms.borrow().found());
+        let (fork_text, ()) = crate::concurrent::join(
             move || {
                 for (doc, name, args, d) in later {
                     fork.private_part(doc, name, args, d);
@@ -151,11 +151,11 @@ impl Writer<'_> {
                 });
                 terms.rewriting_only(&roots(second))
             } else {
-                terms.rewriting_only(&[])
+                terms.found()
             }
         };
         let fork = self.fork(fork_terms);
-        let (later, mut drafts) = crate::concurrent::join_owned(
+        let (later, mut drafts) = crate::concurrent::join(
             move || -> Vec<Draft> { second.iter().map(|c| fork.part_draft(c, cached)).collect() },
             || -> Vec<Draft> { first.iter().map(|c| self.part_draft(c, cached)).collect() },
         );

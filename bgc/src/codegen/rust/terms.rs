@@ -107,12 +107,20 @@ impl ParamTerms {
             .map(|&e| (e.clone(), self.rewrite(e)))
             .collect();
         ParamTerms {
+            memo,
+            ..self.found()
+        }
+    }
+
+    /// The terms found so far, without the memos: for writing on another thread bodies already drafted.
+    pub(in crate::codegen) fn found(&self) -> ParamTerms {
+        ParamTerms {
             terms: self.terms.clone(),
             by_expr: self.by_expr.clone(),
             fields: self.fields.clone(),
             derived: self.derived.clone(),
             pure: ExprMap::default(),
-            memo,
+            memo: ExprMap::default(),
         }
     }
 

@@ -649,7 +649,7 @@ fn derivative_law(
         return Ok(None);
     };
     // input = g(energy): the energy variable appears as a placeholder symbol while inverting.
-    let placeholder = Sym::Tear(usize::MAX);
+    let placeholder = Sym::Tear(symbols::PLACEHOLDER);
     let mut c = Ctx {
         model: ctx.model,
         port: ctx.port.clone(),

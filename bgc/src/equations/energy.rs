@@ -142,7 +142,7 @@ fn stored_energy(
         ));
     }
     // x = g(y) with y the own variable: write g in a placeholder for y, integrate, put y back.
-    let y = Sym::Tear(usize::MAX);
+    let y = Sym::Tear(symbols::PLACEHOLDER);
     let bond_var = if capacitor {
         effort_var(b)
     } else {

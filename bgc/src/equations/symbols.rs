@@ -41,6 +41,9 @@ pub enum Sym {
     InputDot(usize),
 }
 
+/// The index of a tear that stands for no variable: the unknown while a law is inverted or integrated.
+pub(crate) const PLACEHOLDER: usize = Symbol::MAX_INDEX;
+
 impl Sym {
     /// The engine's symbol of `self`.
     pub fn symbol(self) -> Symbol {

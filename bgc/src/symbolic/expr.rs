@@ -37,37 +37,76 @@ pub enum SymbolKind {
 /// A variable of an expression: a kind and either a name, or an index into a table of its kind that its user keeps
 /// (the equations stage numbers its parameters, states, bond variables, ... and names them when it prints).
 /// Two symbols are the same when kind, name and index agree; they sort by kind, then name, then index.
-#[derive(Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+///
+/// A symbol is three words, not five: every node of every expression holds one, so its size is the size of the
+/// hash-consing table. The kind and the index share a word (`packed`).
+#[derive(Clone)]
 pub struct Symbol {
-    kind: SymbolKind,
     name: Arc<str>,
-    /// `None` for a named symbol.
-    index: Option<usize>,
+    /// The kind in the top byte; below it the index plus one, or zero for a named symbol.
+    packed: u64,
 }
 
+/// Bits of `Symbol::packed` below the kind.
+const INDEX_BITS: u32 = 56;
+const INDEX_MASK: u64 = (1 << INDEX_BITS) - 1;
+
+/// The kinds in declaration order, so that a kind comes back from its number.
+const KINDS: [SymbolKind; 9] = [
+    SymbolKind::Param,
+    SymbolKind::Input,
+    SymbolKind::Time,
+    SymbolKind::State,
+    SymbolKind::Intermediate,
+    SymbolKind::Output,
+    SymbolKind::Tear,
+    SymbolKind::StateRate,
+    SymbolKind::InputRate,
+];
+
+// `KINDS[k as usize]` is `k`.
+const _: () = {
+    let mut i = 0;
+    while i < KINDS.len() {
+        assert!(KINDS[i] as usize == i);
+        i += 1;
+    }
+};
+
 impl Symbol {
+    /// The largest index of a symbol made by [`Symbol::indexed`] (2^56 − 2).
+    pub const MAX_INDEX: usize = (INDEX_MASK - 1) as usize;
+
     pub fn new(name: impl Into<Arc<str>>, kind: SymbolKind) -> Symbol {
         Symbol {
-            kind,
             name: name.into(),
-            index: None,
+            packed: (kind as u64) << INDEX_BITS,
         }
     }
 
     /// The symbol numbered `index` among those of `kind`, without a name (it prints as `kind#index`, so its user
     /// prints it with its own names, e.g. through [`crate::symbolic::to_text_with`]).
+    ///
+    /// The index is at most [`Symbol::MAX_INDEX`]: a position in a table its user holds in memory is below 2^48
+    /// (the address space), and a placeholder index beyond every table is `MAX_INDEX` itself.
     pub fn indexed(kind: SymbolKind, index: usize) -> Symbol {
         static EMPTY: LazyLock<Arc<str>> = LazyLock::new(|| Arc::from(""));
+        debug_assert!(
+            index <= Symbol::MAX_INDEX,
+            "symbol index {index} out of range"
+        );
         Symbol {
-            kind,
             name: EMPTY.clone(),
-            index: Some(index),
+            packed: ((kind as u64) << INDEX_BITS) | ((index as u64 + 1) & INDEX_MASK),
         }
     }
 
     /// The index of a symbol made by [`Symbol::indexed`].
     pub fn index(&self) -> Option<usize> {
-        self.index
+        match self.packed & INDEX_MASK {
+            0 => None,
+            plus_one => Some((plus_one - 1) as usize),
+        }
     }
 
     pub fn param(name: impl Into<Arc<str>>) -> Symbol {
@@ -100,15 +139,45 @@ impl Symbol {
     }
 
     pub fn kind(&self) -> SymbolKind {
-        self.kind
+        KINDS[(self.packed >> INDEX_BITS) as usize]
+    }
+}
+
+impl PartialEq for Symbol {
+    fn eq(&self, other: &Symbol) -> bool {
+        self.packed == other.packed && self.name == other.name
+    }
+}
+
+impl Eq for Symbol {}
+
+impl Hash for Symbol {
+    /// The fields in the order and form of the unpacked symbol (kind, name, optional index), so that structural
+    /// hashes, and with them the order of every map of expressions, do not depend on the packing.
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        self.kind().hash(state);
+        self.name.hash(state);
+        self.index().hash(state);
+    }
+}
+
+impl PartialOrd for Symbol {
+    fn partial_cmp(&self, other: &Symbol) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Symbol {
+    fn cmp(&self, other: &Symbol) -> std::cmp::Ordering {
+        (self.kind(), &self.name, self.index()).cmp(&(other.kind(), &other.name, other.index()))
     }
 }
 
 impl fmt::Debug for Symbol {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.index() {
-            Some(i) => write!(f, "{:?}#{i}", self.kind),
-            None => write!(f, "{}:{:?}", self.name, self.kind),
+            Some(i) => write!(f, "{:?}#{i}", self.kind()),
+            None => write!(f, "{}:{:?}", self.name, self.kind()),
         }
     }
 }
@@ -116,7 +185,7 @@ impl fmt::Debug for Symbol {
 impl fmt::Display for Symbol {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.index() {
-            Some(i) => write!(f, "{:?}#{i}", self.kind),
+            Some(i) => write!(f, "{:?}#{i}", self.kind()),
             None => f.write_str(&self.name),
         }
     }

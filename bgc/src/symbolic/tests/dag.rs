@@ -373,3 +373,48 @@ fn substituting_into_many_at_once_is_substituting_into_each() {
     assert_eq!(reads_k, expected);
     assert_eq!(reads_k.iter().filter(|&&r| r).count(), 60);
 }
+
+#[test]
+fn a_symbol_keeps_its_kind_name_and_index_and_sorts_by_them_in_that_order() {
+    use super::super::SymbolKind::*;
+    let kinds = [
+        Param,
+        Input,
+        Time,
+        State,
+        Intermediate,
+        Output,
+        Tear,
+        StateRate,
+        InputRate,
+    ];
+    let mut made = Vec::new();
+    for kind in kinds {
+        for index in [0, 1, 7, 1 << 40] {
+            let symbol = Symbol::indexed(kind, index);
+            assert_eq!(
+                (symbol.kind(), symbol.name(), symbol.index()),
+                (kind, "", Some(index))
+            );
+            made.push(symbol);
+        }
+        for name in ["a", "b"] {
+            let symbol = Symbol::new(name, kind);
+            assert_eq!(
+                (symbol.kind(), symbol.name(), symbol.index()),
+                (kind, name, None)
+            );
+            made.push(symbol);
+        }
+    }
+    // Sorted by kind, then name (the indexed symbols have the empty name), then index.
+    let key = |s: &Symbol| (s.kind(), s.name().to_owned(), s.index());
+    let mut by_key = made.clone();
+    by_key.sort_by_key(key);
+    made.sort();
+    assert!(made.iter().map(key).eq(by_key.iter().map(key)));
+    assert_ne!(Symbol::indexed(State, 3), Symbol::indexed(Param, 3));
+    assert_ne!(Symbol::indexed(State, 3), Symbol::indexed(State, 4));
+    assert_eq!(Symbol::indexed(State, 3), Symbol::indexed(State, 3));
+    assert_ne!(Symbol::state("x"), Symbol::indexed(State, 0));
+}

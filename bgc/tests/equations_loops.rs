@@ -315,3 +315,44 @@ fn a_mass_matrix_behind_a_loop_is_linearised_in_the_rates() {
         assert_eq!(sparse, SparseNumericStateSpace::from_dense(&ss));
     }
 }
+
+/// The diagnostics of deriving the single model of `text`, each as its code and the source text its primary label
+/// marks.
+fn derive_findings(text: &str) -> Vec<(String, String)> {
+    let mut sources = SourceMap::new();
+    let root = sources.add("m.bg", text);
+    let (models, diags) = lower(&mut sources, root, &mut MemoryLoader::new());
+    assert!(diags.iter().all(|d| !d.is_error()), "{diags:?}");
+    let (causality, _) = analyse(&models[0]);
+    let (_, diags) = derive(&models[0], &causality);
+    diags
+        .iter()
+        .filter(|d| d.is_error())
+        .map(|d| {
+            let marked = d.primary_span().map_or("", |s| sources.snippet(s));
+            (d.code.0.to_string(), marked.to_string())
+        })
+        .collect()
+}
+
+/// A singular loop (loop gain one: `u = R1 i − R1 i`) leaves the current undetermined, and a stroke that puts both
+/// storages of an LC circuit in derivative causality leaves no state to find it from. Neither model has an output
+/// or a rate that reads the undetermined variables, only the energy terms do: the model is still refused, with one
+/// error at the loop or the storage, as it is when an output reads them (and then only once).
+#[test]
+fn a_variable_only_the_energy_terms_read_is_refused_when_it_is_undetermined() {
+    let singular = "model m { domain electrical; param R1 = 1 [Ohm]; input u [V]; Se a = u; 1 j; R r1 = R1; \
+                    R r2 { e = -R1 * f; } bond a -> j -> r1, r2; OUTPUT }";
+    let chain = "model m { domain electrical; input u [V]; Se a = u; 1 j; I i = 2; C c = 0.25; \
+                 bond a -> j -> i; bond j -> c stroke c; OUTPUT }";
+    for (text, output, code, at) in [
+        (singular, "output i [A] = f(r1);", "BG0603", "R r1 = R1;"),
+        (chain, "output vc [V] = e(c);", "BG0604", "I i = 2;"),
+    ] {
+        let without = derive_findings(&text.replace("OUTPUT", ""));
+        assert_eq!(without, [(code.to_string(), at.to_string())], "{text}");
+        let with = derive_findings(&text.replace("OUTPUT", output));
+        assert_eq!(with.len(), 1, "{with:?}");
+        assert_eq!(with[0].0, code, "{with:?}");
+    }
+}

@@ -14,7 +14,7 @@
 
 use super::build::{Ctx, effort_var, flow_var};
 use super::codes;
-use super::resolve::Resolver;
+use super::resolve::{ResolveError, Resolver};
 use super::symbols::{self, Sym, SymExt, add, div, mul, pow};
 use crate::diagnostic::Diagnostic;
 use crate::ir::{Model, Relation};
@@ -163,7 +163,15 @@ fn stored_energy(
     }))
 }
 
-/// Every element's energy term.
+/// An energy term whose bond variables the equations do not determine: the model is ill-posed there (a singular
+/// loop, a chain of storages in derivative causality), even when no rate or output reads those variables.
+pub(crate) struct Unresolved {
+    pub element: String,
+    pub kind: EnergyKind,
+    pub why: ResolveError,
+}
+
+/// Every element's energy term, and the terms left without a value because their variables are not determined.
 pub(crate) fn terms(
     model: &Model,
     ctx: &Ctx,
@@ -171,8 +179,9 @@ pub(crate) fn terms(
     rates_of: &dyn Fn(&[Expr]) -> Vec<Expr>,
     mass: &[super::field::MassBlock],
     diags: &mut Vec<Diagnostic>,
-) -> Vec<EnergyTerm> {
+) -> (Vec<EnergyTerm>, Vec<Unresolved>) {
     let mut out = Vec::new();
+    let mut unresolved = Vec::new();
     for node in model.graph.node_indices() {
         let w = &model.graph[node];
         if ctx.velocity.get(node.index()).copied().unwrap_or(false) {
@@ -181,7 +190,7 @@ pub(crate) fn terms(
         }
         if w.kind.is_field() {
             if let Some((kind, raw)) = super::field::energy(model, ctx, node, mass, diags) {
-                let value = raw.and_then(|r| resolver.expr(&r).ok());
+                let value = resolved(resolver, &mut unresolved, &w.name, kind, raw);
                 out.push(EnergyTerm {
                     element: w.name.clone(),
                     kind,
@@ -227,7 +236,7 @@ pub(crate) fn terms(
         // (`Sym::InputDot`): its power is `e·f` with `e = I·du/dt` (or `f = C·du/dt`), and leaving that out would
         // break the energy balance whenever the input varies. A consumer supplies `du/dt` (the simulator
         // differentiates the input signals) or leaves the term out and says so (generated code).
-        let value = raw.and_then(|r| resolver.expr(&r).ok());
+        let value = resolved(resolver, &mut unresolved, &w.name, kind, raw);
         out.push(EnergyTerm {
             element: w.name.clone(),
             kind,
@@ -242,7 +251,29 @@ pub(crate) fn terms(
         t.value = substituted.next();
     }
     drop_needing_acceleration(model, &mut out, diags);
-    out
+    (out, unresolved)
+}
+
+/// `raw` in states, inputs and parameters, or `None` (recorded in `unresolved`) when its variables are not
+/// determined.
+fn resolved(
+    resolver: &mut Resolver,
+    unresolved: &mut Vec<Unresolved>,
+    element: &str,
+    kind: EnergyKind,
+    raw: Option<Expr>,
+) -> Option<Expr> {
+    match resolver.expr(&raw?) {
+        Ok(value) => Some(value),
+        Err(why) => {
+            unresolved.push(Unresolved {
+                element: element.to_string(),
+                kind,
+                why,
+            });
+            None
+        }
+    }
 }
 
 /// Leaves out (with a warning) the power of each element that needs an acceleration the equations give only

@@ -372,10 +372,13 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
     // Explicit rates, with ẋ of derivative-causality storages still symbolic.
     let mut implicit = Vec::with_capacity(nstates);
     let mut rate_ok = vec![true; nstates];
+    // Whether a rate or an output could not be resolved (an energy term then reports no cause of its own).
+    let mut reported = false;
     for (i, rate) in built.rates.iter().enumerate() {
         match resolver.expr(rate) {
             Ok(e) => implicit.push(e),
             Err(e) => {
+                reported = true;
                 diags.push(resolve_diag(
                     model,
                     &built,
@@ -575,6 +578,7 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
                     &e,
                     &format!("output `{}`", out.name),
                 ));
+                reported = true;
                 None
             }
         };
@@ -613,7 +617,7 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
     }
     // The readable form and the check for values that cannot be finite on a second thread, while this one derives
     // the energy terms: neither reads what the other makes, and the two halves take about the same time.
-    let ((readable, finite_diags), ()) = crate::concurrent::join(
+    let ((readable, finite_diags), terms) = crate::concurrent::join(
         || {
             let mut found = Vec::new();
             not_finite(model, &built.states, &eqs.f, &eqs.outputs, &mut found);
@@ -621,16 +625,28 @@ pub fn derive(model: &Model, causality: &Causality) -> (Equations, Vec<Diagnosti
             (readable, found)
         },
         || {
-            eqs.energy = energy::terms(
+            energy::terms(
                 model,
                 &ctx,
                 &mut resolver,
                 &rates_of,
                 &built.mass,
                 &mut diags,
-            );
+            )
         },
     );
+    let (energy, unresolved) = terms;
+    eqs.energy = energy;
+    // A variable that only an energy term reads is as undetermined as one a rate reads: the model is ill-posed.
+    // One cause is reported, and none when a rate or an output has reported one already: the terms of the
+    // elements around one singular loop or derivative chain fail through different variables of the same cause.
+    if let Some(u) = unresolved.first().filter(|_| !reported) {
+        let what = match u.kind {
+            EnergyKind::Stored => format!("the stored energy of `{}`", u.element),
+            kind => format!("the {} power of `{}`", kind.name(), u.element),
+        };
+        diags.push(resolve_diag(model, &built, &u.why, &what));
+    }
     diags.extend(finite_diags);
     for o in &mut eqs.outputs {
         o.value = readable.alias(&o.value);

@@ -262,6 +262,27 @@ pub fn parse_unit(u: &UnitExpr) -> Result<Unit, UnitError> {
     Ok(out)
 }
 
+/// Whether a unit text (as [`parse_unit_text`] reads it) counts cycles (`Hz`, with any prefix) and whether it counts
+/// angle (`rad`, `deg`, `rpm`). Both kinds are `1/s` apart from a factor, since the radian is dimensionless; but a
+/// hertz is one cycle per second and a cycle is 2π rad, so a value converted between the two would be off by 2π.
+pub fn cycles_and_angle(text: &str) -> (bool, bool) {
+    let mut cycles = false;
+    let mut angle = false;
+    for factor in text.split(|c: char| c.is_whitespace() || c == '/') {
+        let symbol = factor.split('^').next().unwrap_or("");
+        let symbol = symbol.trim_matches(|c| c == '(' || c == ')');
+        let unprefixed = |base: &str| {
+            symbol == base
+                || PREFIXES
+                    .iter()
+                    .any(|(prefix, _)| symbol.strip_prefix(prefix) == Some(base))
+        };
+        cycles |= unprefixed("Hz");
+        angle |= unprefixed("rad") || symbol == "deg" || symbol == "rpm";
+    }
+    (cycles, angle)
+}
+
 /// Parses a unit written as in a `.bg` file but without the brackets (`mH`, `N m/rad`, `rad/s^2`, `1`), as the
 /// command line takes it after a number: `--param 'L_a=2.5 [mH]'`.
 pub fn parse_unit_text(text: &str) -> Result<Unit, String> {

@@ -107,6 +107,56 @@ fn a_bare_number_on_the_command_line_is_in_the_declared_unit() {
     assert!(err.contains("unknown unit `furlong`"), "{err}");
 }
 
+/// A hertz is 1/s and so is a radian per second, but a hertz counts cycles of 2π rad: 50 Hz is 3000 rpm as a speed
+/// of turning and 477 rpm as a value of 1/s. The command line converts neither way between hertz and an angle unit;
+/// within the angle units (and within the frequency units) it converts as usual.
+#[test]
+fn a_value_is_not_converted_between_hertz_and_an_angle_unit() {
+    let shaft = |unit: &str, value: &str| {
+        format!(
+            "model shaft {{ domain rotational; param w0 = {value} [{unit}]; Sf drive = w0; 1 s; R fr = 2; \
+             bond drive -> s -> fr; output torque [N m] = e(fr); }}"
+        )
+    };
+    let rpm = temp_model("shaft_rpm", &shaft("rpm", "3000"));
+    let hz = temp_model("shaft_hz", &shaft("Hz", "50"));
+    for (path, given) in [
+        (&rpm, "w0=50 [Hz]"),
+        (&rpm, "w0=3 [kHz]"),
+        (&hz, "w0=3000 [rpm]"),
+        (&hz, "w0=314 [rad/s]"),
+        (&hz, "w0=1 [deg/s]"),
+    ] {
+        let (code, _, err) = bgc(&["simulate", path, "--t-end", "0.1", "--param", given]);
+        assert_eq!(code, 1, "{given}: {err}");
+        assert!(err.contains("ambiguous by 2π"), "{given}: {err}");
+    }
+    // 3000 rpm = 314.159 rad/s: the friction torque 2 × 314.159 N m, given in any angle unit; 50 Hz = 50 1/s.
+    let (code, out, err) = bgc(&[
+        "simulate",
+        &rpm,
+        "--t-end",
+        "0.1",
+        "--param",
+        "w0=18000 [deg/s]",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let csv = Csv::parse(&out);
+    let tau = csv.col("torque")[0];
+    assert!(close(tau, 200.0 * std::f64::consts::PI, 1e-12), "{tau}");
+    let (code, out, err) = bgc(&[
+        "simulate",
+        &hz,
+        "--t-end",
+        "0.1",
+        "--param",
+        "w0=0.05 [kHz]",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let tau = Csv::parse(&out).col("torque")[0];
+    assert!(close(tau, 100.0, 1e-12), "{tau}");
+}
+
 #[test]
 fn initial_states_inputs_and_operating_points_take_units() {
     let path = temp_model("rotor_rpm_x0", ROTOR);

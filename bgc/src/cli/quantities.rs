@@ -8,7 +8,7 @@
 use super::params::Assignment;
 use bgc::equations::{Equations, StateKind};
 use bgc::ir::Model;
-use bgc::units::{Unit, domain_units, parse_unit_text};
+use bgc::units::{Unit, cycles_and_angle, domain_units, parse_unit_text};
 use petgraph::Direction;
 
 /// What a name on the command line stands for, with the unit its values are written in.
@@ -144,6 +144,22 @@ pub fn factor_to_declared(what: &str, d: &Declared, written: Option<&str>) -> Re
         return Err(format!(
             "{what} `{}` is in {declared}, but [{text}] is in {}",
             d.name, unit.dim
+        ));
+    }
+    let (cycles, angle) = cycles_and_angle(text);
+    let (declared_cycles, declared_angle) = cycles_and_angle(&d.text);
+    if (cycles && declared_angle) || (angle && declared_cycles) {
+        let instead = match declared_cycles {
+            true => format!("give the value in [{}], cycles per second", d.text),
+            false => "give the value in an angle unit such as [rad/s] or [rpm] (one turn per second is 60 rpm, \
+                      2π rad/s)"
+                .to_string(),
+        };
+        return Err(format!(
+            "{what} `{}` is in [{}] and the value in [{text}]: a hertz counts cycles of 2π rad, so converting between \
+             hertz and an angle unit is ambiguous by 2π (bgc's hertz is 1/s, which is 1 rad/s, not one turn per \
+             second); {instead}",
+            d.name, d.text
         ));
     }
     Ok(unit.scale / d.unit.scale)

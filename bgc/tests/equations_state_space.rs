@@ -118,3 +118,33 @@ model coils {
         );
     }
 }
+
+/// A mass on a spring with its position `x = ∫ f(mass)` declared as a coordinate beside the spring's deflection:
+/// `x − q` is constant (both integrate the one flow), but three coordinates for the three states in play are a
+/// plain change of variables. Numeric and symbolic paths give the hand-derived `ẋ = v`, `m v̇ = F − d v − k q`,
+/// `q̇ = v` (the symbolic one used to eliminate the invariant and refuse the map as not invertible).
+#[test]
+fn as_many_declared_coordinates_as_states_are_a_change_of_variables_whatever_the_invariants() {
+    let eqs = equations_of(
+        "model osc { domain translational; param m = 2 [kg]; param k = 8 [N/m]; param d = 1 [N s/m];
+         input F [N]; Se push = F; 1 v; I mass = m; C spring = 1 / k; R damper = d;
+         var x [m] = int(f(mass)); bond push -> v -> mass, spring, damper;
+         coords [x, f(mass), q(spring)]; output pos [m] = x; }",
+    );
+    let (m, k, d) = (2.0, 8.0, 1.0);
+    let a = [[0.0, 1.0, 0.0], [0.0, -d / m, -k / m], [0.0, 1.0, 0.0]];
+    let b = [0.0, 1.0 / m, 0.0];
+    let p = eqs.default_params();
+    let numeric = bgc::equations::declared_state_space(&eqs, &p).expect("numeric");
+    let symbolic = bgc::equations::declared_state_space_symbolic(&eqs).expect("symbolic");
+    let symbolic = bgc::equations::evaluate_at(&eqs, &symbolic, &p, &[0.0; 3], &[0.0], 0.0)
+        .expect("evaluated");
+    for ss in [numeric, symbolic] {
+        assert_eq!(ss.states, ["x", "f_mass", "q_spring"]);
+        for r in 0..3 {
+            assert_eq!(ss.a[r], a[r], "A row {r}");
+            assert_eq!(ss.b[r], [b[r]], "B row {r}");
+        }
+        assert_eq!(ss.c, [[1.0, 0.0, 0.0]]);
+    }
+}

@@ -5,7 +5,8 @@
 //! an energy-state row that reduces to zero is a combination `ẋ_i = Σ α_r ẋ_r` of earlier rows, so on the
 //! invariant subspace `x_i = Σ α_r x_r` and `x_i` is eliminated. On the remaining states `r`:
 //! `A_r = A_rr + A_re S`, `C_r = C_r + C_e S` (`x_e = S r`), `z = T_r r`, and
-//! `A_z = T_r A_r T_r⁻¹`, `B_z = T_r B_r`, `C_z = C_r T_r⁻¹`, `D_z = D`. A zero that the canonical form does not
+//! `A_z = T_r A_r T_r⁻¹`, `B_z = T_r B_r`, `C_z = C_r T_r⁻¹`, `D_z = D`. When there are as many coordinates as
+//! states in play, nothing is eliminated: `T` is square and the map the plain similarity. A zero that the canonical form does not
 //! recognise would hide an invariant; the result is then refused (a dimension error), never silently wrong.
 
 use super::Equations;
@@ -86,7 +87,10 @@ pub fn declared_state_space_symbolic(eqs: &Equations) -> Result<Jacobians, Coord
     let mut pivots: Vec<(usize, Vec<Expr>, Vec<Expr>)> = Vec::new();
     // (position, coefficients of x_pos = Σ coef x_other)
     let mut eliminated: Vec<(usize, Vec<Expr>)> = Vec::new();
-    for (pos, &i) in order.iter().enumerate() {
+    // As many coordinates as states in play: `T` is square over them, and the map is the plain similarity
+    // `A_z = T A T⁻¹` (when `T` is invertible), invariants or not, as in the numeric version.
+    let square = coords.len() == n;
+    for (pos, &i) in order.iter().enumerate().filter(|_| !square) {
         let mut row = row_of(i);
         let mut comb: Vec<Expr> = (0..n)
             .map(|k| if k == pos { Expr::one() } else { Expr::zero() })

@@ -148,3 +148,45 @@ fn as_many_declared_coordinates_as_states_are_a_change_of_variables_whatever_the
         assert_eq!(ss.c, [[1.0, 0.0, 0.0]]);
     }
 }
+
+/// A coefficient that varies with time (`MSe src = u*cos(w*t)`: `B = cos(w t)/R`) is not a nonlinearity in the
+/// states or inputs: the refusal says the model is time-varying and names the element, where it used to say "not
+/// linear" and ask for an operating point as if a state were to blame. A term in `t` that no element's value holds
+/// (an output's own) is named once, not "a value that uses `t`, whose value uses `t`".
+#[test]
+fn a_time_varying_coefficient_and_a_signal_written_into_an_output_are_named_as_such() {
+    let eqs = equations_of(
+        "model m { domain electrical; param w = 2 [rad/s]; input u [V]; MSe src = u * cos(w * t); 1 j;
+         R r = 2; C c = 0.5; bond src -> j -> r, c; }",
+    );
+    let rows = bgc::equations::ModelRows::new(&eqs);
+    for result in [
+        linear_state_space(&eqs, StateSelection::Energy).map(|_| ()),
+        bgc::equations::sparse_linear_state_space(&eqs, &rows, StateSelection::Energy).map(|_| ()),
+    ] {
+        match result {
+            Err(e @ LinearError::TimeVarying { .. }) => {
+                let msg = e.to_string();
+                assert!(
+                    msg.contains("B[0][0] depends on `t` through `src`"),
+                    "{msg}"
+                );
+            }
+            other => panic!("expected a time-varying model, got {other:?}"),
+        }
+    }
+    let eqs = equations_of(
+        "model m { domain electrical; param w = 2 [rad/s]; param V0 = 3 [V]; input u [V]; Se src = u; 1 j;
+         R r = 2; C c = 0.5; bond src -> j -> r, c; output y [V] = e(c) + V0 * sin(w * t); }",
+    );
+    match linear_state_space(&eqs, StateSelection::Energy) {
+        Err(e @ LinearError::TimeDependent { .. }) => {
+            let msg = e.to_string();
+            assert!(
+                msg.contains("output `y` depends on time through a term written with `t`:"),
+                "{msg}"
+            );
+        }
+        other => panic!("expected a refusal of the signal in `y`, got {other:?}"),
+    }
+}

@@ -136,7 +136,9 @@ fn state_space(d: &Derived, args: &StateSpaceArgs<'_>) -> Result<Value, String> 
             }
             let declared = |e: CoordsError| match e {
                 CoordsError::Linear(
-                    l @ (LinearError::NotLinear { .. } | LinearError::Affine { .. }),
+                    l @ (LinearError::NotLinear { .. }
+                    | LinearError::TimeVarying { .. }
+                    | LinearError::Affine { .. }),
                 ) => format!(
                     "the state space in declared coordinates needs a linear model: {l}; use --coords energy with --at"
                 ),
@@ -187,6 +189,7 @@ fn energy_coords(
         Ok(j) => Ok(j),
         Err(
             e @ (LinearError::NotLinear { .. }
+            | LinearError::TimeVarying { .. }
             | LinearError::Affine { .. }
             | LinearError::MassMatrix { .. }),
         ) => Err(e),
@@ -201,12 +204,17 @@ fn energy_coords(
             return Err(format!("no state space: {e}"));
         }
         if !equations::linear_through_loops(eqs, selection) {
-            return Err(format!(
-                "the model is not linear ({why}): give an operating point with --at NAME=VALUE,... (states: {}; \
-                 inputs: {}; those not given are 0)",
-                name_list(&state_names),
-                name_list(&eqs.inputs)
-            ));
+            let (states, inputs) = (name_list(&state_names), name_list(&eqs.inputs));
+            return Err(match why {
+                LinearError::TimeVarying { .. } => format!(
+                    "no state space: {why} (--at NAME=VALUE,...; states: {states}; inputs: {inputs}; those not \
+                     given are 0)"
+                ),
+                _ => format!(
+                    "the model is not linear ({why}): give an operating point with --at NAME=VALUE,... (states: \
+                     {states}; inputs: {inputs}; those not given are 0)"
+                ),
+            });
         }
     }
     let fixed = fixed_params(eqs, args.params, params);

@@ -35,6 +35,12 @@ pub enum LinearError {
         symbol: String,
     },
     #[error(
+        "the model is time-varying: {entry} depends on `t` through {elements}; a state space ẋ = A x + B u has \
+         constant matrices. Linearise at an operating point (`--at`), which takes the coefficients at t = 0, or \
+         simulate the model"
+    )]
+    TimeVarying { entry: String, elements: String },
+    #[error(
         "{what} has a constant part (an affine model): linearise it at an operating point instead"
     )]
     Affine { what: String },
@@ -49,7 +55,7 @@ pub enum LinearError {
     )]
     MassMatrix { element: String },
     #[error(
-        "{what} depends on time through {elements}, whose value uses `t`: the state space ẋ = A x + B u has no column for a signal of time. Make it an input: declare `input NAME [UNIT];`, write the element's value in it (`Se mains = NAME;`), and give the signal at run time (`bgc simulate --input 'NAME=V0*sin(w*t)'`)"
+        "{what} depends on time through {elements}: the state space ẋ = A x + B u has no column for a signal of time. Make it an input: declare `input NAME [UNIT];`, write the element's value in it (`Se mains = NAME;`), and give the signal at run time (`bgc simulate --input 'NAME=V0*sin(w*t)'`)"
     )]
     TimeDependent { what: String, elements: String },
     #[error("the mass matrix of `{element}` is singular at this point")]
@@ -338,11 +344,14 @@ pub fn linear_state_space(
                     }
                 });
                 if let Some(s) = found {
-                    return Err(LinearError::NotLinear {
-                        what: what.to_string(),
-                        entry: format!("{name}[{r}][{c}]"),
-                        symbol: eqs.sym_name(s),
-                    });
+                    let entry = format!("{name}[{r}][{c}]");
+                    return Err(not_linear(
+                        eqs,
+                        what,
+                        entry,
+                        s == Sym::Time,
+                        eqs.sym_name(s),
+                    ));
                 }
             }
         }
@@ -382,13 +391,37 @@ pub fn linear_state_space(
     Ok(j)
 }
 
-/// The elements whose values use `t`, as a phrase: "`mains`", "`a`, `b`".
-pub(super) fn time_elements_text(eqs: &Equations) -> String {
-    if eqs.time_signals.is_empty() {
-        return "a value that uses `t`".into();
+/// The error for an entry `entry` of the Jacobians of `what` (`f`, `h`) that depends on the variable `symbol`
+/// (time when `time`).
+pub(super) fn not_linear(
+    eqs: &Equations,
+    what: &str,
+    entry: String,
+    time: bool,
+    symbol: String,
+) -> LinearError {
+    match time {
+        true => LinearError::TimeVarying {
+            entry,
+            elements: time_elements_text(eqs),
+        },
+        false => LinearError::NotLinear {
+            what: what.to_string(),
+            entry,
+            symbol,
+        },
     }
+}
+
+/// Where `t` comes from, as a phrase: "`mains`, whose value uses `t`", "`a`, `b`, whose values use `t`", or a term
+/// written with `t` (an output's) when no element's value uses it.
+pub(super) fn time_elements_text(eqs: &Equations) -> String {
     let names: Vec<String> = eqs.time_signals.iter().map(|n| format!("`{n}`")).collect();
-    names.join(", ")
+    match names.len() {
+        0 => "a term written with `t`".into(),
+        1 => format!("{}, whose value uses `t`", names[0]),
+        _ => format!("{}, whose values use `t`", names.join(", ")),
+    }
 }
 
 /// The rows of the I-fields' flow states in `j`, solved: for a constant inertia matrix `M`, `M ẋ = F` gives

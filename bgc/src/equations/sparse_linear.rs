@@ -335,11 +335,15 @@ pub fn sparse_linear_state_space(
             if small(&all, j.states.len() + j.inputs.len()) {
                 linear::linear_state_space(eqs, selection)?;
             }
-            return Err(LinearError::NotLinear {
-                what: what.to_string(),
-                entry: format!("{name}[{r}][{c}]"),
-                symbol: eqs.symbol_name(&symbol),
-            });
+            let entry = format!("{name}[{r}][{c}]");
+            let time = symbol.kind() == SymbolKind::Time;
+            return Err(linear::not_linear(
+                eqs,
+                what,
+                entry,
+                time,
+                eqs.symbol_name(&symbol),
+            ));
         }
     }
     // Linear, not affine: f(0, 0, t) = 0 and h(0, 0, t) = 0 for every t.

@@ -584,6 +584,14 @@ pub(crate) fn kind_name(kind: ElementKind) -> &'static str {
     }
 }
 
+/// [`kind_name`] after its indefinite article: "a 0-junction", "an `R`", "a `TF`".
+pub(crate) fn kind_with_article(kind: ElementKind) -> String {
+    match kind {
+        ElementKind::Zero | ElementKind::One => format!("a {}", kind_name(kind)),
+        k => k.with_article(),
+    }
+}
+
 /// Whether a statement declares a name in its scope (bond labels, rare, are left to grow the table).
 fn declares_name(stmt: &Stmt) -> bool {
     matches!(

@@ -103,19 +103,19 @@ impl Builder<'_> {
         };
         let (what, help) = match var {
             PortVar::Momentum => (
-                "a momentum",
+                "momentum",
                 "only an inertia `I` has a momentum `p`; use `f(x)` or `e(x)`",
             ),
             PortVar::Displacement => (
-                "a displacement",
+                "displacement",
                 "only a compliance `C` has a displacement `q`; use `f(x)` or `e(x)`",
             ),
             PortVar::Effort => (
-                "a single effort",
+                "single effort",
                 "a 1-junction has one common flow and a TF or GY two efforts: name a bond instead",
             ),
             PortVar::Flow => (
-                "a single flow",
+                "single flow",
                 "a 0-junction has one common effort and a TF or GY two flows: name a bond instead",
             ),
         };
@@ -123,8 +123,8 @@ impl Builder<'_> {
             Diagnostic::error(
                 "BG0207",
                 format!(
-                    "`{letter}({name})` is not defined: `{name}` is a {} and has no {what}",
-                    super::flatten::kind_name(kind)
+                    "`{letter}({name})` is not defined: `{name}` is {} and has no {what}",
+                    super::flatten::kind_with_article(kind)
                 ),
             )
             .with_primary(span, format!("no `{letter}` here"))

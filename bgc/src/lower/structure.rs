@@ -120,7 +120,7 @@ impl Builder<'_> {
                     )
                     .with_primary(
                         decl_span,
-                        format!("a {} has an input and an output port", k.keyword()),
+                        format!("{} has an input and an output port", k.with_article()),
                     );
                     for e in all {
                         d = d.with_secondary(self.bond_span(*e), "a bond of it");
@@ -246,8 +246,10 @@ impl Builder<'_> {
             (
                 format!("the bond of source `{name}` points into it"),
                 format!("this bond points from `{from}` into `{name}`"),
-                "a source's bond usually points away from it, so that the power it delivers counts positive; drawn \
-                 into it, the source absorbs `e·f` and `supplied` counts it with the opposite sign",
+                "a source's bond usually points away from it, along the power it delivers; drawn into it, the source \
+                 is connected the other way round at its junction (a battery with its terminals swapped): its own \
+                 `e`, `f` and `supplied` (the power it delivers) are the same either way, but the bond's flow is \
+                 minus the source's",
             )
         } else {
             (

@@ -1064,3 +1064,15 @@ fn constants_of_other_tools_say_how_to_write_them() {
         assert_eq!(unknown[0].fix(), fix, "{value}");
     }
 }
+
+#[test]
+fn a_bond_name_refused_on_a_chain_is_not_reported_again_where_it_is_used() {
+    // BG0110 drops the name; `f(d)` is then no "unknown element `d`" (BG0201), a follow-on of the same mistake.
+    let text = "model m { domain electrical; Se drive = 1; 0 n; R r = 2; C c = 1; \
+                bond d: drive -> n -> r, c; output y [A] = f(d); }";
+    assert_eq!(codes(text), vec!["BG0110"]);
+    // A name no statement declares still is.
+    let text = "model m { domain electrical; Se drive = 1; 0 n; R r = 2; C c = 1; \
+                bond drive -> n -> r, c; output y [A] = f(d); }";
+    assert_eq!(codes(text), vec!["BG0201"]);
+}

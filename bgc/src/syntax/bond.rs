@@ -115,6 +115,8 @@ impl Parser<'_> {
             }
             self.diags
                 .push(d.with_help("name a single bond: write it as its own `bond NAME: a -> b;`"));
+            // The name is declared by nothing now: a reference to it is not reported again as unknown.
+            self.unparsed.names.push(label.clone());
         }
         if let Some(h) = &bond.hint {
             let mut d = Diagnostic::error(

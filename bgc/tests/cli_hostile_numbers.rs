@@ -486,3 +486,42 @@ fn a_zero_parameter_the_equations_divide_by_is_named() {
     let last = out.lines().last().unwrap_or_default();
     assert!(last.starts_with("1,1e-1,3e0,"), "{last}");
 }
+
+/// A resistor across an effort source with no output reading it: only its dissipated power `u²/R0` divides by
+/// `R0`. With `R0 = 0` the run used to start and stop at once with "the derivative of `dissipated` became
+/// non-finite"; it is now refused before it starts, naming the parameter and the element, as for a rate.
+#[test]
+fn a_zero_parameter_only_an_energy_term_divides_by_is_named() {
+    let path = temp_file(
+        "zero_r_power.bg",
+        "model m {\n    domain electrical;\n    param R0 = 1 [Ohm];\n    input u [V];\n    Se a = u;\n    0 n;\n    \
+         R r = R0;\n    R r2 = 1;\n    bond a -> n -> r, r2;\n}\n",
+    );
+    let (code, _, err) = bgc(&[
+        "simulate", &path, "--t-end", "1", "--input", "u=1", "--param", "R0=0",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains(
+            "error: parameter `R0` = 0 with these parameter values: the derived equations divide by it (the \
+             coefficient of R `r`)"
+        ),
+        "{err}"
+    );
+    // With R0 = 2: dissipated = (1/2 + 1/1) u² t = 1.5 J after 1 s at u = 1, all of it supplied.
+    let (code, out, err) = bgc(&[
+        "simulate", &path, "--t-end", "1", "--input", "u=1", "--param", "R0=2",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let last: Vec<f64> = out
+        .lines()
+        .last()
+        .unwrap_or_default()
+        .split(',')
+        .map(|x| x.parse().unwrap_or(f64::NAN))
+        .collect();
+    assert!(
+        (last[2] - 1.5).abs() < 1e-9 && (last[3] - 1.5).abs() < 1e-9,
+        "{last:?}"
+    );
+}

@@ -788,7 +788,9 @@ fn not_finite(
     let held = Expr::non_finite_constants(&values);
     let (rates_held, outputs_held) = held.split_at(rates.len().min(held.len()));
     let why = "it divides by a part that is zero whatever the parameters are, or takes a function outside its domain there";
-    let help = "look for a difference of equal terms in a denominator or under a logarithm";
+    let help = "look for an element whose value is 0 where the causality divides by it (a resistance of 0 that \
+                an effort drives: f = e/R; a compliance or inertia of 0), or a difference of equal terms in a \
+                denominator or under a logarithm";
     for (s, _) in states.iter().zip(rates_held).filter(|(_, v)| v.is_some()) {
         let d = Diagnostic::error(
             codes::NOT_FINITE,

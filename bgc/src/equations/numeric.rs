@@ -240,13 +240,15 @@ impl Equations {
     }
 
     /// The parameters the equations divide by (raised to a negative power in a rate, an intermediate, an output,
-    /// a loop residual or a mass matrix), in index order: a value without a finite reciprocal (0) makes them
-    /// non-finite, although the coefficient checks may allow it (a resistance of 0 in conductance causality).
+    /// an energy term, a loop residual or a mass matrix), in index order: a value without a finite reciprocal (0)
+    /// makes them non-finite, although the coefficient checks may allow it (a resistance of 0 in conductance
+    /// causality).
     pub fn divisor_params(&self) -> Vec<usize> {
         let mut roots: Vec<Expr> = self.rates.clone();
         roots.extend(self.f.iter().flatten().cloned());
         roots.extend(self.intermediates.iter().map(|i| i.value.clone()));
         roots.extend(self.outputs.iter().map(|o| o.value.clone()));
+        roots.extend(self.energy.iter().filter_map(|t| t.value.clone()));
         for block in &self.tear_blocks {
             roots.extend(block.residuals.iter().cloned());
         }

@@ -42,7 +42,7 @@ fn chain() -> String {
 
 struct Session {
     client: Connection,
-    server: Option<std::thread::JoinHandle<Result<(), String>>>,
+    server: Option<std::thread::JoinHandle<bgc::lsp::Ended>>,
     uri: Uri,
     version: i32,
 }

@@ -55,7 +55,7 @@ fn apply_every_fix(name: &str, text: &str, errors: usize) -> (Vec<String>, Strin
     );
     let left = client.diagnostics(&doc, 2);
     assert!(left.is_empty(), "{fixed}\n{left:#?}");
-    assert_eq!(client.shutdown(), Ok(()));
+    assert_eq!(client.shutdown(), bgc::lsp::Ended::Shutdown);
     (titles, fixed)
 }
 

@@ -104,6 +104,6 @@ proptest! {
         let fresh = bgc::lsp::analysis::analyse(&name, &text, &mut bgc::lower::MemoryLoader::new());
         let expected = bgc::lsp::diagnostics::document_diagnostics(&fresh);
         prop_assert_eq!(served, expected);
-        prop_assert_eq!(client.shutdown(), Ok(()));
+        prop_assert_eq!(client.shutdown(), bgc::lsp::Ended::Shutdown);
     }
 }

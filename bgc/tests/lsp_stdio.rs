@@ -102,27 +102,49 @@ fn a_session_over_stdio_ends_with_status_zero() {
     assert_eq!(codes, ["BG0510", "BG0510"]);
 }
 
-/// A client that sends a document before `initialized` breaks the protocol. The server stops with status 2; its
-/// message said "the connection failed: sending on a disconnected channel" (the reader thread's failure to hand
-/// over the messages that followed), and now names the protocol error.
+/// A client that sends a document before `initialized`, then a request after `shutdown`, and ends with `exit`:
+/// the server stopped with status 2 at the first ("expected initialized notification") and, had it got past it, at
+/// the second ("unexpected message during shutdown"), losing the session. It now takes the early document, answers
+/// the late request `InvalidRequest` and ends with status 0; an `exit` without `shutdown` is status 1.
 #[test]
-fn a_protocol_error_is_named_not_the_reader_thread_that_fails_after_it() {
+fn a_session_goes_on_past_an_early_notification_and_a_late_request() {
     let session = [
         serde_json::json!({"jsonrpc": "2.0", "id": 1, "method": "initialize",
             "params": {"processId": null, "rootUri": null, "capabilities": {}}}),
         serde_json::json!({"jsonrpc": "2.0", "method": "textDocument/didOpen", "params": {"textDocument":
-            {"uri": "file:///tmp/early.bg", "languageId": "bg", "version": 1, "text": "model a { }"}}}),
+            {"uri": "file:///tmp/early.bg", "languageId": "bg", "version": 1, "text": "model a { 0 j; }"}}}),
+        serde_json::json!({"jsonrpc": "2.0", "method": "initialized", "params": {}}),
         serde_json::json!({"jsonrpc": "2.0", "id": 2, "method": "shutdown", "params": null}),
+        serde_json::json!({"jsonrpc": "2.0", "id": 3, "method": "textDocument/hover", "params":
+            {"textDocument": {"uri": "file:///tmp/early.bg"}, "position": {"line": 0, "character": 10}}}),
         serde_json::json!({"jsonrpc": "2.0", "method": "exit", "params": null}),
     ];
     let out = serve(&["lsp"], &session);
     let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("initialisation failed: expected initialized notification"),
-        "{err}"
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    let received = messages(&out.stdout);
+    let late = received
+        .iter()
+        .find(|m| m["id"] == 3)
+        .expect("an answer to the late request");
+    assert_eq!(late["error"]["code"], -32600, "{late}");
+    let published = received
+        .iter()
+        .find(|m| m["method"] == "textDocument/publishDiagnostics")
+        .expect("the early document's diagnostics");
+    assert_eq!(published["params"]["uri"], "file:///tmp/early.bg");
+    let without_shutdown = [
+        serde_json::json!({"jsonrpc": "2.0", "id": 1, "method": "initialize",
+            "params": {"processId": null, "rootUri": null, "capabilities": {}}}),
+        serde_json::json!({"jsonrpc": "2.0", "method": "exit", "params": null}),
+    ];
+    let out = serve(&["lsp"], &without_shutdown);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
     );
-    assert!(!err.contains("disconnected channel"), "{err}");
 }
 
 /// A body that is not JSON ended the session ("malformed LSP payload", status 2), losing every open document. It

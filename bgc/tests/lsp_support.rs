@@ -59,7 +59,7 @@ pub fn unsaved(name: &str) -> PathBuf {
 
 pub struct Client {
     connection: Connection,
-    server: Option<JoinHandle<Result<(), String>>>,
+    server: Option<JoinHandle<bgc::lsp::Ended>>,
     next_id: i32,
     /// Notifications received while waiting for a response.
     notifications: VecDeque<Notification>,
@@ -188,8 +188,8 @@ impl Client {
         }
     }
 
-    /// `shutdown` and `exit`; returns what the server's loop returned.
-    pub fn shutdown(mut self) -> Result<(), String> {
+    /// `shutdown` and `exit`; returns how the server says the session ended.
+    pub fn shutdown(mut self) -> bgc::lsp::Ended {
         let response = self.raw_request("shutdown", serde_json::Value::Null);
         assert_eq!(response.result, Some(serde_json::Value::Null));
         self.notify::<lsp_types::notification::Exit>(());

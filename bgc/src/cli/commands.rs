@@ -187,7 +187,9 @@ pub fn lsp(include: &[PathBuf]) -> Status {
         ..bgc::lsp::Options::default()
     };
     match bgc::lsp::run_stdio(options) {
-        Ok(()) => Status::Ok,
+        Ok(bgc::lsp::Ended::Shutdown | bgc::lsp::Ended::Closed) => Status::Ok,
+        // The protocol's status for an `exit` that no `shutdown` came before.
+        Ok(bgc::lsp::Ended::ExitWithoutShutdown) => Status::InputErrors,
         Err(e) => {
             stderrln(&format!("error: bgc lsp: {e}"));
             Status::UsageOrIo

@@ -20,12 +20,14 @@ pub mod edits;
 pub mod files;
 pub mod hover;
 pub mod index;
+pub mod lifecycle;
 pub mod line_diff;
 pub mod lines;
 pub mod navigation;
 pub mod server;
 pub mod transport;
 
+pub use lifecycle::Ended;
 use lsp_server::Connection;
 use lsp_types::{
     CodeActionKind, CodeActionOptions, CodeActionProviderCapability, CompletionOptions,
@@ -89,8 +91,8 @@ impl Default for Options {
     }
 }
 
-/// Initialises the connection and serves it until the client says `shutdown` and `exit` (or goes away).
-pub fn serve(connection: &Connection, options: Options) -> Result<(), String> {
+/// Initialises the connection and serves it until the client says `exit` (or goes away).
+pub fn serve(connection: &Connection, options: Options) -> Ended {
     let init = serde_json::json!({
         "capabilities": capabilities(),
         "serverInfo": ServerInfo {
@@ -98,14 +100,19 @@ pub fn serve(connection: &Connection, options: Options) -> Result<(), String> {
             version: Some(env!("CARGO_PKG_VERSION").to_string()),
         },
     });
-    let fail = |e: lsp_server::ProtocolError| format!("initialisation failed: {e}");
-    let (id, _params) = connection.initialize_start().map_err(fail)?;
-    connection.initialize_finish(id, init).map_err(fail)?;
+    let id = match lifecycle::await_initialize(connection) {
+        Ok((id, _params)) => id,
+        Err(ended) => return ended,
+    };
+    // The `initialized` notification that follows is one the server loop drops, like any it does not use.
+    let _ = connection
+        .sender
+        .send(lsp_server::Response::new_ok(id, init).into());
     server::Server::new(options, connection).run(connection)
 }
 
-/// Serves on standard input and output.
-pub fn run_stdio(options: Options) -> Result<(), String> {
+/// Serves on standard input and output: how the session ended, or why the connection failed.
+pub fn run_stdio(options: Options) -> Result<Ended, String> {
     let (connection, transport) =
         transport::stdio().map_err(|e| format!("the connection's threads could not start: {e}"))?;
     let served = serve(&connection, options);

@@ -11,6 +11,7 @@ use super::analysis::{Analysis, analyse_front, derive_equations};
 use super::background::{Job, Worker};
 use super::document::Documents;
 use super::files::{OverlayLoader, document_key, uri_to_path};
+use super::lifecycle::{self, Ended, Step};
 use super::{completion, diagnostics, edits, hover, navigation};
 use crate::build::FsLoader;
 use lsp_server::{Connection, ErrorCode, Message, Notification, Request, RequestId, Response};
@@ -72,13 +73,14 @@ impl Server {
         }
     }
 
-    /// Serves an initialised connection until `shutdown` and `exit` (or until the client goes away).
-    pub fn run(&mut self, connection: &Connection) -> Result<(), String> {
+    /// Serves an initialised connection until `exit` (or until the client goes away).
+    pub fn run(&mut self, connection: &Connection) -> Ended {
+        let mut shut = false;
         loop {
             let message = if self.stale.is_empty() {
                 match connection.receiver.recv() {
                     Ok(m) => m,
-                    Err(_) => return Ok(()),
+                    Err(_) => return Ended::Closed,
                 }
             } else {
                 match connection.receiver.try_recv() {
@@ -87,23 +89,23 @@ impl Server {
                         self.refresh(connection);
                         continue;
                     }
-                    Err(_) => return Ok(()),
+                    Err(_) => return Ended::Closed,
                 }
             };
             match message {
                 Message::Request(request) => {
-                    if connection
-                        .handle_shutdown(&request)
-                        .map_err(|e| e.to_string())?
-                    {
-                        return Ok(());
-                    }
+                    let Step::Answer(request) = lifecycle::request(connection, request, &mut shut)
+                    else {
+                        continue;
+                    };
                     self.refresh(connection);
                     self.collect_done();
                     let response = self.respond(request);
                     send(connection, response.into());
                 }
-                Message::Notification(n) if n.method == "exit" => return Ok(()),
+                Message::Notification(n) if n.method == "exit" => return lifecycle::exit(shut),
+                // After `shutdown` the documents no longer change.
+                Message::Notification(_) if shut => {}
                 Message::Notification(n) => self.notify(n),
                 Message::Response(_) => {}
             }

@@ -8,6 +8,7 @@
 //! - a body is read as it arrives, never allocated up front from the length its header declares, so a corrupt
 //!   `Content-Length` cannot exhaust the memory.
 
+use super::lifecycle::Ended;
 use lsp_server::{Connection, ErrorCode, Message, Notification, RequestId, Response};
 use std::io::{self, BufRead, Read, Write};
 use std::sync::{Arc, Mutex, PoisonError};
@@ -62,15 +63,12 @@ pub fn stdio() -> io::Result<(Connection, Transport)> {
 }
 
 impl Transport {
-    /// The outcome of a session that `served` ended, once everything the server sent is written. A broken input
-    /// is the cause to name (the server only saw its channel close). The reader is waited for only after a normal
-    /// end (the client said `exit` or closed the input): after a protocol error, the client may keep its end open.
-    pub fn finish(self, served: Result<(), String>) -> Result<(), String> {
+    /// The outcome of a session that ended as `ended`, once everything the server sent is written. A broken input
+    /// is the cause to name (the server only saw its channel close). The session ends when the client says `exit`
+    /// or closes the input, so the reader has stopped or is about to.
+    pub fn finish(self, ended: Ended) -> Result<Ended, String> {
         let written = self.writer.join();
-        let read = match served {
-            Ok(()) => self.reader.join(),
-            Err(_) => Ok(()),
-        };
+        let read = self.reader.join();
         if let Some(why) = self
             .broken
             .lock()
@@ -79,9 +77,8 @@ impl Transport {
         {
             return Err(format!("the connection failed: {why}"));
         }
-        served?;
         match (read, written) {
-            (Ok(()), Ok(Ok(()))) => Ok(()),
+            (Ok(()), Ok(Ok(()))) => Ok(ended),
             (Ok(()), Ok(Err(e))) => Err(format!("writing to standard output failed: {e}")),
             _ => Err("a thread of the connection panicked".to_string()),
         }

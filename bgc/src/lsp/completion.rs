@@ -114,8 +114,10 @@ pub fn complete(analysis: &Analysis, offset: usize) -> Vec<CompletionItem> {
     in_scope(analysis, analysis.root, word.end)
 }
 
+/// The unit symbols a file may write: `Ω` is known (to say what to write instead) but is not ASCII (`BG0104`).
 fn units() -> Vec<CompletionItem> {
     crate::units::symbols()
+        .filter(|(s, _)| s.is_ascii())
         .map(|(s, u)| item(s, CompletionItemKind::UNIT, format!("{u} (SI)")))
         .collect()
 }

@@ -146,6 +146,14 @@ pub fn check_new_name(name: &str) -> Result<(), String> {
     if crate::syntax::KEYWORDS.contains(&name) || matches!(name, "t" | "pi") {
         return Err(format!("`{name}` is reserved by the language"));
     }
+    // Ordinary names with a meaning of their own in some places: a parameter renamed `f` would read as the
+    // element's own flow in a law block, `mass` as an inertia matrix entry in an I-field.
+    if matches!(name, "e" | "f" | "p" | "q" | "int" | "mass") {
+        return Err(format!(
+            "`{name}` has a meaning of its own in some places (`e`, `f`, `p`, `q` in a law and as functions, `int` \
+             in a `var`, `mass` in an I-field): renamed to it, a name could change what the model says"
+        ));
+    }
     Ok(())
 }
 

@@ -141,7 +141,7 @@ fn fmt_one(path: &Path, check_only: bool, color: bool) -> std::io::Result<bool> 
         Err(diags) => {
             stderr(&render::to_text(&sources, &diags, color));
             stderrln(&format!(
-                "{}: not formatted: the file has syntax errors",
+                "{}: not formatted",
                 sources.get(id).map(|f| f.name.as_str()).unwrap_or_default()
             ));
             return Ok(false);

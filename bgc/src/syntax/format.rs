@@ -31,12 +31,25 @@ pub fn format(file: &File) -> String {
 
 /// Parses `text` and formats it in its own line endings (CRLF when its first line break is CRLF) and with its
 /// byte-order mark, if it has one; refuses (returning the diagnostics) when the text has syntax errors.
+/// The formatted text is read back before it is returned: a layout that would not parse (a limit the layout
+/// reaches where the file did not) is refused, with the reason, rather than written over a valid file.
 pub fn format_source(file: FileId, text: &str) -> Result<String, Vec<Diagnostic>> {
     let (tree, diags) = super::parse(file, text);
     if has_errors(&diags) {
         return Err(diags);
     }
-    Ok(in_style_of(text, format(&tree)))
+    let formatted = format(&tree);
+    let (_, again) = super::parse(file, &formatted);
+    if let Some(d) = again.iter().find(|d| d.is_error()) {
+        return Err(vec![Diagnostic::error(
+            d.code.0,
+            format!(
+                "the canonical layout of this file would not read back ({}); the file is left as it is",
+                d.message
+            ),
+        )]);
+    }
+    Ok(in_style_of(text, formatted))
 }
 
 /// `formatted` (from [`format()`]: `\n` line breaks, no byte-order mark) with the conventions of the file it came
@@ -510,15 +523,29 @@ fn wrap(e: &Expr, parens: bool) -> String {
     }
 }
 
+/// The operators of a `+ -` or `* /` chain printed without parentheses before its left operand is put in them.
+/// The parser counts each operator of a chain as a level of nesting (at most 200, `BG0105`); a left operand that is a
+/// chain of its own needs no parentheses to keep the tree, and without them the chains a file wrote in groups would
+/// join into one too deep to read back. Groups of this many keep a chain of `n` operators about `n/50 + 50` deep.
+const CHAIN_GROUP: usize = 50;
+
 /// An expression with the fewest parentheses that keep its tree: left-associative `+ -` and `* /` parenthesise a
-/// right operand of the same strength, the right-associative `^` a left one; a power's base is an atom.
+/// right operand of the same strength, the right-associative `^` a left one; a power's base is an atom. A chain's
+/// left operands are grouped every [`CHAIN_GROUP`] operators, and a negation of a negation is `--x`, so that the
+/// text nests no deeper than the parser accepts.
 pub fn expr(e: &Expr) -> String {
+    expr_in_chain(e, 0)
+}
+
+/// [`expr`] of `e`, under `above` operators of the same chain printed without parentheses.
+fn expr_in_chain(e: &Expr, above: usize) -> String {
     match &e.kind {
         ExprKind::Number(v) => number(*v),
         ExprKind::Name(n) => n.clone(),
         ExprKind::Indexed(n, i) => format!("{n}[{i}]"),
         ExprKind::Call(f, args) => format!("{}({})", f.name, list(args)),
         ExprKind::Node(n) => node(n),
+        ExprKind::Neg(x) if matches!(x.kind, ExprKind::Neg(_)) => format!("-{}", expr(x)),
         ExprKind::Neg(x) => format!("-{}", wrap(x, strength(x) <= 3)),
         ExprKind::Binary(op, a, b) => {
             let (sym, level) = match op {
@@ -535,11 +562,13 @@ pub fn expr(e: &Expr) -> String {
                     wrap(b, strength(b) < 3)
                 )
             } else {
-                format!(
-                    "{} {sym} {}",
-                    wrap(a, strength(a) < level),
-                    wrap(b, strength(b) <= level)
-                )
+                let left = match strength(a).cmp(&level) {
+                    std::cmp::Ordering::Less => wrap(a, true),
+                    std::cmp::Ordering::Equal if above + 1 >= CHAIN_GROUP => wrap(a, true),
+                    std::cmp::Ordering::Equal => expr_in_chain(a, above + 1),
+                    std::cmp::Ordering::Greater => expr(a),
+                };
+                format!("{left} {sym} {}", wrap(b, strength(b) <= level))
             }
         }
     }

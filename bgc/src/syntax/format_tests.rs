@@ -83,7 +83,8 @@ fn minimal_parentheses_keep_the_tree() {
         ("(a ^ b) ^ c", "(a ^ b) ^ c"),
         ("a ^ (b ^ c)", "a ^ b ^ c"),
         ("a ^ (-b)", "a ^ -b"),
-        ("-(-a)", "-(-a)"),
+        // Each parenthesis is a level of nesting to the parser: a negation of a negation goes without.
+        ("-(-a)", "--a"),
         ("a * (-b)", "a * -b"),
         ("-(a + b)", "-(a + b)"),
         ("(((x)))", "x"),
@@ -98,6 +99,38 @@ fn minimal_parentheses_keep_the_tree() {
             "{src}"
         );
     }
+}
+
+/// A file within the parser's nesting limit (200, BG0105) formats to one within it: two groups of 101 terms (each
+/// operator of a chain counts a level, so the flat sum of 202 terms is too deep), the same for products and
+/// differences, and 101 negations, which `-(-(…))` would nest twice as deep. The layout groups a chain's left
+/// operands every 50 operators; the tree, and so the meaning, is the same.
+#[test]
+fn a_file_within_the_nesting_limit_formats_to_one_within_it() {
+    let chain = |op: &str| vec!["p"; 101].join(op);
+    let cases = [
+        format!("({}) + ({})", chain(" + "), chain(" + ")),
+        format!("({}) * ({})", chain(" * "), chain(" * ")),
+        format!("({}) - ({})", chain(" - "), chain(" - ")),
+        format!("{}p", "-".repeat(101)),
+    ];
+    for src in cases {
+        let file = format!("model m {{\n    param p = 2 [1];\n    output y [1] = {src};\n}}\n");
+        let (_, diags) = parse(FileId(0), &file);
+        assert!(
+            !crate::diagnostic::has_errors(&diags),
+            "the case itself parses"
+        );
+        check_round_trip(&file);
+        assert!(format_source(FileId(0), &file).is_ok());
+    }
+    // A flat chain of 120 terms (119 operators) comes out with 50 operators after each group: the innermost
+    // group has the 20 terms left over.
+    let flat = vec!["p"; 120].join(" + ");
+    let out = check_round_trip(&format!("model m {{\n    output y [1] = {flat};\n}}\n"));
+    let more = " + p".repeat(50);
+    let want = format!("(({}){more}){more}", vec!["p"; 20].join(" + "));
+    assert_eq!(out, format!("model m {{\n    output y [1] = {want};\n}}\n"));
 }
 
 #[test]

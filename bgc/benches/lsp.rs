@@ -8,7 +8,8 @@
 //! the server's size for deriving equations on the loop (`Options::background_above`), those of parse, lowering
 //! and causality, while the equations follow from the worker thread.
 //!
-//! `lsp_references` times find-all-references of a parameter with 100,000 uses. `fmt_check` times the unified diff of `bgc fmt --check` (shared with range formatting) on a file of 800,000
+//! `lsp_references` times find-all-references of a parameter with 100,000 uses. `lsp_positions` times the positions
+//! of the 20,000 declarations of a model written on one line. `fmt_check` times the unified diff of `bgc fmt --check` (shared with range formatting) on a file of 800,000
 //! lines, 100,000 of them changed.
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -246,5 +247,35 @@ fn bench_references(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench, bench_format_diff, bench_references);
+/// Every declaration's position in a generated model written on one line of 20,000 parameters (500 kB): each answer
+/// about such a document (its diagnostics, its outline) converts thousands of byte offsets to positions.
+fn bench_positions(c: &mut Criterion) {
+    let mut text = String::from("model m { domain translational;");
+    for i in 0..20_000 {
+        text.push_str(&format!(" param p{i} = {i} [1];"));
+    }
+    text.push_str(" }\n");
+    let offsets: Vec<usize> = text.match_indices("param").map(|(i, _)| i).collect();
+    let index = bgc::lsp::lines::LineIndex::new(&text);
+    let mut group = c.benchmark_group("lsp_positions");
+    group.sample_size(10);
+    group.bench_function("one_line_of_20k_parameters", |b| {
+        b.iter(|| {
+            let columns: u64 = offsets
+                .iter()
+                .map(|&o| u64::from(index.position(&text, o).character))
+                .sum();
+            assert!(columns > 0);
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    bench,
+    bench_format_diff,
+    bench_references,
+    bench_positions
+);
 criterion_main!(benches);

@@ -12,6 +12,9 @@ use lsp_types::{Position, Range};
 pub struct LineIndex {
     /// Byte offset of the start of each line (the first is 0).
     starts: Vec<usize>,
+    /// Whether each line is ASCII: its UTF-16 columns are then its byte offsets, and a conversion costs no walk
+    /// of the line (a generated model on one line of 500 kB has thousands of positions to convert).
+    ascii: Vec<bool>,
     len: usize,
 }
 
@@ -26,11 +29,21 @@ impl LineIndex {
                     .filter(|&(i, m)| m == "\n" || lone_cr(i))
                     .map(|(i, _)| i + 1),
             )
+            .collect::<Vec<usize>>();
+        let ascii = starts
+            .iter()
+            .zip(starts.iter().skip(1).chain(std::iter::once(&text.len())))
+            .map(|(&a, &b)| text.as_bytes().get(a..b).is_some_and(<[u8]>::is_ascii))
             .collect();
         LineIndex {
             starts,
+            ascii,
             len: text.len(),
         }
+    }
+
+    fn is_ascii(&self, line: usize) -> bool {
+        self.ascii.get(line).copied().unwrap_or(false)
     }
 
     /// The position of a byte offset (clamped to the text, and moved back to a character boundary).
@@ -44,10 +57,13 @@ impl LineIndex {
             Err(l) => l.saturating_sub(1),
         };
         let start = self.starts.get(line).copied().unwrap_or(0);
-        let column: usize = text
-            .get(start..offset)
-            .map(|s| s.chars().map(char::len_utf16).sum())
-            .unwrap_or(0);
+        let column: usize = match self.is_ascii(line) {
+            true => offset.saturating_sub(start),
+            false => text
+                .get(start..offset)
+                .map(|s| s.chars().map(char::len_utf16).sum())
+                .unwrap_or(0),
+        };
         Position::new(line as u32, column as u32)
     }
 
@@ -62,8 +78,12 @@ impl LineIndex {
             .get(position.line as usize + 1)
             .map(|&next| next - 1)
             .unwrap_or(text.len());
+        let ascii = self.is_ascii(position.line as usize);
         let line = text.get(start..end).unwrap_or("");
         let line = line.strip_suffix('\r').unwrap_or(line);
+        if ascii {
+            return start + line.len().min(position.character as usize);
+        }
         let mut units = 0usize;
         for (i, c) in line.char_indices() {
             let width = c.len_utf16();
@@ -99,6 +119,34 @@ mod tests {
         let second = text.find("second").unwrap_or(0);
         assert_eq!(index.position(text, second + 3), Position::new(1, 3));
         assert_eq!(index.offset(text, Position::new(1, 3)), second + 3);
+    }
+
+    /// ASCII lines convert by arithmetic, the others by walking their characters: both agree with counting the
+    /// UTF-16 units from the line's start, on every offset of a text that mixes them and every line break.
+    #[test]
+    fn ascii_lines_and_the_others_convert_alike() {
+        let text = "model m { param a = 1 [1]; }\r\n// µ 𝜔 x\nplain line\rτ_m = 2\n\nlast";
+        let index = LineIndex::new(text);
+        let mut line = 0u32;
+        let mut start = 0usize;
+        let mut chars = text.char_indices().peekable();
+        while let Some((i, c)) = chars.next() {
+            let column: usize = text[start..i].chars().map(char::len_utf16).sum();
+            let at = Position::new(line, column as u32);
+            assert_eq!(index.position(text, i), at, "offset {i}");
+            if c != '\r' && c != '\n' {
+                assert_eq!(index.offset(text, at), i, "{at:?}");
+            }
+            let ends_line = c == '\n' || (c == '\r' && chars.peek().map(|&(_, n)| n) != Some('\n'));
+            if ends_line {
+                line += 1;
+                start = i + 1;
+            }
+        }
+        assert_eq!(
+            index.offset(text, Position::new(0, 500)),
+            text.find('\r').unwrap_or(0)
+        );
     }
 
     #[test]

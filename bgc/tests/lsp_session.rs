@@ -630,6 +630,24 @@ fn range_formatting_changes_only_the_selected_lines() {
         apply(messy, &edits),
         "model m {\n    domain rotational;\n    param k = 1 [N m/rad];\n  Se s = 1; 1 j; C c = 1/k;\n    bond s -> j -> c;\n}\n"
     );
+    // Adjacent messy lines that the layout changes in place: only the selected one changes.
+    let adjacent = "model m {\ndomain rotational;\nparam k = 1 [N m/rad];\nparam d=2 [N m s/rad];\n    Se s = 1;\n    1 j;\n    C c = 1 / k;\n    R r = d;\n    bond s -> j -> c, r;\n}\n";
+    let second = uri(&unsaved("adjacent_range.bg"));
+    client.open(&second, adjacent);
+    client.diagnostics(&second, 1);
+    let edits = client
+        .request::<RangeFormatting>(lsp_types::DocumentRangeFormattingParams {
+            text_document: TextDocumentIdentifier::new(second.clone()),
+            range: range(3, 0, 3, 3),
+            options: Default::default(),
+            work_done_progress_params: Default::default(),
+        })
+        .expect("range formatting answers")
+        .expect("edits");
+    assert_eq!(
+        apply(adjacent, &edits),
+        adjacent.replace("param d=2 [N m s/rad];", "    param d = 2 [N m s/rad];")
+    );
     // The whole file as the range gives what whole-document formatting gives.
     let all = format(&mut client, range(0, 0, 6, 0)).expect("edits");
     assert_eq!(

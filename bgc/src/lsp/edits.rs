@@ -28,9 +28,10 @@ pub fn format(text: &str) -> Option<Vec<TextEdit>> {
 }
 
 /// The edits of [`format()`] that touch the lines of `range`: the canonical layout's line changes, each hunk of a
-/// line diff of the old and the formatted text kept when it overlaps (or, for an insertion, borders) those lines,
-/// so a run of adjacent changed lines is formatted whole; the rest of the file stays as written. `None` when the
-/// text has syntax errors.
+/// line diff of the old and the formatted text kept when it overlaps (or, for an insertion, borders) those lines.
+/// A hunk that replaces as many lines as it writes pairs them line by line, and only the selected ones change; one
+/// that joins or splits lines is formatted whole. The rest of the file stays as written. `None` when the text has
+/// syntax errors.
 pub fn format_range(text: &str, range: Range) -> Option<Vec<TextEdit>> {
     let formatted = crate::syntax::format_source(crate::span::FileId(0), text).ok()?;
     let starts = line_starts(text);
@@ -49,7 +50,22 @@ pub fn format_range(text: &str, range: Range) -> Option<Vec<TextEdit>> {
         } else {
             old.start <= last && first < old.end
         };
-        if touches {
+        if !touches {
+            continue;
+        }
+        if old.len() == new.len()
+            && old
+                .clone()
+                .zip(new.clone())
+                .all(|(o, n)| same_statement(old_lines[o], new_lines[n]))
+        {
+            for (o, n) in old.zip(new).filter(|(o, _)| (first..=last).contains(o)) {
+                edits.push(TextEdit::new(
+                    lines.range(text, starts[o]..starts[o + 1]),
+                    new_lines[n].to_string(),
+                ));
+            }
+        } else {
             let bytes = starts[old.start]..starts[old.end];
             edits.push(TextEdit::new(
                 lines.range(text, bytes),
@@ -58,6 +74,24 @@ pub fn format_range(text: &str, range: Range) -> Option<Vec<TextEdit>> {
         }
     }
     Some(edits)
+}
+
+/// Whether a line and its counterpart in the canonical layout start alike (the same first word, or both a
+/// comment): then the layout changed the line in place, and it can be formatted alone. Where lines shifted (a
+/// comment moved to the next line), the hunk is formatted whole.
+fn same_statement(old: &str, new: &str) -> bool {
+    let first_word = |line: &str| -> String {
+        let line = line.trim_start();
+        match line.starts_with("//") {
+            true => "//".to_string(),
+            false => line
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect(),
+        }
+    };
+    let word = first_word(old);
+    !word.is_empty() && word == first_word(new)
 }
 
 /// The byte offset of the start of each line of `text`, and its length last (`starts[k]..starts[k + 1]` is line

@@ -60,12 +60,20 @@ pub fn recorded_inputs(
     Ok(Recorded { warning, signals })
 }
 
-/// A warning when the record starts after 0 or ends before `t_end`: its end values then hold.
+/// A warning when the record starts after 0 or ends before `t_end` (its end values then hold), or starts before 0
+/// (the run does not replay what comes before its start).
 fn coverage_warning(place: &str, times: &[f64], t_end: f64) -> Option<String> {
     let (&first, &last) = (times.first()?, times.last()?);
     let mut held = Vec::new();
     if first > 0.0 {
         held.push(format!("its first values hold from t = 0 to {first}"));
+    }
+    if first < 0.0 {
+        // `bgc fit` starts its states at the record's first time; a run starts at t = 0.
+        held.push(format!(
+            "the run starts at t = 0 with the initial states, so the samples before it are not replayed (`bgc fit` \
+             starts at the record's first time, t = {first})"
+        ));
     }
     if last < t_end {
         held.push(format!(
@@ -87,7 +95,14 @@ mod tests {
     #[test]
     fn a_record_shorter_than_the_run_is_named() {
         assert_eq!(coverage_warning("r.csv", &[0.0, 1.0], 1.0), None);
-        assert_eq!(coverage_warning("r.csv", &[-1.0, 2.0], 1.0), None);
+        // A record that starts before the run: what comes before t = 0 is not replayed, unlike in `bgc fit`.
+        assert_eq!(
+            coverage_warning("r.csv", &[-1.0, 2.0], 1.0).as_deref(),
+            Some(
+                "the record r.csv covers t = -1 to 2 s: the run starts at t = 0 with the initial states, so the \
+                 samples before it are not replayed (`bgc fit` starts at the record's first time, t = -1)"
+            )
+        );
         assert_eq!(
             coverage_warning("r.csv", &[0.5, 1.0], 2.0).as_deref(),
             Some(

@@ -531,7 +531,7 @@ const CHAIN_GROUP: usize = 50;
 
 /// An expression with the fewest parentheses that keep its tree: left-associative `+ -` and `* /` parenthesise a
 /// right operand of the same strength, the right-associative `^` a left one; a power's base is an atom. A chain's
-/// left operands are grouped every [`CHAIN_GROUP`] operators, and a negation of a negation is `--x`, so that the
+/// left operands are grouped every 50 operators (`CHAIN_GROUP`), and a negation of a negation is `--x`, so that the
 /// text nests no deeper than the parser accepts.
 pub fn expr(e: &Expr) -> String {
     expr_in_chain(e, 0)

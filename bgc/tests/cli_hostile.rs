@@ -731,6 +731,26 @@ fn an_output_over_an_input_is_refused_and_the_input_kept() {
     assert_eq!(read("m.bg"), model);
     assert_eq!(read("lib.bg"), lib);
     assert!(read("rig.csv").starts_with("t,v,i\n"));
+    // A plot that cannot be written is an I/O error, status 2 as for `draw -o`, after the fit's report (it was 1).
+    let args = [
+        "fit",
+        "m.bg",
+        "--data",
+        "rig.csv",
+        "--free",
+        "h.r",
+        "--plot",
+        "no_dir/fit.svg",
+    ];
+    let run = bgc(&dir, &args);
+    assert_eq!(run.status, 2, "{}", run.transcript());
+    assert!(
+        run.stderr
+            .contains("error: cannot write the plot no_dir/fit.svg"),
+        "{}",
+        run.transcript()
+    );
+    assert!(!run.stdout.is_empty(), "{}", run.transcript());
 }
 
 /// `bgc fmt` rewrote a CRLF file (a Windows checkout) with `\n` line breaks, and `bgc fmt --check` failed on every

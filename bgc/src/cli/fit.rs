@@ -97,8 +97,14 @@ fn fit_record(
             .iter()
             .map(|&o| outputs[o].to_string())
             .collect();
-        super::fit_plot::write(out, &record, &report, &names)
-            .map_err(|e| format!("cannot write the plot {}: {e}", out.display()))?;
+        // The report is printed; a plot that cannot be written is an I/O error (status 2), as for every command.
+        if let Err(e) = super::fit_plot::write(out, &record, &report, &names) {
+            stderrln(&format!(
+                "error: cannot write the plot {}: {e}",
+                out.display()
+            ));
+            return Ok(Status::UsageOrIo);
+        }
     }
     if !report.convergence.converged() {
         stderrln(&format!(

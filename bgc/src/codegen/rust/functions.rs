@@ -231,7 +231,7 @@ impl<'a> Writer<'a> {
                     label: format!("{} = ", lhs.get(i).map_or("", String::as_str)),
                     expr: r,
                     head: format!("{}[{i}] = ", target.0),
-                    tail: ";".into(),
+                    tail: ";",
                 })
                 .collect();
             let out = Out {
@@ -526,7 +526,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
                 label: entry_label(names, r, c),
                 expr: e,
                 head: format!("jac[({r}, {c})] = "),
-                tail: ";".into(),
+                tail: ";",
             })
             .collect()
     }
@@ -540,7 +540,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
     ) {
         d.lines.push("    jac.fill(0.0);".into());
         for s in self.entry_statements(entries, names) {
-            self.statement(d, &s.label, s.expr, &s.head, &s.tail);
+            self.statement(d, &s.label, s.expr, &s.head, s.tail);
         }
     }
 
@@ -700,7 +700,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
                     ),
                     expr: e,
                     head: format!("entry('{var}', {r}, {col}, "),
-                    tail: ");".into(),
+                    tail: ");",
                 });
             }
         }
@@ -724,7 +724,7 @@ pub fn outputs(p: &Params, t: f64, x: &State, u: &Inputs) -> Outputs {
             let mut d = self.draft(&exprs);
             self.shared_statements(&mut d, shared);
             for s in &statements {
-                self.statement(&mut d, &s.label, s.expr, &s.head, &s.tail);
+                self.statement(&mut d, &s.label, s.expr, &s.head, s.tail);
             }
             d
         };
@@ -946,7 +946,7 @@ impl Writer<'_> {
                 label: format!("{element}: "),
                 expr: e,
                 head: "*total += ".into(),
-                tail: ";".into(),
+                tail: ";",
             })
             .collect();
         let out = Out {

@@ -32,7 +32,7 @@ pub(super) struct Statement<'e> {
     pub label: String,
     pub expr: &'e Expr,
     pub head: String,
-    pub tail: String,
+    pub tail: &'static str,
 }
 
 /// The argument every part writes through and how the calling function passes it (`jac`, or `&mut total`).
@@ -172,7 +172,7 @@ impl Writer<'_> {
             self.draft(&exprs)
         };
         for s in chunk {
-            self.statement(&mut d, &s.label, s.expr, &s.head, &s.tail);
+            self.statement(&mut d, &s.label, s.expr, &s.head, s.tail);
         }
         d
     }

@@ -72,7 +72,7 @@ impl Writer<'_> {
                 label: entry_label((rows, cols, row_prefix), r, c),
                 expr: e,
                 head: format!("values[{k}] = "),
-                tail: ";".into(),
+                tail: ";",
             })
             .collect();
         let mut d = if self.splits(statements.len()) {
@@ -86,7 +86,7 @@ impl Writer<'_> {
             let exprs: Vec<&Expr> = entries.iter().map(|e| e.2).collect();
             let mut d = self.draft(&exprs);
             for s in &statements {
-                self.statement(&mut d, &s.label, s.expr, &s.head, &s.tail);
+                self.statement(&mut d, &s.label, s.expr, &s.head, s.tail);
             }
             d
         };

@@ -627,3 +627,24 @@ fn a_singular_mass_matrix_stops_the_run_naming_its_element() {
     let (code, _, err) = bgc(&["simulate", &path, "--t-end", "1"]);
     assert_eq!(code, 0, "{err}");
 }
+
+/// `y = -e(c)` at rest is `-0.0`, which the CSV printed as `-0e0` (it reads back exactly, but reads as a negative
+/// number to a person and to a plot's axis); a zero is now `0e0` whatever its sign.
+#[test]
+fn a_zero_is_printed_without_a_sign() {
+    let path = temp_model(
+        "negative_zero",
+        "model m {\n    domain electrical;\n    input u [V];\n    Se s = u;\n    1 j;\n    R r = 1;\n    C c = 1;\n    \
+         bond s -> j -> r, c;\n    output y [V] = -e(c);\n}\n",
+    );
+    let (code, out, err) = bgc(&["simulate", &path, "--t-end", "1", "--input", "u=0"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.lines().count() > 2, "{out}");
+    assert!(!out.contains("-0e0"), "{out}");
+    assert!(
+        out.lines()
+            .nth(1)
+            .is_some_and(|row| row == "0,0e0,0e0,0e0,0e0,0e0"),
+        "{out}"
+    );
+}

@@ -167,7 +167,9 @@ fn csv(
             balance.see(t, row);
             write_time(&mut line, t);
             for v in row {
-                // Shortest round-trip form: the printed numbers read back exactly.
+                // Shortest round-trip form: the printed numbers read back exactly. A zero is printed `0e0`
+                // whatever its sign (`-0.0 + 0.0` is `0.0`): `-0e0` reads as a negative number to most readers.
+                let v = v + 0.0;
                 let _ = write!(line, ",{v:e}");
             }
             line.push('\n');

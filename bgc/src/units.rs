@@ -221,21 +221,23 @@ const PREFIXES: [(&str, f64); 11] = [
 
 /// Parses one unit symbol such as `m`, `mm`, `kN`, `min`, `µs`.
 pub fn parse_symbol(symbol: &str) -> Option<Unit> {
-    let exact = |s: &str| {
-        EXACT
-            .iter()
-            .chain(PREFIXABLE.iter())
-            .find(|(name, _)| *name == s)
-            .map(|(_, u)| *u)
-    };
-    if let Some(u) = exact(symbol) {
-        return Some(u);
+    resolve_symbol(symbol).map(|(_, u)| u)
+}
+
+/// One unit symbol as the table's symbol it is made from (`kHz` is `Hz`) and its unit, the prefix applied.
+fn resolve_symbol(symbol: &str) -> Option<(&'static str, Unit)> {
+    let exact = EXACT
+        .iter()
+        .chain(PREFIXABLE.iter())
+        .find(|(name, _)| *name == symbol);
+    if let Some(&(name, u)) = exact {
+        return Some((name, u));
     }
     for (prefix, factor) in PREFIXES {
         if let Some(rest) = symbol.strip_prefix(prefix)
-            && let Some((_, u)) = PREFIXABLE.iter().find(|(name, _)| *name == rest)
+            && let Some(&(name, u)) = PREFIXABLE.iter().find(|(name, _)| *name == rest)
         {
-            return Some(Unit::new(u.dim, u.scale * factor));
+            return Some((name, Unit::new(u.dim, u.scale * factor)));
         }
     }
     None
@@ -270,15 +272,11 @@ pub fn cycles_and_angle(text: &str) -> (bool, bool) {
     let mut angle = false;
     for factor in text.split(|c: char| c.is_whitespace() || c == '/') {
         let symbol = factor.split('^').next().unwrap_or("");
-        let symbol = symbol.trim_matches(|c| c == '(' || c == ')');
-        let unprefixed = |base: &str| {
-            symbol == base
-                || PREFIXES
-                    .iter()
-                    .any(|(prefix, _)| symbol.strip_prefix(prefix) == Some(base))
-        };
-        cycles |= unprefixed("Hz");
-        angle |= unprefixed("rad") || symbol == "deg" || symbol == "rpm";
+        match resolve_symbol(symbol.trim_matches(|c| c == '(' || c == ')')) {
+            Some(("Hz", _)) => cycles = true,
+            Some(("rad" | "deg" | "rpm", _)) => angle = true,
+            _ => {}
+        }
     }
     (cycles, angle)
 }

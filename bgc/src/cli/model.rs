@@ -204,15 +204,17 @@ fn energy_coords(
             return Err(format!("no state space: {e}"));
         }
         if !equations::linear_through_loops(eqs, selection) {
-            let (states, inputs) = (name_list(&state_names), name_list(&eqs.inputs));
+            let names = format!(
+                "states: {}; inputs: {}; those not given are 0",
+                name_list(&state_names),
+                name_list(&eqs.inputs)
+            );
             return Err(match why {
-                LinearError::TimeVarying { .. } => format!(
-                    "no state space: {why} (--at NAME=VALUE,...; states: {states}; inputs: {inputs}; those not \
-                     given are 0)"
-                ),
+                LinearError::TimeVarying { .. } => {
+                    format!("no state space: {why} (--at NAME=VALUE,...; {names})")
+                }
                 _ => format!(
-                    "the model is not linear ({why}): give an operating point with --at NAME=VALUE,... (states: \
-                     {states}; inputs: {inputs}; those not given are 0)"
+                    "the model is not linear ({why}): give an operating point with --at NAME=VALUE,... ({names})"
                 ),
             });
         }

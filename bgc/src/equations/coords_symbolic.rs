@@ -6,8 +6,9 @@
 //! invariant subspace `x_i = Σ α_r x_r` and `x_i` is eliminated. On the remaining states `r`:
 //! `A_r = A_rr + A_re S`, `C_r = C_r + C_e S` (`x_e = S r`), `z = T_r r`, and
 //! `A_z = T_r A_r T_r⁻¹`, `B_z = T_r B_r`, `C_z = C_r T_r⁻¹`, `D_z = D`. When there are as many coordinates as
-//! states in play, nothing is eliminated: `T` is square and the map the plain similarity. A zero that the canonical form does not
-//! recognise would hide an invariant; the result is then refused (a dimension error), never silently wrong.
+//! states in play, nothing is eliminated: `T` is square and the map the plain similarity. A zero that the canonical
+//! form does not recognise would hide an invariant; the result is then refused (a dimension error), never silently
+//! wrong.
 
 use super::Equations;
 use super::coords::CoordsError;
@@ -88,9 +89,9 @@ pub fn declared_state_space_symbolic(eqs: &Equations) -> Result<Jacobians, Coord
     // (position, coefficients of x_pos = Σ coef x_other)
     let mut eliminated: Vec<(usize, Vec<Expr>)> = Vec::new();
     // As many coordinates as states in play: `T` is square over them, and the map is the plain similarity
-    // `A_z = T A T⁻¹` (when `T` is invertible), invariants or not, as in the numeric version.
-    let square = coords.len() == n;
-    for (pos, &i) in order.iter().enumerate().filter(|_| !square) {
+    // `A_z = T A T⁻¹` (when `T` is invertible), invariants or not, as in the numeric version: no row is reduced.
+    let reduced: &[usize] = if coords.len() == n { &[] } else { &order };
+    for (pos, &i) in reduced.iter().enumerate() {
         let mut row = row_of(i);
         let mut comb: Vec<Expr> = (0..n)
             .map(|k| if k == pos { Expr::one() } else { Expr::zero() })

@@ -7,7 +7,7 @@
 
 use super::Equations;
 use super::symbols::{self, Sym, SymExt};
-use crate::symbolic::Expr;
+use crate::symbolic::{Expr, Symbol, SymbolKind};
 use std::collections::{BTreeSet, HashMap};
 
 /// Which states make up the state vector.
@@ -345,13 +345,7 @@ pub fn linear_state_space(
                 });
                 if let Some(s) = found {
                     let entry = format!("{name}[{r}][{c}]");
-                    return Err(not_linear(
-                        eqs,
-                        what,
-                        entry,
-                        s == Sym::Time,
-                        eqs.sym_name(s),
-                    ));
+                    return Err(not_linear(eqs, what, entry, &s.symbol()));
                 }
             }
         }
@@ -391,24 +385,22 @@ pub fn linear_state_space(
     Ok(j)
 }
 
-/// The error for an entry `entry` of the Jacobians of `what` (`f`, `h`) that depends on the variable `symbol`
-/// (time when `time`).
+/// The error for an entry `entry` of the Jacobians of `what` (`f`, `h`) that depends on the variable `symbol`.
 pub(super) fn not_linear(
     eqs: &Equations,
     what: &str,
     entry: String,
-    time: bool,
-    symbol: String,
+    symbol: &Symbol,
 ) -> LinearError {
-    match time {
-        true => LinearError::TimeVarying {
+    match symbol.kind() {
+        SymbolKind::Time => LinearError::TimeVarying {
             entry,
             elements: time_elements_text(eqs),
         },
-        false => LinearError::NotLinear {
+        _ => LinearError::NotLinear {
             what: what.to_string(),
             entry,
-            symbol,
+            symbol: eqs.symbol_name(symbol),
         },
     }
 }

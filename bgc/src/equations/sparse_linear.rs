@@ -336,14 +336,7 @@ pub fn sparse_linear_state_space(
                 linear::linear_state_space(eqs, selection)?;
             }
             let entry = format!("{name}[{r}][{c}]");
-            let time = symbol.kind() == SymbolKind::Time;
-            return Err(linear::not_linear(
-                eqs,
-                what,
-                entry,
-                time,
-                eqs.symbol_name(&symbol),
-            ));
+            return Err(linear::not_linear(eqs, what, entry, &symbol));
         }
     }
     // Linear, not affine: f(0, 0, t) = 0 and h(0, 0, t) = 0 for every t.
